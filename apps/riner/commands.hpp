@@ -1,0 +1,10 @@
+// The riner subcommands. Each parses its own arguments (from argv[first]) and returns the
+// process exit code; errors are thrown and mapped to exit codes in main.cpp.
+#pragma once
+
+namespace riner::app {
+
+int run_devices(int argc, char** argv, int first);
+int run_info(int argc, char** argv, int first);
+
+}  // namespace riner::app

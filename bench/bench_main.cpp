@@ -1,0 +1,74 @@
+// riner_bench: run benchmark cases, print a table, append JSON lines.
+//   riner_bench --case=NAME|all [--size=tiny|small|medium|large] [--runs=N] [--warmup=N]
+//               [--device=SEL] [--json=FILE] [--KEY=VALUE ...]
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <string>
+
+#include "harness.hpp"
+#include "riner/device.hpp"
+
+int main(int argc, char** argv) {
+  riner::bench::Options options;
+  options.self = argv[0];
+  std::string which = "all";
+  for (int i = 1; i < argc; ++i) {
+    std::string arg = argv[i];
+    if (arg == "--help" || arg == "-h") {
+      std::printf(
+          "usage: riner_bench --case=NAME|all [--size=S] [--runs=N] [--warmup=N] "
+          "[--device=SEL] [--json=FILE]\n\ncases:\n");
+      for (const auto& c : riner::bench::cases()) {
+        std::printf("  %-20s %s\n", c.name.c_str(), c.summary.c_str());
+      }
+      return 0;
+    }
+    if (arg.rfind("--", 0) != 0 || arg.find('=') == std::string::npos) {
+      std::fprintf(stderr, "riner_bench: expected --key=value, got '%s'\n", arg.c_str());
+      return 2;
+    }
+    const std::string key = arg.substr(2, arg.find('=') - 2);
+    const std::string value = arg.substr(arg.find('=') + 1);
+    if (key == "case")
+      which = value;
+    else if (key == "size")
+      options.size = value;
+    else if (key == "runs")
+      options.runs = std::stoi(value);
+    else if (key == "warmup")
+      options.warmup = std::stoi(value);
+    else if (key == "device")
+      options.device = value;
+    else if (key == "json")
+      options.json_path = value;
+    else
+      options.extra[key] = value;
+  }
+  bool ran = false;
+  for (const auto& c : riner::bench::cases()) {
+    if (which != "all" && which != c.name) continue;
+    ran = true;
+    try {
+      for (const riner::bench::Result& r : c.fn(options)) {
+        std::printf("%-20s %s\n", r.case_name.c_str(), r.fields.dump().c_str());
+        if (!options.json_path.empty()) {
+          nlohmann::json line = r.fields;
+          line["case"] = r.case_name;
+          line["size"] = options.size;
+          line["meta"] =
+              riner::bench::metadata(riner::Device::open(options.device).info().full_name());
+          std::ofstream(options.json_path, std::ios::app) << line.dump() << "\n";
+        }
+      }
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "riner_bench: case %s failed: %s\n", c.name.c_str(), e.what());
+      return 1;
+    }
+  }
+  if (!ran) {
+    std::fprintf(stderr, "riner_bench: no case named '%s' (see --help)\n", which.c_str());
+    return 2;
+  }
+  return 0;
+}

@@ -1,0 +1,11 @@
+# Warnings and sanitizers for riner's own targets only; global flags are never touched.
+function(riner_set_warnings target)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wnon-virtual-dtor)
+  if(RINER_WERROR)
+    target_compile_options(${target} PRIVATE -Werror)
+  endif()
+  if(RINER_SANITIZE)
+    target_compile_options(${target} PRIVATE -fsanitize=${RINER_SANITIZE} -fno-omit-frame-pointer)
+    target_link_options(${target} PRIVATE -fsanitize=${RINER_SANITIZE})
+  endif()
+endfunction()

@@ -1,0 +1,56 @@
+// A dense float32 N-d array in C order (last axis fastest): the one in-memory form of every
+// sinogram, projection stack, image and volume riner handles.
+#pragma once
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace riner {
+
+struct Array {
+  std::vector<std::size_t> shape;
+  std::vector<float> data;
+
+  Array() = default;
+  explicit Array(std::vector<std::size_t> shape_, float fill = 0.0f);
+  Array(std::vector<std::size_t> shape_, std::vector<float> data_);
+
+  std::size_t rank() const { return shape.size(); }
+  std::size_t size() const { return data.size(); }
+  float* ptr() { return data.data(); }
+  const float* ptr() const { return data.data(); }
+
+  // 2D and 3D element access (row-major); no bounds checks in release builds.
+  float& operator()(std::size_t i, std::size_t j) { return data[i * shape[1] + j]; }
+  float operator()(std::size_t i, std::size_t j) const { return data[i * shape[1] + j]; }
+  float& operator()(std::size_t i, std::size_t j, std::size_t k) {
+    return data[(i * shape[1] + j) * shape[2] + k];
+  }
+  float operator()(std::size_t i, std::size_t j, std::size_t k) const {
+    return data[(i * shape[1] + j) * shape[2] + k];
+  }
+};
+
+// Number of elements a shape holds; throws InputError if the product overflows.
+std::size_t shape_size(const std::vector<std::size_t>& shape);
+
+// "[360, 500]"
+std::string shape_string(const std::vector<std::size_t>& shape);
+
+struct ArrayStats {
+  std::size_t count = 0;
+  std::size_t finite = 0;
+  std::size_t nan = 0;
+  std::size_t pos_inf = 0;
+  std::size_t neg_inf = 0;
+  double min = 0.0;  // over finite values; 0 when there are none
+  double max = 0.0;
+  double mean = 0.0;
+  double stddev = 0.0;
+  std::size_t non_finite() const { return nan + pos_inf + neg_inf; }
+};
+
+ArrayStats compute_stats(const Array& array);
+
+}  // namespace riner

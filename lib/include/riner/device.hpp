@@ -1,0 +1,75 @@
+// OpenCL devices: discovery, capabilities and selection.
+#pragma once
+
+#include <CL/cl.h>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace riner {
+
+namespace cl {
+class Context;
+}
+
+// What later kernels need to know about a device.
+struct DeviceInfo {
+  int index = 0;  // position in list_devices()
+  std::string platform;
+  std::string platform_version;
+  std::string name;
+  std::string vendor;
+  std::string type;  // "GPU", "CPU", "accelerator", "other"
+  std::string version;
+  std::string driver_version;
+  std::string opencl_c_version;
+  std::uint32_t compute_units = 0;
+  std::uint32_t max_clock_mhz = 0;
+  std::size_t max_work_group_size = 0;
+  std::uint64_t local_mem_bytes = 0;
+  bool local_mem_is_global = false;  // CPUs emulate local memory in global memory
+  std::uint64_t global_mem_bytes = 0;
+  std::uint64_t max_alloc_bytes = 0;
+  bool fp64 = false;
+  std::uint32_t preferred_vector_width_float = 0;
+  std::uint32_t native_vector_width_float = 0;
+  std::uint32_t preferred_vector_width_int = 0;
+  std::uint32_t native_vector_width_int = 0;
+
+  // "Portable Computing Language / pthread-skylake-avx512-..."
+  std::string full_name() const;
+};
+
+// Every device of every platform; empty when no OpenCL platform is installed.
+std::vector<DeviceInfo> list_devices();
+
+// An OpenCL context and in-order queue on one device: what every riner computation runs on.
+// Cheap to copy (shared ownership).
+class Device {
+ public:
+  // selector: "" (then $RINER_DEVICE, then the first GPU, then the first device), a device
+  // index from list_devices(), or a case-insensitive substring of "platform / device".
+  // Throws Error when nothing matches or no device exists.
+  static Device open(std::string_view selector = "", bool profiling = false);
+
+  // Wraps a context and queue the caller already has (interop); riner retains them.
+  static Device from_handles(cl_context context, cl_command_queue queue, bool profiling = false);
+
+  const DeviceInfo& info() const;
+  bool profiling() const;
+
+  // Finishes all queued work.
+  void finish() const;
+
+  // Internal access for the library's own ops.
+  cl::Context& context() const { return *context_; }
+
+ private:
+  explicit Device(std::shared_ptr<cl::Context> context) : context_(std::move(context)) {}
+  std::shared_ptr<cl::Context> context_;
+};
+
+}  // namespace riner

@@ -1,0 +1,75 @@
+// The scan geometry: one convention for the whole product (README.md, "Geometry convention").
+// Units are millimetres and radians; rotation is about the z axis through the origin, which is
+// the centre of the reconstruction grid.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace riner {
+
+enum class GeometryType { kParallel2d, kFan2d, kCone3d, kParallel3d };
+
+const char* geometry_type_name(GeometryType type);
+
+// The uniform angle form of the scan contract: count views from start over range (endpoint
+// excluded, so 360 views over 2*pi never repeat a view).
+struct UniformAngles {
+  std::size_t count = 0;
+  double start_rad = 0.0;
+  double range_rad = 0.0;
+};
+
+struct Geometry {
+  GeometryType type = GeometryType::kParallel2d;
+
+  // Detector: u runs along the row, v along the rotation axis (3D only).
+  std::size_t n_u = 0;
+  std::size_t n_v = 1;
+  double pitch_u = 1.0;
+  double pitch_v = 1.0;
+  double offset_u = 0.0;  // in elements; the centre-of-rotation offset
+  double offset_v = 0.0;
+
+  // Fan and cone beam only.
+  double source_origin_mm = 0.0;
+  double origin_detector_mm = 0.0;
+
+  std::vector<double> angles;                   // one per view, radians
+  std::optional<UniformAngles> uniform_angles;  // set when the file used the uniform form
+
+  // Reconstruction grid: [n_y, n_x] in 2D, [n_z, n_y, n_x] in 3D; isotropic voxels.
+  std::vector<std::size_t> volume_shape;
+  double voxel_mm = 1.0;
+
+  bool is_3d() const { return type == GeometryType::kCone3d || type == GeometryType::kParallel3d; }
+  bool is_divergent() const {
+    return type == GeometryType::kFan2d || type == GeometryType::kCone3d;
+  }
+  std::size_t n_views() const { return angles.size(); }
+
+  // Shape of the measurement array: [views, n_u] in 2D, [views, n_v, n_u] in 3D.
+  std::vector<std::size_t> measurement_shape() const;
+
+  // Throws InputError naming the first bad field.
+  void validate() const;
+
+  // Throws InputError if a measurement array of this shape does not belong to this geometry.
+  void check_measurement_shape(const std::vector<std::size_t>& shape,
+                               std::string_view what = "measurement") const;
+
+  // Parses the scan-contract JSON; `source` names the file in error messages.
+  static Geometry from_json(std::string_view json_text, std::string_view source = "geometry");
+  static Geometry load(const std::filesystem::path& path);
+  std::string to_json() const;
+  void save(const std::filesystem::path& path) const;
+};
+
+// Uniform angles start + range * i / count, i = 0..count-1.
+std::vector<double> uniform_angles(const UniformAngles& spec);
+
+}  // namespace riner

@@ -1,0 +1,72 @@
+// Reading and writing arrays in the formats CT people use, chosen by file extension:
+//   .npy           NumPy, float32/float64/uint8/uint16/int16/int32/uint32, C or Fortran order,
+//                  either byte order
+//   .nii           NIfTI-1 single file, read float32/float64/int16/uint16/uint8/int32 with
+//                  scl_slope/scl_inter; written as float32
+//   .tif/.tiff     TIFF, one page = 2D, several pages = 3D [pages, rows, cols];
+//                  float32/uint16/uint8 (read), float32 (written)
+//   .raw/.bin      raw samples described by a JSON sidecar "<file>.json":
+//                  {"dtype": "float32", "shape": [..], "byte_order": "little", "offset_bytes": 0}
+// Every reader checks the header against the file size and throws InputError naming the file
+// and what is wrong. Every writer writes a temporary file and renames it into place, and
+// refuses to write over a file this process has read.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "riner/array.hpp"
+
+namespace riner {
+
+enum class FileFormat { kNpy, kNifti, kTiff, kRaw, kPng, kJson };
+
+// Format implied by the extension; throws InputError for one riner does not know.
+FileFormat format_from_path(const std::filesystem::path& path);
+const char* format_name(FileFormat format);
+
+struct ArrayFile {
+  Array array;
+  FileFormat format = FileFormat::kNpy;
+  std::string dtype;               // as stored in the file: "float32", "uint16", ...
+  std::vector<double> voxel_size;  // per axis in array order, when the file states it (NIfTI)
+  std::size_t non_finite = 0;      // NaN and +-inf values in the data
+};
+
+ArrayFile read_array(const std::filesystem::path& path);
+
+struct WriteOptions {
+  std::vector<double> voxel_size;  // per axis in array order; NIfTI pixdim (mm)
+};
+
+void write_array(const std::filesystem::path& path, const Array& array,
+                 const WriteOptions& options = {});
+
+// Display window for previews.
+struct Window {
+  float lo = 0.0f;
+  float hi = 1.0f;
+};
+
+// Window from the given percentiles of the finite values (1 and 99 by default).
+Window percentile_window(const Array& image, double lo_percent = 1.0, double hi_percent = 99.0);
+
+// 8-bit grey PNG of a 2D array (or of the middle slice of a 3D one) mapped through the window.
+void write_png(const std::filesystem::path& path, const Array& image, const Window& window);
+void write_png(const std::filesystem::path& path, const Array& image);  // percentile window
+
+// 8-bit RGB PNG; rgb is [rows, cols, 3] in 0..255.
+void write_png_rgb(const std::filesystem::path& path, const std::vector<unsigned char>& rgb,
+                   std::size_t rows, std::size_t cols);
+
+// Text outputs (JSON summaries, CSV histories), written atomically like every other output.
+void write_text(const std::filesystem::path& path, std::string_view text);
+std::string read_text(const std::filesystem::path& path);
+
+// Marks a path as an input of this process: writers refuse to replace it. Readers call this
+// themselves; call it for inputs read by other means.
+void register_input(const std::filesystem::path& path);
+
+}  // namespace riner

@@ -1,0 +1,27 @@
+// A scan: the log-normalised measurement ρ̃ plus the geometry it was taken with (the scan
+// contract of METHOD.md §3).
+#pragma once
+
+#include <filesystem>
+
+#include "riner/array.hpp"
+#include "riner/geometry.hpp"
+
+namespace riner {
+
+struct Scan {
+  Array measurement;  // [views, elements] in 2D, [views, rows, columns] in 3D
+  Geometry geometry;
+  std::size_t non_finite = 0;  // NaN/inf measurements (dead elements), kept as they are
+};
+
+// Reads both files and checks they belong together. With an empty geometry path, looks for
+// "geometry.json" beside the measurement. Throws InputError when the shapes disagree or no
+// measurement is finite.
+Scan load_scan(const std::filesystem::path& measurement,
+               const std::filesystem::path& geometry = {});
+
+// Checks a measurement array against its geometry (shape, at least one finite value).
+void check_scan(const Scan& scan, std::string_view what = "measurement");
+
+}  // namespace riner

@@ -1,0 +1,39 @@
+#include "cl/program.hpp"
+
+#include <atomic>
+
+namespace riner::cl {
+
+namespace {
+std::atomic<long> g_live_buffers{0};
+}
+
+long live_buffer_count() { return g_live_buffers.load(); }
+void note_buffer_created() { ++g_live_buffers; }
+void note_buffer_released() { --g_live_buffers; }
+
+Kernel::Kernel(const Program& program, const std::string& name) : name_(name) {
+  cl_int status = CL_SUCCESS;
+  cl_kernel kernel = clCreateKernel(program.get(), name.c_str(), &status);
+  if (status != CL_SUCCESS) {
+    throw ClError(status, "clCreateKernel(" + name + " in " + program.name() + ")", RINER_HERE);
+  }
+  kernel_ = Handle<cl_kernel>(kernel);
+}
+
+void Kernel::set_raw(cl_uint index, std::size_t size, const void* value) {
+  cl_int status = clSetKernelArg(kernel_.get(), index, size, value);
+  if (status != CL_SUCCESS) {
+    throw ClError(status, "clSetKernelArg(" + name_ + ", " + std::to_string(index) + ")",
+                  RINER_HERE);
+  }
+}
+
+std::size_t Kernel::max_work_group_size(cl_device_id device) const {
+  std::size_t size = 0;
+  RINER_CL_CALL(clGetKernelWorkGroupInfo, kernel_.get(), device, CL_KERNEL_WORK_GROUP_SIZE,
+                sizeof(size), &size, nullptr);
+  return size;
+}
+
+}  // namespace riner::cl

@@ -1,0 +1,68 @@
+#include "riner/array.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "riner/error.hpp"
+
+namespace riner {
+
+std::size_t shape_size(const std::vector<std::size_t>& shape) {
+  std::size_t n = 1;
+  for (std::size_t d : shape) {
+    if (d != 0 && n > std::numeric_limits<std::size_t>::max() / d) {
+      throw InputError("array shape " + shape_string(shape) + " is too large");
+    }
+    n *= d;
+  }
+  return n;
+}
+
+std::string shape_string(const std::vector<std::size_t>& shape) {
+  std::string s = "[";
+  for (std::size_t i = 0; i < shape.size(); ++i) s += (i ? ", " : "") + std::to_string(shape[i]);
+  return s + "]";
+}
+
+Array::Array(std::vector<std::size_t> shape_, float fill)
+    : shape(std::move(shape_)), data(shape_size(shape), fill) {}
+
+Array::Array(std::vector<std::size_t> shape_, std::vector<float> data_)
+    : shape(std::move(shape_)), data(std::move(data_)) {
+  if (shape_size(shape) != data.size()) {
+    throw InputError("array shape " + shape_string(shape) + " does not match " +
+                     std::to_string(data.size()) + " values");
+  }
+}
+
+ArrayStats compute_stats(const Array& array) {
+  ArrayStats stats;
+  stats.count = array.size();
+  double sum = 0.0;
+  double sum_sq = 0.0;
+  double lo = std::numeric_limits<double>::infinity();
+  double hi = -lo;
+  for (float v : array.data) {
+    if (std::isnan(v)) {
+      ++stats.nan;
+    } else if (std::isinf(v)) {
+      ++(v > 0 ? stats.pos_inf : stats.neg_inf);
+    } else {
+      ++stats.finite;
+      sum += v;
+      sum_sq += static_cast<double>(v) * v;
+      lo = std::min(lo, static_cast<double>(v));
+      hi = std::max(hi, static_cast<double>(v));
+    }
+  }
+  if (stats.finite > 0) {
+    stats.min = lo;
+    stats.max = hi;
+    stats.mean = sum / static_cast<double>(stats.finite);
+    const double var = sum_sq / static_cast<double>(stats.finite) - stats.mean * stats.mean;
+    stats.stddev = std::sqrt(std::max(0.0, var));
+  }
+  return stats;
+}
+
+}  // namespace riner

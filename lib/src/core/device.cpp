@@ -1,0 +1,30 @@
+#include "riner/device.hpp"
+
+#include "cl/context.hpp"
+#include "cl/device_list.hpp"
+
+namespace riner {
+
+std::string DeviceInfo::full_name() const { return platform + " / " + name; }
+
+std::vector<DeviceInfo> list_devices() {
+  std::vector<DeviceInfo> infos;
+  for (cl::DeviceEntry& entry : cl::enumerate_devices()) infos.push_back(std::move(entry.info));
+  return infos;
+}
+
+Device Device::open(std::string_view selector, bool profiling) {
+  cl::DeviceEntry entry = cl::select_device(selector);
+  auto context = std::make_shared<cl::Context>(entry.device, profiling);
+  return Device(std::move(context));
+}
+
+Device Device::from_handles(cl_context context, cl_command_queue queue, bool profiling) {
+  return Device(std::make_shared<cl::Context>(context, queue, profiling));
+}
+
+const DeviceInfo& Device::info() const { return context_->info(); }
+bool Device::profiling() const { return context_->profiling(); }
+void Device::finish() const { context_->finish(); }
+
+}  // namespace riner

@@ -1,0 +1,99 @@
+#include "riner/error.hpp"
+
+#include <CL/cl.h>
+
+namespace riner {
+
+namespace {
+
+std::string cl_message(int status, const std::string& call, const std::string& where) {
+  return call + " failed: " + cl_error_name(status) + " (" + std::to_string(status) + ") at " +
+         where;
+}
+
+}  // namespace
+
+ClError::ClError(int status, std::string call, const std::string& where)
+    : Error(cl_message(status, call, where)), status_(status), call_(std::move(call)) {}
+
+const char* ClError::status_name() const { return cl_error_name(status_); }
+
+BuildError::BuildError(int status, const std::string& program, std::string options, std::string log,
+                       const std::string& where)
+    : ClError(status, "clBuildProgram(" + program + ")", where),
+      options_(std::move(options)),
+      log_(std::move(log)) {}
+
+const char* cl_error_name(int status) {
+  switch (status) {
+#define RINER_CASE(code) \
+  case code:             \
+    return #code
+    RINER_CASE(CL_SUCCESS);
+    RINER_CASE(CL_DEVICE_NOT_FOUND);
+    RINER_CASE(CL_DEVICE_NOT_AVAILABLE);
+    RINER_CASE(CL_COMPILER_NOT_AVAILABLE);
+    RINER_CASE(CL_MEM_OBJECT_ALLOCATION_FAILURE);
+    RINER_CASE(CL_OUT_OF_RESOURCES);
+    RINER_CASE(CL_OUT_OF_HOST_MEMORY);
+    RINER_CASE(CL_PROFILING_INFO_NOT_AVAILABLE);
+    RINER_CASE(CL_MEM_COPY_OVERLAP);
+    RINER_CASE(CL_IMAGE_FORMAT_MISMATCH);
+    RINER_CASE(CL_IMAGE_FORMAT_NOT_SUPPORTED);
+    RINER_CASE(CL_BUILD_PROGRAM_FAILURE);
+    RINER_CASE(CL_MAP_FAILURE);
+    RINER_CASE(CL_MISALIGNED_SUB_BUFFER_OFFSET);
+    RINER_CASE(CL_EXEC_STATUS_ERROR_FOR_EVENTS_IN_WAIT_LIST);
+    RINER_CASE(CL_COMPILE_PROGRAM_FAILURE);
+    RINER_CASE(CL_LINKER_NOT_AVAILABLE);
+    RINER_CASE(CL_LINK_PROGRAM_FAILURE);
+    RINER_CASE(CL_DEVICE_PARTITION_FAILED);
+    RINER_CASE(CL_KERNEL_ARG_INFO_NOT_AVAILABLE);
+    RINER_CASE(CL_INVALID_VALUE);
+    RINER_CASE(CL_INVALID_DEVICE_TYPE);
+    RINER_CASE(CL_INVALID_PLATFORM);
+    RINER_CASE(CL_INVALID_DEVICE);
+    RINER_CASE(CL_INVALID_CONTEXT);
+    RINER_CASE(CL_INVALID_QUEUE_PROPERTIES);
+    RINER_CASE(CL_INVALID_COMMAND_QUEUE);
+    RINER_CASE(CL_INVALID_HOST_PTR);
+    RINER_CASE(CL_INVALID_MEM_OBJECT);
+    RINER_CASE(CL_INVALID_IMAGE_FORMAT_DESCRIPTOR);
+    RINER_CASE(CL_INVALID_IMAGE_SIZE);
+    RINER_CASE(CL_INVALID_SAMPLER);
+    RINER_CASE(CL_INVALID_BINARY);
+    RINER_CASE(CL_INVALID_BUILD_OPTIONS);
+    RINER_CASE(CL_INVALID_PROGRAM);
+    RINER_CASE(CL_INVALID_PROGRAM_EXECUTABLE);
+    RINER_CASE(CL_INVALID_KERNEL_NAME);
+    RINER_CASE(CL_INVALID_KERNEL_DEFINITION);
+    RINER_CASE(CL_INVALID_KERNEL);
+    RINER_CASE(CL_INVALID_ARG_INDEX);
+    RINER_CASE(CL_INVALID_ARG_VALUE);
+    RINER_CASE(CL_INVALID_ARG_SIZE);
+    RINER_CASE(CL_INVALID_KERNEL_ARGS);
+    RINER_CASE(CL_INVALID_WORK_DIMENSION);
+    RINER_CASE(CL_INVALID_WORK_GROUP_SIZE);
+    RINER_CASE(CL_INVALID_WORK_ITEM_SIZE);
+    RINER_CASE(CL_INVALID_GLOBAL_OFFSET);
+    RINER_CASE(CL_INVALID_EVENT_WAIT_LIST);
+    RINER_CASE(CL_INVALID_EVENT);
+    RINER_CASE(CL_INVALID_OPERATION);
+    RINER_CASE(CL_INVALID_GL_OBJECT);
+    RINER_CASE(CL_INVALID_BUFFER_SIZE);
+    RINER_CASE(CL_INVALID_MIP_LEVEL);
+    RINER_CASE(CL_INVALID_GLOBAL_WORK_SIZE);
+    RINER_CASE(CL_INVALID_PROPERTY);
+    RINER_CASE(CL_INVALID_IMAGE_DESCRIPTOR);
+    RINER_CASE(CL_INVALID_COMPILER_OPTIONS);
+    RINER_CASE(CL_INVALID_LINKER_OPTIONS);
+    RINER_CASE(CL_INVALID_DEVICE_PARTITION_COUNT);
+#undef RINER_CASE
+    case -1001:
+      return "CL_PLATFORM_NOT_FOUND_KHR";
+    default:
+      return "CL_UNKNOWN_ERROR";
+  }
+}
+
+}  // namespace riner

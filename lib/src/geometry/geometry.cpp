@@ -1,0 +1,70 @@
+#include "riner/geometry.hpp"
+
+#include <cmath>
+
+#include "riner/array.hpp"
+#include "riner/error.hpp"
+
+namespace riner {
+
+std::vector<std::size_t> Geometry::measurement_shape() const {
+  if (is_3d()) return {n_views(), n_v, n_u};
+  return {n_views(), n_u};
+}
+
+void Geometry::validate() const {
+  auto fail = [](const std::string& what) { throw InputError(what); };
+  if (n_u < 1) fail("detector.count must be >= 1");
+  if (is_3d() && n_v < 1) fail("detector.count[1] must be >= 1");
+  if (!is_3d() && n_v != 1) fail("a 2D geometry has one detector row");
+  if (!(pitch_u > 0.0) || !(pitch_v > 0.0) || !std::isfinite(pitch_u) || !std::isfinite(pitch_v)) {
+    fail("detector.pitch_mm must be finite and > 0");
+  }
+  if (!std::isfinite(offset_u) || !std::isfinite(offset_v))
+    fail("detector.offset_px must be finite");
+  if (angles.empty()) fail("angles: there must be at least one view");
+  for (double a : angles) {
+    if (!std::isfinite(a)) fail("angles must be finite");
+  }
+  const std::size_t rank = is_3d() ? 3 : 2;
+  if (volume_shape.size() != rank) {
+    fail(std::string("volume.shape must have ") + (is_3d() ? "3" : "2") + " entries");
+  }
+  for (std::size_t n : volume_shape) {
+    if (n < 1) fail("volume.shape entries must be >= 1");
+  }
+  if (!(voxel_mm > 0.0) || !std::isfinite(voxel_mm)) fail("volume.voxel_mm must be finite and > 0");
+  if (is_divergent()) {
+    if (!(source_origin_mm > 0.0) || !std::isfinite(source_origin_mm)) {
+      fail("source_origin_mm must be finite and > 0");
+    }
+    if (!(origin_detector_mm > 0.0) || !std::isfinite(origin_detector_mm)) {
+      fail("origin_detector_mm must be finite and > 0");
+    }
+    // The source circles the rotation axis; inside the grid every ray would start in the object.
+    const double nx = static_cast<double>(volume_shape[rank - 1]);
+    const double ny = static_cast<double>(volume_shape[rank - 2]);
+    const double half_diagonal = 0.5 * voxel_mm * std::hypot(nx, ny);
+    if (source_origin_mm <= half_diagonal) {
+      fail("source_origin_mm (" + std::to_string(source_origin_mm) +
+           ") puts the source inside the reconstruction grid (half-diagonal " +
+           std::to_string(half_diagonal) + " mm)");
+    }
+  }
+}
+
+void Geometry::check_measurement_shape(const std::vector<std::size_t>& shape,
+                                       std::string_view what) const {
+  const std::vector<std::size_t> expected = measurement_shape();
+  if (shape == expected) return;
+  std::string message = std::string(what) + " has shape " + shape_string(shape) + " but the " +
+                        geometry_type_name(type) + " geometry expects " + shape_string(expected) +
+                        (is_3d() ? " [views, rows, columns]" : " [views, elements]");
+  if (shape.size() == expected.size() && shape[0] != expected[0]) {
+    message += ": it has " + std::to_string(shape[0]) + " views but the geometry lists " +
+               std::to_string(expected[0]) + " angles";
+  }
+  throw InputError(message);
+}
+
+}  // namespace riner

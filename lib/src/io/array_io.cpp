@@ -1,0 +1,189 @@
+// Format dispatch, atomic outputs and previews.
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <fstream>
+
+#include "io/file_access.hpp"
+#include "io/formats.hpp"
+#include "riner/error.hpp"
+#include "riner/io.hpp"
+#include "util/atomic_file.hpp"
+
+namespace riner {
+
+namespace {
+
+std::string lower_extension(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+// Writes through a temporary file in the target's directory, renamed into place at the end.
+template <typename WriteFn>
+void write_atomically(const std::filesystem::path& path, WriteFn&& write) {
+  io::check_output_path(path);
+  util::AtomicFile file(path);
+  write(file.temp_path());
+  file.commit();
+}
+
+// The 2D image a preview shows: the array itself, or the middle slice of a 3D stack.
+Array preview_slice(const Array& image) {
+  if (image.rank() == 2) return image;
+  if (image.rank() == 3) {
+    const std::size_t rows = image.shape[1];
+    const std::size_t cols = image.shape[2];
+    const std::size_t middle = image.shape[0] / 2;
+    Array slice({rows, cols});
+    std::copy_n(image.ptr() + middle * rows * cols, rows * cols, slice.ptr());
+    return slice;
+  }
+  throw InputError("a preview needs a 2D image or a 3D volume, not rank " +
+                   std::to_string(image.rank()));
+}
+
+}  // namespace
+
+FileFormat format_from_path(const std::filesystem::path& path) {
+  const std::string ext = lower_extension(path);
+  if (ext == ".npy") return FileFormat::kNpy;
+  if (ext == ".nii") return FileFormat::kNifti;
+  if (ext == ".tif" || ext == ".tiff") return FileFormat::kTiff;
+  if (ext == ".raw" || ext == ".bin") return FileFormat::kRaw;
+  if (ext == ".png") return FileFormat::kPng;
+  if (ext == ".json") return FileFormat::kJson;
+  if (ext == ".gz") {
+    throw InputError(io::prefix(path) + "compressed files are not supported; decompress first");
+  }
+  throw InputError(io::prefix(path) + "unknown file type '" + ext +
+                   "' (riner reads .npy, .nii, .tif/.tiff, .raw/.bin with a .json sidecar)");
+}
+
+const char* format_name(FileFormat format) {
+  switch (format) {
+    case FileFormat::kNpy:
+      return "npy";
+    case FileFormat::kNifti:
+      return "nifti";
+    case FileFormat::kTiff:
+      return "tiff";
+    case FileFormat::kRaw:
+      return "raw";
+    case FileFormat::kPng:
+      return "png";
+    case FileFormat::kJson:
+      return "json";
+  }
+  return "unknown";
+}
+
+ArrayFile read_array(const std::filesystem::path& path) {
+  switch (format_from_path(path)) {
+    case FileFormat::kNpy:
+      return io::read_npy(path);
+    case FileFormat::kNifti:
+      return io::read_nifti(path);
+    case FileFormat::kTiff:
+      return io::read_tiff(path);
+    case FileFormat::kRaw:
+      return io::read_raw(path);
+    case FileFormat::kPng:
+      throw InputError(io::prefix(path) + "PNG files are previews; riner does not read them");
+    case FileFormat::kJson:
+      throw InputError(io::prefix(path) + "is JSON, not an array file");
+  }
+  throw InputError(io::prefix(path) + "unknown file type");
+}
+
+void write_array(const std::filesystem::path& path, const Array& array,
+                 const WriteOptions& options) {
+  if (array.shape.empty() || shape_size(array.shape) != array.size()) {
+    throw InputError(io::prefix(path) + "array shape " + shape_string(array.shape) +
+                     " does not match its " + std::to_string(array.size()) + " values");
+  }
+  const FileFormat format = format_from_path(path);
+  switch (format) {
+    case FileFormat::kNpy:
+      return write_atomically(path, [&](const auto& tmp) { io::write_npy(tmp, array); });
+    case FileFormat::kNifti:
+      return write_atomically(
+          path, [&](const auto& tmp) { io::write_nifti(tmp, array, options.voxel_size); });
+    case FileFormat::kTiff:
+      return write_atomically(path, [&](const auto& tmp) { io::write_tiff(tmp, array); });
+    case FileFormat::kRaw: {
+      std::filesystem::path sidecar = path;
+      sidecar += ".json";
+      io::check_output_path(sidecar);
+      write_atomically(path, [&](const auto& tmp) {
+        std::ofstream file(tmp, std::ios::binary);
+        file.write(reinterpret_cast<const char*>(array.ptr()),
+                   static_cast<std::streamsize>(array.size() * sizeof(float)));
+        if (!file.flush()) throw Error(io::prefix(path) + "write failed");
+      });
+      return write_text(sidecar, io::raw_sidecar_json(array));
+    }
+    case FileFormat::kPng:
+      return write_png(path, array);
+    case FileFormat::kJson:
+      throw InputError(io::prefix(path) + "arrays are not written as JSON");
+  }
+}
+
+Window percentile_window(const Array& image, double lo_percent, double hi_percent) {
+  std::vector<float> finite;
+  finite.reserve(image.size());
+  for (float v : image.data) {
+    if (std::isfinite(v)) finite.push_back(v);
+  }
+  if (finite.empty()) return {0.0f, 1.0f};
+  auto at = [&](double percent) {
+    const std::size_t k = std::min(
+        finite.size() - 1, static_cast<std::size_t>(percent / 100.0 * (finite.size() - 1) + 0.5));
+    std::nth_element(finite.begin(), finite.begin() + k, finite.end());
+    return finite[k];
+  };
+  Window window{at(lo_percent), at(hi_percent)};
+  if (!(window.hi > window.lo)) window.hi = window.lo + 1.0f;  // flat image: no division by 0
+  return window;
+}
+
+void write_png(const std::filesystem::path& path, const Array& image, const Window& window) {
+  const Array slice = preview_slice(image);
+  const float scale = 255.0f / (window.hi - window.lo);
+  std::vector<unsigned char> pixels(slice.size());
+  for (std::size_t i = 0; i < slice.size(); ++i) {
+    const float v = slice.data[i];
+    // Non-finite values show as black: a preview must never hide them as mid-grey.
+    const float g = std::isfinite(v) ? (v - window.lo) * scale : 0.0f;
+    pixels[i] = static_cast<unsigned char>(std::clamp(g, 0.0f, 255.0f) + 0.5f);
+  }
+  write_atomically(path, [&](const auto& tmp) {
+    io::write_png_gray8(tmp, pixels, slice.shape[0], slice.shape[1]);
+  });
+}
+
+void write_png(const std::filesystem::path& path, const Array& image) {
+  write_png(path, image, percentile_window(preview_slice(image)));
+}
+
+void write_png_rgb(const std::filesystem::path& path, const std::vector<unsigned char>& rgb,
+                   std::size_t rows, std::size_t cols) {
+  if (rgb.size() != rows * cols * 3)
+    throw InputError(io::prefix(path) + "RGB buffer size mismatch");
+  write_atomically(path, [&](const auto& tmp) { io::write_png_rgb8(tmp, rgb, rows, cols); });
+}
+
+void write_text(const std::filesystem::path& path, std::string_view text) {
+  write_atomically(path, [&](const auto& tmp) {
+    std::ofstream file(tmp, std::ios::binary);
+    file.write(text.data(), static_cast<std::streamsize>(text.size()));
+    if (!file.flush()) throw Error(io::prefix(path) + "write failed");
+  });
+}
+
+std::string read_text(const std::filesystem::path& path) { return io::read_file_bytes(path); }
+
+}  // namespace riner

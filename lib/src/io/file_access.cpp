@@ -1,0 +1,100 @@
+#include "io/file_access.hpp"
+
+#include <fstream>
+#include <iterator>
+#include <mutex>
+#include <set>
+#include <system_error>
+
+#include "riner/array.hpp"
+#include "riner/error.hpp"
+#include "riner/io.hpp"
+
+namespace riner {
+
+namespace {
+
+std::mutex& registry_mutex() {
+  static std::mutex mutex;
+  return mutex;
+}
+
+std::set<std::filesystem::path>& registry() {
+  static std::set<std::filesystem::path> inputs;
+  return inputs;
+}
+
+std::filesystem::path canonical_or_absolute(const std::filesystem::path& path) {
+  std::error_code error;
+  std::filesystem::path result = std::filesystem::weakly_canonical(path, error);
+  return error ? std::filesystem::absolute(path) : result;
+}
+
+}  // namespace
+
+void register_input(const std::filesystem::path& path) {
+  std::lock_guard<std::mutex> lock(registry_mutex());
+  registry().insert(canonical_or_absolute(path));
+}
+
+namespace io {
+
+std::string prefix(const std::filesystem::path& path) { return path.string() + ": "; }
+
+std::size_t element_count(const std::filesystem::path& path,
+                          const std::vector<std::size_t>& shape) {
+  try {
+    return shape_size(shape);
+  } catch (const InputError& e) {
+    throw InputError(prefix(path) + e.what());
+  }
+}
+
+std::uint64_t input_file_size(const std::filesystem::path& path) {
+  std::error_code error;
+  const auto status = std::filesystem::status(path, error);
+  if (error || !std::filesystem::exists(status)) throw InputError(prefix(path) + "no such file");
+  if (std::filesystem::is_directory(status)) throw InputError(prefix(path) + "is a directory");
+  if (!std::filesystem::is_regular_file(status)) {
+    throw InputError(prefix(path) + "is not a regular file");
+  }
+  const std::uint64_t size = std::filesystem::file_size(path, error);
+  if (error) throw InputError(prefix(path) + "cannot read its size: " + error.message());
+  return size;
+}
+
+std::string read_file_bytes(const std::filesystem::path& path) {
+  const std::uint64_t size = input_file_size(path);
+  std::ifstream file(path, std::ios::binary);
+  if (!file) throw InputError(prefix(path) + "cannot open for reading");
+  std::string bytes(size, '\0');
+  if (!file.read(bytes.data(), static_cast<std::streamsize>(size))) {
+    throw InputError(prefix(path) + "read failed");
+  }
+  register_input(path);
+  return bytes;
+}
+
+void check_output_path(const std::filesystem::path& path) {
+  const std::filesystem::path target = canonical_or_absolute(path);
+  {
+    std::lock_guard<std::mutex> lock(registry_mutex());
+    for (const std::filesystem::path& input : registry()) {
+      std::error_code error;
+      if (input == target || std::filesystem::equivalent(input, target, error)) {
+        throw InputError(prefix(path) + "refusing to overwrite an input file");
+      }
+    }
+  }
+  const std::filesystem::path dir = target.parent_path();
+  std::error_code error;
+  if (!dir.empty() && !std::filesystem::is_directory(dir, error)) {
+    throw InputError(prefix(path) + "output directory " + dir.string() + " does not exist");
+  }
+  if (std::filesystem::is_directory(target, error)) {
+    throw InputError(prefix(path) + "is a directory");
+  }
+}
+
+}  // namespace io
+}  // namespace riner

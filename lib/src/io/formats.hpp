@@ -1,0 +1,35 @@
+// One reader and writer per file format; array_io.cpp dispatches by extension. Writers write
+// exactly the path they are given (array_io.cpp passes a temporary file and renames it).
+#pragma once
+
+#include <filesystem>
+
+#include "riner/io.hpp"
+
+namespace riner::io {
+
+ArrayFile read_npy(const std::filesystem::path& path);
+void write_npy(const std::filesystem::path& path, const Array& array);
+
+ArrayFile read_nifti(const std::filesystem::path& path);
+void write_nifti(const std::filesystem::path& path, const Array& array,
+                 const std::vector<double>& voxel_size);
+
+ArrayFile read_tiff(const std::filesystem::path& path);
+void write_tiff(const std::filesystem::path& path, const Array& array);
+
+// The sidecar is "<path>.json".
+ArrayFile read_raw(const std::filesystem::path& path);
+std::string raw_sidecar_json(const Array& array);
+
+// 8-bit PNG of prepared pixels (rows x cols x channels).
+void write_png_gray8(const std::filesystem::path& path, const std::vector<unsigned char>& pixels,
+                     std::size_t rows, std::size_t cols);
+void write_png_rgb8(const std::filesystem::path& path, const std::vector<unsigned char>& pixels,
+                    std::size_t rows, std::size_t cols);
+
+// C-order copy of data stored in Fortran (first axis fastest) order.
+std::vector<float> fortran_to_c_order(const std::vector<float>& data,
+                                      const std::vector<std::size_t>& shape);
+
+}  // namespace riner::io

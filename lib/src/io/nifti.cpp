@@ -1,0 +1,188 @@
+// NIfTI-1 single-file (.nii) images
+// (https://nifti.nimh.nih.gov/nifti-1/documentation/nifti1fields). The file's first axis (x) runs
+// fastest, so the array shape is the file's dims reversed: dim = [nx, ny, nz] becomes an array [nz,
+// ny, nx].
+#include <cmath>
+#include <cstring>
+#include <fstream>
+
+#include "io/file_access.hpp"
+#include "io/formats.hpp"
+#include "io/sample_type.hpp"
+#include "riner/error.hpp"
+
+namespace riner::io {
+
+namespace {
+
+constexpr std::size_t kHeaderSize = 348;
+constexpr std::size_t kDataOffset = 352;  // header + 4-byte extension flag
+
+template <typename T>
+T field(const std::string& bytes, std::size_t offset, bool swap) {
+  unsigned char b[sizeof(T)];
+  std::memcpy(b, bytes.data() + offset, sizeof(T));
+  if (swap) {
+    for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(b[i], b[sizeof(T) - 1 - i]);
+  }
+  T value;
+  std::memcpy(&value, b, sizeof(T));
+  return value;
+}
+
+template <typename T>
+void put(std::string& bytes, std::size_t offset, T value) {
+  static_assert(sizeof(T) <= 8);
+  std::memcpy(bytes.data() + offset, &value, sizeof(T));  // written in host order, little here
+}
+
+SampleType nifti_type(int code, const std::filesystem::path& path) {
+  switch (code) {
+    case 2:
+      return SampleType::kUint8;
+    case 4:
+      return SampleType::kInt16;
+    case 8:
+      return SampleType::kInt32;
+    case 16:
+      return SampleType::kFloat32;
+    case 64:
+      return SampleType::kFloat64;
+    case 256:
+      return SampleType::kInt8;
+    case 512:
+      return SampleType::kUint16;
+    case 768:
+      return SampleType::kUint32;
+    default:
+      throw InputError(prefix(path) + "unsupported NIfTI datatype code " + std::to_string(code));
+  }
+}
+
+}  // namespace
+
+ArrayFile read_nifti(const std::filesystem::path& path) {
+  const std::string bytes = read_file_bytes(path);
+  if (bytes.size() < kHeaderSize) {
+    throw InputError(prefix(path) + "too short for a NIfTI-1 header (" +
+                     std::to_string(bytes.size()) + " bytes)");
+  }
+  const std::int32_t sizeof_hdr = field<std::int32_t>(bytes, 0, false);
+  bool swap = false;
+  if (sizeof_hdr != 348) {
+    if (field<std::int32_t>(bytes, 0, true) != 348) {
+      throw InputError(prefix(path) + "not a NIfTI-1 file (sizeof_hdr is not 348)");
+    }
+    swap = true;
+  }
+  if (std::memcmp(bytes.data() + 344, "n+1", 4) != 0) {
+    if (std::memcmp(bytes.data() + 344, "ni1", 4) == 0) {
+      throw InputError(prefix(path) + "is a .hdr/.img pair header; riner reads single-file .nii");
+    }
+    throw InputError(prefix(path) + "not a NIfTI-1 file (bad magic)");
+  }
+  const int ndim = field<std::int16_t>(bytes, 40, swap);
+  if (ndim < 1 || ndim > 7) {
+    throw InputError(prefix(path) + "dim[0] = " + std::to_string(ndim) + " is not in 1..7");
+  }
+  std::vector<std::size_t> dims;
+  std::vector<double> spacing;
+  for (int d = 1; d <= ndim; ++d) {
+    const int n = field<std::int16_t>(bytes, 40 + 2 * d, swap);
+    if (n < 1) {
+      throw InputError(prefix(path) + "dim[" + std::to_string(d) + "] = " + std::to_string(n) +
+                       " is not positive");
+    }
+    dims.push_back(static_cast<std::size_t>(n));
+    spacing.push_back(std::fabs(field<float>(bytes, 76 + 4 * d, swap)));
+  }
+  // Trailing singleton axes (a 2D slice stored as nx x ny x 1) carry no information.
+  while (dims.size() > 1 && dims.back() == 1) {
+    dims.pop_back();
+    spacing.pop_back();
+  }
+  const SampleType type = nifti_type(field<std::int16_t>(bytes, 70, swap), path);
+  // Single-file images put the data after the header; 0 is a common writer's shorthand.
+  float vox_offset = field<float>(bytes, 108, swap);
+  if (!(vox_offset >= static_cast<float>(kDataOffset)) || vox_offset > bytes.size()) {
+    if (vox_offset == 0.0f) {
+      vox_offset = kDataOffset;
+    } else {
+      throw InputError(prefix(path) + "vox_offset " + std::to_string(vox_offset) +
+                       " is outside the file");
+    }
+  }
+  const std::size_t start = static_cast<std::size_t>(vox_offset);
+
+  ArrayFile file;
+  file.format = FileFormat::kNifti;
+  file.dtype = sample_type_name(type);
+  std::vector<std::size_t> shape(dims.rbegin(), dims.rend());
+  file.voxel_size.assign(spacing.rbegin(), spacing.rend());
+  for (double& v : file.voxel_size) {
+    if (!(v > 0.0) || !std::isfinite(v)) v = 1.0;
+  }
+  const std::size_t count = element_count(path, shape);
+  const std::size_t item = sample_bytes(type);
+  const std::size_t available = bytes.size() - start;
+  if (count > available / item) {
+    throw InputError(prefix(path) + "header says " + shape_string(shape) + " " + file.dtype +
+                     " but the file holds only " + std::to_string(available) + " data bytes");
+  }
+  std::vector<float> data(count);
+  decode_samples(reinterpret_cast<const unsigned char*>(bytes.data()) + start, count, type,
+                 host_is_little_endian() != swap, data.data());
+  const float slope = field<float>(bytes, 112, swap);
+  const float inter = field<float>(bytes, 116, swap);
+  // Per the standard, a zero (or absent) slope means the stored values are the values.
+  if (std::isfinite(slope) && slope != 0.0f) {
+    const float offset = std::isfinite(inter) ? inter : 0.0f;
+    for (float& v : data) v = v * slope + offset;
+  }
+  for (float v : data) file.non_finite += !std::isfinite(v);
+  file.array = Array(std::move(shape), std::move(data));
+  return file;
+}
+
+void write_nifti(const std::filesystem::path& path, const Array& array,
+                 const std::vector<double>& voxel_size) {
+  if (array.rank() < 1 || array.rank() > 7) {
+    throw InputError(prefix(path) + "NIfTI holds 1 to 7 dimensions, not " +
+                     std::to_string(array.rank()));
+  }
+  for (std::size_t d : array.shape) {
+    if (d > 32767) {
+      throw InputError(prefix(path) + "dimension " + std::to_string(d) +
+                       " exceeds NIfTI-1's limit of 32767");
+    }
+  }
+  if (!host_is_little_endian()) throw Error("NIfTI writing assumes a little-endian host");
+  std::string header(kDataOffset, '\0');
+  put<std::int32_t>(header, 0, 348);
+  header[38] = 'r';
+  const std::size_t rank = array.rank();
+  put<std::int16_t>(header, 40, static_cast<std::int16_t>(rank));
+  for (std::size_t d = 0; d < 7; ++d) {
+    const std::size_t n = d < rank ? array.shape[rank - 1 - d] : 1;
+    put<std::int16_t>(header, 42 + 2 * d, static_cast<std::int16_t>(n));
+  }
+  put<std::int16_t>(header, 70, 16);  // float32
+  put<std::int16_t>(header, 72, 32);
+  put<float>(header, 76, 1.0f);  // qfac
+  for (std::size_t d = 0; d < 7; ++d) {
+    const double v = d < rank && voxel_size.size() == rank ? voxel_size[rank - 1 - d] : 1.0;
+    put<float>(header, 80 + 4 * d, static_cast<float>(v));
+  }
+  put<float>(header, 108, static_cast<float>(kDataOffset));
+  put<float>(header, 112, 1.0f);
+  header[123] = 2;  // xyzt_units: millimetres
+  std::memcpy(header.data() + 148, "riner", 5);
+  std::memcpy(header.data() + 344, "n+1", 4);
+  std::ofstream file(path, std::ios::binary);
+  file.write(header.data(), static_cast<std::streamsize>(header.size()));
+  file.write(reinterpret_cast<const char*>(array.ptr()),
+             static_cast<std::streamsize>(array.size() * sizeof(float)));
+  if (!file.flush()) throw Error(prefix(path) + "write failed");
+}
+
+}  // namespace riner::io

@@ -1,0 +1,176 @@
+// NumPy .npy, format versions 1.0-3.0
+// (https://numpy.org/doc/stable/reference/generated/numpy.lib.format.html).
+#include <cstring>
+#include <fstream>
+#include <regex>
+
+#include "io/file_access.hpp"
+#include "io/formats.hpp"
+#include "io/sample_type.hpp"
+#include "riner/error.hpp"
+
+namespace riner::io {
+
+namespace {
+
+constexpr char kMagic[] = "\x93NUMPY";
+constexpr std::size_t kMagicSize = 6;
+
+struct NpyHeader {
+  SampleType type;
+  bool little_endian;
+  bool fortran_order;
+  std::vector<std::size_t> shape;
+};
+
+SampleType parse_kind(char kind, int bytes, const std::string& descr,
+                      const std::filesystem::path& path) {
+  if (kind == 'f' && bytes == 4) return SampleType::kFloat32;
+  if (kind == 'f' && bytes == 8) return SampleType::kFloat64;
+  if (kind == 'u' && bytes == 1) return SampleType::kUint8;
+  if (kind == 'i' && bytes == 1) return SampleType::kInt8;
+  if (kind == 'u' && bytes == 2) return SampleType::kUint16;
+  if (kind == 'i' && bytes == 2) return SampleType::kInt16;
+  if (kind == 'u' && bytes == 4) return SampleType::kUint32;
+  if (kind == 'i' && bytes == 4) return SampleType::kInt32;
+  throw InputError(prefix(path) + "unsupported dtype '" + descr +
+                   "' (riner reads float32/64, int8/16/32, uint8/16/32)");
+}
+
+NpyHeader parse_header(const std::string& dict, const std::filesystem::path& path) {
+  static const std::regex descr_re(R"('descr'\s*:\s*'([<>|=])([a-zA-Z])(\d+)')");
+  static const std::regex fortran_re(R"('fortran_order'\s*:\s*(True|False))");
+  static const std::regex shape_re(R"('shape'\s*:\s*\(([^)]*)\))");
+  std::smatch m;
+  NpyHeader header{};
+  if (!std::regex_search(dict, m, descr_re)) {
+    throw InputError(prefix(path) +
+                     "header has no simple 'descr' (structured dtypes are not "
+                     "supported)");
+  }
+  const std::string descr = m[1].str() + m[2].str() + m[3].str();
+  const int bytes = std::stoi(m[3].str());
+  header.type = parse_kind(m[2].str()[0], bytes, descr, path);
+  const char order = m[1].str()[0];
+  header.little_endian = order == '<' || order == '|' || (order == '=' && host_is_little_endian());
+  if (!std::regex_search(dict, m, fortran_re)) {
+    throw InputError(prefix(path) + "header has no 'fortran_order'");
+  }
+  header.fortran_order = m[1].str() == "True";
+  if (!std::regex_search(dict, m, shape_re))
+    throw InputError(prefix(path) + "header has no 'shape'");
+  const std::string dims = m[1].str();
+  static const std::regex int_re(R"(\s*(\d+)\s*(,|$))");
+  for (auto it = std::sregex_iterator(dims.begin(), dims.end(), int_re);
+       it != std::sregex_iterator(); ++it) {
+    const std::string digits = (*it)[1].str();
+    if (digits.size() > 12) throw InputError(prefix(path) + "absurd dimension " + digits);
+    header.shape.push_back(std::stoull(digits));
+  }
+  if (header.shape.empty()) throw InputError(prefix(path) + "holds a scalar, not an array");
+  return header;
+}
+
+}  // namespace
+
+std::vector<float> fortran_to_c_order(const std::vector<float>& data,
+                                      const std::vector<std::size_t>& shape) {
+  const std::size_t rank = shape.size();
+  std::vector<float> out(data.size());
+  if (data.empty()) return out;
+  // Walk the C-order output with an index counter; track the Fortran offset alongside.
+  std::vector<std::size_t> index(rank, 0);
+  std::vector<std::size_t> fortran_stride(rank, 1);
+  for (std::size_t d = 1; d < rank; ++d) fortran_stride[d] = fortran_stride[d - 1] * shape[d - 1];
+  std::size_t source = 0;
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    out[i] = data[source];
+    for (std::size_t d = rank; d-- > 0;) {
+      if (++index[d] < shape[d]) {
+        source += fortran_stride[d];
+        break;
+      }
+      source -= (shape[d] - 1) * fortran_stride[d];
+      index[d] = 0;
+    }
+  }
+  return out;
+}
+
+ArrayFile read_npy(const std::filesystem::path& path) {
+  const std::string bytes = read_file_bytes(path);
+  if (bytes.size() < kMagicSize + 4 || std::memcmp(bytes.data(), kMagic, kMagicSize) != 0) {
+    throw InputError(prefix(path) + "not a NumPy .npy file (bad magic)");
+  }
+  const int major = static_cast<unsigned char>(bytes[6]);
+  std::size_t header_len = 0;
+  std::size_t data_start = 0;
+  const auto* u = reinterpret_cast<const unsigned char*>(bytes.data());
+  if (major == 1) {
+    header_len = u[8] | (u[9] << 8);
+    data_start = 10 + header_len;
+  } else if (major == 2 || major == 3) {
+    if (bytes.size() < 12) throw InputError(prefix(path) + "truncated header");
+    header_len = u[8] | (u[9] << 8) | (u[10] << 16) | (static_cast<std::size_t>(u[11]) << 24);
+    data_start = 12 + header_len;
+  } else {
+    throw InputError(prefix(path) + "unsupported .npy version " + std::to_string(major));
+  }
+  if (data_start > bytes.size()) throw InputError(prefix(path) + "truncated header");
+  const NpyHeader header = parse_header(bytes.substr(data_start - header_len, header_len), path);
+
+  ArrayFile file;
+  file.format = FileFormat::kNpy;
+  file.dtype = sample_type_name(header.type);
+  const std::size_t count = element_count(path, header.shape);
+  const std::size_t item = sample_bytes(header.type);
+  const std::size_t available = bytes.size() - data_start;
+  if (count > available / item || count * item != available) {
+    throw InputError(prefix(path) + "header says " + shape_string(header.shape) + " " + file.dtype +
+                     " (" + std::to_string(count) + " values) but the file holds " +
+                     std::to_string(available) + " data bytes");
+  }
+  std::vector<float> data(count);
+  file.non_finite =
+      decode_samples(u + data_start, count, header.type, header.little_endian, data.data());
+  if (header.fortran_order && header.shape.size() > 1)
+    data = fortran_to_c_order(data, header.shape);
+  file.array = Array(header.shape, std::move(data));
+  return file;
+}
+
+void write_npy(const std::filesystem::path& path, const Array& array) {
+  std::string dims;
+  for (std::size_t d = 0; d < array.shape.size(); ++d) {
+    dims += (d > 0 ? ", " : "") + std::to_string(array.shape[d]);
+  }
+  if (array.shape.size() == 1) dims += ",";  // a 1-tuple is "(n,)"
+  std::string dict = "{'descr': '<f4', 'fortran_order': False, 'shape': (" + dims + "), }";
+  // Pad with spaces so the data starts on a 64-byte boundary; the header ends with '\n'.
+  const std::size_t unpadded = kMagicSize + 4 + dict.size() + 1;
+  dict.append((64 - unpadded % 64) % 64, ' ');
+  dict += '\n';
+  std::string out(kMagic, kMagicSize);
+  out += '\x01';
+  out += '\x00';
+  out += static_cast<char>(dict.size() & 0xff);
+  out += static_cast<char>((dict.size() >> 8) & 0xff);
+  out += dict;
+  std::ofstream file(path, std::ios::binary);
+  file.write(out.data(), static_cast<std::streamsize>(out.size()));
+  std::vector<float> le(array.data);
+  if (!host_is_little_endian()) {
+    for (float& v : le) {
+      unsigned char b[4];
+      std::memcpy(b, &v, 4);
+      std::swap(b[0], b[3]);
+      std::swap(b[1], b[2]);
+      std::memcpy(&v, b, 4);
+    }
+  }
+  file.write(reinterpret_cast<const char*>(le.data()),
+             static_cast<std::streamsize>(le.size() * sizeof(float)));
+  if (!file.flush()) throw Error(prefix(path) + "write failed");
+}
+
+}  // namespace riner::io

@@ -1,0 +1,204 @@
+// TIFF through libtiff: each page is a 2D image; several pages stack into [pages, rows, cols].
+#include <tiffio.h>
+
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+
+#include "io/file_access.hpp"
+#include "io/formats.hpp"
+#include "io/sample_type.hpp"
+#include "riner/error.hpp"
+
+namespace riner::io {
+
+namespace {
+
+// libtiff reports through global handlers; keep the first error of this thread's current call.
+thread_local std::string t_tiff_error;
+
+void capture_error(const char* module, const char* fmt, va_list args) {
+  if (!t_tiff_error.empty()) return;
+  char buffer[512];
+  std::vsnprintf(buffer, sizeof(buffer), fmt, args);
+  (void)module;  // libtiff passes the file name, which our messages already start with
+  t_tiff_error = buffer;
+}
+
+void ignore_warning(const char*, const char*, va_list) {}
+
+void install_handlers() {
+  static const bool installed = [] {
+    TIFFSetErrorHandler(capture_error);
+    TIFFSetWarningHandler(ignore_warning);
+    return true;
+  }();
+  (void)installed;
+}
+
+struct TiffCloser {
+  void operator()(TIFF* tif) const { TIFFClose(tif); }
+};
+using TiffPtr = std::unique_ptr<TIFF, TiffCloser>;
+
+SampleType page_type(TIFF* tif, const std::filesystem::path& path) {
+  uint16_t bits = 0;
+  uint16_t format = SAMPLEFORMAT_UINT;
+  uint16_t samples = 1;
+  TIFFGetFieldDefaulted(tif, TIFFTAG_BITSPERSAMPLE, &bits);
+  TIFFGetFieldDefaulted(tif, TIFFTAG_SAMPLEFORMAT, &format);
+  TIFFGetFieldDefaulted(tif, TIFFTAG_SAMPLESPERPIXEL, &samples);
+  if (samples != 1) {
+    throw InputError(prefix(path) + "has " + std::to_string(samples) +
+                     " samples per pixel; riner reads single-channel images");
+  }
+  if (format == SAMPLEFORMAT_IEEEFP && bits == 32) return SampleType::kFloat32;
+  if (format == SAMPLEFORMAT_IEEEFP && bits == 64) return SampleType::kFloat64;
+  if (format == SAMPLEFORMAT_UINT && bits == 8) return SampleType::kUint8;
+  if (format == SAMPLEFORMAT_UINT && bits == 16) return SampleType::kUint16;
+  if (format == SAMPLEFORMAT_UINT && bits == 32) return SampleType::kUint32;
+  if (format == SAMPLEFORMAT_INT && bits == 16) return SampleType::kInt16;
+  if (format == SAMPLEFORMAT_INT && bits == 32) return SampleType::kInt32;
+  throw InputError(prefix(path) + "unsupported TIFF sample type (" + std::to_string(bits) +
+                   " bits, format " + std::to_string(format) + ")");
+}
+
+[[noreturn]] void fail(const std::filesystem::path& path, const std::string& what) {
+  std::string detail = t_tiff_error.empty() ? what : what + " (" + t_tiff_error + ")";
+  throw InputError(prefix(path) + detail);
+}
+
+// Reads one page of rows x cols samples into out (host-order bytes, as libtiff delivers them).
+void read_page(TIFF* tif, std::size_t rows, std::size_t cols, std::size_t item, unsigned char* out,
+               const std::filesystem::path& path) {
+  if (TIFFIsTiled(tif)) {
+    uint32_t tile_w = 0;
+    uint32_t tile_h = 0;
+    TIFFGetField(tif, TIFFTAG_TILEWIDTH, &tile_w);
+    TIFFGetField(tif, TIFFTAG_TILELENGTH, &tile_h);
+    if (tile_w == 0 || tile_h == 0) fail(path, "tiled TIFF without tile size");
+    std::vector<unsigned char> tile(TIFFTileSize(tif));
+    for (uint32_t y0 = 0; y0 < rows; y0 += tile_h) {
+      for (uint32_t x0 = 0; x0 < cols; x0 += tile_w) {
+        if (TIFFReadTile(tif, tile.data(), x0, y0, 0, 0) < 0) fail(path, "corrupt tile data");
+        for (uint32_t y = y0; y < std::min<std::size_t>(rows, y0 + tile_h); ++y) {
+          const std::size_t n = std::min<std::size_t>(cols - x0, tile_w);
+          std::memcpy(out + (y * cols + x0) * item, tile.data() + (y - y0) * tile_w * item,
+                      n * item);
+        }
+      }
+    }
+    return;
+  }
+  if (static_cast<std::size_t>(TIFFScanlineSize(tif)) != cols * item) {
+    fail(path, "scanline size does not match width x sample size");
+  }
+  for (uint32_t y = 0; y < rows; ++y) {
+    if (TIFFReadScanline(tif, out + y * cols * item, y, 0) < 0) {
+      fail(path, "truncated or corrupt image data at row " + std::to_string(y));
+    }
+  }
+}
+
+}  // namespace
+
+ArrayFile read_tiff(const std::filesystem::path& path) {
+  input_file_size(path);
+  install_handlers();
+  t_tiff_error.clear();
+  TiffPtr tif(TIFFOpen(path.c_str(), "r"));
+  if (!tif) fail(path, "not a readable TIFF file");
+  register_input(path);
+
+  ArrayFile file;
+  file.format = FileFormat::kTiff;
+  std::size_t rows = 0;
+  std::size_t cols = 0;
+  SampleType type = SampleType::kFloat32;
+  std::vector<unsigned char> raw;
+  std::size_t pages = 0;
+  do {
+    uint32_t width = 0;
+    uint32_t height = 0;
+    if (!TIFFGetField(tif.get(), TIFFTAG_IMAGEWIDTH, &width) ||
+        !TIFFGetField(tif.get(), TIFFTAG_IMAGELENGTH, &height) || width == 0 || height == 0) {
+      fail(path, "page " + std::to_string(pages) + " has no valid size");
+    }
+    const SampleType this_type = page_type(tif.get(), path);
+    if (pages == 0) {
+      rows = height;
+      cols = width;
+      type = this_type;
+      // Refuse sizes the file cannot possibly hold before allocating for them: uncompressed
+      // data needs its bytes; compression rarely beats 1000:1.
+      uint16_t compression = COMPRESSION_NONE;
+      TIFFGetFieldDefaulted(tif.get(), TIFFTAG_COMPRESSION, &compression);
+      const std::uint64_t file_bytes = input_file_size(path);
+      const std::uint64_t limit =
+          compression == COMPRESSION_NONE ? file_bytes / sample_bytes(type) : 1024 * file_bytes;
+      if (shape_size({rows, cols}) > limit) {
+        fail(path, "page size " + std::to_string(height) + " x " + std::to_string(width) +
+                       " is absurd for a file of this size");
+      }
+    } else if (height != rows || width != cols || this_type != type) {
+      fail(path, "page " + std::to_string(pages) + " differs in size or type from page 0");
+    }
+    const std::size_t item = sample_bytes(type);
+    raw.resize((pages + 1) * rows * cols * item);
+    read_page(tif.get(), rows, cols, item, raw.data() + pages * rows * cols * item, path);
+    ++pages;
+  } while (TIFFReadDirectory(tif.get()));
+  if (!t_tiff_error.empty()) fail(path, "corrupt directory");
+
+  file.dtype = sample_type_name(type);
+  std::vector<std::size_t> shape = pages == 1 ? std::vector<std::size_t>{rows, cols}
+                                              : std::vector<std::size_t>{pages, rows, cols};
+  std::vector<float> data(shape_size(shape));
+  file.non_finite =
+      decode_samples(raw.data(), data.size(), type, host_is_little_endian(), data.data());
+  file.array = Array(std::move(shape), std::move(data));
+  return file;
+}
+
+void write_tiff(const std::filesystem::path& path, const Array& array) {
+  if (array.rank() != 2 && array.rank() != 3) {
+    throw InputError(prefix(path) + "TIFF output takes a 2D image or a 3D stack, not rank " +
+                     std::to_string(array.rank()));
+  }
+  install_handlers();
+  t_tiff_error.clear();
+  const std::size_t pages = array.rank() == 3 ? array.shape[0] : 1;
+  const std::size_t rows = array.shape[array.rank() - 2];
+  const std::size_t cols = array.shape[array.rank() - 1];
+  const bool big = array.size() * sizeof(float) > (std::size_t{1} << 31);
+  TiffPtr tif(TIFFOpen(path.c_str(), big ? "w8" : "w"));
+  if (!tif) throw Error(prefix(path) + "cannot create TIFF file");
+  std::vector<float> row(cols);
+  for (std::size_t p = 0; p < pages; ++p) {
+    TIFFSetField(tif.get(), TIFFTAG_IMAGEWIDTH, static_cast<uint32_t>(cols));
+    TIFFSetField(tif.get(), TIFFTAG_IMAGELENGTH, static_cast<uint32_t>(rows));
+    TIFFSetField(tif.get(), TIFFTAG_BITSPERSAMPLE, 32);
+    TIFFSetField(tif.get(), TIFFTAG_SAMPLEFORMAT, SAMPLEFORMAT_IEEEFP);
+    TIFFSetField(tif.get(), TIFFTAG_SAMPLESPERPIXEL, 1);
+    TIFFSetField(tif.get(), TIFFTAG_PHOTOMETRIC, PHOTOMETRIC_MINISBLACK);
+    TIFFSetField(tif.get(), TIFFTAG_PLANARCONFIG, PLANARCONFIG_CONTIG);
+    TIFFSetField(tif.get(), TIFFTAG_COMPRESSION, COMPRESSION_NONE);
+    TIFFSetField(tif.get(), TIFFTAG_ROWSPERSTRIP, TIFFDefaultStripSize(tif.get(), 0));
+    if (pages > 1) {
+      TIFFSetField(tif.get(), TIFFTAG_SUBFILETYPE, FILETYPE_PAGE);
+      TIFFSetField(tif.get(), TIFFTAG_PAGENUMBER, static_cast<uint16_t>(p),
+                   static_cast<uint16_t>(pages));
+    }
+    for (std::size_t y = 0; y < rows; ++y) {
+      std::memcpy(row.data(), array.ptr() + (p * rows + y) * cols, cols * sizeof(float));
+      if (TIFFWriteScanline(tif.get(), row.data(), static_cast<uint32_t>(y), 0) < 0) {
+        throw Error(prefix(path) + "TIFF write failed: " + t_tiff_error);
+      }
+    }
+    if (!TIFFWriteDirectory(tif.get())) throw Error(prefix(path) + "TIFF write failed");
+  }
+}
+
+}  // namespace riner::io

@@ -1,0 +1,144 @@
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <string>
+
+#include "riner/error.hpp"
+#include "riner/geometry.hpp"
+#include "support/fixture.hpp"
+
+namespace {
+
+const char* kFan = R"({
+  "type": "fan2d",
+  "detector": {"count": 500, "pitch_mm": 2.0, "offset_px": 0.0},
+  "source_origin_mm": 370.0,
+  "origin_detector_mm": 370.0,
+  "angles": {"count": 360, "start_rad": 0.0, "range_rad": 6.283185307179586},
+  "volume": {"shape": [256, 256], "voxel_mm": 1.0}
+})";
+
+const char* kCone = R"({
+  "type": "cone3d",
+  "detector": {"count": [300, 200], "pitch_mm": [2.0, 2.0], "offset_px": [0.5, -1.0]},
+  "source_origin_mm": 300.0,
+  "origin_detector_mm": 300.0,
+  "angles_rad": [0.0, 0.5, 1.0],
+  "volume": {"shape": [100, 256, 256], "voxel_mm": 1.0}
+})";
+
+// Replaces the first occurrence of `from` in the fan-beam example.
+std::string fan_with(const std::string& from, const std::string& to) {
+  std::string text = kFan;
+  const auto pos = text.find(from);
+  REQUIRE(pos != std::string::npos);
+  return text.replace(pos, from.size(), to);
+}
+
+void check_error(const std::string& json, const std::string& expected) {
+  try {
+    riner::Geometry::from_json(json, "g.json");
+    FAIL("accepted a bad geometry; expected: " << expected);
+  } catch (const riner::InputError& e) {
+    CHECK(std::string(e.what()) == expected);
+  }
+}
+
+}  // namespace
+
+TEST_SUITE("geometry_json") {
+  TEST_CASE("the METHOD.md fan-beam example parses exactly") {
+    const riner::Geometry g = riner::Geometry::from_json(kFan);
+    CHECK(g.type == riner::GeometryType::kFan2d);
+    CHECK(g.n_u == 500);
+    CHECK(g.pitch_u == 2.0);
+    CHECK(g.source_origin_mm == 370.0);
+    REQUIRE(g.n_views() == 360);
+    CHECK(g.angles[0] == 0.0);
+    // Endpoint excluded: 360 views over 2 pi never repeat a view.
+    CHECK(g.angles[359] == doctest::Approx(2 * M_PI * 359 / 360));
+    CHECK(g.measurement_shape() == std::vector<std::size_t>{360, 500});
+  }
+
+  TEST_CASE("3D pairs and explicit angle lists") {
+    const riner::Geometry g = riner::Geometry::from_json(kCone);
+    CHECK(g.is_3d());
+    CHECK(g.n_u == 300);
+    CHECK(g.n_v == 200);
+    CHECK(g.offset_v == -1.0);
+    CHECK(g.angles == std::vector<double>{0.0, 0.5, 1.0});
+    CHECK(g.measurement_shape() == std::vector<std::size_t>{3, 200, 300});
+  }
+
+  TEST_CASE("to_json round-trips") {
+    for (const char* text : {kFan, kCone}) {
+      const riner::Geometry g = riner::Geometry::from_json(text);
+      const riner::Geometry h = riner::Geometry::from_json(g.to_json());
+      CHECK(h.to_json() == g.to_json());
+      CHECK(h.angles == g.angles);
+      CHECK(h.n_u == g.n_u);
+      CHECK(h.offset_v == g.offset_v);
+    }
+  }
+
+  TEST_CASE("every bad field is named") {
+    try {
+      riner::Geometry::from_json("{", "g.json");
+      FAIL("accepted truncated JSON");
+    } catch (const riner::InputError& e) {
+      CHECK(std::string(e.what()).rfind("g.json: invalid JSON: ", 0) == 0);
+    }
+    check_error("[]", "g.json: top level must be a JSON object");
+    check_error(fan_with("\"fan2d\"", "\"fan\""),
+                "g.json: type must be one of parallel2d, fan2d, cone3d, parallel3d (got \"fan\")");
+    check_error(fan_with("\"count\": 500", "\"count\": 0"),
+                "g.json: detector.count must be >= 1 (got 0)");
+    check_error(fan_with("\"count\": 500", "\"count\": 2.5"),
+                "g.json: detector.count must be a positive integer");
+    check_error(fan_with("\"count\": 500", "\"count\": [500, 2]"),
+                "g.json: detector.count must be a single value in 2D");
+    check_error(fan_with("\"pitch_mm\": 2.0", "\"pitch_mm\": -2"),
+                "g.json: detector.pitch_mm must be > 0 (got -2)");
+    check_error(fan_with("\"pitch_mm\": 2.0", "\"pitch_mm\": \"2\""),
+                "g.json: detector.pitch_mm must be a number");
+    check_error(fan_with("\"source_origin_mm\": 370.0,", ""),
+                "g.json: source_origin_mm is missing");
+    check_error(fan_with("\"origin_detector_mm\": 370.0", "\"origin_detector_mm\": 0"),
+                "g.json: origin_detector_mm must be > 0 (got 0)");
+    check_error(fan_with("\"source_origin_mm\": 370.0", "\"source_origin_mm\": 100"),
+                "g.json: source_origin_mm (100.000000) puts the source inside the reconstruction "
+                "grid (half-diagonal 181.019336 mm)");
+    check_error(fan_with("\"count\": 360", "\"count\": -4"),
+                "g.json: angles.count must be >= 1 (got -4)");
+    check_error(fan_with("\"range_rad\": 6.283185307179586", "\"range_rad\": 0"),
+                "g.json: angles.range_rad must not be 0");
+    check_error(fan_with("\"angles\"", "\"angles_rad\": [0.1], \"angles\""),
+                "g.json: angles must be given once: either \"angles\" or \"angles_rad\"");
+    check_error(fan_with("[256, 256]", "[256]"),
+                "g.json: volume.shape must be [n_y, n_x] for a 2D geometry");
+    check_error(fan_with("\"voxel_mm\": 1.0", "\"voxel_mm\": 0"),
+                "g.json: volume.voxel_mm must be > 0 (got 0)");
+    check_error(fan_with("\"volume\"", "\"volumes\""), "g.json: volume is missing");
+  }
+
+  TEST_CASE("measurement shape mismatch names both shapes and the view count") {
+    const riner::Geometry g = riner::Geometry::from_json(kFan);
+    CHECK_NOTHROW(g.check_measurement_shape({360, 500}));
+    CHECK_THROWS_WITH_AS(g.check_measurement_shape({359, 500}, "sino.npy"),
+                         "sino.npy has shape [359, 500] but the fan2d geometry expects [360, 500] "
+                         "[views, elements]: it has 359 views but the geometry lists 360 angles",
+                         riner::InputError);
+    CHECK_THROWS_AS(g.check_measurement_shape({360, 500, 1}), riner::InputError);
+  }
+
+  TEST_CASE("the shared real-scan geometries parse") {
+    for (const char* name :
+         {"neutron360", "wood_neutron", "htc2022_disc", "tooth", "savu_proj3d"}) {
+      const auto path = riner::test::shared_data(std::string(name) + "/geometry.json");
+      if (path.empty()) continue;
+      CAPTURE(name);
+      const riner::Geometry g = riner::Geometry::load(path);
+      CHECK(g.n_views() > 0);
+    }
+  }
+}

@@ -1,0 +1,60 @@
+// Outputs are atomic and never replace an input.
+#include <doctest/doctest.h>
+
+#include "riner/error.hpp"
+#include "riner/io.hpp"
+#include "support/fixture.hpp"
+
+TEST_SUITE("output_safety") {
+  TEST_CASE("a file this process read cannot be overwritten, by any name") {
+    riner::test::TempDir dir;
+    const riner::Array a({2, 2}, 1.0f);
+    riner::write_array(dir / "in.npy", a);
+    riner::read_array(dir / "in.npy");
+    const std::string message = (dir / "in.npy").string() + ": refusing to overwrite an input file";
+    CHECK_THROWS_WITH_AS(riner::write_array(dir / "in.npy", a), message.c_str(), riner::InputError);
+    // Through a different spelling of the same path.
+    const auto dotted = dir.path() / "." / "in.npy";
+    CHECK_THROWS_AS(riner::write_array(dotted, a), riner::InputError);
+    CHECK_THROWS_AS(riner::write_text(dir / "in.npy", "x"), riner::InputError);
+    // And through a hard link.
+    std::filesystem::create_hard_link(dir / "in.npy", dir / "alias.npy");
+    CHECK_THROWS_AS(riner::write_array(dir / "alias.npy", a), riner::InputError);
+  }
+
+  TEST_CASE("writes leave no temporary files and replace outputs whole") {
+    riner::test::TempDir dir;
+    riner::write_array(dir / "out.nii", riner::Array({3, 3}, 1.0f));
+    riner::write_array(dir / "out.nii", riner::Array({4, 4}, 2.0f));
+    CHECK(riner::read_array(dir / "out.nii").array.shape == std::vector<std::size_t>{4, 4});
+    int files = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(dir.path())) {
+      (void)entry;
+      ++files;
+    }
+    CHECK(files == 1);
+  }
+
+  TEST_CASE("a missing output directory is a clear error") {
+    riner::test::TempDir dir;
+    const auto path = dir / "no_such_dir" / "x.npy";
+    CHECK_THROWS_WITH_AS(
+        riner::write_array(path, riner::Array({1}, 0.0f)),
+        (path.string() + ": output directory " + (dir / "no_such_dir").string() + " does not exist")
+            .c_str(),
+        riner::InputError);
+  }
+
+  TEST_CASE("PNG previews window by percentiles and refuse non-images") {
+    riner::test::TempDir dir;
+    riner::Array ramp({10, 100});
+    for (std::size_t i = 0; i < ramp.size(); ++i) ramp.data[i] = static_cast<float>(i % 100);
+    const riner::Window w = riner::percentile_window(ramp);
+    CHECK(w.lo == doctest::Approx(1.0));
+    CHECK(w.hi == doctest::Approx(98.0));
+    riner::write_png(dir / "ramp.png", ramp);
+    const std::string png = riner::test::read_bytes(dir / "ramp.png");
+    CHECK(png.substr(1, 3) == "PNG");
+    CHECK_THROWS_AS(riner::write_png(dir / "bad.png", riner::Array({5})), riner::InputError);
+  }
+}
