@@ -6,5 +6,8 @@ namespace riner::app {
 
 int run_devices(int argc, char** argv, int first);
 int run_info(int argc, char** argv, int first);
+int run_simulate(int argc, char** argv, int first);
+int run_fbp(int argc, char** argv, int first);
+int run_compare(int argc, char** argv, int first);
 
 }  // namespace riner::app

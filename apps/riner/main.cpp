@@ -21,6 +21,9 @@ struct Command {
 constexpr Command kCommands[] = {
     {"devices", riner::app::run_devices, "list OpenCL devices and their capabilities"},
     {"info", riner::app::run_info, "describe an array file or a geometry file"},
+    {"simulate", riner::app::run_simulate, "simulate a ring-corrupted scan (paper protocol)"},
+    {"fbp", riner::app::run_fbp, "filtered backprojection (FBP / FDK) of a scan"},
+    {"compare", riner::app::run_compare, "PSNR / SSIM / MAE of an image against a reference"},
 };
 
 void print_usage(std::FILE* out) {

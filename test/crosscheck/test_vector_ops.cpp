@@ -42,10 +42,21 @@ TEST_SUITE("vector_ops") {
     riner::cl::Buffer<float> dx(ctx, std::span<const float>(x));
     for (int repeat = 0; repeat < 3; ++repeat) {
       riner::cl::Buffer<float> total(ctx, 1);
-      total.fill(0.0f);
+      riner::ops::VectorOps(ctx).fill(total, 0.0f);
       riner::ops::VectorOps(ctx).sum(dx, total);
       // 20000 float additions in arbitrary order: error grows like n * eps * |sum| at worst.
       CHECK(total.read()[0] == doctest::Approx(want).epsilon(20000 * 6e-8));
+    }
+  }
+}
+
+TEST_SUITE("vector_ops") {
+  TEST_CASE("fill sets every element, at odd sizes") {
+    riner::cl::Context& ctx = riner::test::device().context();
+    for (std::size_t n : {1u, 13u, 1024u}) {
+      riner::cl::Buffer<float> y(ctx, n);
+      riner::ops::VectorOps(ctx).fill(y, -2.5f);
+      CHECK(y.read() == std::vector<float>(n, -2.5f));
     }
   }
 }

@@ -53,7 +53,10 @@ class Kernel {
   void set_arg(cl_uint index, const LocalMemory& local) { set_raw(index, local.bytes, nullptr); }
   template <typename T>
   void set_arg(cl_uint index, const T& value) {
-    static_assert(std::is_arithmetic_v<T>, "kernel scalar arguments are numbers");
+    // Structs go by value when their device mirror has the same layout (see ray_geometry.cl).
+    static_assert(
+        std::is_arithmetic_v<T> || (std::is_class_v<T> && std::is_trivially_copyable_v<T>),
+        "kernel arguments are numbers, buffers or plain structs");
     // size_t differs between host and device; kernels take uint/int counts.
     static_assert(!std::is_same_v<T, std::size_t> && !std::is_same_v<T, long> &&
                       !std::is_same_v<T, unsigned long>,

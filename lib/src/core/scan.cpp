@@ -1,5 +1,7 @@
 #include "riner/scan.hpp"
 
+#include "io/file_access.hpp"
+
 #include "riner/error.hpp"
 #include "riner/io.hpp"
 
@@ -14,6 +16,7 @@ void check_scan(const Scan& scan, std::string_view what) {
 }
 
 Scan load_scan(const std::filesystem::path& measurement, const std::filesystem::path& geometry) {
+  io::input_file_size(measurement);  // a missing scan is the first thing to report
   std::filesystem::path geometry_path = geometry;
   if (geometry_path.empty()) {
     geometry_path = measurement.parent_path() / "geometry.json";

@@ -15,12 +15,15 @@ class VectorOps {
   void axpy(float a, const cl::Buffer<float>& x, cl::Buffer<float>& y);
   // total[0] += sum(x); float atomics, so the last bits depend on thread order.
   void sum(const cl::Buffer<float>& x, cl::Buffer<float>& total);
+  // y[i] = value
+  void fill(cl::Buffer<float>& y, float value);
 
  private:
   cl::Context& context_;
   std::shared_ptr<const cl::Program> program_;
   cl::Kernel axpy_;
   cl::Kernel sum_;
+  cl::Kernel fill_;
 };
 
 }  // namespace riner::ops

@@ -1,0 +1,51 @@
+#include "cli_common.hpp"
+
+#include <cstdio>
+
+#include "riner/error.hpp"
+#include "riner/simulate.hpp"
+
+namespace riner::app {
+
+void add_engine_flags(Args& args) {
+  args.option("engine", "NAME", "opencl, or reference (the CPU twin of every kernel)", "opencl");
+  args.option("device", "SEL", "OpenCL device: index or name substring (see riner devices)", "");
+}
+
+Engine engine_from(const Args& args) { return parse_engine(args.get("engine")); }
+
+std::optional<Device> device_from(const Args& args, Engine engine) {
+  if (engine != Engine::kOpenCL) return std::nullopt;
+  return Device::open(args.get("device"));
+}
+
+std::filesystem::path make_output_dir(const std::string& path) {
+  std::error_code error;
+  std::filesystem::create_directories(path, error);
+  if (!std::filesystem::is_directory(path)) {
+    throw InputError(path + ": cannot create the output folder" +
+                     (error ? " (" + error.message() + ")" : std::string()));
+  }
+  return path;
+}
+
+Geometry geometry_from(const std::string& name_or_path) {
+  if (is_preset_geometry(name_or_path)) return preset_geometry(name_or_path);
+  return Geometry::load(name_or_path);
+}
+
+void Console::line(const std::string& text) const {
+  if (quiet_) return;
+  std::fprintf(json_ ? stderr : stdout, "%s\n", text.c_str());
+}
+
+void Console::summary(const nlohmann::json& json) const {
+  if (json_) std::printf("%s\n", json.dump(1).c_str());
+}
+
+nlohmann::json metrics_json(double psnr, double ssim, double mae, double rmse, double data_range) {
+  return {
+      {"psnr_db", psnr}, {"ssim", ssim}, {"mae", mae}, {"rmse", rmse}, {"data_range", data_range}};
+}
+
+}  // namespace riner::app

@@ -1,0 +1,45 @@
+// Pieces several subcommands share: device and engine flags, output folders, summaries.
+#pragma once
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+
+#include "cli_args.hpp"
+#include "riner/array.hpp"
+#include "riner/device.hpp"
+#include "riner/engine.hpp"
+#include "riner/geometry.hpp"
+
+namespace riner::app {
+
+// --device and --engine (opencl | reference).
+void add_engine_flags(Args& args);
+Engine engine_from(const Args& args);
+// The device for the OpenCL engine (nullopt for the reference engine).
+std::optional<Device> device_from(const Args& args, Engine engine);
+
+// Creates the folder (and parents) if needed; InputError if it is a file.
+std::filesystem::path make_output_dir(const std::string& path);
+
+// A preset name or a geometry JSON file.
+Geometry geometry_from(const std::string& name_or_path);
+
+// Human lines go to stdout, or to stderr when stdout carries --json; nothing with --quiet.
+class Console {
+ public:
+  explicit Console(const Args& args) : json_(args.is_set("json")), quiet_(args.is_set("quiet")) {}
+  void line(const std::string& text) const;
+  // With --json, prints the summary on stdout.
+  void summary(const nlohmann::json& json) const;
+  bool quiet() const { return quiet_; }
+
+ private:
+  bool json_;
+  bool quiet_;
+};
+
+nlohmann::json metrics_json(double psnr, double ssim, double mae, double rmse, double data_range);
+
+}  // namespace riner::app

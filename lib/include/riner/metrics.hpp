@@ -1,0 +1,34 @@
+// Image quality against a ground truth (METHOD.md §5): PSNR, SSIM as scikit-image's
+// structural_similarity defaults (7-wide uniform window, K1 = 0.01, K2 = 0.03, sample
+// covariance, mean over the map with a 3-pixel border cropped), MAE, RMSE. 2D and 3D.
+#pragma once
+
+#include <optional>
+
+#include "riner/array.hpp"
+
+namespace riner {
+
+struct ImageMetrics {
+  double psnr = 0.0;  // dB
+  double ssim = 0.0;
+  double mae = 0.0;
+  double rmse = 0.0;
+  double data_range = 0.0;  // max - min of the reference (inside the mask when one is given)
+  std::size_t pixels = 0;   // compared pixels
+};
+
+// A mask (1 inside, 0 outside) of the disk, or cylinder in 3D, inscribed in the last two axes,
+// of radius fraction * min(n_y, n_x) / 2 around the grid centre.
+Array circle_mask(const std::vector<std::size_t>& shape, double fraction = 1.0);
+
+// image and reference must have the same shape; a mask (same shape, nonzero = inside)
+// restricts every metric, SSIM to the masked part of its cropped map. data_range <= 0 means
+// max - min of the reference. InputError for mismatched shapes or non-finite values.
+ImageMetrics compare_images(const Array& image, const Array& reference, const Array* mask = nullptr,
+                            double data_range = 0.0);
+
+double psnr(const Array& image, const Array& reference, double data_range = 0.0);
+double ssim(const Array& image, const Array& reference, double data_range = 0.0);
+
+}  // namespace riner

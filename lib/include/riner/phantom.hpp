@@ -1,0 +1,41 @@
+// Analytic phantoms made of ellipses/ellipsoids: exact values anywhere, exact line integrals
+// along any ray (the oracle the projector is tested against), and supersampled rasters.
+#pragma once
+
+#include <array>
+#include <vector>
+
+#include "riner/array.hpp"
+#include "riner/geometry.hpp"
+#include "riner/rays.hpp"
+
+namespace riner {
+
+struct Ellipsoid {
+  Vec3 centre;                                                // mm
+  Vec3 semi_axes;                                             // mm; z ignored for 2D use
+  std::array<double, 9> rotation{1, 0, 0, 0, 1, 0, 0, 0, 1};  // world -> local, row-major
+  double value = 0.0;                                         // added inside (1/mm)
+};
+
+struct Phantom {
+  std::vector<Ellipsoid> ellipsoids;
+
+  double value_at(const Vec3& p) const;
+  // Exact integral of the phantom along the whole line (mm x 1/mm).
+  double line_integral(const Ray& ray) const;
+};
+
+// The modified Shepp-Logan head (Toft's contrast), scaled so that its outer ellipse spans
+// 0.95 x the smaller half-width of the geometry's grid (and 0.95 x its half-height in 3D);
+// values in "head units" (skull 1.0, brain 0.2) times mu_scale (1/mm). The default scale 0.1
+// makes the brain water-like, 0.02 / mm.
+Phantom shepp_logan(const Geometry& g, double mu_scale = 0.1);
+
+// Voxel averages over supersample^d points per voxel, on the geometry's grid.
+Array rasterize(const Phantom& phantom, const Geometry& g, int supersample = 4);
+
+// Exact line integrals of every detector ray of the geometry, as a measurement array.
+Array exact_projections(const Phantom& phantom, const Geometry& g);
+
+}  // namespace riner

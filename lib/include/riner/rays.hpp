@@ -1,0 +1,50 @@
+// Rays of a scan geometry and their clipping to the reconstruction region: the one place that
+// simulation, FBP/FDK and Riner's sampler get their rays from (kernels/ray_geometry.cl is the
+// device copy of the same formulas, cross-checked against this one).
+#pragma once
+
+#include <cstddef>
+
+#include "riner/geometry.hpp"
+
+namespace riner {
+
+struct Vec3 {
+  double x = 0.0;
+  double y = 0.0;
+  double z = 0.0;
+};
+
+// origin + t * direction, direction of unit length, t in mm. 2D rays have z = 0.
+// Fan/cone rays start at the source; parallel rays at their closest point to the rotation axis.
+struct Ray {
+  Vec3 origin;
+  Vec3 direction;
+};
+
+// The ray to detector element (u, v) at `view`. u and v are element indices and may be
+// fractional (positions inside an element); v is ignored in 2D.
+Ray detector_ray(const Geometry& g, std::size_t view, double u, double v = 0.0);
+
+// Where detector element (u, v) sits in the world at `view` (its centre for integer indices).
+Vec3 detector_position(const Geometry& g, std::size_t view, double u, double v = 0.0);
+
+// Parameter interval [enter, exit] of a ray inside a region; empty when it misses.
+struct Segment {
+  double enter = 0.0;
+  double exit = 0.0;
+  bool empty() const { return !(exit > enter); }
+  double length() const { return empty() ? 0.0 : exit - enter; }
+};
+
+// The reconstruction box: |x| <= n_x p / 2, |y| <= n_y p / 2 (and |z| <= n_z p / 2 in 3D).
+Segment clip_to_box(const Geometry& g, const Ray& ray);
+
+// The inscribed disk (2D) or cylinder (3D, clipped to the box in z), radius min(n_x, n_y) p / 2:
+// the region every view sees in a full scan.
+Segment clip_to_cylinder(const Geometry& g, const Ray& ray);
+
+// World coordinates of the centre of voxel (k, i[, l]) = (column, row[, slice]).
+Vec3 voxel_centre(const Geometry& g, double column, double row, double slice = 0.0);
+
+}  // namespace riner

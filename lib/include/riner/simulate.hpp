@@ -1,0 +1,56 @@
+// Ring-artifact simulation (METHOD.md §4): per-element detector responses alpha (some
+// elements non-ideal, some dead), Poisson photon counts, rho = -ln(I / I0). Reproducible from a
+// seed: the random draws come from one std::mt19937_64 stream with riner's own samplers, so the
+// same seed gives bit-identical output on any platform (given the same clean projections).
+#pragma once
+
+#include <cstdint>
+#include <string_view>
+
+#include "riner/array.hpp"
+#include "riner/geometry.hpp"
+#include "riner/projector.hpp"
+#include "riner/scan.hpp"
+
+namespace riner {
+
+struct RingModel {
+  double nonideal_fraction = 0.75;  // of all detector elements (pixels in 3D), exactly rounded
+  double alpha_min = 0.75;          // non-ideal responses ~ U[alpha_min, alpha_max]
+  double alpha_max = 1.25;
+  std::size_t dead_elements = 2;  // alpha = 0: the whole column reads +inf
+  std::size_t dead_rows = 0;      // 3D: whole detector rows dead
+  std::size_t dead_columns = 0;   // 3D: whole detector columns dead
+  double photons = 1e7;           // I0; 0 = no noise (rho = p - ln alpha exactly)
+  std::uint64_t seed = 0;
+
+  void validate() const;  // InputError for impossible settings
+};
+
+// True responses: alpha per element, [n_u] in 2D and [n_v, n_u] in 3D; 0 marks dead elements.
+// Exactly round(nonideal_fraction * n) elements get U[alpha_min, alpha_max]; exactly
+// dead_elements (plus whole rows/columns) get 0; the rest get 1. Dead elements are chosen
+// first, then the non-ideal ones among the others.
+Array draw_responses(const Geometry& g, const RingModel& model);
+
+// rho~ from clean line integrals: I ~ Poisson(alpha I0 exp(-p)), rho~ = -ln(I / I0); I = 0
+// (every dead element, or a starved ray) gives +inf. Consumes the stream after draw_responses.
+Array corrupt_measurement(const Array& clean, const Array& alpha, const RingModel& model);
+
+struct SimulatedScan {
+  Scan scan;           // the ring-corrupted, noisy measurement and its geometry
+  Array clean;         // exact projections of the ground truth: no rings, no noise
+  Array alpha;         // true responses (0 = dead)
+  Array ground_truth;  // mu (1/mm) on the geometry's grid
+};
+
+// Projects the ground truth with `projector` and corrupts it.
+SimulatedScan simulate(const Array& ground_truth, const Projector& projector,
+                       const RingModel& model);
+
+// Named geometries of METHOD.md §4: "fan2d-paper" (the DeepLesion/LIDC setting) and
+// "cone3d-paper" (the AAPM setting); InputError for other names.
+Geometry preset_geometry(std::string_view name);
+bool is_preset_geometry(std::string_view name);
+
+}  // namespace riner

@@ -1,0 +1,135 @@
+#include "analytic/fbp_setup.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <numeric>
+#include <unsupported/Eigen/FFT>
+
+namespace riner::analytic {
+
+std::size_t repair_non_finite(Array& measurement, std::size_t n_u) {
+  std::size_t replaced = 0;
+  const std::size_t lines = measurement.size() / n_u;
+  for (std::size_t line = 0; line < lines; ++line) {
+    float* p = measurement.ptr() + line * n_u;
+    long previous = -1;  // last finite index
+    for (std::size_t j = 0; j <= n_u; ++j) {
+      if (j < n_u && !std::isfinite(p[j])) continue;
+      // Fill the gap (previous, j) from its finite ends.
+      for (std::size_t k = static_cast<std::size_t>(previous + 1); k < j; ++k) {
+        float value = 0.0f;
+        if (previous >= 0 && j < n_u) {
+          const float w = static_cast<float>(k - previous) / static_cast<float>(j - previous);
+          value = (1.0f - w) * p[previous] + w * p[j];
+        } else if (previous >= 0) {
+          value = p[previous];
+        } else if (j < n_u) {
+          value = p[j];
+        }
+        p[k] = value;
+        ++replaced;
+      }
+      previous = static_cast<long>(j);
+    }
+  }
+  return replaced;
+}
+
+void cosine_weight(Array& measurement, const Geometry& g) {
+  if (!g.is_divergent()) return;
+  const double sdd = g.source_origin_mm + g.origin_detector_mm;
+  const std::size_t rows = g.is_3d() ? g.n_v : 1;
+  std::vector<float> weight(rows * g.n_u);
+  for (std::size_t r = 0; r < rows; ++r) {
+    const double v = g.is_3d() ? (r - 0.5 * (g.n_v - 1.0) + g.offset_v) * g.pitch_v : 0.0;
+    for (std::size_t j = 0; j < g.n_u; ++j) {
+      const double u = (j - 0.5 * (g.n_u - 1.0) + g.offset_u) * g.pitch_u;
+      weight[r * g.n_u + j] = static_cast<float>(sdd / std::sqrt(sdd * sdd + u * u + v * v));
+    }
+  }
+  for (std::size_t i = 0; i < measurement.size(); ++i)
+    measurement.data[i] *= weight[i % weight.size()];
+}
+
+double filter_spacing(const Geometry& g) {
+  if (!g.is_divergent()) return g.pitch_u;
+  return g.pitch_u * g.source_origin_mm / (g.source_origin_mm + g.origin_detector_mm);
+}
+
+std::vector<double> filter_taps(std::size_t n_u, double tau, FbpFilter filter) {
+  std::size_t padded = 1;
+  while (padded < 2 * n_u) padded *= 2;
+  // The spatial Ram-Lak kernel on the circular grid: h(0) = 1/(4 tau^2), h(odd k) =
+  // -1/(pi k tau)^2, h(even k) = 0.
+  std::vector<double> h(padded, 0.0);
+  for (std::size_t m = 0; m < padded; ++m) {
+    const long k =
+        m <= padded / 2 ? static_cast<long>(m) : static_cast<long>(m) - static_cast<long>(padded);
+    if (k == 0) {
+      h[m] = 1.0 / (4.0 * tau * tau);
+    } else if (k % 2 != 0) {
+      h[m] = -1.0 / (M_PI * M_PI * static_cast<double>(k * k) * tau * tau);
+    }
+  }
+  if (filter != FbpFilter::kRamLak) {
+    Eigen::FFT<double> fft;
+    std::vector<std::complex<double>> spectrum;
+    fft.fwd(spectrum, h);
+    for (std::size_t m = 0; m < padded; ++m) {
+      const double f =
+          (m <= padded / 2 ? static_cast<double>(m) : static_cast<double>(m) - padded) /
+          static_cast<double>(padded);  // cycles per sample, |f| <= 1/2
+      double window = 1.0;
+      if (filter == FbpFilter::kSheppLogan) {
+        window = f == 0.0 ? 1.0 : std::sin(M_PI * f) / (M_PI * f);
+      } else {
+        window = 0.5 * (1.0 + std::cos(2.0 * M_PI * f));
+      }
+      spectrum[m] *= window;
+    }
+    fft.inv(h, spectrum);
+  }
+  std::vector<double> taps(2 * n_u - 1);
+  for (long k = -static_cast<long>(n_u - 1); k <= static_cast<long>(n_u - 1); ++k) {
+    const std::size_t m =
+        static_cast<std::size_t>((k + static_cast<long>(padded)) % static_cast<long>(padded));
+    taps[static_cast<std::size_t>(k + static_cast<long>(n_u) - 1)] = h[m] * tau;
+  }
+  return taps;
+}
+
+std::vector<double> view_weights(const Geometry& g, bool* short_scan) {
+  const std::size_t n = g.n_views();
+  const double period = g.is_divergent() ? 2.0 * M_PI : M_PI;
+  std::vector<double> phase(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    phase[i] = std::fmod(g.angles[i], period);
+    if (phase[i] < 0.0) phase[i] += period;
+  }
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return phase[a] < phase[b]; });
+  // Each view owns half the gap to each neighbour, cyclically: the shares sum to the period.
+  std::vector<double> weights(n, period);
+  double largest_gap = 0.0;
+  std::vector<double> gaps(n);
+  for (std::size_t s = 0; s < n && n > 1; ++s) {
+    const double next = s + 1 < n ? phase[order[s + 1]] : phase[order[0]] + period;
+    gaps[s] = next - phase[order[s]];
+    largest_gap = std::max(largest_gap, gaps[s]);
+  }
+  for (std::size_t s = 0; s < n && n > 1; ++s) {
+    weights[order[s]] = 0.5 * (gaps[s] + gaps[(s + n - 1) % n]);
+  }
+  if (short_scan != nullptr) {
+    // A gap several times the mean step means part of the circle was never seen.
+    *short_scan = n == 1 || largest_gap > 3.0 * period / static_cast<double>(n);
+  }
+  const double scale = g.is_divergent() ? 0.5 : 1.0;
+  for (double& w : weights) w *= scale;
+  return weights;
+}
+
+}  // namespace riner::analytic

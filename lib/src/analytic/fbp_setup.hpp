@@ -1,0 +1,37 @@
+// The host-side parts of FBP/FDK shared by both engines: repairing non-finite measurements,
+// cosine pre-weighting for divergent beams, the ramp-filter taps and the per-view weights.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "riner/array.hpp"
+#include "riner/fbp.hpp"
+#include "riner/geometry.hpp"
+
+namespace riner::analytic {
+
+// Replaces NaN/inf in every detector row of every view by linear interpolation between the
+// nearest finite neighbours (constant beyond the last one; 0 for a row with none). Returns the
+// number replaced.
+std::size_t repair_non_finite(Array& measurement, std::size_t n_u);
+
+// Multiplies fan/cone measurements by SDD / sqrt(SDD^2 + u^2 + v^2) (the cosine of the ray's
+// angle to the central ray); parallel beams are unchanged.
+void cosine_weight(Array& measurement, const Geometry& g);
+
+// Detector spacing the filter works in: the pitch, scaled to the isocentre for divergent beams.
+double filter_spacing(const Geometry& g);
+
+// Convolution taps h[k], k = -(n_u - 1) .. n_u - 1 stored at k + n_u - 1: the band-limited ramp
+// (Ram-Lak, Kak & Slaney eq. 3.61) times the window, designed on a zero-padded grid of
+// 2^ceil(log2(2 n_u)) so that linear convolution with them equals FFT filtering with padding.
+// Already multiplied by the spacing tau: filtered = sum_k taps[k] * p[j - k].
+std::vector<double> filter_taps(std::size_t n_u, double tau, FbpFilter filter);
+
+// Per-view backprojection weights: each view's share of the angular coverage (angles taken
+// modulo pi for parallel beams, 2 pi for divergent ones), times 1/2 for divergent beams, so
+// that sum(weights) = pi either way. Sets *short_scan when part of the period was never seen.
+std::vector<double> view_weights(const Geometry& g, bool* short_scan);
+
+}  // namespace riner::analytic

@@ -1,0 +1,108 @@
+#include "riner/rays.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace riner {
+
+namespace {
+
+// Offset of element index j from the detector centre, in mm.
+double element_offset(double j, std::size_t n, double offset, double pitch) {
+  return (j - 0.5 * static_cast<double>(n - 1) + offset) * pitch;
+}
+
+Vec3 normalised(Vec3 v) {
+  const double n = std::sqrt(v.x * v.x + v.y * v.y + v.z * v.z);
+  return {v.x / n, v.y / n, v.z / n};
+}
+
+// Slab test on one axis: intersects [enter, exit] with the t where |o + t d| <= half.
+void clip_axis(double o, double d, double half, Segment& s) {
+  if (d == 0.0) {
+    if (std::fabs(o) > half) s.exit = s.enter;  // parallel to the slab and outside it
+    return;
+  }
+  double t0 = (-half - o) / d;
+  double t1 = (half - o) / d;
+  if (t0 > t1) std::swap(t0, t1);
+  s.enter = std::max(s.enter, t0);
+  s.exit = std::min(s.exit, t1);
+}
+
+}  // namespace
+
+Vec3 detector_position(const Geometry& g, std::size_t view, double u, double v) {
+  const double c = std::cos(g.angles[view]);
+  const double s = std::sin(g.angles[view]);
+  const double a = element_offset(u, g.n_u, g.offset_u, g.pitch_u);
+  const double z = g.is_3d() ? element_offset(v, g.n_v, g.offset_v, g.pitch_v) : 0.0;
+  // R(theta) (a, b) = (a c - b s, a s + b c); the detector plane is at b = ODD (0 for parallel).
+  const double b = g.is_divergent() ? g.origin_detector_mm : 0.0;
+  return {a * c - b * s, a * s + b * c, z};
+}
+
+Ray detector_ray(const Geometry& g, std::size_t view, double u, double v) {
+  const double c = std::cos(g.angles[view]);
+  const double s = std::sin(g.angles[view]);
+  const Vec3 target = detector_position(g, view, u, v);
+  if (g.is_divergent()) {
+    const Vec3 source{g.source_origin_mm * s, -g.source_origin_mm * c, 0.0};
+    return {source, normalised({target.x - source.x, target.y - source.y, target.z - source.z})};
+  }
+  return {target, {-s, c, 0.0}};
+}
+
+Segment clip_to_box(const Geometry& g, const Ray& ray) {
+  const std::size_t rank = g.volume_shape.size();
+  const double nx = static_cast<double>(g.volume_shape[rank - 1]);
+  const double ny = static_cast<double>(g.volume_shape[rank - 2]);
+  Segment s{-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  clip_axis(ray.origin.x, ray.direction.x, 0.5 * nx * g.voxel_mm, s);
+  clip_axis(ray.origin.y, ray.direction.y, 0.5 * ny * g.voxel_mm, s);
+  if (g.is_3d()) {
+    clip_axis(ray.origin.z, ray.direction.z,
+              0.5 * static_cast<double>(g.volume_shape[0]) * g.voxel_mm, s);
+  }
+  if (s.empty()) return {};
+  return s;
+}
+
+Segment clip_to_cylinder(const Geometry& g, const Ray& ray) {
+  const std::size_t rank = g.volume_shape.size();
+  const double radius =
+      0.5 * g.voxel_mm *
+      static_cast<double>(std::min(g.volume_shape[rank - 1], g.volume_shape[rank - 2]));
+  // |o_xy + t d_xy|^2 = r^2
+  const double a = ray.direction.x * ray.direction.x + ray.direction.y * ray.direction.y;
+  const double b = ray.origin.x * ray.direction.x + ray.origin.y * ray.direction.y;
+  const double c = ray.origin.x * ray.origin.x + ray.origin.y * ray.origin.y - radius * radius;
+  Segment s;
+  if (a == 0.0) {
+    if (c > 0.0) return {};
+    s = {-std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity()};
+  } else {
+    const double disc = b * b - a * c;
+    if (disc <= 0.0) return {};
+    const double root = std::sqrt(disc);
+    s = {(-b - root) / a, (-b + root) / a};
+  }
+  if (g.is_3d()) {
+    clip_axis(ray.origin.z, ray.direction.z,
+              0.5 * static_cast<double>(g.volume_shape[0]) * g.voxel_mm, s);
+  }
+  if (s.empty()) return {};
+  return s;
+}
+
+Vec3 voxel_centre(const Geometry& g, double column, double row, double slice) {
+  const std::size_t rank = g.volume_shape.size();
+  const double nx = static_cast<double>(g.volume_shape[rank - 1]);
+  const double ny = static_cast<double>(g.volume_shape[rank - 2]);
+  const double nz = g.is_3d() ? static_cast<double>(g.volume_shape[0]) : 1.0;
+  return {(column - 0.5 * (nx - 1.0)) * g.voxel_mm, (0.5 * (ny - 1.0) - row) * g.voxel_mm,
+          g.is_3d() ? (slice - 0.5 * (nz - 1.0)) * g.voxel_mm : 0.0};
+}
+
+}  // namespace riner

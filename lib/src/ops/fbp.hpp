@@ -1,0 +1,37 @@
+// Host side of kernels/fbp.cl: ramp filtering by direct convolution, and the pixel-driven
+// weighted backprojection of FBP/FDK.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "cl/buffer.hpp"
+#include "cl/program.hpp"
+#include "ops/device_geometry.hpp"
+
+namespace riner::ops {
+
+class FbpOp {
+ public:
+  FbpOp(cl::Context& context, const Geometry& geometry, const std::vector<double>& taps,
+        const std::vector<double>& view_weights);
+
+  // out = in convolved with the taps along every detector row.
+  void filter(const cl::Buffer<float>& in, cl::Buffer<float>& out);
+  // volume = weighted backprojection of the filtered measurement.
+  void backproject(const cl::Buffer<float>& filtered, cl::Buffer<float>& volume);
+
+ private:
+  cl::Context& context_;
+  DeviceGeometry geometry_;
+  cl::Buffer<cl_float2> views_;
+  cl::Buffer<float> taps_;
+  cl::Buffer<float> view_weights_;
+  cl_uint n_samples_;
+  cl_uint n_voxels_;
+  std::shared_ptr<const cl::Program> program_;
+  cl::Kernel filter_;
+  cl::Kernel backproject_;
+};
+
+}  // namespace riner::ops

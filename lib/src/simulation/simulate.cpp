@@ -1,0 +1,160 @@
+#include "riner/simulate.hpp"
+
+#include <cmath>
+#include <numeric>
+
+#include "riner/error.hpp"
+#include "simulation/random.hpp"
+
+namespace riner {
+
+namespace {
+
+// Independent streams for responses and noise, both derived from the user's seed (splitmix64).
+std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t stream) {
+  std::uint64_t z = seed + stream * 0x9E3779B97F4A7C15ull;
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+// The first k entries of a uniformly random permutation of `pool` (partial Fisher-Yates).
+std::vector<std::size_t> choose(std::vector<std::size_t> pool, std::size_t k, sim::Random& rng) {
+  k = std::min(k, pool.size());
+  for (std::size_t i = 0; i < k; ++i) {
+    const std::size_t j = i + static_cast<std::size_t>(rng.below(pool.size() - i));
+    std::swap(pool[i], pool[j]);
+  }
+  pool.resize(k);
+  return pool;
+}
+
+std::vector<std::size_t> iota(std::size_t n) {
+  std::vector<std::size_t> v(n);
+  std::iota(v.begin(), v.end(), std::size_t{0});
+  return v;
+}
+
+}  // namespace
+
+void RingModel::validate() const {
+  if (!(nonideal_fraction >= 0.0 && nonideal_fraction <= 1.0)) {
+    throw InputError("the non-ideal fraction must be in [0, 1]");
+  }
+  if (!(alpha_min > 0.0) || !(alpha_max >= alpha_min) || !std::isfinite(alpha_max)) {
+    throw InputError("the response range must satisfy 0 < alpha_min <= alpha_max");
+  }
+  if (!(photons >= 0.0) || !std::isfinite(photons)) throw InputError("photons must be >= 0");
+}
+
+Array draw_responses(const Geometry& g, const RingModel& model) {
+  model.validate();
+  const std::size_t rows = g.is_3d() ? g.n_v : 1;
+  const std::size_t n = rows * g.n_u;
+  if (!g.is_3d() && (model.dead_rows > 0 || model.dead_columns > 0)) {
+    throw InputError("dead rows and columns need a 3D detector");
+  }
+  if (model.dead_rows > rows || model.dead_columns > g.n_u || model.dead_elements > n) {
+    throw InputError("more dead rows, columns or elements than the detector has");
+  }
+  sim::Random rng(stream_seed(model.seed, 1));
+  std::vector<char> dead(n, 0);
+  for (std::size_t r : choose(iota(rows), model.dead_rows, rng)) {
+    for (std::size_t u = 0; u < g.n_u; ++u) dead[r * g.n_u + u] = 1;
+  }
+  for (std::size_t u : choose(iota(g.n_u), model.dead_columns, rng)) {
+    for (std::size_t r = 0; r < rows; ++r) dead[r * g.n_u + u] = 1;
+  }
+  std::vector<std::size_t> live;
+  for (std::size_t e = 0; e < n; ++e) {
+    if (!dead[e]) live.push_back(e);
+  }
+  for (std::size_t e : choose(live, model.dead_elements, rng)) dead[e] = 1;
+  live.clear();
+  for (std::size_t e = 0; e < n; ++e) {
+    if (!dead[e]) live.push_back(e);
+  }
+  Array alpha(g.is_3d() ? std::vector<std::size_t>{rows, g.n_u} : std::vector<std::size_t>{g.n_u},
+              1.0f);
+  for (std::size_t e = 0; e < n; ++e) {
+    if (dead[e]) alpha.data[e] = 0.0f;
+  }
+  const auto nonideal = static_cast<std::size_t>(std::llround(model.nonideal_fraction * n));
+  for (std::size_t e : choose(live, nonideal, rng)) {
+    alpha.data[e] =
+        static_cast<float>(model.alpha_min + (model.alpha_max - model.alpha_min) * rng.uniform());
+  }
+  return alpha;
+}
+
+Array corrupt_measurement(const Array& clean, const Array& alpha, const RingModel& model) {
+  model.validate();
+  if (alpha.size() == 0 || clean.size() % alpha.size() != 0) {
+    throw InputError("the response map does not match the measurement's detector");
+  }
+  sim::Random rng(stream_seed(model.seed, 2));
+  Array out(clean.shape);
+  const std::size_t per_view = alpha.size();
+  for (std::size_t r = 0; r < clean.size(); ++r) {
+    const double p = clean.data[r];
+    if (!std::isfinite(p)) throw InputError("clean projections must be finite");
+    const double a = alpha.data[r % per_view];
+    double rho;
+    if (model.photons == 0.0) {
+      rho = a > 0.0 ? p - std::log(a) : INFINITY;
+    } else {
+      const std::uint64_t counts = rng.poisson(a * model.photons * std::exp(-p));
+      rho = counts > 0 ? -std::log(static_cast<double>(counts) / model.photons) : INFINITY;
+    }
+    out.data[r] = static_cast<float>(rho);
+  }
+  return out;
+}
+
+SimulatedScan simulate(const Array& ground_truth, const Projector& projector,
+                       const RingModel& model) {
+  SimulatedScan sim;
+  sim.ground_truth = ground_truth;
+  sim.clean = projector.project(ground_truth);
+  sim.alpha = draw_responses(projector.geometry(), model);
+  sim.scan.geometry = projector.geometry();
+  sim.scan.measurement = corrupt_measurement(sim.clean, sim.alpha, model);
+  sim.scan.non_finite = compute_stats(sim.scan.measurement).non_finite();
+  return sim;
+}
+
+bool is_preset_geometry(std::string_view name) {
+  return name == "fan2d-paper" || name == "cone3d-paper";
+}
+
+Geometry preset_geometry(std::string_view name) {
+  Geometry g;
+  UniformAngles angles{360, 0.0, 2.0 * M_PI};
+  if (name == "fan2d-paper") {
+    g.type = GeometryType::kFan2d;
+    g.n_u = 500;
+    g.pitch_u = 2.0;
+    g.source_origin_mm = 370.0;
+    g.origin_detector_mm = 370.0;
+    g.volume_shape = {256, 256};
+  } else if (name == "cone3d-paper") {
+    g.type = GeometryType::kCone3d;
+    g.n_u = 300;
+    g.n_v = 200;
+    g.pitch_u = 2.0;
+    g.pitch_v = 2.0;
+    g.source_origin_mm = 300.0;
+    g.origin_detector_mm = 300.0;
+    g.volume_shape = {100, 256, 256};
+  } else {
+    throw InputError("unknown preset geometry \"" + std::string(name) +
+                     "\" (presets: fan2d-paper, cone3d-paper)");
+  }
+  g.voxel_mm = 1.0;
+  g.uniform_angles = angles;
+  g.angles = uniform_angles(angles);
+  g.validate();
+  return g;
+}
+
+}  // namespace riner

@@ -1,0 +1,130 @@
+// The riner executable end to end: exit codes, one-line errors, outputs that read back.
+#include <doctest/doctest.h>
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "riner/io.hpp"
+#include "support/fixture.hpp"
+
+namespace {
+
+struct Run {
+  int code = -1;
+  std::string out;  // stdout
+  std::string err;  // stderr
+};
+
+Run riner_cli(const std::string& arguments, const riner::test::TempDir& dir) {
+  const std::string err_file = (dir / "stderr.txt").string();
+  const std::string command = std::string(RINER_CLI_PATH) + " " + arguments + " 2>" + err_file;
+  Run run;
+  FILE* pipe = popen(command.c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  std::array<char, 4096> buffer;
+  std::size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.out.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  run.err = riner::test::read_bytes(err_file);
+  return run;
+}
+
+void expect_error(const Run& run, int code, const std::string& message) {
+  CAPTURE(run.err);
+  CHECK(run.code == code);
+  CHECK(run.err.find("riner: error: " + message) != std::string::npos);
+  // One line.
+  CHECK(std::count(run.err.begin(), run.err.end(), '\n') == 1);
+}
+
+}  // namespace
+
+TEST_SUITE("cli") {
+  TEST_CASE("usage errors exit 2 with a pointer to --help") {
+    riner::test::TempDir dir;
+    CHECK(riner_cli("--version", dir).code == 0);
+    CHECK(riner_cli("", dir).code == 2);
+    expect_error(riner_cli("frobnicate", dir), 2,
+                 "unknown command 'frobnicate' (see riner --help)");
+    expect_error(riner_cli("info", dir), 2, "missing FILE (see riner info --help)");
+    expect_error(riner_cli("simulate --seed x --out " + dir.path().string(), dir), 2,
+                 "--seed expects an integer, got 'x'");
+    expect_error(riner_cli("fbp a.npy --out b.nii --filter box", dir), 2, "a.npy: no such file");
+    const Run help = riner_cli("fbp --help", dir);
+    CHECK(help.code == 0);
+    CHECK(help.out.find("usage: riner fbp SCAN") == 0);
+  }
+
+  TEST_CASE("simulate -> fbp -> compare, with JSON summaries") {
+    riner::test::TempDir dir;
+    const std::string out = (dir / "sim").string();
+    Run sim = riner_cli("simulate --out " + out + " --seed 5 --json", dir);
+    REQUIRE(sim.code == 0);
+    const auto summary = nlohmann::json::parse(sim.out);
+    CHECK(summary["dead_elements"].size() == 2);
+    CHECK(summary["non_finite_measurements"] == 720);
+    for (const char* f : {"sino.npy", "sino_clean.npy", "alpha.npy", "ground_truth.nii",
+                          "geometry.json", "simulation.json", "sino.png", "ground_truth.png"}) {
+      CHECK(std::filesystem::exists(std::filesystem::path(out) / f));
+    }
+    REQUIRE(riner_cli("fbp " + out + "/sino_clean.npy --geometry " + out + "/geometry.json --out " +
+                          out + "/fbp.nii --png --quiet",
+                      dir)
+                .code == 0);
+    CHECK(std::filesystem::exists(std::filesystem::path(out) / "fbp.png"));
+    const Run compare =
+        riner_cli("compare " + out + "/fbp.nii " + out + "/ground_truth.nii --json", dir);
+    REQUIRE(compare.code == 0);
+    CHECK(nlohmann::json::parse(compare.out)["psnr_db"].get<double>() > 30.0);
+    // Same seed, same scan, bit for bit.
+    REQUIRE(riner_cli("simulate --quiet --seed 5 --out " + out + "2", dir).code == 0);
+    CHECK(riner::test::read_bytes(out + "/sino.npy") ==
+          riner::test::read_bytes(out + "2/sino.npy"));
+  }
+
+  TEST_CASE("bad inputs: mismatched geometry, overwriting an input, missing device") {
+    riner::test::TempDir dir;
+    const std::string out = (dir / "sim").string();
+    REQUIRE(riner_cli("simulate --quiet --out " + out, dir).code == 0);
+    riner::test::write_bytes(dir / "small.json", R"({"type": "fan2d",
+      "detector": {"count": 400, "pitch_mm": 2.0}, "source_origin_mm": 370, "origin_detector_mm": 370,
+      "angles": {"count": 360, "range_rad": 6.283185307179586}, "volume": {"shape": [256, 256], "voxel_mm": 1.0}})");
+    expect_error(riner_cli("fbp " + out + "/sino.npy --geometry " + (dir / "small.json").string() +
+                               " --out " + out + "/x.nii",
+                           dir),
+                 2,
+                 out + "/sino.npy has shape [360, 500] but the fan2d geometry expects [360, 400]");
+    expect_error(riner_cli("fbp " + out + "/sino.npy --out " + out + "/sino.npy", dir), 2,
+                 out + "/sino.npy: refusing to overwrite an input file");
+    expect_error(riner_cli("fbp " + out + "/sino.npy --out " + out + "/x.nii --device 99", dir), 1,
+                 "--device=99: no such device");
+    expect_error(riner_cli("fbp " + out + "/sino.npy --out " + out + "/x.dcm", dir), 2,
+                 out + "/x.dcm: unknown file type '.dcm'");
+    expect_error(riner_cli("compare " + out + "/sino.npy " + out + "/ground_truth.nii", dir), 2,
+                 "cannot compare images of shapes [360, 500] and [256, 256]");
+    expect_error(riner_cli("simulate --phantom " + out + "/sino.npy --out " + out + "/again", dir),
+                 2, out + "/sino.npy has shape [360, 500] but the geometry's grid is [256, 256]");
+  }
+
+  TEST_CASE("simulate from an image in 1/cm, on the reference engine") {
+    riner::test::TempDir dir;
+    riner::Array image({256, 256}, 0.2f);  // water in 1/cm
+    riner::write_array(dir / "water.nii", image);
+    const std::string out = (dir / "w").string();
+    REQUIRE(riner_cli("simulate --quiet --phantom " + (dir / "water.nii").string() +
+                          " --mu-unit cm --engine reference --photons 0 --dead 0 "
+                          "--nonideal-fraction 0 --out " +
+                          out,
+                      dir)
+                .code == 0);
+    const riner::Array clean = riner::read_array(out + "/sino_clean.npy").array;
+    const riner::Array sino = riner::read_array(out + "/sino.npy").array;
+    CHECK(clean.data == sino.data);  // no noise, ideal detector
+    // The central ray crosses 256 mm of 0.02 / mm.
+    CHECK(clean(0, 249) == doctest::Approx(256 * 0.02).epsilon(0.01));
+  }
+}

@@ -1,0 +1,103 @@
+// The host-side pieces of FBP: taps, view weights, cosine weights, non-finite repair.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <complex>
+#include <numeric>
+#include <unsupported/Eigen/FFT>
+
+#include "analytic/fbp_setup.hpp"
+#include "support/geometries.hpp"
+
+namespace {
+
+// Frequency response of the taps (already times tau) at frequency f cycles/sample.
+double response(const std::vector<double>& taps, double f) {
+  const long n = static_cast<long>(taps.size() + 1) / 2;
+  double sum = 0.0;
+  for (long k = -(n - 1); k <= n - 1; ++k)
+    sum += taps[static_cast<std::size_t>(k + n - 1)] * std::cos(2 * M_PI * f * k);
+  return sum;
+}
+
+}  // namespace
+
+TEST_SUITE("fbp_setup") {
+  TEST_CASE("Ram-Lak taps: Kak & Slaney values and a ramp response") {
+    const double tau = 0.5;
+    const auto taps = riner::analytic::filter_taps(64, tau, riner::FbpFilter::kRamLak);
+    REQUIRE(taps.size() == 127);
+    CHECK(taps[63] == doctest::Approx(1.0 / (4.0 * tau)));
+    CHECK(taps[64] == doctest::Approx(-1.0 / (M_PI * M_PI * tau)));
+    CHECK(taps[65] == doctest::Approx(0.0));
+    CHECK(taps[62] == taps[64]);
+    // The band-limited ramp: response |f| / tau (per mm units), within truncation error.
+    for (double f : {0.1, 0.25, 0.4})
+      CHECK(response(taps, f) == doctest::Approx(f / tau).epsilon(0.02));
+    CHECK(std::fabs(response(taps, 0.0)) < 0.01 / tau);
+  }
+
+  TEST_CASE("windows shape the ramp: Shepp-Logan sinc, Hann to zero at Nyquist") {
+    const auto ramlak = riner::analytic::filter_taps(128, 1.0, riner::FbpFilter::kRamLak);
+    const auto shepp = riner::analytic::filter_taps(128, 1.0, riner::FbpFilter::kSheppLogan);
+    const auto hann = riner::analytic::filter_taps(128, 1.0, riner::FbpFilter::kHann);
+    const double f = 0.3;
+    CHECK(response(shepp, f) ==
+          doctest::Approx(response(ramlak, f) * std::sin(M_PI * f) / (M_PI * f)).epsilon(0.01));
+    CHECK(response(hann, f) ==
+          doctest::Approx(response(ramlak, f) * 0.5 * (1 + std::cos(2 * M_PI * f))).epsilon(0.01));
+    CHECK(std::fabs(response(hann, 0.5)) < 0.01);
+  }
+
+  TEST_CASE("view weights cover pi, whatever the angle list") {
+    bool short_scan = true;
+    // Fan beam, 360 views over [0, 2 pi): each view 2 pi / 360 / 2.
+    auto fan = riner::test::make_geometry(riner::GeometryType::kFan2d, 360, 8, 1, {8, 8}, 1.0, 1.0);
+    auto w = riner::analytic::view_weights(fan, &short_scan);
+    CHECK_FALSE(short_scan);
+    for (double x : w) CHECK(x == doctest::Approx(M_PI / 360.0));
+    // Parallel beam over 0..180 degrees inclusive (like the tooth scan): the first and last
+    // views see the same lines and share one step.
+    auto par =
+        riner::test::make_geometry(riner::GeometryType::kParallel2d, 181, 8, 1, {8, 8}, 1.0, 1.0);
+    par.angles.clear();
+    for (int i = 0; i <= 180; ++i) par.angles.push_back(i * M_PI / 180.0);
+    w = riner::analytic::view_weights(par, &short_scan);
+    CHECK(std::accumulate(w.begin(), w.end(), 0.0) == doctest::Approx(M_PI));
+    CHECK(w[0] + w[180] == doctest::Approx(M_PI / 180.0));
+    CHECK(w[90] == doctest::Approx(M_PI / 180.0));
+    CHECK_FALSE(short_scan);
+    // A 360 degree parallel scan counts every line twice: half weights.
+    par.angles.clear();
+    for (int i = 0; i < 100; ++i) par.angles.push_back(i * 2 * M_PI / 100.0);
+    w = riner::analytic::view_weights(par, &short_scan);
+    CHECK(w[17] == doctest::Approx(M_PI / 100.0));
+    // Unsorted, irregular angles: still a partition of the period.
+    fan.angles = {3.0, 0.5, 5.9, 1.0, 2.0};
+    w = riner::analytic::view_weights(fan, &short_scan);
+    CHECK(std::accumulate(w.begin(), w.end(), 0.0) == doctest::Approx(M_PI));
+    CHECK(w[1] == doctest::Approx(0.5 * 0.5 * (0.5 + (0.5 + 2 * M_PI - 5.9))));
+    // A fan scan over half a turn is flagged.
+    fan.angles.clear();
+    for (int i = 0; i < 90; ++i) fan.angles.push_back(i * M_PI / 90.0);
+    riner::analytic::view_weights(fan, &short_scan);
+    CHECK(short_scan);
+  }
+
+  TEST_CASE("non-finite repair: interpolated inside, constant at the ends, zero for empty rows") {
+    riner::Array m({3, 5}, std::vector<float>{1, NAN, NAN, 4, 5,               //
+                                              INFINITY, 2, 3, -INFINITY, NAN,  //
+                                              NAN, NAN, NAN, NAN, NAN});
+    CHECK(riner::analytic::repair_non_finite(m, 5) == 10);
+    CHECK(m.data == std::vector<float>{1, 2, 3, 4, 5, 2, 2, 3, 3, 3, 0, 0, 0, 0, 0});
+  }
+
+  TEST_CASE("cosine weights: 1 on the central ray, SDD / distance elsewhere") {
+    auto fan = riner::test::make_geometry(riner::GeometryType::kFan2d, 1, 3, 1, {8, 8}, 10.0, 1.0);
+    riner::Array m({1, 3}, 1.0f);
+    riner::analytic::cosine_weight(m, fan);
+    const double sdd = fan.source_origin_mm + fan.origin_detector_mm;
+    CHECK(m.data[1] == doctest::Approx(1.0));
+    CHECK(m.data[0] == doctest::Approx(sdd / std::sqrt(sdd * sdd + 100.0)));
+  }
+}

@@ -1,0 +1,64 @@
+// PSNR/SSIM against scikit-image's values on committed fixtures
+// (test/fixtures/make_metrics_fixtures.py), plus properties.
+#include <doctest/doctest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "riner/error.hpp"
+#include "riner/io.hpp"
+#include "riner/metrics.hpp"
+#include "support/fixture.hpp"
+
+namespace {
+const std::filesystem::path kFixtures =
+    std::filesystem::path(RINER_SOURCE_DIR) / "test/fixtures/metrics";
+}
+
+TEST_SUITE("metrics") {
+  TEST_CASE("PSNR and SSIM match scikit-image to 1e-4 (2D square, 2D odd rectangle, 3D)") {
+    const auto expected = nlohmann::json::parse(riner::read_text(kFixtures / "expected.json"));
+    for (const auto& c : expected["cases"]) {
+      const std::string name = c["name"];
+      CAPTURE(name);
+      const riner::Array image = riner::read_array(kFixtures / (name + "_image.npy")).array;
+      const riner::Array reference = riner::read_array(kFixtures / (name + "_reference.npy")).array;
+      const riner::ImageMetrics m = riner::compare_images(image, reference);
+      // scikit-image takes max - min in float32; riner in double.
+      CHECK(m.data_range == doctest::Approx(c["data_range"].get<double>()).epsilon(1e-6));
+      CHECK(std::fabs(m.psnr - c["psnr"].get<double>()) < 1e-4);
+      CHECK(std::fabs(m.ssim - c["ssim"].get<double>()) < 1e-4);
+    }
+  }
+
+  TEST_CASE("identical images: infinite PSNR, SSIM 1, zero errors") {
+    riner::Array a({16, 16});
+    for (std::size_t i = 0; i < a.size(); ++i) a.data[i] = static_cast<float>(i % 7);
+    const riner::ImageMetrics m = riner::compare_images(a, a);
+    CHECK(std::isinf(m.psnr));
+    CHECK(m.ssim == doctest::Approx(1.0));
+    CHECK(m.mae == 0.0);
+  }
+
+  TEST_CASE("masks restrict every metric") {
+    riner::Array ref({20, 20}, 1.0f);
+    riner::Array img = ref;
+    img(0, 0) = 100.0f;  // a corner pixel, outside the inscribed circle
+    const riner::Array mask = riner::circle_mask(ref.shape);
+    CHECK(mask(0, 0) == 0.0f);
+    CHECK(mask(10, 10) == 1.0f);
+    const riner::ImageMetrics inside = riner::compare_images(img, ref, &mask, 1.0);
+    CHECK(inside.mae == 0.0);
+    const riner::ImageMetrics all = riner::compare_images(img, ref, nullptr, 1.0);
+    CHECK(all.mae == doctest::Approx(99.0 / 400.0));
+  }
+
+  TEST_CASE("bad inputs are InputErrors") {
+    CHECK_THROWS_AS(riner::compare_images(riner::Array({8, 8}), riner::Array({8, 9})),
+                    riner::InputError);
+    riner::Array nan_image({8, 8}, 0.0f);
+    nan_image.data[3] = NAN;
+    CHECK_THROWS_AS(riner::compare_images(nan_image, riner::Array({8, 8})), riner::InputError);
+    CHECK_THROWS_AS(riner::compare_images(riner::Array({4, 4}), riner::Array({4, 4})),
+                    riner::InputError);
+  }
+}
