@@ -18,8 +18,8 @@ function(riner_embed_kernels target)
       COMMENT "Embedding kernel ${stem}.cl"
       VERBATIM)
     target_sources(${target} PRIVATE ${out})
-    string(APPEND declarations "extern const char ${stem}_cl[];\nextern const std::size_t ${stem}_cl_size;\n")
-    string(APPEND entries "    {\"${stem}\", std::string_view(${stem}_cl, ${stem}_cl_size)},\n")
+    string(APPEND declarations "extern const unsigned char ${stem}_cl[];\nextern const std::size_t ${stem}_cl_size;\n")
+    string(APPEND entries "    {\"${stem}\", std::string_view(reinterpret_cast<const char*>(${stem}_cl), ${stem}_cl_size)},\n")
   endforeach()
   set(registry ${gen_dir}/kernel_registry.cpp)
   file(CONFIGURE OUTPUT ${registry} CONTENT

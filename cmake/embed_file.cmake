@@ -11,9 +11,9 @@ file(WRITE "${OUTPUT}.tmp"
   "// Generated from ${INPUT} by cmake/embed_file.cmake; do not edit.\n"
   "#include <cstddef>\n"
   "namespace ${NAMESPACE} {\n"
-  "extern const char ${SYMBOL}[];\n"
+  "extern const unsigned char ${SYMBOL}[];\n"
   "extern const std::size_t ${SYMBOL}_size;\n"
-  "const char ${SYMBOL}[] = {\n${bytes}0x00};\n"
+  "const unsigned char ${SYMBOL}[] = {\n${bytes}0x00};\n"
   "const std::size_t ${SYMBOL}_size = ${size};\n"
   "}  // namespace ${NAMESPACE}\n")
 file(RENAME "${OUTPUT}.tmp" "${OUTPUT}")

@@ -19,6 +19,7 @@ struct Command {
 };
 
 constexpr Command kCommands[] = {
+    {"reconstruct", riner::app::run_reconstruct, "remove ring artifacts: train Riner on a scan"},
     {"devices", riner::app::run_devices, "list OpenCL devices and their capabilities"},
     {"info", riner::app::run_info, "describe an array file or a geometry file"},
     {"simulate", riner::app::run_simulate, "simulate a ring-corrupted scan (paper protocol)"},

@@ -1,0 +1,129 @@
+// riner reconstruct: Riner on a scan: the image, the detector's response and mask, the loss.
+#include <cstdio>
+#include <fstream>
+
+#include "cli_common.hpp"
+#include "commands.hpp"
+#include "detector_outputs.hpp"
+#include "progress.hpp"
+#include "riner/error.hpp"
+#include "riner/io.hpp"
+#include "riner/reconstructor.hpp"
+#include "riner/scan.hpp"
+
+namespace riner::app {
+
+namespace {
+
+RinerConfig config_from(const Args& args) {
+  RinerConfig config;
+  if (const std::string file = args.get("config"); !file.empty()) {
+    config.update_from_json(read_text(file), file);
+  }
+  // Flags override the file.
+  if (auto v = args.maybe("steps"); v && !v->empty()) config.training.steps = static_cast<int>(args.integer("steps"));
+  if (auto v = args.maybe("seed"); v && !v->empty()) config.training.seed = static_cast<std::uint64_t>(args.integer("seed"));
+  if (auto v = args.maybe("rays-per-step"); v && !v->empty()) {
+    config.training.rays_per_step = static_cast<int>(args.integer("rays-per-step"));
+  }
+  if (auto v = args.maybe("lr"); v && !v->empty()) config.training.learning_rate = args.number("lr");
+  if (args.is_set("paper")) config = RinerConfig::paper();
+  config.engine = engine_from(args);
+  config.validate();
+  return config;
+}
+
+void write_history(const std::filesystem::path& path, const std::vector<LossRecord>& history) {
+  std::string csv = "step,data_loss,penalty,learning_rate\n";
+  char line[128];
+  for (const LossRecord& r : history) {
+    std::snprintf(line, sizeof(line), "%d,%.9g,%.9g,%.6g\n", r.step, r.data_loss, r.penalty, r.learning_rate);
+    csv += line;
+  }
+  write_text(path, csv);
+}
+
+}  // namespace
+
+int run_reconstruct(int argc, char** argv, int first) {
+  Args args("reconstruct",
+            "Removes ring artifacts: trains Riner's neural field of the image together with each "
+            "detector element's response alpha and validity beta, then writes the image "
+            "(image.<format>, image.png), alpha.npy, beta.npy, detector.png, loss.csv, "
+            "config.json and summary.json into the output folder.");
+  args.positional("SCAN", "the measurement (rho = -ln(I/I0)): .npy, .nii, .tif, .raw")
+      .option("geometry", "FILE", "geometry JSON (default: geometry.json beside SCAN)", "")
+      .option("out", "DIR", "output folder (created if missing)")
+      .option("format", "EXT", "image format: nii, npy, tif or raw", "nii")
+      .option("config", "FILE", "settings JSON ({\"training\": {\"steps\": 4000}, ...})", "")
+      .option("steps", "N", "training steps", "")
+      .option("seed", "N", "random seed", "")
+      .option("rays-per-step", "N", "rays per training step", "")
+      .option("lr", "RATE", "initial learning rate", "")
+      .option("offset-px", "PX", "override the detector's centre-of-rotation offset", "")
+      .option("report-every", "N", "steps between progress reports", "200")
+      .flag("paper", "use the paper's settings (L=10, T=2^10, F=8, width 128, 4000 steps, ...)");
+  add_engine_flags(args);
+  args.output_flags();
+  if (!args.parse(argc, argv, first)) return 0;
+  Console console(args);
+  Scan scan = load_scan(args.get("SCAN"), args.get("geometry"));
+  if (auto v = args.maybe("offset-px"); v && !v->empty()) scan.geometry.offset_u = args.number("offset-px");
+  const RinerConfig config = config_from(args);
+  const std::string format = args.get("format");
+  if (format != "nii" && format != "npy" && format != "tif" && format != "raw") {
+    throw UsageError("--format must be nii, npy, tif or raw");
+  }
+  const std::filesystem::path out = make_output_dir(args.get("out"));
+  if (scan.non_finite > 0) {
+    console.line(std::to_string(scan.non_finite) + " measurements are NaN/inf (dead elements?): they count as 0 "
+                 "and their elements' beta learns to switch them off");
+  }
+
+  Reconstructor reconstructor(std::move(scan), config, device_from(args, config.engine));
+  {
+    Progress progress("reconstruct", static_cast<std::size_t>(config.training.steps), console.quiet());
+    reconstructor.run(
+        [&](const TrainingProgress& p) {
+          char status[64];
+          std::snprintf(status, sizeof(status), "loss %.4g", p.loss);
+          progress.update(static_cast<std::size_t>(p.step), status);
+          return true;
+        },
+        static_cast<int>(args.integer("report-every")));
+    progress.finish();
+  }
+
+  const Geometry& g = reconstructor.scan().geometry;
+  const Array image = reconstructor.image();
+  const std::filesystem::path image_path = out / ("image." + format);
+  write_array(image_path, image, {std::vector<double>(image.rank(), g.voxel_mm)});
+  write_png(out / "image.png", image);
+  const std::vector<std::size_t> dead =
+      write_detector_outputs(out, reconstructor.alpha(), reconstructor.beta());
+  write_history(out / "loss.csv", reconstructor.history());
+  write_text(out / "config.json", config.to_json());
+
+  const TrainingStats stats = reconstructor.stats();
+  nlohmann::json summary = {{"image", image_path.string()},
+                            {"shape", image.shape},
+                            {"steps", stats.steps},
+                            {"seconds", stats.seconds},
+                            {"samples", stats.samples},
+                            {"samples_per_second", stats.seconds > 0 ? stats.samples / stats.seconds : 0.0},
+                            {"parameters", stats.parameters},
+                            {"non_finite_measurements", stats.non_finite},
+                            {"dead_elements", dead},
+                            {"engine", stats.engine},
+                            {"device", stats.device},
+                            {"gradient_mode", stats.gradient_mode},
+                            {"final_loss", reconstructor.history().empty() ? 0.0 : reconstructor.history().back().data_loss}};
+  write_text(out / "summary.json", summary.dump(1) + "\n");
+  console.line("reconstructed " + shape_string(image.shape) + " in " + format_duration(stats.seconds) + " (" +
+               std::to_string(stats.steps) + " steps, " + std::to_string(dead.size()) +
+               " elements flagged dead) -> " + out.string());
+  console.summary(summary);
+  return 0;
+}
+
+}  // namespace riner::app

@@ -1,0 +1,51 @@
+#include "detector_outputs.hpp"
+
+#include <algorithm>
+
+#include "riner/io.hpp"
+#include "riner/plot.hpp"
+
+namespace riner::app {
+
+std::vector<std::size_t> write_detector_outputs(const std::filesystem::path& dir, const Array& alpha,
+                                                const Array& beta) {
+  write_array(dir / "alpha.npy", alpha);
+  write_array(dir / "beta.npy", beta);
+  std::vector<std::size_t> dead;
+  for (std::size_t e = 0; e < beta.size(); ++e) {
+    if (beta.data[e] < 0.5f) dead.push_back(e);
+  }
+  if (alpha.rank() == 1) {
+    LinePlot plot;
+    plot.title = "estimated detector response alpha (blue) and mask beta (orange)";
+    plot.x_label = "element";
+    plot.y_label = "";
+    PlotSeries a{"alpha", {}, {}, {31, 119, 180}, false};
+    PlotSeries b{"beta", {}, {}, {255, 127, 14}, false};
+    for (std::size_t e = 0; e < alpha.size(); ++e) {
+      a.x.push_back(static_cast<double>(e));
+      a.y.push_back(std::min(alpha.data[e], 3.0f));  // a wild alpha must not flatten the plot
+      b.x.push_back(static_cast<double>(e));
+      b.y.push_back(beta.data[e]);
+    }
+    plot.series = {a, b};
+    plot.horizontal_lines = {{0.5, "dead below 0.5"}};
+    write_plot_png(dir / "detector.png", plot);
+  } else {
+    // 3D: the two maps side by side, each windowed on its own.
+    const std::size_t rows = alpha.shape[0];
+    const std::size_t cols = alpha.shape[1];
+    Array both({rows, 2 * cols + 4}, 0.0f);
+    const Window wa = percentile_window(alpha);
+    for (std::size_t r = 0; r < rows; ++r) {
+      for (std::size_t c = 0; c < cols; ++c) {
+        both(r, c) = (alpha(r, c) - wa.lo) / (wa.hi - wa.lo);
+        both(r, cols + 4 + c) = beta(r, c);
+      }
+    }
+    write_png(dir / "detector.png", both, Window{0.0f, 1.0f});
+  }
+  return dead;
+}
+
+}  // namespace riner::app

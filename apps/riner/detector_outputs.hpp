@@ -1,0 +1,17 @@
+// Writing what a reconstruction learnt about the detector: alpha and beta arrays, a plot (2D)
+// or maps (3D), and the list of elements flagged dead.
+#pragma once
+
+#include <filesystem>
+#include <vector>
+
+#include "riner/array.hpp"
+
+namespace riner::app {
+
+// alpha.npy, beta.npy and detector.png (both against element index; in 3D, alpha and beta maps
+// side by side) in dir. Returns the elements with beta < 0.5.
+std::vector<std::size_t> write_detector_outputs(const std::filesystem::path& dir, const Array& alpha,
+                                                const Array& beta);
+
+}  // namespace riner::app

@@ -1,0 +1,128 @@
+// hash_grid.cl: the multiresolution grid encoding (instant-NGP) and its gradient.
+//   Helpers: hash_grid_encode(levels, table, pos, out), hash_grid_scatter(levels, grad, pos, d_out)
+//   hash_grid_forward(n, levels, table, positions, features)
+//     one work-item per point; features [n][N_LEVELS * N_FEATURES]
+//   hash_grid_backward(n, levels, positions, d_features, grad)
+//     one work-item per point, scattering into grad with GRAD_ADD (compile with
+//     -D ATOMIC_GRADIENTS when several work-items share grad)
+// -D DIMS (2 or 3), N_LEVELS, N_FEATURES, TABLE_SIZE (entries of a hashed level).
+// Level l maps a normalised position x in [0, 1]^DIMS to x * scale + 0.5 grid units and
+// interpolates (bi/trilinearly) the features of the surrounding vertices: dense levels index
+// vertex (c0, c1, c2) at c0 + res (c1 + res c2), hashed levels at
+// (c0 ^ c1 * 2654435761 ^ c2 * 805459861) mod TABLE_SIZE. Feature f of index i of level l is
+// table[levels[l].offset + i * N_FEATURES + f]. Host mirror: lib/src/model/parameter_layout.hpp.
+// Needs common.cl.
+
+#ifndef DIMS
+#error "DIMS must be defined"
+#endif
+#ifndef N_LEVELS
+#error "N_LEVELS must be defined"
+#endif
+#ifndef N_FEATURES
+#error "N_FEATURES must be defined"
+#endif
+#ifndef TABLE_SIZE
+#error "TABLE_SIZE must be defined"
+#endif
+
+#define N_CORNERS (1 << DIMS)
+#define N_ENCODED (N_LEVELS * N_FEATURES)
+
+typedef struct {
+  float scale;
+  uint resolution;
+  uint offset;
+  uint hashed;
+} GridLevel;
+
+// The cell a position falls in at one level, and its position inside the cell.
+inline void hash_grid_cell(__constant const GridLevel* level, const float* pos, uint* cell, float* frac) {
+  for (int d = 0; d < DIMS; ++d) {
+    const float x = clamp(pos[d], 0.0f, 1.0f) * level->scale + 0.5f;
+    const float f = floor(x);
+    cell[d] = (uint)f;
+    frac[d] = x - f;
+  }
+}
+
+// Parameter index (feature 0) and interpolation weight of one corner of the cell.
+inline uint hash_grid_corner(__constant const GridLevel* level, const uint* cell, const float* frac,
+                             int corner, float* weight) {
+  uint coords[DIMS];
+  float w = 1.0f;
+  for (int d = 0; d < DIMS; ++d) {
+    const uint upper = (corner >> d) & 1;
+    coords[d] = cell[d] + upper;
+    w *= upper ? frac[d] : 1.0f - frac[d];
+  }
+  *weight = w;
+  uint index;
+  if (level->hashed) {
+    index = coords[0] ^ (coords[1] * 2654435761u);
+#if DIMS == 3
+    index ^= coords[2] * 805459861u;
+#endif
+    index %= TABLE_SIZE;
+  } else {
+    index = coords[0] + coords[1] * level->resolution;
+#if DIMS == 3
+    index += coords[2] * level->resolution * level->resolution;
+#endif
+  }
+  return level->offset + index * N_FEATURES;
+}
+
+inline void hash_grid_encode(__constant const GridLevel* levels, __global const float* table,
+                             const float* pos, float* out) {
+  for (int l = 0; l < N_LEVELS; ++l) {
+    uint cell[DIMS];
+    float frac[DIMS];
+    hash_grid_cell(&levels[l], pos, cell, frac);
+    float acc[N_FEATURES];
+    for (int f = 0; f < N_FEATURES; ++f) acc[f] = 0.0f;
+    for (int c = 0; c < N_CORNERS; ++c) {
+      float w;
+      const uint index = hash_grid_corner(&levels[l], cell, frac, c, &w);
+      for (int f = 0; f < N_FEATURES; ++f) acc[f] += w * table[index + f];
+    }
+    for (int f = 0; f < N_FEATURES; ++f) out[l * N_FEATURES + f] = acc[f];
+  }
+}
+
+inline void hash_grid_scatter(__constant const GridLevel* levels, __global float* grad, const float* pos,
+                              const float* d_out) {
+  for (int l = 0; l < N_LEVELS; ++l) {
+    uint cell[DIMS];
+    float frac[DIMS];
+    hash_grid_cell(&levels[l], pos, cell, frac);
+    for (int c = 0; c < N_CORNERS; ++c) {
+      float w;
+      const uint index = hash_grid_corner(&levels[l], cell, frac, c, &w);
+      for (int f = 0; f < N_FEATURES; ++f) GRAD_ADD(&grad[index + f], w * d_out[l * N_FEATURES + f]);
+    }
+  }
+}
+
+__kernel void hash_grid_forward(const uint n, __constant const GridLevel* levels, __global const float* table,
+                                __global const float* positions, __global float* features) {
+  const uint i = get_global_id(0);
+  if (i >= n) return;
+  float pos[DIMS];
+  for (int d = 0; d < DIMS; ++d) pos[d] = positions[i * DIMS + d];
+  float out[N_ENCODED];
+  hash_grid_encode(levels, table, pos, out);
+  for (int k = 0; k < N_ENCODED; ++k) features[i * N_ENCODED + k] = out[k];
+}
+
+__kernel void hash_grid_backward(const uint n, __constant const GridLevel* levels,
+                                 __global const float* positions, __global const float* d_features,
+                                 __global float* grad) {
+  const uint i = get_global_id(0);
+  if (i >= n) return;
+  float pos[DIMS];
+  for (int d = 0; d < DIMS; ++d) pos[d] = positions[i * DIMS + d];
+  float d_out[N_ENCODED];
+  for (int k = 0; k < N_ENCODED; ++k) d_out[k] = d_features[i * N_ENCODED + k];
+  hash_grid_scatter(levels, grad, pos, d_out);
+}

@@ -1,0 +1,79 @@
+// Riner: a ring-artifact-free image from a scan, by training an implicit neural representation
+// of the image together with each detector element's response alpha and validity mask beta
+// (METHOD.md §1-2). The CLI's `riner reconstruct` is a thin client of this class.
+//
+//   riner::Reconstructor r(scan, config);   // builds kernels, uploads the scan
+//   r.run([](const riner::TrainingProgress& p) { ...; return true; });
+//   riner::Array image = r.image();        // mu (1/mm) on the geometry's grid
+//   riner::Array alpha = r.alpha();        // estimated response per detector element
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "riner/array.hpp"
+#include "riner/device.hpp"
+#include "riner/riner_config.hpp"
+#include "riner/scan.hpp"
+
+namespace riner {
+
+struct LossRecord {
+  int step = 0;             // 0-based
+  double data_loss = 0.0;   // the L1 data term of the step's batch
+  double penalty = 0.0;     // lambda * sum(-beta^2) over the batch's elements
+  double learning_rate = 0.0;
+};
+
+struct TrainingProgress {
+  int step = 0;   // steps done
+  int total = 0;  // steps planned
+  double loss = 0.0;
+  double seconds = 0.0;
+};
+
+// Return false to stop training early.
+using ProgressCallback = std::function<bool(const TrainingProgress&)>;
+
+struct TrainingStats {
+  int steps = 0;
+  double seconds = 0.0;             // wall time inside step()/run()
+  double samples = 0.0;             // field evaluations trained on (forward + backward)
+  std::size_t non_finite = 0;       // measurements that were NaN/inf (treated as 0)
+  std::size_t parameters = 0;
+  std::string engine;
+  std::string device;               // device name, or "CPU reference"
+  std::string gradient_mode;        // "partitioned" (per-lane partial gradients) or "atomic"
+};
+
+class Reconstructor {
+ public:
+  // The OpenCL engine runs on `device` (default Device::open()). Throws InputError for a scan
+  // or configuration that cannot work (see RinerConfig::validate, check_scan).
+  Reconstructor(Scan scan, RinerConfig config, std::optional<Device> device = std::nullopt);
+  ~Reconstructor();
+  Reconstructor(Reconstructor&&) noexcept;
+  Reconstructor& operator=(Reconstructor&&) noexcept;
+
+  // n more training steps.
+  void step(int n = 1);
+  // Trains until config.training.steps, calling back every `report_every` steps and at the end.
+  void run(const ProgressCallback& callback = {}, int report_every = 50);
+
+  int steps_done() const;
+  Array image() const;  // the field at every voxel centre, mu in 1/mm
+  Array alpha() const;  // max(alpha0, 1e-8) per element: [n_u] in 2D, [n_v, n_u] in 3D
+  Array beta() const;   // sigmoid(beta0) per element; < 0.5 marks an element as dead
+  std::vector<LossRecord> history() const;
+  TrainingStats stats() const;
+  const RinerConfig& config() const;
+  const Scan& scan() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace riner

@@ -1,0 +1,106 @@
+// Settings of a Riner reconstruction (METHOD.md §2): the hash-grid encoding, the MLP, the
+// forward model and the training schedule. Defaults are the measured best trade-off of run time
+// against error (bench/RESULTS.md); the paper's values are reachable through the same fields.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "riner/engine.hpp"
+
+namespace riner {
+
+// Multiresolution grid (instant-NGP): level l has scale base_resolution * b^l - 1 with b chosen
+// so that the last level reaches finest_resolution; a level is dense while it fits in
+// 2^log2_table_size entries and spatially hashed above that.
+struct EncodingConfig {
+  int levels = 8;
+  int features = 2;  // per level
+  int log2_table_size = 18;
+  int base_resolution = 16;
+  int finest_resolution = 256;
+};
+
+// input (levels * features) -> [width, ReLU] x hidden_layers -> 1, linear output.
+struct NetworkConfig {
+  int width = 16;  // a multiple of 16 (the kernels hold hidden layers in float16 vectors)
+  int hidden_layers = 1;
+};
+
+// How the data term weighs the batch's rays. Element mean: each detector element's term is the
+// mean |residual| of its rays in the batch, so the balance against the -lambda beta^2 term does
+// not depend on batch size or sampler; mean: the mean over all rays (the authors' earlier code);
+// sum: the sum over rays (the paper's formula).
+enum class DataTerm { kElementMean, kMean, kSum };
+
+enum class Sampler {
+  kViewsTimesElements,  // the paper's: random views x a run of adjacent random elements
+  kUniform,             // rays drawn uniformly over (view, element)
+  kMixed,               // both in one batch: uniform rays for the image, a views x elements
+                        // block that shows a few elements from many views for alpha and beta
+};
+
+struct TrainingConfig {
+  int steps = 12000;
+  Sampler sampler = Sampler::kUniform;
+  int rays_per_step = 80;        // uniform sampler
+  int views_per_step = 40;       // views x elements sampler
+  int elements_per_step = 2;     // views x elements sampler: adjacent elements
+  double sample_spacing = 1.0;   // along each ray, in voxels (the paper's fixed interval)
+  bool jitter = false;           // stratified random offsets while training (midpoints if off)
+  bool circle_region = false;    // sample the inscribed circle instead of the whole grid
+  double learning_rate = 1e-3;
+  int lr_decay_steps = 3000;     // the rate is multiplied by lr_decay every this many steps
+  double lr_decay = 0.5;
+  double adam_beta1 = 0.9;
+  double adam_beta2 = 0.99;
+  double adam_epsilon = 1e-15;
+  double lambda = 0.01;          // weight of the -beta^2 term
+  // alpha0 and beta0 learn at learning_rate times these scales, and stay at their initial
+  // values for their first warm-up steps (beta: while the image is still far off every
+  // element's residual is large, and beta would switch live elements off).
+  double alpha_lr_scale = 1.0;
+  double beta_lr_scale = 3.0;
+  int alpha_warmup_steps = 0;
+  int beta_warmup_steps = 0;
+  // Coarse to fine: when > 0, level l >= 1 of the encoding fades in over steps
+  // [(l - 1) k, l k] with k = level_warmup_steps (its features are scaled by 0 .. 1), so the
+  // image can hold fine structure, rings included, only after alpha has had time to explain
+  // the per-element offsets.
+  int level_warmup_steps = 0;
+  // Ring prior: weight of the squared view-averaged curvature of the model's projections across
+  // adjacent elements of the views x elements block (kernels/riner_step.cl). Needs the
+  // views-x-elements or mixed sampler with elements_per_step >= 3; 0 turns it off.
+  double ring_lambda = 0.0;
+  DataTerm data_term = DataTerm::kElementMean;
+  // Multiplies the data term. With the element mean, an element is pushed towards beta = 0 when
+  // the mean |residual| of its rays exceeds 2 lambda beta / data_weight: 0.1 at the default
+  // 0.2, above what alpha errors leave on live elements, below a dead element's.
+  double data_weight = 0.2;
+  std::uint64_t seed = 0;
+};
+
+struct RinerConfig {
+  EncodingConfig encoding;
+  NetworkConfig network;
+  TrainingConfig training;
+  Engine engine = Engine::kOpenCL;
+
+  // InputError naming the first impossible setting.
+  void validate() const;
+
+  // Reads the settings a JSON object names ({"encoding": {"levels": 10}, "training": {...}});
+  // missing keys keep their current values, unknown keys are an InputError.
+  void update_from_json(std::string_view json_text, std::string_view source = "config");
+  std::string to_json() const;
+
+  // The paper's settings: L=10, T=2^10, F=8, N_min=2, b=2, width 128, 80 rays per step
+  // (40 views x 2 elements), lr 1e-3 halved every 1000 steps, 4000 steps, summed data term.
+  static RinerConfig paper();
+};
+
+const char* sampler_name(Sampler sampler);
+const char* data_term_name(DataTerm term);
+
+}  // namespace riner

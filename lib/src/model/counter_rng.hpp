@@ -1,0 +1,31 @@
+// Counter-based random numbers: the same draws on the host and in kernels/common.cl, so the
+// OpenCL and reference engines see identical batches, jitter and initial weights.
+#pragma once
+
+#include <cstdint>
+
+namespace riner::model {
+
+// A 32-bit integer hash with good avalanche (Chris Wellons' "lowbias32").
+constexpr std::uint32_t hash32(std::uint32_t x) {
+  x ^= x >> 16;
+  x *= 0x7feb352du;
+  x ^= x >> 15;
+  x *= 0x846ca68bu;
+  x ^= x >> 16;
+  return x;
+}
+
+// Hash of a tuple of keys.
+constexpr std::uint32_t hash_keys(std::uint32_t a, std::uint32_t b, std::uint32_t c = 0,
+                                  std::uint32_t d = 0) {
+  return hash32(d ^ hash32(c ^ hash32(b ^ hash32(a))));
+}
+
+// Uniform in [0, 1) with 24 bits: exactly representable in float on both sides.
+constexpr float uniform24(std::uint32_t h) { return static_cast<float>(h >> 8) * (1.0f / 16777216.0f); }
+
+// Streams keyed in hash_keys' first slot.
+enum Stream : std::uint32_t { kInitStream = 1, kBatchStream = 2, kJitterStream = 3 };
+
+}  // namespace riner::model

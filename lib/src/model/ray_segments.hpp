@@ -1,0 +1,46 @@
+// Where each detector ray crosses the reconstruction region, and how it is sampled there
+// (METHOD.md §2: points at a fixed interval, only inside the region). Computed once per scan on
+// the host in double and stored in float, so both engines sample exactly the same points.
+//
+// Coordinates are normalised to the encoding's domain: the cube (square in 2D) of side
+// `extent` = the grid's largest side, centred on the origin, mapped to [0, 1]^d.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "riner/geometry.hpp"
+
+namespace riner::model {
+
+// Host mirror of the float8 a kernel reads per ray.
+struct RaySegment {
+  float start[3];  // normalised position where the sampled part begins
+  float step[3];   // normalised advance per sample
+  float dx;        // mm per sample: the ray sum is sum(mu) * dx
+  std::uint32_t count;  // samples (0: the ray misses the region)
+};
+static_assert(sizeof(RaySegment) == 32);
+
+struct SamplingDomain {
+  double extent_mm = 1.0;  // side of the normalised cube
+  int dims = 2;
+};
+
+SamplingDomain sampling_domain(const Geometry& g);
+
+// spacing_mm: the nominal interval; each ray's own interval is its length / ceil(length /
+// spacing) so the samples tile it exactly. circle: clip to the inscribed circle/cylinder
+// instead of the box.
+std::vector<RaySegment> ray_segments(const Geometry& g, double spacing_mm, bool circle);
+
+// Sample k of a segment at fractional offset u in [0, 1) within its interval (0.5: midpoint).
+inline void sample_position(const RaySegment& s, std::uint32_t k, float u, float out[3]) {
+  const float t = static_cast<float>(k) + u;
+  for (int d = 0; d < 3; ++d) out[d] = s.start[d] + t * s.step[d];
+}
+
+// Normalised coordinates of voxel centres, [n][dims], in the grid's C order.
+std::vector<float> voxel_positions(const Geometry& g);
+
+}  // namespace riner::model

@@ -1,0 +1,17 @@
+// The -D options that specialise the model kernels (hash_grid.cl, mlp.cl, riner_step.cl) for
+// one parameter layout, and the upload of its level table.
+#pragma once
+
+#include <string>
+
+#include "cl/buffer.hpp"
+#include "model/parameter_layout.hpp"
+
+namespace riner::ops {
+
+// "-D DIMS=2 -D N_LEVELS=8 ..."; atomic adds -D ATOMIC_GRADIENTS.
+std::string model_build_options(const model::ParameterLayout& layout, bool atomic_gradients);
+
+cl::Buffer<model::GridLevel> upload_levels(cl::Context& context, const model::ParameterLayout& layout);
+
+}  // namespace riner::ops

@@ -1,0 +1,149 @@
+#include "reference/riner_step_ref.hpp"
+
+#include "model/counter_rng.hpp"
+#include "reference/hash_grid_ref.hpp"
+#include "reference/mlp_ref.hpp"
+#include "reference/ray_sum_ref.hpp"
+#include "util/parallel.hpp"
+
+namespace riner::ref {
+
+float sample_jitter(std::uint32_t seed, std::uint32_t step, std::uint32_t ray, std::uint32_t k) {
+  return model::uniform24(model::hash32(k ^ model::hash_keys(model::kJitterStream, seed, step, ray)));
+}
+
+void scale_levels(const model::ParameterLayout& l, const std::vector<float>& level_weights, double* values) {
+  if (level_weights.empty()) return;
+  for (int level = 0; level < l.levels; ++level) {
+    for (int f = 0; f < l.features; ++f) values[level * l.features + f] *= level_weights[static_cast<std::size_t>(level)];
+  }
+}
+
+StepResult riner_step(const StepInputs& in, const model::Batch& batch, const std::vector<double>& params,
+                      bool with_gradient) {
+  const model::ParameterLayout& l = *in.layout;
+  const std::size_t n = batch.rays.size();
+  auto position = [&](std::uint32_t ray, std::uint32_t k, double pos[3]) {
+    const float u = in.jitter ? sample_jitter(in.seed, in.step, ray, k) : 0.5f;
+    float p[3];
+    model::sample_position((*in.segments)[ray], k, u, p);
+    for (int d = 0; d < 3; ++d) pos[d] = p[d];
+  };
+  // Forward: every ray's sum of mu dx (threads own disjoint rays).
+  std::vector<double> sums(n, 0.0);
+  util::parallel_for(n, [&](std::size_t begin, std::size_t end) {
+    std::vector<double> features(static_cast<std::size_t>(l.inputs));
+    for (std::size_t b = begin; b < end; ++b) {
+      const std::uint32_t ray = batch.rays[b];
+      const model::RaySegment& s = (*in.segments)[ray];
+      double sum = 0.0;
+      for (std::uint32_t k = 0; k < s.count; ++k) {
+        double pos[3];
+        position(ray, k, pos);
+        hash_grid_encode(l, params.data(), pos, features.data());
+        scale_levels(l, in.level_weights, features.data());
+        sum += mlp_forward(l, params.data(), features.data());
+      }
+      sums[b] = sum * s.dx;
+    }
+  });
+
+  // Loss, in batch order like the kernel.
+  StepResult result;
+  if (with_gradient) result.grad.assign(l.total, 0.0);
+  std::vector<double> d_sums(n, 0.0);
+  for (std::size_t b = 0; b < n; ++b) {
+    const std::uint32_t ray = batch.rays[b];
+    const std::size_t e = ray % in.elements_per_view;
+    const RayLoss rl = ray_loss(sums[b], params[l.alpha_offset + e], params[l.beta_offset + e],
+                                (*in.measurement)[ray], batch.weights[b]);
+    result.data_loss += rl.loss;
+    d_sums[b] = rl.d_sum;
+    if (with_gradient) {
+      result.grad[l.alpha_offset + e] += rl.d_alpha0;
+      result.grad[l.beta_offset + e] += rl.d_beta0;
+    }
+  }
+  for (std::uint32_t e : batch.elements) {
+    double d_beta0 = 0.0;
+    result.penalty += beta_penalty(params[l.beta_offset + e], in.lambda, &d_beta0);
+    if (with_gradient) result.grad[l.beta_offset + e] += d_beta0;
+  }
+  result.penalty += ring_prior(batch, sums, in.ring_lambda, &d_sums);
+  if (!with_gradient) return result;
+
+  // Backward: threads own contiguous rays and their own gradients, summed in order.
+  std::vector<std::vector<double>> partials =
+      util::parallel_map_chunks(n, [&](std::size_t begin, std::size_t end) {
+        std::vector<double> grad(l.total, 0.0);
+        std::vector<double> features(static_cast<std::size_t>(l.inputs));
+        std::vector<double> d_features(static_cast<std::size_t>(l.inputs));
+        for (std::size_t b = begin; b < end; ++b) {
+          const std::uint32_t ray = batch.rays[b];
+          const model::RaySegment& s = (*in.segments)[ray];
+          const double d_mu = d_sums[b] * s.dx;
+          if (d_mu == 0.0) continue;
+          for (std::uint32_t k = 0; k < s.count; ++k) {
+            double pos[3];
+            position(ray, k, pos);
+            hash_grid_encode(l, params.data(), pos, features.data());
+            scale_levels(l, in.level_weights, features.data());
+            MlpTrace trace;
+            mlp_forward(l, params.data(), features.data(), &trace);
+            mlp_backward(l, params.data(), features.data(), trace, d_mu, grad.data(), d_features.data());
+            scale_levels(l, in.level_weights, d_features.data());
+            hash_grid_scatter(l, pos, d_features.data(), grad.data());
+          }
+        }
+        return grad;
+      });
+  for (const std::vector<double>& g : partials) {
+    for (std::size_t i = 0; i < l.total; ++i) result.grad[i] += g[i];
+  }
+  return result;
+}
+
+double ring_prior(const model::Batch& batch, const std::vector<double>& sums, double ring_lambda,
+                  std::vector<double>* d_sums) {
+  const std::uint32_t V = batch.block_views;
+  const std::uint32_t E = batch.block_elements;
+  if (ring_lambda <= 0.0 || V == 0 || E < 3) return 0.0;
+  double penalty = 0.0;
+  for (std::uint32_t e = 1; e + 1 < E; ++e) {
+    double r = 0.0;
+    for (std::uint32_t v = 0; v < V; ++v) {
+      const std::size_t base = batch.block_first + static_cast<std::size_t>(v) * E;
+      r += sums[base + e - 1] - 2.0 * sums[base + e] + sums[base + e + 1];
+    }
+    r /= V;
+    penalty += ring_lambda * r * r;
+    if (d_sums == nullptr) continue;
+    const double g = 2.0 * ring_lambda * r / V;
+    for (std::uint32_t v = 0; v < V; ++v) {
+      const std::size_t base = batch.block_first + static_cast<std::size_t>(v) * E;
+      (*d_sums)[base + e - 1] += g;
+      (*d_sums)[base + e] -= 2.0 * g;
+      (*d_sums)[base + e + 1] += g;
+    }
+  }
+  return penalty;
+}
+
+std::vector<float> field_evaluate(const model::ParameterLayout& l, const std::vector<double>& params,
+                                  const std::vector<float>& positions, const std::vector<float>& level_weights) {
+  const std::size_t n = positions.size() / static_cast<std::size_t>(l.dims);
+  std::vector<float> out(n);
+  util::parallel_for(n, [&](std::size_t begin, std::size_t end) {
+    std::vector<double> features(static_cast<std::size_t>(l.inputs));
+    for (std::size_t i = begin; i < end; ++i) {
+      double pos[3] = {0, 0, 0};
+      for (int d = 0; d < l.dims; ++d) pos[d] = positions[i * l.dims + d];
+      hash_grid_encode(l, params.data(), pos, features.data());
+      scale_levels(l, level_weights, features.data());
+      out[i] = static_cast<float>(mlp_forward(l, params.data(), features.data()));
+    }
+  });
+  return out;
+}
+
+}  // namespace riner::ref

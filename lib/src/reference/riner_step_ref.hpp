@@ -1,0 +1,52 @@
+// CPU twin of kernels/riner_step.cl: the loss of one batch of rays and its gradient over every
+// parameter (grid, MLP, alpha0, beta0), in double. The reference engine trains with it; the
+// OpenCL step is checked against it, and it against finite differences.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "model/batch_sampler.hpp"
+#include "model/parameter_layout.hpp"
+#include "model/ray_segments.hpp"
+
+namespace riner::ref {
+
+struct StepInputs {
+  const model::ParameterLayout* layout = nullptr;
+  const std::vector<model::RaySegment>* segments = nullptr;
+  const std::vector<float>* measurement = nullptr;  // rho per ray id
+  std::size_t elements_per_view = 0;                // n_u * n_v
+  bool jitter = true;
+  std::uint32_t seed = 0;
+  std::uint32_t step = 0;
+  double lambda = 0.01;
+  double ring_lambda = 0.0;
+  std::vector<float> level_weights;  // per encoding level (empty: all 1)
+};
+
+struct StepResult {
+  double data_loss = 0.0;
+  double penalty = 0.0;
+  std::vector<double> grad;  // over the whole parameter buffer
+};
+
+StepResult riner_step(const StepInputs& in, const model::Batch& batch, const std::vector<double>& params,
+                      bool with_gradient = true);
+
+// The ring prior of kernels/riner_step.cl on the batch's views x elements block: returns its
+// value and adds its gradient with respect to the ray sums into d_sums (when not null).
+double ring_prior(const model::Batch& batch, const std::vector<double>& sums, double ring_lambda,
+                  std::vector<double>* d_sums);
+
+// Jitter of sample k of a ray at a step, shared with the kernels (model/counter_rng.hpp).
+float sample_jitter(std::uint32_t seed, std::uint32_t step, std::uint32_t ray, std::uint32_t k);
+
+// mu at normalised positions [n][dims] (evaluation of the trained field).
+std::vector<float> field_evaluate(const model::ParameterLayout& l, const std::vector<double>& params,
+                                  const std::vector<float>& positions, const std::vector<float>& level_weights);
+
+// Multiplies level l's values by level_weights[l] (no-op when empty).
+void scale_levels(const model::ParameterLayout& l, const std::vector<float>& level_weights, double* values);
+
+}  // namespace riner::ref

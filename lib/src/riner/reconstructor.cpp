@@ -1,0 +1,122 @@
+#include "riner/reconstructor.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include "riner/error.hpp"
+#include "riner/trainer.hpp"
+
+namespace riner {
+
+struct Reconstructor::Impl {
+  detail::TrainingSetup setup;
+  model::BatchSampler sampler;
+  std::unique_ptr<detail::Trainer> trainer;
+  int steps = 0;
+  double seconds = 0.0;
+  double samples = 0.0;
+  std::vector<LossRecord> history;
+
+  Impl(Scan scan, RinerConfig config)
+      : setup(std::move(scan), std::move(config)), sampler(setup.scan.geometry, setup.config.training) {}
+
+  void drain() {
+    for (LossRecord& r : trainer->drain_losses()) {
+      if (!std::isfinite(r.data_loss)) {
+        throw Error("training diverged at step " + std::to_string(r.step) +
+                    " (the loss is not finite); try a smaller learning rate");
+      }
+      history.push_back(r);
+    }
+  }
+};
+
+Reconstructor::Reconstructor(Scan scan, RinerConfig config, std::optional<Device> device)
+    : impl_(std::make_unique<Impl>(std::move(scan), std::move(config))) {
+  if (impl_->setup.config.engine == Engine::kReference) {
+    impl_->trainer = detail::make_reference_trainer(impl_->setup);
+  } else {
+    impl_->trainer = detail::make_opencl_trainer(impl_->setup, device ? *device : Device::open());
+  }
+}
+
+Reconstructor::~Reconstructor() = default;
+Reconstructor::Reconstructor(Reconstructor&&) noexcept = default;
+Reconstructor& Reconstructor::operator=(Reconstructor&&) noexcept = default;
+
+void Reconstructor::step(int n) {
+  const auto start = std::chrono::steady_clock::now();
+  for (int i = 0; i < n; ++i) {
+    const int index = impl_->steps;
+    const model::Batch batch = impl_->sampler.batch(static_cast<std::uint32_t>(index));
+    for (std::uint32_t r : batch.rays) impl_->samples += impl_->setup.segments[r].count;
+    impl_->trainer->step(index, batch);
+    ++impl_->steps;
+  }
+  impl_->seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void Reconstructor::run(const ProgressCallback& callback, int report_every) {
+  const int total = impl_->setup.config.training.steps;
+  report_every = std::max(1, report_every);
+  while (impl_->steps < total) {
+    step(std::min(report_every, total - impl_->steps));
+    impl_->drain();  // also the divergence check, once per block
+    if (callback) {
+      const double loss = impl_->history.empty() ? 0.0 : impl_->history.back().data_loss;
+      if (!callback({impl_->steps, total, loss, impl_->seconds})) break;
+    }
+  }
+}
+
+int Reconstructor::steps_done() const { return impl_->steps; }
+
+Array Reconstructor::image() const {
+  const Geometry& g = impl_->setup.scan.geometry;
+  Array out(g.volume_shape);
+  out.data = impl_->trainer->evaluate_grid();
+  return out;
+}
+
+Array Reconstructor::alpha() const {
+  const model::ParameterLayout& l = impl_->setup.layout;
+  const std::vector<float> p = impl_->trainer->parameters();
+  const Geometry& g = impl_->setup.scan.geometry;
+  Array out(g.is_3d() ? std::vector<std::size_t>{g.n_v, g.n_u} : std::vector<std::size_t>{g.n_u});
+  for (std::size_t e = 0; e < l.elements; ++e) out.data[e] = std::max(p[l.alpha_offset + e], 1e-8f);
+  return out;
+}
+
+Array Reconstructor::beta() const {
+  const model::ParameterLayout& l = impl_->setup.layout;
+  const std::vector<float> p = impl_->trainer->parameters();
+  const Geometry& g = impl_->setup.scan.geometry;
+  Array out(g.is_3d() ? std::vector<std::size_t>{g.n_v, g.n_u} : std::vector<std::size_t>{g.n_u});
+  for (std::size_t e = 0; e < l.elements; ++e) {
+    out.data[e] = 1.0f / (1.0f + std::exp(-p[l.beta_offset + e]));
+  }
+  return out;
+}
+
+std::vector<LossRecord> Reconstructor::history() const {
+  impl_->drain();
+  return impl_->history;
+}
+
+TrainingStats Reconstructor::stats() const {
+  TrainingStats s;
+  s.steps = impl_->steps;
+  s.seconds = impl_->seconds;
+  s.samples = impl_->samples;
+  s.non_finite = impl_->setup.scan.non_finite;
+  s.parameters = impl_->setup.layout.total;
+  s.engine = engine_name(impl_->setup.config.engine);
+  s.device = impl_->trainer->device_name();
+  s.gradient_mode = impl_->trainer->gradient_mode();
+  return s;
+}
+
+const RinerConfig& Reconstructor::config() const { return impl_->setup.config; }
+const Scan& Reconstructor::scan() const { return impl_->setup.scan; }
+
+}  // namespace riner

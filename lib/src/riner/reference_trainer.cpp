@@ -1,0 +1,72 @@
+// The reference engine: the whole step in double on the CPU (reference/riner_step_ref.cpp).
+#include "reference/adam_ref.hpp"
+#include "reference/riner_step_ref.hpp"
+#include "riner/trainer.hpp"
+
+namespace riner::detail {
+
+namespace {
+
+class ReferenceTrainer final : public Trainer {
+ public:
+  explicit ReferenceTrainer(const TrainingSetup& setup) : setup_(setup) {
+    const std::vector<float> init = model::initial_parameters(setup.layout, setup.config.training.seed);
+    params_.assign(init.begin(), init.end());
+    m_.assign(params_.size(), 0.0);
+    v_.assign(params_.size(), 0.0);
+    inputs_.layout = &setup_.layout;
+    inputs_.segments = &setup_.segments;
+    inputs_.measurement = &setup_.scan.measurement.data;
+    inputs_.elements_per_view = setup_.elements_per_view;
+    inputs_.jitter = setup_.config.training.jitter;
+    inputs_.seed = setup_.seed;
+    inputs_.lambda = setup_.config.training.lambda;
+    inputs_.ring_lambda = setup_.config.training.ring_lambda;
+  }
+
+  void step(int index, const model::Batch& batch) override {
+    inputs_.step = static_cast<std::uint32_t>(index);
+    inputs_.level_weights = setup_.level_weights(index);
+    const ref::StepResult r = ref::riner_step(inputs_, batch, params_);
+    const TrainingConfig& t = setup_.config.training;
+    const AdamRates rates = setup_.adam_rates(index);
+    ref::adam_step({rates.field, setup_.layout.alpha_offset, rates.alpha, setup_.layout.beta_offset, rates.beta,
+                    t.adam_beta1, t.adam_beta2, t.adam_epsilon},
+                   index + 1, r.grad, params_, m_, v_);
+    losses_.push_back({index, r.data_loss, r.penalty, rates.field});
+    steps_ = index + 1;
+  }
+
+  std::vector<LossRecord> drain_losses() override {
+    std::vector<LossRecord> out;
+    out.swap(losses_);
+    return out;
+  }
+
+  std::vector<float> parameters() override { return {params_.begin(), params_.end()}; }
+
+  std::vector<float> evaluate_grid() override {
+    return ref::field_evaluate(setup_.layout, params_, model::voxel_positions(setup_.scan.geometry),
+                               setup_.level_weights(steps_));
+  }
+
+  std::string device_name() const override { return "CPU reference"; }
+  std::string gradient_mode() const override { return "partitioned"; }
+
+ private:
+  const TrainingSetup& setup_;
+  ref::StepInputs inputs_;
+  std::vector<double> params_;
+  std::vector<double> m_;
+  std::vector<double> v_;
+  std::vector<LossRecord> losses_;
+  int steps_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<Trainer> make_reference_trainer(const TrainingSetup& setup) {
+  return std::make_unique<ReferenceTrainer>(setup);
+}
+
+}  // namespace riner::detail

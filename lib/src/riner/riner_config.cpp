@@ -1,0 +1,254 @@
+#include "riner/riner_config.hpp"
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "riner/error.hpp"
+
+namespace riner {
+
+namespace {
+
+using nlohmann::json;
+
+void require(bool ok, const std::string& message) {
+  if (!ok) throw InputError("config: " + message);
+}
+
+// Copies obj[key] into value when present, checking its type; unknown keys are rejected by
+// the caller's key list.
+template <typename T>
+void read(const json& obj, const char* section, const char* key, T& value) {
+  if (!obj.contains(key)) return;
+  const json& v = obj.at(key);
+  const std::string name = std::string(section) + "." + key;
+  if constexpr (std::is_same_v<T, bool>) {
+    require(v.is_boolean(), name + " must be true or false");
+    value = v.get<bool>();
+  } else if constexpr (std::is_integral_v<T>) {
+    require(v.is_number_integer(), name + " must be an integer");
+    value = v.get<T>();
+  } else {
+    require(v.is_number(), name + " must be a number");
+    value = v.get<T>();
+  }
+}
+
+void check_keys(const json& obj, const char* section, std::initializer_list<const char*> keys) {
+  require(obj.is_object(), std::string(section) + " must be an object");
+  for (const auto& [key, _] : obj.items()) {
+    bool known = false;
+    for (const char* k : keys) known = known || key == k;
+    require(known, "unknown setting " + std::string(section) + "." + key);
+  }
+}
+
+}  // namespace
+
+const char* data_term_name(DataTerm t) {
+  switch (t) {
+    case DataTerm::kElementMean: return "element-mean";
+    case DataTerm::kMean: return "mean";
+    case DataTerm::kSum: return "sum";
+  }
+  return "unknown";
+}
+
+const char* sampler_name(Sampler s) {
+  switch (s) {
+    case Sampler::kUniform: return "uniform";
+    case Sampler::kViewsTimesElements: return "views-x-elements";
+    case Sampler::kMixed: return "mixed";
+  }
+  return "unknown";
+}
+
+void RinerConfig::validate() const {
+  const EncodingConfig& e = encoding;
+  require(e.levels >= 1 && e.levels <= 32, "encoding.levels must be in 1..32");
+  require(e.features >= 1 && e.features <= 8, "encoding.features must be in 1..8");
+  require(e.log2_table_size >= 4 && e.log2_table_size <= 26, "encoding.log2_table_size must be in 4..26");
+  require(e.base_resolution >= 2 && e.base_resolution <= 65536, "encoding.base_resolution must be in 2..65536");
+  require(e.finest_resolution >= e.base_resolution && e.finest_resolution <= 1 << 20,
+          "encoding.finest_resolution must be >= base_resolution and <= 2^20");
+  require(network.width >= 16 && network.width <= 256 && network.width % 16 == 0,
+          "network.width must be a multiple of 16 in 16..256");
+  require(network.hidden_layers >= 1 && network.hidden_layers <= 4, "network.hidden_layers must be in 1..4");
+  const TrainingConfig& t = training;
+  require(t.steps >= 0 && t.steps <= 10000000, "training.steps must be in 0..10^7");
+  require(t.rays_per_step >= 1 && t.rays_per_step <= 1 << 20, "training.rays_per_step must be in 1..2^20");
+  require(t.views_per_step >= 1 && t.views_per_step <= 1 << 16, "training.views_per_step must be in 1..65536");
+  require(t.elements_per_step >= 1 && t.elements_per_step <= 1 << 16,
+          "training.elements_per_step must be in 1..65536");
+  require(t.sample_spacing > 0.01 && t.sample_spacing <= 100.0, "training.sample_spacing must be in (0.01, 100] voxels");
+  require(t.learning_rate > 0.0 && t.learning_rate < 10.0 && std::isfinite(t.learning_rate),
+          "training.learning_rate must be in (0, 10)");
+  require(t.lr_decay_steps >= 1, "training.lr_decay_steps must be >= 1");
+  require(t.lr_decay > 0.0 && t.lr_decay <= 1.0, "training.lr_decay must be in (0, 1]");
+  require(t.adam_beta1 >= 0.0 && t.adam_beta1 < 1.0, "training.adam_beta1 must be in [0, 1)");
+  require(t.adam_beta2 >= 0.0 && t.adam_beta2 < 1.0, "training.adam_beta2 must be in [0, 1)");
+  require(t.adam_epsilon > 0.0 && t.adam_epsilon < 1.0, "training.adam_epsilon must be in (0, 1)");
+  require(t.lambda >= 0.0 && t.lambda < 1e6 && std::isfinite(t.lambda), "training.lambda must be >= 0");
+  require(t.alpha_lr_scale >= 0.0 && t.alpha_lr_scale < 1e3, "training.alpha_lr_scale must be in [0, 1000)");
+  require(t.beta_lr_scale >= 0.0 && t.beta_lr_scale < 1e3, "training.beta_lr_scale must be in [0, 1000)");
+  require(t.alpha_warmup_steps >= 0, "training.alpha_warmup_steps must be >= 0");
+  require(t.beta_warmup_steps >= 0, "training.beta_warmup_steps must be >= 0");
+  require(t.level_warmup_steps >= 0, "training.level_warmup_steps must be >= 0");
+  require(t.ring_lambda >= 0.0 && t.ring_lambda < 1e9 && std::isfinite(t.ring_lambda),
+          "training.ring_lambda must be >= 0");
+  require(t.ring_lambda == 0.0 || (t.sampler != Sampler::kUniform && t.elements_per_step >= 3),
+          "training.ring_lambda needs the views-x-elements or mixed sampler with elements_per_step >= 3");
+  require(t.data_weight > 0.0 && t.data_weight < 1e6 && std::isfinite(t.data_weight),
+          "training.data_weight must be > 0");
+}
+
+void RinerConfig::update_from_json(std::string_view text, std::string_view source) {
+  json root;
+  try {
+    root = json::parse(text);
+  } catch (const json::exception& e) {
+    throw InputError(std::string(source) + ": invalid JSON: " + e.what());
+  }
+  try {
+    check_keys(root, "config", {"encoding", "network", "training", "engine"});
+    if (root.contains("encoding")) {
+      const json& e = root["encoding"];
+      check_keys(e, "encoding", {"levels", "features", "log2_table_size", "base_resolution", "finest_resolution"});
+      read(e, "encoding", "levels", encoding.levels);
+      read(e, "encoding", "features", encoding.features);
+      read(e, "encoding", "log2_table_size", encoding.log2_table_size);
+      read(e, "encoding", "base_resolution", encoding.base_resolution);
+      read(e, "encoding", "finest_resolution", encoding.finest_resolution);
+    }
+    if (root.contains("network")) {
+      const json& n = root["network"];
+      check_keys(n, "network", {"width", "hidden_layers"});
+      read(n, "network", "width", network.width);
+      read(n, "network", "hidden_layers", network.hidden_layers);
+    }
+    if (root.contains("training")) {
+      const json& t = root["training"];
+      check_keys(t, "training",
+                 {"steps", "sampler", "rays_per_step", "views_per_step", "elements_per_step", "sample_spacing",
+                  "jitter", "circle_region", "learning_rate", "lr_decay_steps", "lr_decay", "adam_beta1",
+                  "adam_beta2", "adam_epsilon", "lambda", "alpha_lr_scale", "beta_lr_scale", "alpha_warmup_steps", "beta_warmup_steps", "level_warmup_steps", "ring_lambda",
+                  "data_term", "data_weight", "seed"});
+      read(t, "training", "steps", training.steps);
+      if (t.contains("sampler")) {
+        require(t["sampler"].is_string(), "training.sampler must be a string");
+        const std::string s = t["sampler"];
+        bool known = false;
+        for (Sampler option : {Sampler::kUniform, Sampler::kViewsTimesElements, Sampler::kMixed}) {
+          if (s == sampler_name(option)) {
+            training.sampler = option;
+            known = true;
+          }
+        }
+        require(known, "training.sampler must be uniform, views-x-elements or mixed");
+      }
+      read(t, "training", "rays_per_step", training.rays_per_step);
+      read(t, "training", "views_per_step", training.views_per_step);
+      read(t, "training", "elements_per_step", training.elements_per_step);
+      read(t, "training", "sample_spacing", training.sample_spacing);
+      read(t, "training", "jitter", training.jitter);
+      read(t, "training", "circle_region", training.circle_region);
+      read(t, "training", "learning_rate", training.learning_rate);
+      read(t, "training", "lr_decay_steps", training.lr_decay_steps);
+      read(t, "training", "lr_decay", training.lr_decay);
+      read(t, "training", "adam_beta1", training.adam_beta1);
+      read(t, "training", "adam_beta2", training.adam_beta2);
+      read(t, "training", "adam_epsilon", training.adam_epsilon);
+      read(t, "training", "lambda", training.lambda);
+      if (t.contains("data_term")) {
+        require(t["data_term"].is_string(), "training.data_term must be a string");
+        const std::string d = t["data_term"];
+        bool known = false;
+        for (DataTerm term : {DataTerm::kElementMean, DataTerm::kMean, DataTerm::kSum}) {
+          if (d == data_term_name(term)) {
+            training.data_term = term;
+            known = true;
+          }
+        }
+        require(known, "training.data_term must be element-mean, mean or sum");
+      }
+      read(t, "training", "data_weight", training.data_weight);
+      read(t, "training", "alpha_lr_scale", training.alpha_lr_scale);
+      read(t, "training", "beta_lr_scale", training.beta_lr_scale);
+      read(t, "training", "alpha_warmup_steps", training.alpha_warmup_steps);
+      read(t, "training", "beta_warmup_steps", training.beta_warmup_steps);
+      read(t, "training", "level_warmup_steps", training.level_warmup_steps);
+      read(t, "training", "ring_lambda", training.ring_lambda);
+      read(t, "training", "seed", training.seed);
+    }
+    if (root.contains("engine")) {
+      require(root["engine"].is_string(), "engine must be a string");
+      engine = parse_engine(root["engine"].get<std::string>());
+    }
+  } catch (const json::exception& e) {
+    throw InputError(std::string(source) + ": " + e.what());
+  } catch (const InputError& e) {
+    throw InputError(std::string(source) + ": " + e.what());
+  }
+  validate();
+}
+
+std::string RinerConfig::to_json() const {
+  json root = {
+      {"encoding",
+       {{"levels", encoding.levels},
+        {"features", encoding.features},
+        {"log2_table_size", encoding.log2_table_size},
+        {"base_resolution", encoding.base_resolution},
+        {"finest_resolution", encoding.finest_resolution}}},
+      {"network", {{"width", network.width}, {"hidden_layers", network.hidden_layers}}},
+      {"training",
+       {{"steps", training.steps},
+        {"sampler", sampler_name(training.sampler)},
+        {"rays_per_step", training.rays_per_step},
+        {"views_per_step", training.views_per_step},
+        {"elements_per_step", training.elements_per_step},
+        {"sample_spacing", training.sample_spacing},
+        {"jitter", training.jitter},
+        {"circle_region", training.circle_region},
+        {"learning_rate", training.learning_rate},
+        {"lr_decay_steps", training.lr_decay_steps},
+        {"lr_decay", training.lr_decay},
+        {"adam_beta1", training.adam_beta1},
+        {"adam_beta2", training.adam_beta2},
+        {"adam_epsilon", training.adam_epsilon},
+        {"lambda", training.lambda},
+        {"data_term", data_term_name(training.data_term)},
+        {"data_weight", training.data_weight},
+        {"alpha_lr_scale", training.alpha_lr_scale},
+        {"beta_lr_scale", training.beta_lr_scale},
+        {"alpha_warmup_steps", training.alpha_warmup_steps},
+        {"beta_warmup_steps", training.beta_warmup_steps},
+        {"level_warmup_steps", training.level_warmup_steps},
+        {"ring_lambda", training.ring_lambda},
+        {"seed", training.seed}}},
+      {"engine", engine_name(engine)}};
+  return root.dump(1) + "\n";
+}
+
+RinerConfig RinerConfig::paper() {
+  RinerConfig c;
+  c.encoding = {10, 8, 10, 2, 1024};  // b = 2: 2 * 2^9 = 1024
+  c.network = {128, 1};
+  c.training.steps = 4000;
+  c.training.sampler = Sampler::kViewsTimesElements;
+  c.training.views_per_step = 40;
+  c.training.elements_per_step = 2;
+  c.training.learning_rate = 1e-3;
+  c.training.lr_decay_steps = 1000;
+  c.training.lr_decay = 0.5;
+  c.training.adam_beta1 = 0.9;
+  c.training.adam_beta2 = 0.999;
+  c.training.adam_epsilon = 1e-8;
+  c.training.data_term = DataTerm::kSum;
+  c.training.data_weight = 1.0;
+  c.training.alpha_lr_scale = 1.0;
+  c.training.beta_lr_scale = 1.0;
+  return c;
+}
+
+}  // namespace riner

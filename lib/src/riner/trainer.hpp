@@ -1,0 +1,56 @@
+// The engine behind a Reconstructor: one training step, the parameters, the field on the grid.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "model/batch_sampler.hpp"
+#include "model/parameter_layout.hpp"
+#include "model/ray_segments.hpp"
+#include "riner/device.hpp"
+#include "riner/reconstructor.hpp"
+
+namespace riner::detail {
+
+struct AdamRates {
+  double field = 0.0;
+  double alpha = 0.0;
+  double beta = 0.0;
+};
+
+// What both engines share: layout, rays, batches, schedule.
+struct TrainingSetup {
+  Scan scan;
+  RinerConfig config;
+  model::ParameterLayout layout;
+  std::vector<model::RaySegment> segments;
+  std::size_t elements_per_view = 0;
+  std::uint32_t seed = 0;
+
+  TrainingSetup(Scan scan, RinerConfig config);
+  double learning_rate(int step) const;
+  // Adam settings of a step: the schedule for the field, alpha0 and beta0.
+  AdamRates adam_rates(int step) const;
+  // Scale of each encoding level's features at a step (coarse to fine); all 1 when done.
+  std::vector<float> level_weights(int step) const;
+};
+
+class Trainer {
+ public:
+  virtual ~Trainer() = default;
+  // One step (0-based index).
+  virtual void step(int index, const model::Batch& batch) = 0;
+  // Loss records of the steps since the last call, in order.
+  virtual std::vector<LossRecord> drain_losses() = 0;
+  virtual std::vector<float> parameters() = 0;
+  virtual std::vector<float> evaluate_grid() = 0;
+  virtual std::string device_name() const = 0;
+  virtual std::string gradient_mode() const = 0;
+};
+
+std::unique_ptr<Trainer> make_reference_trainer(const TrainingSetup& setup);
+std::unique_ptr<Trainer> make_opencl_trainer(const TrainingSetup& setup, Device device);
+
+}  // namespace riner::detail

@@ -1,0 +1,46 @@
+#include <algorithm>
+#include <cmath>
+
+#include "riner/error.hpp"
+#include "riner/trainer.hpp"
+
+namespace riner::detail {
+
+TrainingSetup::TrainingSetup(Scan s, RinerConfig c) : scan(std::move(s)), config(std::move(c)) {
+  config.validate();
+  scan.geometry.validate();
+  check_scan(scan);
+  const Geometry& g = scan.geometry;
+  elements_per_view = g.n_u * (g.is_3d() ? g.n_v : 1);
+  layout = model::make_layout(g.is_3d() ? 3 : 2, config.encoding, config.network, elements_per_view);
+  segments = model::ray_segments(g, config.training.sample_spacing * g.voxel_mm, config.training.circle_region);
+  std::size_t hit = 0;
+  for (const model::RaySegment& segment : segments) hit += segment.count > 0;
+  if (hit == 0) throw InputError("no detector ray crosses the reconstruction grid: check the geometry");
+  seed = static_cast<std::uint32_t>(config.training.seed ^ (config.training.seed >> 32));
+}
+
+double TrainingSetup::learning_rate(int step) const {
+  const TrainingConfig& t = config.training;
+  return t.learning_rate * std::pow(t.lr_decay, step / t.lr_decay_steps);
+}
+
+std::vector<float> TrainingSetup::level_weights(int step) const {
+  const int k = config.training.level_warmup_steps;
+  std::vector<float> w(static_cast<std::size_t>(layout.levels), 1.0f);
+  if (k <= 0) return w;
+  for (int l = 1; l < layout.levels; ++l) {
+    const double t = (static_cast<double>(step) - (l - 1) * static_cast<double>(k)) / k;
+    w[static_cast<std::size_t>(l)] = static_cast<float>(std::clamp(t, 0.0, 1.0));
+  }
+  return w;
+}
+
+AdamRates TrainingSetup::adam_rates(int step) const {
+  const TrainingConfig& t = config.training;
+  const double lr = learning_rate(step);
+  return {lr, step < t.alpha_warmup_steps ? 0.0 : lr * t.alpha_lr_scale,
+          step < t.beta_warmup_steps ? 0.0 : lr * t.beta_lr_scale};
+}
+
+}  // namespace riner::detail

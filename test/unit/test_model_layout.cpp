@@ -1,0 +1,106 @@
+// The parameter layout, initialisation, ray segments and batch sampler shared by both engines.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <map>
+
+#include "model/batch_sampler.hpp"
+#include "model/parameter_layout.hpp"
+#include "model/ray_segments.hpp"
+#include "riner/rays.hpp"
+#include "support/geometries.hpp"
+
+TEST_SUITE("model_layout") {
+  TEST_CASE("levels: scale, resolution, dense until the table is full, then hashed") {
+    const riner::EncodingConfig enc{4, 2, 10, 4, 32};  // b = 2: scales 3, 7, 15, 31
+    const auto l = riner::model::make_layout(2, enc, {16, 1}, 7);
+    REQUIRE(l.grid.size() == 4);
+    CHECK(l.grid[0].scale == doctest::Approx(3.0));
+    CHECK(l.grid[3].scale == doctest::Approx(31.0));
+    CHECK(l.grid[0].resolution == 5);   // ceil(3) + 2
+    CHECK(l.grid[2].resolution == 17);  // 17^2 = 289 <= 1024: dense
+    CHECK(l.grid[2].hashed == 0);
+    CHECK(l.grid[3].resolution == 33);  // 33^2 = 1089 > 1024: hashed into 1024 entries
+    CHECK(l.grid[3].hashed == 1);
+    CHECK(l.grid[1].offset == 25 * 2);
+    CHECK(l.grid_params == (25 + 81 + 289 + 1024) * 2u);
+    CHECK(l.mlp_params == 8 * 16 + 16 + 16 + 1u);
+    CHECK(l.alpha_offset == l.grid_params + l.mlp_params);
+    CHECK(l.total == l.beta_offset + 7);
+    const auto deep = riner::model::make_layout(3, enc, {32, 3}, 5);
+    CHECK(deep.w_hidden(1) == deep.b_in() + 32u);
+    CHECK(deep.w_out() == deep.w_hidden(3));
+    CHECK(deep.mlp_params == 8 * 32 + 32 + 2 * (32 * 32 + 32) + 32 + 1u);
+  }
+
+  TEST_CASE("initial values follow instant-NGP and PyTorch, alpha0 = beta0 = 1") {
+    const auto l = riner::model::make_layout(2, {4, 2, 10, 4, 32}, {16, 1}, 7);
+    const auto p = riner::model::initial_parameters(l, 42);
+    for (std::size_t i = 0; i < l.grid_params; ++i) REQUIRE(std::fabs(p[i]) <= 1e-4f);
+    for (std::size_t i = l.w_in(); i < l.b_in(); ++i) REQUIRE(std::fabs(p[i]) <= 1.0f / std::sqrt(8.0f));
+    for (std::size_t e = 0; e < 7; ++e) {
+      CHECK(p[l.alpha_offset + e] == 1.0f);
+      CHECK(p[l.beta_offset + e] == 1.0f);
+    }
+    CHECK(riner::model::initial_parameters(l, 42) == p);
+    CHECK(riner::model::initial_parameters(l, 43) != p);
+  }
+
+  TEST_CASE("ray segments tile the clipped ray exactly, inside the unit square") {
+    const riner::Geometry g = riner::test::small_fan2d();
+    const auto segments = riner::model::ray_segments(g, 1.0, false);
+    REQUIRE(segments.size() == g.n_views() * g.n_u);
+    int hit = 0;
+    for (std::size_t r = 0; r < segments.size(); ++r) {
+      const auto& s = segments[r];
+      const riner::Ray ray = riner::detector_ray(g, r / g.n_u, static_cast<double>(r % g.n_u));
+      const riner::Segment clip = riner::clip_to_box(g, ray);
+      if (clip.empty()) {
+        CHECK(s.count == 0);
+        continue;
+      }
+      ++hit;
+      CHECK(s.count == static_cast<std::uint32_t>(std::ceil(clip.length() - 1e-9)));
+      CHECK(s.dx * s.count == doctest::Approx(clip.length()).epsilon(1e-5));
+      for (std::uint32_t k : {0u, s.count - 1}) {
+        float p[3];
+        riner::model::sample_position(s, k, 0.5f, p);
+        CHECK(p[0] >= 0.0f);
+        CHECK(p[0] <= 1.0f);
+        CHECK(p[1] >= 0.0f);
+        CHECK(p[1] <= 1.0f);
+      }
+    }
+    CHECK(hit > 0);
+  }
+
+  TEST_CASE("batches: deterministic per step, in range, weights per the data term") {
+    const riner::Geometry g = riner::test::small_fan2d();
+    riner::TrainingConfig t;
+    t.sampler = riner::Sampler::kMixed;
+    t.rays_per_step = 50;
+    t.views_per_step = 6;
+    t.elements_per_step = 5;
+    t.data_weight = 0.2;
+    const riner::model::BatchSampler sampler(g, t);
+    const auto b = sampler.batch(3);
+    REQUIRE(b.rays.size() == 80);
+    CHECK(sampler.batch(3).rays == b.rays);
+    CHECK(sampler.batch(4).rays != b.rays);
+    for (std::uint32_t r : b.rays) CHECK(r < g.n_views() * g.n_u);
+    CHECK(b.block_first == 50);
+    CHECK(b.block_views == 6);
+    CHECK(b.block_elements == 5);
+    // The block: same run of 5 adjacent elements in every view.
+    for (std::uint32_t v = 0; v < 6; ++v) {
+      for (std::uint32_t e = 1; e < 5; ++e) {
+        CHECK(b.rays[50 + v * 5 + e] == b.rays[50 + v * 5] + e);
+      }
+    }
+    // Element mean: each element's weights sum to data_weight.
+    std::map<std::uint32_t, double> per_element;
+    for (std::size_t i = 0; i < b.rays.size(); ++i) per_element[b.rays[i] % g.n_u] += b.weights[i];
+    for (const auto& [e, w] : per_element) CHECK(w == doctest::Approx(0.2));
+    CHECK(per_element.size() == b.elements.size());
+  }
+}

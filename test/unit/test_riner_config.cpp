@@ -1,0 +1,60 @@
+#include <doctest/doctest.h>
+
+#include "riner/error.hpp"
+#include "riner/riner_config.hpp"
+
+TEST_SUITE("riner_config") {
+  TEST_CASE("defaults are valid and round-trip through JSON") {
+    riner::RinerConfig c;
+    CHECK_NOTHROW(c.validate());
+    riner::RinerConfig d;
+    d.training.steps = 1;
+    d.update_from_json(c.to_json());
+    CHECK(d.to_json() == c.to_json());
+  }
+
+  TEST_CASE("the paper preset holds the paper's values") {
+    const riner::RinerConfig p = riner::RinerConfig::paper();
+    CHECK(p.encoding.levels == 10);
+    CHECK(p.encoding.log2_table_size == 10);
+    CHECK(p.encoding.features == 8);
+    CHECK(p.encoding.base_resolution == 2);
+    CHECK(p.encoding.finest_resolution == 1024);
+    CHECK(p.network.width == 128);
+    CHECK(p.training.steps == 4000);
+    CHECK(p.training.views_per_step * p.training.elements_per_step == 80);
+    CHECK(p.training.learning_rate == 1e-3);
+    CHECK(p.training.lr_decay_steps == 1000);
+    CHECK(p.training.data_term == riner::DataTerm::kSum);
+    CHECK_NOTHROW(p.validate());
+  }
+
+  TEST_CASE("partial JSON updates and precise errors") {
+    riner::RinerConfig c;
+    c.update_from_json(R"({"network": {"width": 64}, "training": {"sampler": "mixed", "elements_per_step": 8}})");
+    CHECK(c.network.width == 64);
+    CHECK(c.training.sampler == riner::Sampler::kMixed);
+    CHECK(c.encoding.levels == 8);  // untouched
+    auto expect = [](const std::string& json, const std::string& message) {
+      riner::RinerConfig cfg;
+      try {
+        cfg.update_from_json(json, "c.json");
+        FAIL("accepted " << json);
+      } catch (const riner::InputError& e) {
+        CHECK(std::string(e.what()) == message);
+      }
+    };
+    expect(R"({"training": {"stepz": 3}})", "c.json: config: unknown setting training.stepz");
+    expect(R"({"network": {"width": 24}})", "config: network.width must be a multiple of 16 in 16..256");
+    expect(R"({"training": {"steps": "many"}})", "c.json: config: training.steps must be an integer");
+    expect(R"({"training": {"learning_rate": -1}})", "config: training.learning_rate must be in (0, 10)");
+    expect(R"({"training": {"sampler": "random"}})",
+           "c.json: config: training.sampler must be uniform, views-x-elements or mixed");
+    expect(R"({"training": {"ring_lambda": 1}})",
+           "config: training.ring_lambda needs the views-x-elements or mixed sampler with elements_per_step >= 3");
+    expect(R"({"encoding": {"finest_resolution": 8}})",
+           "config: encoding.finest_resolution must be >= base_resolution and <= 2^20");
+    expect(R"({"engine": "gpu"})", "c.json: engine must be opencl or reference (got \"gpu\")");
+    expect("[1, 2]", "c.json: config: config must be an object");
+  }
+}
