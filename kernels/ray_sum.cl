@@ -2,7 +2,7 @@
 //   rho_hat = (-ln alpha + sum(mu) dx) beta,  alpha = max(alpha0, 1e-8),  beta = sigmoid(beta0)
 //   loss = weight |rho_hat - rho beta|, a non-finite measured rho counting as 0;
 //   penalty = lambda (-beta^2) per element of the batch.
-//   Helpers: ray_loss(...), beta_penalty(...)
+//   Helpers: ray_loss(...), ray_mismatch(...), beta_penalty(...)
 //   ray_sum_loss(n_rays, offsets, mu, dx, elements, rho, alpha0, beta0, weight, d_mu, loss,
 //                d_alpha0, d_beta0)
 //     one work-item per ray r, whose samples are mu[offsets[r] .. offsets[r + 1]); writes
@@ -26,6 +26,12 @@ inline float ray_loss(float ray_sum, float alpha0, float beta0, float rho, float
   *d_alpha0 = clamped ? 0.0f : -g * beta / alpha;
   *d_beta0 = g * (inside - rho) * beta * (1.0f - beta);
   return weight * fabs(residual);
+}
+
+// |(-ln alpha + ray_sum) - rho|: how far a ray is from its measurement, before beta.
+inline float ray_mismatch(float ray_sum, float alpha0, float rho) {
+  if (!isfinite(rho)) rho = 0.0f;
+  return fabs(-log(fmax(alpha0, ALPHA_EPSILON)) + ray_sum - rho);
 }
 
 inline float beta_penalty(float beta0, float lambda, float* d_beta0) {

@@ -4,12 +4,19 @@
 //     one work-item per lane; lane l takes the batch's rays l, l + n_lanes, ... (interleaved, so
 //     lanes get similar work). sums[b] = sum over ray b's samples of mu * dx.
 //   riner_step_loss(n_batch, rays, sums, rho, weights, elements_per_view, params, alpha_offset,
-//                   beta_offset, n_elements, elements, lambda, block_first, block_views,
-//                   block_elements, ring_lambda, grad, d_sums, loss)
+//                   beta_offset, n_elements, elements, lambda, relative_threshold, data_weight,
+//                   block_first, block_views, block_elements, ring_lambda, grad, d_sums, loss,
+//                   scratch)
 //     one work-item, over the batch in order (deterministic): each ray's loss (ray_sum.cl) and
 //     its gradient d_sums[b] with respect to sums[b]; alpha0/beta0 gradients into grad; the
 //     -lambda beta^2 term of the batch's elements; and, when ring_lambda > 0, the ring prior on
 //     the views x elements block (below). loss[0] = data term, loss[1] = penalties.
+//     When relative_threshold > 0 the data term's gradients are scaled by
+//     2 lambda / (data_weight relative_threshold max(m, 1e-3)), m the batch's median ray
+//     mismatch (scratch float[n_batch] holds the mismatches): Adam does not see a common scale,
+//     so this changes only the balance against the beta penalty, which then switches an element
+//     off when its rays miss by more than relative_threshold times the batch's typical ray,
+//     whatever the object and however far training has come.
 //   riner_step_backward(n_lanes, n_batch, rays, segments, levels, level_weights, params, grad,
 //                       lane_stride, mlp_offset, seed, step, jitter, d_sums)
 //     one work-item per lane as in forward: recomputes each sample's encoding and activations
@@ -77,14 +84,55 @@ __kernel void riner_step_forward(const uint n_lanes, const uint n_batch, __globa
   }
 }
 
+// The k-th smallest of values[0 .. n) (Hoare's selection; reorders values).
+inline float select_kth(__global float* values, uint n, uint k) {
+  uint lo = 0;
+  uint hi = n - 1;
+  while (lo < hi) {
+    const float pivot = values[(lo + hi) / 2];
+    uint i = lo;
+    uint j = hi;
+    while (i <= j) {
+      while (values[i] < pivot) ++i;
+      while (values[j] > pivot) --j;
+      if (i <= j) {
+        const float t = values[i];
+        values[i] = values[j];
+        values[j] = t;
+        ++i;
+        if (j == 0) break;
+        --j;
+      }
+    }
+    if (k <= j) {
+      hi = j;
+    } else if (k >= i) {
+      lo = i;
+    } else {
+      break;
+    }
+  }
+  return values[k];
+}
+
 __kernel void riner_step_loss(const uint n_batch, __global const uint* rays, __global const float* sums,
                               __global const float* rho, __global const float* weights,
                               const uint elements_per_view, __global const float* params,
                               const uint alpha_offset, const uint beta_offset, const uint n_elements,
-                              __global const uint* elements, const float lambda, const uint block_first,
-                              const uint block_views, const uint block_elements, const float ring_lambda,
-                              __global float* grad, __global float* d_sums, __global float* loss) {
+                              __global const uint* elements, const float lambda, const float relative_threshold,
+                              const float data_weight, const uint block_first, const uint block_views,
+                              const uint block_elements, const float ring_lambda, __global float* grad,
+                              __global float* d_sums, __global float* loss, __global float* scratch) {
   if (get_global_id(0) != 0) return;
+  float scale = 1.0f;
+  if (relative_threshold > 0.0f && n_batch > 0) {
+    for (uint b = 0; b < n_batch; ++b) {
+      const uint ray = rays[b];
+      scratch[b] = ray_mismatch(sums[b], params[alpha_offset + ray % elements_per_view], rho[ray]);
+    }
+    const float median = select_kth(scratch, n_batch, (n_batch - 1) / 2);
+    scale = 2.0f * lambda / (data_weight * relative_threshold * fmax(median, 1e-3f));
+  }
   float data = 0.0f;
   for (uint b = 0; b < n_batch; ++b) {
     const uint ray = rays[b];
@@ -94,9 +142,9 @@ __kernel void riner_step_loss(const uint n_batch, __global const uint* rays, __g
     float d_beta0;
     data += ray_loss(sums[b], params[alpha_offset + e], params[beta_offset + e], rho[ray], weights[b], &d_sum,
                      &d_alpha0, &d_beta0);
-    d_sums[b] = d_sum;
-    GRAD_ADD(&grad[alpha_offset + e], d_alpha0);
-    GRAD_ADD(&grad[beta_offset + e], d_beta0);
+    d_sums[b] = scale * d_sum;
+    GRAD_ADD(&grad[alpha_offset + e], scale * d_alpha0);
+    GRAD_ADD(&grad[beta_offset + e], scale * d_beta0);
   }
   float penalty = 0.0f;
   for (uint i = 0; i < n_elements; ++i) {

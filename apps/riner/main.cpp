@@ -20,6 +20,7 @@ struct Command {
 
 constexpr Command kCommands[] = {
     {"reconstruct", riner::app::run_reconstruct, "remove ring artifacts: train Riner on a scan"},
+    {"demo", riner::app::run_demo, "simulate a ring scan, reconstruct it with FBP and Riner"},
     {"devices", riner::app::run_devices, "list OpenCL devices and their capabilities"},
     {"info", riner::app::run_info, "describe an array file or a geometry file"},
     {"simulate", riner::app::run_simulate, "simulate a ring-corrupted scan (paper protocol)"},

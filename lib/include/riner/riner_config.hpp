@@ -78,6 +78,10 @@ struct TrainingConfig {
   // the mean |residual| of its rays exceeds 2 lambda beta / data_weight: 0.1 at the default
   // 0.2, above what alpha errors leave on live elements, below a dead element's.
   double data_weight = 0.2;
+  // When > 0, the balance is relative instead: an element is pushed off when the mean mismatch
+  // of its rays exceeds this many times the batch's median ray mismatch (the data term's
+  // gradients are rescaled per step, which Adam does not see except against the penalty).
+  double relative_beta_threshold = 0.0;
   std::uint64_t seed = 0;
 };
 

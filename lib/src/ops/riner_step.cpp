@@ -13,6 +13,7 @@ RinerStepOp::RinerStepOp(cl::Context& context, const model::ParameterLayout& lay
       levels_(upload_levels(context, layout)),
       sums_(context, max_batch),
       d_sums_(context, max_batch),
+      scratch_(context, max_batch),
       program_(context.program({"common", "hash_grid", "mlp", "ray_sum", "riner_step"},
                                model_build_options(layout, atomic))),
       forward_(*program_, "riner_step_forward"),
@@ -35,8 +36,8 @@ void RinerStepOp::step(const StepArgs& a, cl_uint n_lanes, const cl::Buffer<floa
   context_.launch(forward_, n_lanes, 1);
   loss_.set_args(a.n_batch, *a.rays, sums_, *a.rho, *a.weights, a.elements_per_view, params,
                  static_cast<cl_uint>(layout_.alpha_offset), static_cast<cl_uint>(layout_.beta_offset),
-                 a.n_elements, *a.elements, a.lambda, a.block_first, a.block_views, a.block_elements,
-                 a.ring_lambda, grad, d_sums_, loss);
+                 a.n_elements, *a.elements, a.lambda, a.relative_threshold, a.data_weight, a.block_first,
+                 a.block_views, a.block_elements, a.ring_lambda, grad, d_sums_, loss, scratch_);
   context_.launch(loss_, 1, 1);
   const auto stride = static_cast<cl_uint>(atomic_ ? 0 : layout_.total);
   backward_.set_args(n_lanes, a.n_batch, *a.rays, *a.segments, levels_, *a.level_weights, params, grad, stride,

@@ -24,6 +24,8 @@ struct StepArgs {
   cl_uint step;
   bool jitter;
   float lambda;
+  float relative_threshold;  // 0: the absolute balance
+  float data_weight;
   cl_uint block_first;
   cl_uint block_views;
   cl_uint block_elements;
@@ -52,6 +54,7 @@ class RinerStepOp {
   cl::Buffer<model::GridLevel> levels_;
   cl::Buffer<float> sums_;
   cl::Buffer<float> d_sums_;
+  cl::Buffer<float> scratch_;
   std::shared_ptr<const cl::Program> program_;
   cl::Kernel forward_;
   cl::Kernel loss_;

@@ -22,6 +22,11 @@ RayLoss ray_loss(double ray_sum, double alpha0, double beta0, double rho, double
   return out;
 }
 
+double ray_mismatch(double ray_sum, double alpha0, double rho) {
+  if (!std::isfinite(rho)) rho = 0.0;
+  return std::fabs(-std::log(alpha0 > kAlphaEpsilon ? alpha0 : kAlphaEpsilon) + ray_sum - rho);
+}
+
 double beta_penalty(double beta0, double lambda, double* d_beta0) {
   const double beta = 1.0 / (1.0 + std::exp(-beta0));
   if (d_beta0 != nullptr) *d_beta0 = -2.0 * lambda * beta * beta * (1.0 - beta);

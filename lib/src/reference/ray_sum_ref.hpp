@@ -18,6 +18,10 @@ struct RayLoss {
 
 RayLoss ray_loss(double ray_sum, double alpha0, double beta0, double rho, double weight);
 
+// |(-ln alpha + ray_sum) - rho| with rho's non-finite values taken as 0: a ray's mismatch
+// before beta.
+double ray_mismatch(double ray_sum, double alpha0, double rho);
+
 // The regulariser of one element, lambda * (-beta^2), and its gradient in beta0.
 double beta_penalty(double beta0, double lambda, double* d_beta0);
 

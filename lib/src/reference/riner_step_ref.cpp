@@ -1,5 +1,7 @@
 #include "reference/riner_step_ref.hpp"
 
+#include <algorithm>
+
 #include "model/counter_rng.hpp"
 #include "reference/hash_grid_ref.hpp"
 #include "reference/mlp_ref.hpp"
@@ -52,16 +54,27 @@ StepResult riner_step(const StepInputs& in, const model::Batch& batch, const std
   StepResult result;
   if (with_gradient) result.grad.assign(l.total, 0.0);
   std::vector<double> d_sums(n, 0.0);
+  double scale = 1.0;
+  if (in.relative_beta_threshold > 0.0 && n > 0) {
+    std::vector<double> mismatch(n);
+    for (std::size_t b = 0; b < n; ++b) {
+      const std::uint32_t ray = batch.rays[b];
+      mismatch[b] = ray_mismatch(sums[b], params[l.alpha_offset + ray % in.elements_per_view], (*in.measurement)[ray]);
+    }
+    std::nth_element(mismatch.begin(), mismatch.begin() + static_cast<long>((n - 1) / 2), mismatch.end());
+    const double median = mismatch[(n - 1) / 2];
+    scale = 2.0 * in.lambda / (in.data_weight * in.relative_beta_threshold * std::max(median, 1e-3));
+  }
   for (std::size_t b = 0; b < n; ++b) {
     const std::uint32_t ray = batch.rays[b];
     const std::size_t e = ray % in.elements_per_view;
     const RayLoss rl = ray_loss(sums[b], params[l.alpha_offset + e], params[l.beta_offset + e],
                                 (*in.measurement)[ray], batch.weights[b]);
     result.data_loss += rl.loss;
-    d_sums[b] = rl.d_sum;
+    d_sums[b] = scale * rl.d_sum;
     if (with_gradient) {
-      result.grad[l.alpha_offset + e] += rl.d_alpha0;
-      result.grad[l.beta_offset + e] += rl.d_beta0;
+      result.grad[l.alpha_offset + e] += scale * rl.d_alpha0;
+      result.grad[l.beta_offset + e] += scale * rl.d_beta0;
     }
   }
   for (std::uint32_t e : batch.elements) {

@@ -22,6 +22,8 @@ struct StepInputs {
   std::uint32_t step = 0;
   double lambda = 0.01;
   double ring_lambda = 0.0;
+  double relative_beta_threshold = 0.0;  // see riner_step.cl, riner_step_loss
+  double data_weight = 1.0;
   std::vector<float> level_weights;  // per encoding level (empty: all 1)
 };
 

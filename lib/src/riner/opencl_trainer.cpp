@@ -90,6 +90,8 @@ class OpenclTrainer final : public Trainer {
     args.step = static_cast<cl_uint>(index);
     args.jitter = t.jitter;
     args.lambda = static_cast<float>(t.lambda);
+    args.relative_threshold = static_cast<float>(t.relative_beta_threshold);
+    args.data_weight = static_cast<float>(t.data_weight);
     args.block_first = batch.block_first;
     args.block_views = batch.block_views;
     args.block_elements = batch.block_elements;

@@ -22,6 +22,8 @@ class ReferenceTrainer final : public Trainer {
     inputs_.seed = setup_.seed;
     inputs_.lambda = setup_.config.training.lambda;
     inputs_.ring_lambda = setup_.config.training.ring_lambda;
+    inputs_.relative_beta_threshold = setup_.config.training.relative_beta_threshold;
+    inputs_.data_weight = setup_.config.training.data_weight;
   }
 
   void step(int index, const model::Batch& batch) override {

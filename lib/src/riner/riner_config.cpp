@@ -98,6 +98,8 @@ void RinerConfig::validate() const {
           "training.ring_lambda must be >= 0");
   require(t.ring_lambda == 0.0 || (t.sampler != Sampler::kUniform && t.elements_per_step >= 3),
           "training.ring_lambda needs the views-x-elements or mixed sampler with elements_per_step >= 3");
+  require(t.relative_beta_threshold >= 0.0 && t.relative_beta_threshold < 1e6,
+          "training.relative_beta_threshold must be >= 0");
   require(t.data_weight > 0.0 && t.data_weight < 1e6 && std::isfinite(t.data_weight),
           "training.data_weight must be > 0");
 }
@@ -132,7 +134,7 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
                  {"steps", "sampler", "rays_per_step", "views_per_step", "elements_per_step", "sample_spacing",
                   "jitter", "circle_region", "learning_rate", "lr_decay_steps", "lr_decay", "adam_beta1",
                   "adam_beta2", "adam_epsilon", "lambda", "alpha_lr_scale", "beta_lr_scale", "alpha_warmup_steps", "beta_warmup_steps", "level_warmup_steps", "ring_lambda",
-                  "data_term", "data_weight", "seed"});
+                  "data_term", "data_weight", "relative_beta_threshold", "seed"});
       read(t, "training", "steps", training.steps);
       if (t.contains("sampler")) {
         require(t["sampler"].is_string(), "training.sampler must be a string");
@@ -172,6 +174,7 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
         require(known, "training.data_term must be element-mean, mean or sum");
       }
       read(t, "training", "data_weight", training.data_weight);
+      read(t, "training", "relative_beta_threshold", training.relative_beta_threshold);
       read(t, "training", "alpha_lr_scale", training.alpha_lr_scale);
       read(t, "training", "beta_lr_scale", training.beta_lr_scale);
       read(t, "training", "alpha_warmup_steps", training.alpha_warmup_steps);
@@ -219,6 +222,7 @@ std::string RinerConfig::to_json() const {
         {"lambda", training.lambda},
         {"data_term", data_term_name(training.data_term)},
         {"data_weight", training.data_weight},
+        {"relative_beta_threshold", training.relative_beta_threshold},
         {"alpha_lr_scale", training.alpha_lr_scale},
         {"beta_lr_scale", training.beta_lr_scale},
         {"alpha_warmup_steps", training.alpha_warmup_steps},
