@@ -11,10 +11,9 @@
 //     its gradient d_sums[b] with respect to sums[b]; alpha0/beta0 gradients into grad; the
 //     -lambda beta^2 term of the batch's elements; and, when ring_lambda > 0, the ring prior on
 //     the views x elements block (below). loss[0] = data term, loss[1] = penalties.
-//     When relative_threshold > 0 the data term's gradients are scaled by
-//     2 lambda / (data_weight relative_threshold max(m, 1e-3)), m the batch's median ray
-//     mismatch (scratch float[n_batch] holds the mismatches): Adam does not see a common scale,
-//     so this changes only the balance against the beta penalty, which then switches an element
+//     When relative_threshold > 0, lambda is replaced by
+//     data_weight relative_threshold max(m, 1e-3) / 2, m the batch's median ray mismatch
+//     (scratch float[n_batch] holds the mismatches): the beta penalty then switches an element
 //     off when its rays miss by more than relative_threshold times the batch's typical ray,
 //     whatever the object and however far training has come.
 //   riner_step_backward(n_lanes, n_batch, rays, segments, levels, level_weights, params, grad,
@@ -124,14 +123,14 @@ __kernel void riner_step_loss(const uint n_batch, __global const uint* rays, __g
                               const uint block_elements, const float ring_lambda, __global float* grad,
                               __global float* d_sums, __global float* loss, __global float* scratch) {
   if (get_global_id(0) != 0) return;
-  float scale = 1.0f;
+  float penalty_weight = lambda;
   if (relative_threshold > 0.0f && n_batch > 0) {
     for (uint b = 0; b < n_batch; ++b) {
       const uint ray = rays[b];
       scratch[b] = ray_mismatch(sums[b], params[alpha_offset + ray % elements_per_view], rho[ray]);
     }
     const float median = select_kth(scratch, n_batch, (n_batch - 1) / 2);
-    scale = 2.0f * lambda / (data_weight * relative_threshold * fmax(median, 1e-3f));
+    penalty_weight = 0.5f * data_weight * relative_threshold * fmax(median, 1e-3f);
   }
   float data = 0.0f;
   for (uint b = 0; b < n_batch; ++b) {
@@ -142,14 +141,14 @@ __kernel void riner_step_loss(const uint n_batch, __global const uint* rays, __g
     float d_beta0;
     data += ray_loss(sums[b], params[alpha_offset + e], params[beta_offset + e], rho[ray], weights[b], &d_sum,
                      &d_alpha0, &d_beta0);
-    d_sums[b] = scale * d_sum;
-    GRAD_ADD(&grad[alpha_offset + e], scale * d_alpha0);
-    GRAD_ADD(&grad[beta_offset + e], scale * d_beta0);
+    d_sums[b] = d_sum;
+    GRAD_ADD(&grad[alpha_offset + e], d_alpha0);
+    GRAD_ADD(&grad[beta_offset + e], d_beta0);
   }
   float penalty = 0.0f;
   for (uint i = 0; i < n_elements; ++i) {
     float d_beta0;
-    penalty += beta_penalty(params[beta_offset + elements[i]], lambda, &d_beta0);
+    penalty += beta_penalty(params[beta_offset + elements[i]], penalty_weight, &d_beta0);
     GRAD_ADD(&grad[beta_offset + elements[i]], d_beta0);
   }
   if (ring_lambda > 0.0f && block_views > 0 && block_elements >= 3) {

@@ -47,8 +47,9 @@ int run_demo(int argc, char** argv, int first) {
   write_array(out / "alpha_true.npy", sim.alpha);
   write_array(out / "ground_truth.nii", sim.ground_truth, {{g.voxel_mm, g.voxel_mm}});
   g.save(out / "geometry.json");
-  console.line("simulated a fan-beam Shepp-Logan scan with rings: " + shape_string(sim.scan.measurement.shape) +
-               ", dead elements " + std::to_string(sim.scan.non_finite / g.n_views()));
+  console.line("simulated a fan-beam Shepp-Logan scan with rings: " +
+               shape_string(sim.scan.measurement.shape) + ", dead elements " +
+               std::to_string(sim.scan.non_finite / g.n_views()));
 
   FbpOptions fbp_options;
   fbp_options.engine = engine;
@@ -64,10 +65,12 @@ int run_demo(int argc, char** argv, int first) {
   Reconstructor riner(sim.scan, config, device);
   {
     Progress progress("riner", static_cast<std::size_t>(config.training.steps), console.quiet());
-    riner.run([&](const TrainingProgress& p) {
-      progress.update(static_cast<std::size_t>(p.step));
-      return true;
-    }, 200);
+    riner.run(
+        [&](const TrainingProgress& p) {
+          progress.update(static_cast<std::size_t>(p.step));
+          return true;
+        },
+        200);
     progress.finish();
   }
   const Array image = riner.image();
@@ -90,14 +93,16 @@ int run_demo(int argc, char** argv, int first) {
   char line[160];
   std::snprintf(line, sizeof(line), "FBP   PSNR %6.2f dB  SSIM %.4f", m_fbp.psnr, m_fbp.ssim);
   console.line(line);
-  std::snprintf(line, sizeof(line), "Riner PSNR %6.2f dB  SSIM %.4f  (%s, %d steps, %zu elements flagged dead)",
-                m_riner.psnr, m_riner.ssim, format_duration(riner.stats().seconds).c_str(), riner.stats().steps,
-                dead.size());
+  std::snprintf(line, sizeof(line),
+                "Riner PSNR %6.2f dB  SSIM %.4f  (%s, %d steps, %zu elements flagged dead)",
+                m_riner.psnr, m_riner.ssim, format_duration(riner.stats().seconds).c_str(),
+                riner.stats().steps, dead.size());
   console.line(line);
   console.line("images side by side (truth | FBP | Riner): " + (out / "comparison.png").string());
   const nlohmann::json summary = {
       {"fbp", metrics_json(m_fbp.psnr, m_fbp.ssim, m_fbp.mae, m_fbp.rmse, m_fbp.data_range)},
-      {"riner", metrics_json(m_riner.psnr, m_riner.ssim, m_riner.mae, m_riner.rmse, m_riner.data_range)},
+      {"riner",
+       metrics_json(m_riner.psnr, m_riner.ssim, m_riner.mae, m_riner.rmse, m_riner.data_range)},
       {"riner_seconds", riner.stats().seconds},
       {"dead_elements_found", dead},
       {"out", out.string()}};

@@ -21,12 +21,15 @@ RinerConfig config_from(const Args& args) {
     config.update_from_json(read_text(file), file);
   }
   // Flags override the file.
-  if (auto v = args.maybe("steps"); v && !v->empty()) config.training.steps = static_cast<int>(args.integer("steps"));
-  if (auto v = args.maybe("seed"); v && !v->empty()) config.training.seed = static_cast<std::uint64_t>(args.integer("seed"));
+  if (auto v = args.maybe("steps"); v && !v->empty())
+    config.training.steps = static_cast<int>(args.integer("steps"));
+  if (auto v = args.maybe("seed"); v && !v->empty())
+    config.training.seed = static_cast<std::uint64_t>(args.integer("seed"));
   if (auto v = args.maybe("rays-per-step"); v && !v->empty()) {
     config.training.rays_per_step = static_cast<int>(args.integer("rays-per-step"));
   }
-  if (auto v = args.maybe("lr"); v && !v->empty()) config.training.learning_rate = args.number("lr");
+  if (auto v = args.maybe("lr"); v && !v->empty())
+    config.training.learning_rate = args.number("lr");
   if (args.is_set("paper")) config = RinerConfig::paper();
   config.engine = engine_from(args);
   config.validate();
@@ -37,7 +40,8 @@ void write_history(const std::filesystem::path& path, const std::vector<LossReco
   std::string csv = "step,data_loss,penalty,learning_rate\n";
   char line[128];
   for (const LossRecord& r : history) {
-    std::snprintf(line, sizeof(line), "%d,%.9g,%.9g,%.6g\n", r.step, r.data_loss, r.penalty, r.learning_rate);
+    std::snprintf(line, sizeof(line), "%d,%.9g,%.9g,%.6g\n", r.step, r.data_loss, r.penalty,
+                  r.learning_rate);
     csv += line;
   }
   write_text(path, csv);
@@ -68,7 +72,8 @@ int run_reconstruct(int argc, char** argv, int first) {
   if (!args.parse(argc, argv, first)) return 0;
   Console console(args);
   Scan scan = load_scan(args.get("SCAN"), args.get("geometry"));
-  if (auto v = args.maybe("offset-px"); v && !v->empty()) scan.geometry.offset_u = args.number("offset-px");
+  if (auto v = args.maybe("offset-px"); v && !v->empty())
+    scan.geometry.offset_u = args.number("offset-px");
   const RinerConfig config = config_from(args);
   const std::string format = args.get("format");
   if (format != "nii" && format != "npy" && format != "tif" && format != "raw") {
@@ -76,13 +81,15 @@ int run_reconstruct(int argc, char** argv, int first) {
   }
   const std::filesystem::path out = make_output_dir(args.get("out"));
   if (scan.non_finite > 0) {
-    console.line(std::to_string(scan.non_finite) + " measurements are NaN/inf (dead elements?): they count as 0 "
+    console.line(std::to_string(scan.non_finite) +
+                 " measurements are NaN/inf (dead elements?): they count as 0 "
                  "and their elements' beta learns to switch them off");
   }
 
   Reconstructor reconstructor(std::move(scan), config, device_from(args, config.engine));
   {
-    Progress progress("reconstruct", static_cast<std::size_t>(config.training.steps), console.quiet());
+    Progress progress("reconstruct", static_cast<std::size_t>(config.training.steps),
+                      console.quiet());
     reconstructor.run(
         [&](const TrainingProgress& p) {
           char status[64];
@@ -105,23 +112,25 @@ int run_reconstruct(int argc, char** argv, int first) {
   write_text(out / "config.json", config.to_json());
 
   const TrainingStats stats = reconstructor.stats();
-  nlohmann::json summary = {{"image", image_path.string()},
-                            {"shape", image.shape},
-                            {"steps", stats.steps},
-                            {"seconds", stats.seconds},
-                            {"samples", stats.samples},
-                            {"samples_per_second", stats.seconds > 0 ? stats.samples / stats.seconds : 0.0},
-                            {"parameters", stats.parameters},
-                            {"non_finite_measurements", stats.non_finite},
-                            {"dead_elements", dead},
-                            {"engine", stats.engine},
-                            {"device", stats.device},
-                            {"gradient_mode", stats.gradient_mode},
-                            {"final_loss", reconstructor.history().empty() ? 0.0 : reconstructor.history().back().data_loss}};
+  nlohmann::json summary = {
+      {"image", image_path.string()},
+      {"shape", image.shape},
+      {"steps", stats.steps},
+      {"seconds", stats.seconds},
+      {"samples", stats.samples},
+      {"samples_per_second", stats.seconds > 0 ? stats.samples / stats.seconds : 0.0},
+      {"parameters", stats.parameters},
+      {"non_finite_measurements", stats.non_finite},
+      {"dead_elements", dead},
+      {"engine", stats.engine},
+      {"device", stats.device},
+      {"gradient_mode", stats.gradient_mode},
+      {"final_loss",
+       reconstructor.history().empty() ? 0.0 : reconstructor.history().back().data_loss}};
   write_text(out / "summary.json", summary.dump(1) + "\n");
-  console.line("reconstructed " + shape_string(image.shape) + " in " + format_duration(stats.seconds) + " (" +
-               std::to_string(stats.steps) + " steps, " + std::to_string(dead.size()) +
-               " elements flagged dead) -> " + out.string());
+  console.line("reconstructed " + shape_string(image.shape) + " in " +
+               format_duration(stats.seconds) + " (" + std::to_string(stats.steps) + " steps, " +
+               std::to_string(dead.size()) + " elements flagged dead) -> " + out.string());
   console.summary(summary);
   return 0;
 }

@@ -7,8 +7,8 @@
 
 namespace riner::app {
 
-std::vector<std::size_t> write_detector_outputs(const std::filesystem::path& dir, const Array& alpha,
-                                                const Array& beta) {
+std::vector<std::size_t> write_detector_outputs(const std::filesystem::path& dir,
+                                                const Array& alpha, const Array& beta) {
   write_array(dir / "alpha.npy", alpha);
   write_array(dir / "beta.npy", beta);
   std::vector<std::size_t> dead;

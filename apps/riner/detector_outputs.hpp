@@ -11,7 +11,7 @@ namespace riner::app {
 
 // alpha.npy, beta.npy and detector.png (both against element index; in 3D, alpha and beta maps
 // side by side) in dir. Returns the elements with beta < 0.5.
-std::vector<std::size_t> write_detector_outputs(const std::filesystem::path& dir, const Array& alpha,
-                                                const Array& beta);
+std::vector<std::size_t> write_detector_outputs(const std::filesystem::path& dir,
+                                                const Array& alpha, const Array& beta);
 
 }  // namespace riner::app

@@ -13,6 +13,7 @@
 #include "riner/metrics.hpp"
 #include "riner/phantom.hpp"
 #include "riner/reconstructor.hpp"
+#include "riner/scan.hpp"
 #include "riner/simulate.hpp"
 
 namespace {
@@ -32,7 +33,8 @@ riner::RinerConfig config_from(const Options& o) {
   if (!c.empty()) {
     if (std::filesystem::exists(c)) {
       std::ifstream f(c);
-      config.update_from_json(std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()), c);
+      config.update_from_json(
+          std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()), c);
     } else {
       config.update_from_json(c, "--config");
     }
@@ -51,7 +53,10 @@ nlohmann::json train_and_measure(riner::Reconstructor& r, const riner::Array& tr
   while (r.steps_done() < total) {
     r.step(std::min(every, total - r.steps_done()));
     const riner::ImageMetrics m = riner::compare_images(r.image(), truth);
-    curve->push_back({{"step", r.steps_done()}, {"seconds", r.stats().seconds}, {"psnr", m.psnr}, {"ssim", m.ssim}});
+    curve->push_back({{"step", r.steps_done()},
+                      {"seconds", r.stats().seconds},
+                      {"psnr", m.psnr},
+                      {"ssim", m.ssim}});
   }
   return curve->empty() ? nlohmann::json() : curve->back();
 }
@@ -71,7 +76,8 @@ std::vector<Result> riner_deeplesion(const Options& o) {
   std::vector<Result> results;
   for (int slice = first; slice <= last; ++slice) {
     const std::filesystem::path path = dir + "/slice_" + std::to_string(slice) + ".nii";
-    if (!std::filesystem::exists(path)) throw std::runtime_error(path.string() + " not found (--data=DIR)");
+    if (!std::filesystem::exists(path))
+      throw std::runtime_error(path.string() + " not found (--data=DIR)");
     riner::Array truth = riner::read_array(path).array;
     for (float& v : truth.data) v *= 0.1f;  // 1/cm -> 1/mm (METHOD.md section 4)
     riner::RingModel model;
@@ -80,9 +86,10 @@ std::vector<Result> riner_deeplesion(const Options& o) {
     const riner::Array fbp_image = riner::fbp(sim.scan, fbp_options);
     const riner::ImageMetrics fbp = riner::compare_images(fbp_image, truth);
 
-    riner::Reconstructor r(sim.scan, config, config.engine == riner::Engine::kOpenCL
-                                                 ? std::optional<riner::Device>(device)
-                                                 : std::nullopt);
+    riner::Reconstructor r(sim.scan, config,
+                           config.engine == riner::Engine::kOpenCL
+                               ? std::optional<riner::Device>(device)
+                               : std::nullopt);
     std::vector<nlohmann::json> curve;
     train_and_measure(r, truth, every, &curve);
     const riner::Array image = r.image();
@@ -104,7 +111,9 @@ std::vector<Result> riner_deeplesion(const Options& o) {
       double clean_mean = 0.0;
       for (std::size_t v = 0; v < g.n_views(); ++v) clean_mean += sim.clean(v, e);
       clean_mean /= static_cast<double>(g.n_views());
-      dead.push_back({{"element", e}, {"beta", beta.data[e]}, {"flagged", beta.data[e] < 0.5f},
+      dead.push_back({{"element", e},
+                      {"beta", beta.data[e]},
+                      {"flagged", beta.data[e] < 0.5f},
                       {"clean_mean", clean_mean}});
     }
     const riner::TrainingStats st = r.stats();
@@ -136,8 +145,8 @@ std::vector<Result> riner_deeplesion(const Options& o) {
                         {"engine", st.engine},
                         {"curve", curve},
                         {"config", nlohmann::json::parse(config.to_json())}}});
-    std::fprintf(stderr, "slice %d: PSNR %.2f SSIM %.4f (FBP %.2f) in %.1fs\n", slice, m.psnr, m.ssim, fbp.psnr,
-                 st.seconds);
+    std::fprintf(stderr, "slice %d: PSNR %.2f SSIM %.4f (FBP %.2f) in %.1fs\n", slice, m.psnr,
+                 m.ssim, fbp.psnr, st.seconds);
   }
   return results;
 }
@@ -171,12 +180,71 @@ std::vector<Result> riner_parallel_shepp_logan(const Options& o) {
   train_and_measure(r, truth, std::stoi(option(o, "checkpoint", "2000")), &curve);
   const riner::ImageMetrics m = riner::compare_images(r.image(), truth);
   return {{"riner_parallel_shepp_logan",
-           {{"psnr", m.psnr}, {"ssim", m.ssim}, {"fbp_psnr", fbp.psnr}, {"fbp_ssim", fbp.ssim},
-            {"seconds", r.stats().seconds}, {"curve", curve}}}};
+           {{"psnr", m.psnr},
+            {"ssim", m.ssim},
+            {"fbp_psnr", fbp.psnr},
+            {"fbp_ssim", fbp.ssim},
+            {"seconds", r.stats().seconds},
+            {"curve", curve}}}};
 }
 
 }  // namespace
 
-RINER_BENCH_CASE(riner_deeplesion, "Riner vs FBP on the paper protocol (DeepLesion slices)", riner_deeplesion);
+RINER_BENCH_CASE(riner_deeplesion, "Riner vs FBP on the paper protocol (DeepLesion slices)",
+                 riner_deeplesion);
 RINER_BENCH_CASE(riner_parallel_shepp_logan, "Riner on a parallel-beam Shepp-Logan ring scan",
                  riner_parallel_shepp_logan);
+
+namespace {
+
+// A real scan (neutron360 by default): FBP and Riner side by side, ring index of each.
+std::vector<Result> riner_real_scan(const Options& o) {
+  const std::string scan_path = option(o, "scan", "../shared/data/neutron360/sino.npy");
+  const std::string png = option(o, "png", "");
+  riner::Scan scan = riner::load_scan(scan_path);
+  riner::Device device = riner::Device::open(o.device);
+  riner::FbpOptions fbp_options;
+  fbp_options.device = device;
+  const riner::Array fbp_image = riner::fbp(scan, fbp_options);
+  const riner::RinerConfig config = config_from(o);
+  riner::Reconstructor r(scan, config, device);
+  r.run();
+  const riner::Array image = r.image();
+  const riner::Array beta = r.beta();
+  int off = 0;
+  for (float b : beta.data) off += b < 0.5f;
+  if (!png.empty()) {
+    // FBP | Riner at the same window (FBP's percentiles), then the central quarter enlarged.
+    const std::size_t ny = image.shape[0], nx = image.shape[1];
+    riner::Array panel({ny, 2 * nx});
+    for (std::size_t i = 0; i < ny; ++i) {
+      for (std::size_t k = 0; k < nx; ++k) {
+        panel(i, k) = fbp_image(i, k);
+        panel(i, nx + k) = image(i, k);
+      }
+    }
+    const riner::Window w = riner::percentile_window(fbp_image, 1.0, 99.5);
+    riner::write_png(png + "_fbp_riner.png", panel, w);
+    const std::size_t h = ny / 4, c0 = ny / 2 - h / 2, c1 = nx / 2 - h / 2;
+    riner::Array zoom({2 * h, 4 * h});
+    for (std::size_t i = 0; i < 2 * h; ++i) {
+      for (std::size_t k = 0; k < 4 * h; ++k) {
+        const riner::Array& src = k < 2 * h ? fbp_image : image;
+        zoom(i, k) = src(c0 + i / 2, c1 + (k % (2 * h)) / 2);
+      }
+    }
+    riner::write_png(png + "_fbp_riner_centre.png", zoom, w);
+  }
+  return {{"riner_real_scan",
+           {{"scan", scan_path},
+            {"fbp_ring_index", riner::ring_index(fbp_image)},
+            {"riner_ring_index", riner::ring_index(image)},
+            {"elements_switched_off", off},
+            {"seconds", r.stats().seconds},
+            {"steps", r.stats().steps}}}};
+}
+
+}  // namespace
+
+RINER_BENCH_CASE(riner_real_scan, "FBP and Riner on a real scan (ring index, PNG pair)",
+                 riner_real_scan);

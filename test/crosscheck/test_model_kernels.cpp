@@ -31,7 +31,8 @@ std::vector<float> uniform(std::size_t n, float lo, float hi, std::uint64_t salt
 
 // Positions at least 1e-3 cells from every level's cell boundaries: float (device) and double
 // (reference) must pick the same cells.
-std::vector<float> safe_positions(const riner::model::ParameterLayout& l, std::size_t n, std::uint64_t salt) {
+std::vector<float> safe_positions(const riner::model::ParameterLayout& l, std::size_t n,
+                                  std::uint64_t salt) {
   std::vector<float> out;
   std::vector<float> candidates = uniform(n * l.dims * 4, 0.0f, 1.0f, salt);
   for (std::size_t i = 0; i + l.dims <= candidates.size() && out.size() < n * l.dims; i += l.dims) {
@@ -43,7 +44,9 @@ std::vector<float> safe_positions(const riner::model::ParameterLayout& l, std::s
         ok = ok && frac > 1e-3 && frac < 1.0 - 1e-3;
       }
     }
-    if (ok) out.insert(out.end(), candidates.begin() + static_cast<long>(i), candidates.begin() + static_cast<long>(i + l.dims));
+    if (ok)
+      out.insert(out.end(), candidates.begin() + static_cast<long>(i),
+                 candidates.begin() + static_cast<long>(i + l.dims));
   }
   REQUIRE(out.size() == n * l.dims);
   return out;
@@ -65,20 +68,24 @@ TEST_SUITE("model_kernels") {
       riner::ops::HashGridOp op(ctx(), l);
       op.forward(d_params, d_positions, d_features);
       // Sums of 2^dims products in fp32: ~1e-7 relative.
-      const auto forward = riner::test::compare(d_features.read(), riner::ref::hash_grid_forward(l, params, positions));
+      const auto forward = riner::test::compare(
+          d_features.read(), riner::ref::hash_grid_forward(l, params, positions));
       CHECK_MESSAGE(forward.rms_rel < 1e-5, forward.describe());
       const std::vector<float> d_out = uniform(n * l.inputs, -1.0f, 1.0f, 12);
-      riner::cl::Buffer<float> d_grad(ctx(), std::span<const float>(std::vector<float>(l.total, 0.0f)));
+      riner::cl::Buffer<float> d_grad(ctx(),
+                                      std::span<const float>(std::vector<float>(l.total, 0.0f)));
       riner::cl::Buffer<float> d_dout(ctx(), std::span<const float>(d_out));
       op.backward(d_positions, d_dout, d_grad);
       // Float atomics in arbitrary order over ~777 points: 1e-5 relative is ample.
-      const auto backward = riner::test::compare(d_grad.read(), riner::ref::hash_grid_backward(l, positions, d_out));
+      const auto backward =
+          riner::test::compare(d_grad.read(), riner::ref::hash_grid_backward(l, positions, d_out));
       CHECK_MESSAGE(backward.rms_rel < 1e-4, backward.describe());
     }
   }
 
   TEST_CASE("MLP forward and backward, widths 16 and 48, one to three hidden layers") {
-    for (const riner::NetworkConfig net : {riner::NetworkConfig{16, 1}, riner::NetworkConfig{48, 3}}) {
+    for (const riner::NetworkConfig net :
+         {riner::NetworkConfig{16, 1}, riner::NetworkConfig{48, 3}}) {
       CAPTURE(net.width);
       const auto l = riner::model::make_layout(2, {5, 2, 10, 4, 32}, net, 1);
       std::vector<float> params = riner::model::initial_parameters(l, 3);
@@ -89,15 +96,18 @@ TEST_SUITE("model_kernels") {
       riner::cl::Buffer<float> d_out(ctx(), n);
       riner::ops::MlpOp op(ctx(), l);
       op.forward(d_params, d_inputs, d_out);
-      const auto forward = riner::test::compare(d_out.read(), riner::ref::mlp_forward_batch(l, params, inputs));
+      const auto forward =
+          riner::test::compare(d_out.read(), riner::ref::mlp_forward_batch(l, params, inputs));
       CHECK_MESSAGE(forward.rms_rel < 1e-5, forward.describe());
       const std::vector<float> d_outputs = uniform(n, -1.0f, 1.0f, 21);
       riner::cl::Buffer<float> d_dout(ctx(), std::span<const float>(d_outputs));
-      riner::cl::Buffer<float> d_grad(ctx(), std::span<const float>(std::vector<float>(l.total, 0.0f)));
+      riner::cl::Buffer<float> d_grad(ctx(),
+                                      std::span<const float>(std::vector<float>(l.total, 0.0f)));
       riner::cl::Buffer<float> d_din(ctx(), n * l.inputs);
       op.backward(d_params, d_inputs, d_dout, d_grad, d_din);
       std::vector<double> ref_din;
-      const std::vector<double> ref_grad = riner::ref::mlp_backward_batch(l, params, inputs, d_outputs, &ref_din);
+      const std::vector<double> ref_grad =
+          riner::ref::mlp_backward_batch(l, params, inputs, d_outputs, &ref_din);
       const auto grad = riner::test::compare(d_grad.read(), ref_grad);
       CHECK_MESSAGE(grad.rms_rel < 1e-4, grad.describe());
       const auto din = riner::test::compare(d_din.read(), ref_din);
@@ -122,20 +132,26 @@ TEST_SUITE("model_kernels") {
     alpha0[2] = -0.5f;  // clamped to 1e-8: no alpha gradient
     const std::vector<float> beta0 = uniform(elements, -2.0f, 2.0f, 35);
     riner::cl::Buffer<cl_uint> d_offsets(ctx(), std::span<const cl_uint>(offsets));
-    riner::cl::Buffer<float> d_mu(ctx(), std::span<const float>(mu)), d_dx(ctx(), std::span<const float>(dx));
+    riner::cl::Buffer<float> d_mu(ctx(), std::span<const float>(mu)),
+        d_dx(ctx(), std::span<const float>(dx));
     riner::cl::Buffer<cl_uint> d_elements(ctx(), std::span<const cl_uint>(element));
     riner::cl::Buffer<float> d_rho(ctx(), std::span<const float>(rho));
-    riner::cl::Buffer<float> d_alpha(ctx(), std::span<const float>(alpha0)), d_beta(ctx(), std::span<const float>(beta0));
+    riner::cl::Buffer<float> d_alpha(ctx(), std::span<const float>(alpha0)),
+        d_beta(ctx(), std::span<const float>(beta0));
     riner::cl::Buffer<float> d_dmu(ctx(), mu.size()), d_loss(ctx(), rays);
-    riner::cl::Buffer<float> g_alpha(ctx(), std::span<const float>(std::vector<float>(elements, 0.0f)));
-    riner::cl::Buffer<float> g_beta(ctx(), std::span<const float>(std::vector<float>(elements, 0.0f)));
+    riner::cl::Buffer<float> g_alpha(ctx(),
+                                     std::span<const float>(std::vector<float>(elements, 0.0f)));
+    riner::cl::Buffer<float> g_beta(ctx(),
+                                    std::span<const float>(std::vector<float>(elements, 0.0f)));
     riner::ops::RaySumOp op(ctx());
-    op.loss({&d_offsets, &d_dx, &d_elements, &d_rho}, d_mu, d_alpha, d_beta, 0.3f, d_dmu, d_loss, g_alpha, g_beta);
+    op.loss({&d_offsets, &d_dx, &d_elements, &d_rho}, d_mu, d_alpha, d_beta, 0.3f, d_dmu, d_loss,
+            g_alpha, g_beta);
     std::vector<double> loss(rays), dmu(mu.size()), ga(elements, 0.0), gb(elements, 0.0);
     for (std::size_t r = 0; r < rays; ++r) {
       double sum = 0.0;
       for (cl_uint k = offsets[r]; k < offsets[r + 1]; ++k) sum += mu[k];
-      const auto rl = riner::ref::ray_loss(sum * dx[r], alpha0[element[r]], beta0[element[r]], rho[r], 0.3);
+      const auto rl =
+          riner::ref::ray_loss(sum * dx[r], alpha0[element[r]], beta0[element[r]], rho[r], 0.3);
       loss[r] = rl.loss;
       for (cl_uint k = offsets[r]; k < offsets[r + 1]; ++k) dmu[k] = rl.d_sum * dx[r];
       ga[element[r]] += rl.d_alpha0;
@@ -161,8 +177,14 @@ TEST_SUITE("model_kernels") {
     rs.beta_learning_rate = 0.0;
     rs.beta2 = 0.99;
     rs.epsilon = 1e-15;
-    riner::ops::AdamSettings ds{rs.learning_rate, rs.alpha_offset, rs.alpha_learning_rate, rs.beta_offset,
-                                rs.beta_learning_rate, rs.beta1, rs.beta2, rs.epsilon};
+    riner::ops::AdamSettings ds{rs.learning_rate,
+                                rs.alpha_offset,
+                                rs.alpha_learning_rate,
+                                rs.beta_offset,
+                                rs.beta_learning_rate,
+                                rs.beta1,
+                                rs.beta2,
+                                rs.epsilon};
     std::vector<double> p(params.begin(), params.end()), m(n, 0.0), v(n, 0.0);
     riner::cl::Buffer<float> d_params(ctx(), std::span<const float>(params));
     riner::cl::Buffer<float> d_grad(ctx(), n * partials);

@@ -62,9 +62,11 @@ TEST_SUITE("riner_training") {
     const riner::Array mask = riner::circle_mask(t.truth.shape, 0.9);
     riner::FbpOptions fbp_options;
     fbp_options.device = riner::test::device();
-    const riner::ImageMetrics fbp = riner::compare_images(riner::fbp(t.scan, fbp_options), t.truth, &mask);
+    const riner::ImageMetrics fbp =
+        riner::compare_images(riner::fbp(t.scan, fbp_options), t.truth, &mask);
     const riner::ImageMetrics m = riner::compare_images(r.image(), t.truth, &mask);
-    MESSAGE("tiny parallel scan: Riner " << m.psnr << " dB, FBP " << fbp.psnr << " dB inside the circle");
+    MESSAGE("tiny parallel scan: Riner " << m.psnr << " dB, FBP " << fbp.psnr
+                                         << " dB inside the circle");
     CHECK(m.psnr > fbp.psnr + 3.0);
     const riner::Array beta = r.beta();
     int dead = 0;
@@ -99,14 +101,16 @@ TEST_SUITE("riner_training") {
     for (float& v : all_nan.measurement.data) v = NAN;
     all_nan.non_finite = all_nan.measurement.size();
     CHECK_THROWS_WITH_AS(riner::Reconstructor(all_nan, c, riner::test::device()),
-                         doctest::Contains("all 4500 values are NaN or infinite"), riner::InputError);
+                         doctest::Contains("all 4500 values are NaN or infinite"),
+                         riner::InputError);
     riner::RinerConfig bad = c;
     bad.network.width = 20;
     CHECK_THROWS_AS(riner::Reconstructor(t.scan, bad, riner::test::device()), riner::InputError);
     riner::Scan offside = t.scan;
     offside.geometry.offset_u = 500.0;  // every ray misses the grid
     CHECK_THROWS_WITH_AS(riner::Reconstructor(offside, c, riner::test::device()),
-                         doctest::Contains("no detector ray crosses the reconstruction grid"), riner::InputError);
+                         doctest::Contains("no detector ray crosses the reconstruction grid"),
+                         riner::InputError);
   }
 
   TEST_CASE("zero steps leave the initial field; alpha and beta start at 1 and sigmoid(1)") {

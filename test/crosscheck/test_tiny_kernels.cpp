@@ -41,7 +41,8 @@ TEST_SUITE("tiny_kernels") {
     }
   }
 
-  TEST_CASE("Riner's training kernels on a tiny problem (mixed batches, ring prior, coarse to fine)") {
+  TEST_CASE(
+      "Riner's training kernels on a tiny problem (mixed batches, ring prior, coarse to fine)") {
     riner::test::TinyProblem t = riner::test::tiny_problem(3);
     riner::RinerConfig c = riner::test::tiny_config();
     c.encoding = {3, 2, 8, 4, 16};
@@ -59,7 +60,8 @@ TEST_SUITE("tiny_kernels") {
     reference.step(3);
     const auto a = device.history();
     const auto b = reference.history();
-    for (std::size_t i = 0; i < 3; ++i) CHECK(a[i].data_loss == doctest::Approx(b[i].data_loss).epsilon(1e-3));
+    for (std::size_t i = 0; i < 3; ++i)
+      CHECK(a[i].data_loss == doctest::Approx(b[i].data_loss).epsilon(1e-3));
     CHECK(riner::test::compare(device.image().data, reference.image().data).rms_rel < 1e-3);
   }
 }

@@ -61,4 +61,24 @@ TEST_SUITE("metrics") {
     CHECK_THROWS_AS(riner::compare_images(riner::Array({4, 4}), riner::Array({4, 4})),
                     riner::InputError);
   }
+
+  TEST_CASE("ring index: high for concentric rings, low for a smooth object") {
+    riner::Array smooth({64, 64});
+    riner::Array ringed({64, 64});
+    for (std::size_t i = 0; i < 64; ++i) {
+      for (std::size_t k = 0; k < 64; ++k) {
+        const double x = static_cast<double>(k) - 40.0;  // off-centre: not rotationally symmetric
+        const double y = static_cast<double>(i) - 30.0;
+        smooth(i, k) = static_cast<float>(std::exp(-(x * x + y * y) / 300.0));
+        const double r = std::hypot(static_cast<double>(i) - 31.5, static_cast<double>(k) - 31.5);
+        ringed(i, k) = smooth(i, k) + 0.2f * static_cast<float>(std::lround(r) % 2);
+      }
+    }
+    const double clean = riner::ring_index(smooth);
+    const double rings = riner::ring_index(ringed);
+    MESSAGE("ring index: smooth " << clean << ", ringed " << rings);
+    CHECK(clean < 0.01);
+    CHECK(rings > 0.05);
+    CHECK_THROWS_AS(riner::ring_index(riner::Array({4, 4, 4})), riner::InputError);
+  }
 }

@@ -37,7 +37,8 @@ TEST_SUITE("model_layout") {
     const auto l = riner::model::make_layout(2, {4, 2, 10, 4, 32}, {16, 1}, 7);
     const auto p = riner::model::initial_parameters(l, 42);
     for (std::size_t i = 0; i < l.grid_params; ++i) REQUIRE(std::fabs(p[i]) <= 1e-4f);
-    for (std::size_t i = l.w_in(); i < l.b_in(); ++i) REQUIRE(std::fabs(p[i]) <= 1.0f / std::sqrt(8.0f));
+    for (std::size_t i = l.w_in(); i < l.b_in(); ++i)
+      REQUIRE(std::fabs(p[i]) <= 1.0f / std::sqrt(8.0f));
     for (std::size_t e = 0; e < 7; ++e) {
       CHECK(p[l.alpha_offset + e] == 1.0f);
       CHECK(p[l.beta_offset + e] == 1.0f);

@@ -59,14 +59,16 @@ TEST_SUITE("reference_gradients") {
       plus[i] += h;
       minus[i] -= h;
       const double fd = (loss(plus) - loss(minus)) / (2.0 * h);
-      const double err = std::fabs(fd - r.grad[i]) / std::max(1e-4, std::fabs(fd) + std::fabs(r.grad[i]));
+      const double err =
+          std::fabs(fd - r.grad[i]) / std::max(1e-4, std::fabs(fd) + std::fabs(r.grad[i]));
       if (err > worst) {
         worst = err;
         worst_index = i;
       }
       ++checked;
     }
-    MESSAGE("checked " << checked << " parameters; worst relative error " << worst << " at " << worst_index);
+    MESSAGE("checked " << checked << " parameters; worst relative error " << worst << " at "
+                       << worst_index);
     CHECK(checked > 300);
     CHECK(worst < 1e-5);
   }

@@ -31,7 +31,8 @@ TEST_SUITE("riner_config") {
 
   TEST_CASE("partial JSON updates and precise errors") {
     riner::RinerConfig c;
-    c.update_from_json(R"({"network": {"width": 64}, "training": {"sampler": "mixed", "elements_per_step": 8}})");
+    c.update_from_json(
+        R"({"network": {"width": 64}, "training": {"sampler": "mixed", "elements_per_step": 8}})");
     CHECK(c.network.width == 64);
     CHECK(c.training.sampler == riner::Sampler::kMixed);
     CHECK(c.encoding.levels == 8);  // untouched
@@ -45,15 +46,20 @@ TEST_SUITE("riner_config") {
       }
     };
     expect(R"({"training": {"stepz": 3}})", "c.json: config: unknown setting training.stepz");
-    expect(R"({"network": {"width": 24}})", "config: network.width must be a multiple of 16 in 16..256");
-    expect(R"({"training": {"steps": "many"}})", "c.json: config: training.steps must be an integer");
-    expect(R"({"training": {"learning_rate": -1}})", "config: training.learning_rate must be in (0, 10)");
+    expect(R"({"network": {"width": 24}})",
+           "config: network.width must be a multiple of 16 in 16..256");
+    expect(R"({"training": {"steps": "many"}})",
+           "c.json: config: training.steps must be an integer");
+    expect(R"({"training": {"learning_rate": -1}})",
+           "config: training.learning_rate must be in (0, 10)");
     expect(R"({"training": {"sampler": "random"}})",
            "c.json: config: training.sampler must be uniform, views-x-elements or mixed");
     expect(R"({"training": {"ring_lambda": 1}})",
-           "config: training.ring_lambda needs the views-x-elements or mixed sampler with elements_per_step >= 3");
+           "config: training.ring_lambda needs the views-x-elements or mixed sampler with "
+           "elements_per_step >= 3");
     expect(R"({"encoding": {"finest_resolution": 8}})",
-           "config: encoding.finest_resolution must be >= base_resolution and <= 2^20");
+           "config: encoding.finest_resolution must be 0 (the grid's size) or >= base_resolution "
+           "and <= 2^20");
     expect(R"({"engine": "gpu"})", "c.json: engine must be opencl or reference (got \"gpu\")");
     expect("[1, 2]", "c.json: config: config must be an object");
   }

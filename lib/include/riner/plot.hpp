@@ -23,7 +23,7 @@ struct LinePlot {
   std::string y_label;
   std::vector<PlotSeries> series;
   std::vector<std::pair<double, std::string>> horizontal_lines;  // y value, label (dashed grey)
-  double y_min = 0.0;  // both 0: from the data
+  double y_min = 0.0;                                            // both 0: from the data
   double y_max = 0.0;
   int width = 900;
   int height = 420;

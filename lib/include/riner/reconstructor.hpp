@@ -21,9 +21,9 @@
 namespace riner {
 
 struct LossRecord {
-  int step = 0;             // 0-based
-  double data_loss = 0.0;   // the L1 data term of the step's batch
-  double penalty = 0.0;     // lambda * sum(-beta^2) over the batch's elements
+  int step = 0;            // 0-based
+  double data_loss = 0.0;  // the L1 data term of the step's batch
+  double penalty = 0.0;    // lambda * sum(-beta^2) over the batch's elements
   double learning_rate = 0.0;
 };
 
@@ -39,13 +39,13 @@ using ProgressCallback = std::function<bool(const TrainingProgress&)>;
 
 struct TrainingStats {
   int steps = 0;
-  double seconds = 0.0;             // wall time inside step()/run()
-  double samples = 0.0;             // field evaluations trained on (forward + backward)
-  std::size_t non_finite = 0;       // measurements that were NaN/inf (treated as 0)
+  double seconds = 0.0;        // wall time inside step()/run()
+  double samples = 0.0;        // field evaluations trained on (forward + backward)
+  std::size_t non_finite = 0;  // measurements that were NaN/inf (treated as 0)
   std::size_t parameters = 0;
   std::string engine;
-  std::string device;               // device name, or "CPU reference"
-  std::string gradient_mode;        // "partitioned" (per-lane partial gradients) or "atomic"
+  std::string device;         // device name, or "CPU reference"
+  std::string gradient_mode;  // "partitioned" (per-lane partial gradients) or "atomic"
 };
 
 class Reconstructor {

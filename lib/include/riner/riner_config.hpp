@@ -19,7 +19,7 @@ struct EncodingConfig {
   int features = 2;  // per level
   int log2_table_size = 18;
   int base_resolution = 16;
-  int finest_resolution = 256;
+  int finest_resolution = 0;  // 0: the grid's largest side (one vertex per voxel at the top)
 };
 
 // input (levels * features) -> [width, ReLU] x hidden_layers -> 1, linear output.
@@ -44,19 +44,19 @@ enum class Sampler {
 struct TrainingConfig {
   int steps = 12000;
   Sampler sampler = Sampler::kUniform;
-  int rays_per_step = 80;        // uniform sampler
-  int views_per_step = 40;       // views x elements sampler
-  int elements_per_step = 2;     // views x elements sampler: adjacent elements
-  double sample_spacing = 1.0;   // along each ray, in voxels (the paper's fixed interval)
-  bool jitter = false;           // stratified random offsets while training (midpoints if off)
-  bool circle_region = false;    // sample the inscribed circle instead of the whole grid
+  int rays_per_step = 80;       // uniform sampler
+  int views_per_step = 40;      // views x elements sampler
+  int elements_per_step = 2;    // views x elements sampler: adjacent elements
+  double sample_spacing = 1.0;  // along each ray, in voxels (the paper's fixed interval)
+  bool jitter = false;          // stratified random offsets while training (midpoints if off)
+  bool circle_region = false;   // sample the inscribed circle instead of the whole grid
   double learning_rate = 1e-3;
-  int lr_decay_steps = 3000;     // the rate is multiplied by lr_decay every this many steps
+  int lr_decay_steps = 3000;  // the rate is multiplied by lr_decay every this many steps
   double lr_decay = 0.5;
   double adam_beta1 = 0.9;
   double adam_beta2 = 0.99;
   double adam_epsilon = 1e-15;
-  double lambda = 0.01;          // weight of the -beta^2 term
+  double lambda = 0.01;  // weight of the -beta^2 term
   // alpha0 and beta0 learn at learning_rate times these scales, and stay at their initial
   // values for their first warm-up steps (beta: while the image is still far off every
   // element's residual is large, and beta would switch live elements off).
@@ -79,8 +79,8 @@ struct TrainingConfig {
   // 0.2, above what alpha errors leave on live elements, below a dead element's.
   double data_weight = 0.2;
   // When > 0, the balance is relative instead: an element is pushed off when the mean mismatch
-  // of its rays exceeds this many times the batch's median ray mismatch (the data term's
-  // gradients are rescaled per step, which Adam does not see except against the penalty).
+  // of its rays exceeds this many times the batch's median ray mismatch (lambda becomes
+  // data_weight * relative_beta_threshold * median / 2, step by step).
   double relative_beta_threshold = 0.0;
   std::uint64_t seed = 0;
 };

@@ -74,14 +74,15 @@ class Buffer {
     return host;
   }
   // Device-side copy of count elements (all by default) into dst at dst_offset; asynchronous.
-  void copy_to(Buffer<T>& dst, std::size_t dst_offset, std::size_t count = static_cast<std::size_t>(-1)) const {
+  void copy_to(Buffer<T>& dst, std::size_t dst_offset,
+               std::size_t count = static_cast<std::size_t>(-1)) const {
     if (count == static_cast<std::size_t>(-1)) count = count_;
     if (count > count_ || dst_offset > dst.size() || count > dst.size() - dst_offset) {
       throw Error("buffer copy of " + std::to_string(count) + " elements does not fit");
     }
     if (count == 0) return;
-    RINER_CL_CALL(clEnqueueCopyBuffer, context_->queue(), mem_.get(), dst.get(), 0, dst_offset * sizeof(T),
-                  count * sizeof(T), 0, nullptr, nullptr);
+    RINER_CL_CALL(clEnqueueCopyBuffer, context_->queue(), mem_.get(), dst.get(), 0,
+                  dst_offset * sizeof(T), count * sizeof(T), 0, nullptr, nullptr);
   }
   void fill(const T& value) {
     if (count_ == 0) return;

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "riner/error.hpp"
+#include "riner/io.hpp"
 
 namespace riner {
 
@@ -165,6 +166,46 @@ ImageMetrics compare_images(const Array& image, const Array& reference, const Ar
                      : std::numeric_limits<double>::infinity();
   m.ssim = ssim_mean(image, reference, mask, m.data_range);
   return m;
+}
+
+double ring_index(const Array& image) {
+  if (image.rank() != 2) throw InputError("the ring index takes a 2D image");
+  const std::size_t ny = image.shape[0];
+  const std::size_t nx = image.shape[1];
+  const double cy = 0.5 * (ny - 1.0);
+  const double cx = 0.5 * (nx - 1.0);
+  const auto bins = static_cast<std::size_t>(0.5 * static_cast<double>(std::min(nx, ny)));
+  if (bins < 8) throw InputError("the ring index needs an image of at least 16 x 16");
+  std::vector<double> sum(bins, 0.0);
+  std::vector<double> count(bins, 0.0);
+  for (std::size_t i = 0; i < ny; ++i) {
+    for (std::size_t k = 0; k < nx; ++k) {
+      const auto r = static_cast<std::size_t>(
+          std::lround(std::hypot(static_cast<double>(i) - cy, static_cast<double>(k) - cx)));
+      if (r >= bins || !std::isfinite(image(i, k))) continue;
+      sum[r] += image(i, k);
+      count[r] += 1.0;
+    }
+  }
+  // Radii no pixel centre rounds to (0 on an even grid) are left out, not taken as 0.
+  std::vector<double> profile;
+  for (std::size_t r = 0; r < bins; ++r) {
+    if (count[r] > 0) profile.push_back(sum[r] / count[r]);
+  }
+  double residual = 0.0;
+  const std::size_t n = profile.size();
+  for (std::size_t r = 0; r < n; ++r) {
+    std::vector<double> window;
+    for (std::size_t k = r >= 3 ? r - 3 : 0; k <= std::min(n - 1, r + 3); ++k)
+      window.push_back(profile[k]);
+    std::nth_element(window.begin(), window.begin() + static_cast<long>(window.size() / 2),
+                     window.end());
+    const double d = profile[r] - window[window.size() / 2];
+    residual += d * d;
+  }
+  const Window w = percentile_window(image, 1.0, 99.0);
+  return std::sqrt(residual / static_cast<double>(n)) /
+         std::max(1e-12, static_cast<double>(w.hi - w.lo));
 }
 
 double psnr(const Array& image, const Array& reference, double data_range) {

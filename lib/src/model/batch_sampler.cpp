@@ -12,7 +12,8 @@ namespace {
 
 std::uint32_t draw(std::uint32_t seed, std::uint32_t step, std::uint32_t i, std::uint32_t n) {
   // 32-bit hash times n, high word: unbiased enough for n << 2^32 and identical everywhere.
-  return static_cast<std::uint32_t>((static_cast<std::uint64_t>(hash_keys(kBatchStream, seed, step, i)) * n) >> 32);
+  return static_cast<std::uint32_t>(
+      (static_cast<std::uint64_t>(hash_keys(kBatchStream, seed, step, i)) * n) >> 32);
 }
 
 }  // namespace
@@ -30,9 +31,12 @@ std::size_t BatchSampler::rays_per_step() const {
   const auto uniform = static_cast<std::size_t>(config_.rays_per_step);
   const auto block = static_cast<std::size_t>(config_.views_per_step) * config_.elements_per_step;
   switch (config_.sampler) {
-    case Sampler::kUniform: return uniform;
-    case Sampler::kViewsTimesElements: return block;
-    case Sampler::kMixed: return uniform + block;
+    case Sampler::kUniform:
+      return uniform;
+    case Sampler::kViewsTimesElements:
+      return block;
+    case Sampler::kMixed:
+      return uniform + block;
   }
   return 0;
 }
@@ -55,7 +59,8 @@ Batch BatchSampler::batch(std::uint32_t step) const {
     // One run of adjacent elements (in one detector row) shared by all the step's views.
     const auto e = static_cast<std::uint32_t>(config_.elements_per_step);
     const std::uint32_t row = draw(seed, step, 0x7fffffffu, static_cast<std::uint32_t>(rows_));
-    const std::uint32_t first = draw(seed, step, 0x7ffffffeu, static_cast<std::uint32_t>(n_u_ - e + 1));
+    const std::uint32_t first =
+        draw(seed, step, 0x7ffffffeu, static_cast<std::uint32_t>(n_u_ - e + 1));
     for (int i = 0; i < config_.views_per_step; ++i) {
       // Keys above the uniform part's, so the two parts draw independently.
       const std::uint32_t view = draw(seed, step, 0x40000000u + static_cast<std::uint32_t>(i),
@@ -64,7 +69,8 @@ Batch BatchSampler::batch(std::uint32_t step) const {
         b.rays.push_back(static_cast<std::uint32_t>(view * per_view + row * n_u_ + first + k));
       }
     }
-    for (std::uint32_t k = 0; k < e; ++k) b.elements.push_back(static_cast<std::uint32_t>(row * n_u_ + first + k));
+    for (std::uint32_t k = 0; k < e; ++k)
+      b.elements.push_back(static_cast<std::uint32_t>(row * n_u_ + first + k));
   }
   std::sort(b.elements.begin(), b.elements.end());
   b.elements.erase(std::unique(b.elements.begin(), b.elements.end()), b.elements.end());
@@ -72,9 +78,12 @@ Batch BatchSampler::batch(std::uint32_t step) const {
   if (config_.data_term == DataTerm::kElementMean) {
     std::unordered_map<std::uint32_t, int> rays_of;
     for (std::uint32_t r : b.rays) ++rays_of[static_cast<std::uint32_t>(r % per_view)];
-    for (std::uint32_t r : b.rays) b.weights.push_back(static_cast<float>(c / rays_of[static_cast<std::uint32_t>(r % per_view)]));
+    for (std::uint32_t r : b.rays)
+      b.weights.push_back(
+          static_cast<float>(c / rays_of[static_cast<std::uint32_t>(r % per_view)]));
   } else {
-    const double w = config_.data_term == DataTerm::kMean ? c / static_cast<double>(b.rays.size()) : c;
+    const double w =
+        config_.data_term == DataTerm::kMean ? c / static_cast<double>(b.rays.size()) : c;
     b.weights.assign(b.rays.size(), static_cast<float>(w));
   }
   return b;

@@ -23,7 +23,9 @@ constexpr std::uint32_t hash_keys(std::uint32_t a, std::uint32_t b, std::uint32_
 }
 
 // Uniform in [0, 1) with 24 bits: exactly representable in float on both sides.
-constexpr float uniform24(std::uint32_t h) { return static_cast<float>(h >> 8) * (1.0f / 16777216.0f); }
+constexpr float uniform24(std::uint32_t h) {
+  return static_cast<float>(h >> 8) * (1.0f / 16777216.0f);
+}
 
 // Streams keyed in hash_keys' first slot.
 enum Stream : std::uint32_t { kInitStream = 1, kBatchStream = 2, kJitterStream = 3 };

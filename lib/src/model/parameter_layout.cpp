@@ -25,12 +25,11 @@ ParameterLayout make_layout(int dims, const EncodingConfig& encoding, const Netw
   l.width = network.width;
   l.hidden_layers = network.hidden_layers;
   // b such that the last level's scale + 1 is the finest resolution (instant-NGP's b).
-  const double growth =
-      encoding.levels > 1
-          ? std::exp((std::log(static_cast<double>(encoding.finest_resolution)) -
-                      std::log(static_cast<double>(encoding.base_resolution))) /
-                     (encoding.levels - 1))
-          : 1.0;
+  const double growth = encoding.levels > 1
+                            ? std::exp((std::log(static_cast<double>(encoding.finest_resolution)) -
+                                        std::log(static_cast<double>(encoding.base_resolution))) /
+                                       (encoding.levels - 1))
+                            : 1.0;
   std::size_t offset = 0;
   for (int level = 0; level < encoding.levels; ++level) {
     GridLevel g{};
@@ -49,13 +48,15 @@ ParameterLayout make_layout(int dims, const EncodingConfig& encoding, const Netw
   l.grid_params = offset;
   l.mlp_offset = offset;
   l.mlp_params = static_cast<std::size_t>(l.inputs) * l.width + l.width +
-                 static_cast<std::size_t>(l.hidden_layers - 1) * (static_cast<std::size_t>(l.width) * l.width + l.width) +
+                 static_cast<std::size_t>(l.hidden_layers - 1) *
+                     (static_cast<std::size_t>(l.width) * l.width + l.width) +
                  l.width + 1;
   l.alpha_offset = l.mlp_offset + l.mlp_params;
   l.beta_offset = l.alpha_offset + elements;
   l.elements = elements;
   l.total = l.beta_offset + elements;
-  if (l.total >= (std::size_t{1} << 32)) throw InputError("the model has more than 2^32 parameters");
+  if (l.total >= (std::size_t{1} << 32))
+    throw InputError("the model has more than 2^32 parameters");
   return l;
 }
 
@@ -67,14 +68,16 @@ std::vector<float> initial_parameters(const ParameterLayout& l, std::uint64_t se
     return bound * (2.0f * u - 1.0f);
   };
   for (std::size_t i = 0; i < l.grid_params; ++i) p[i] = uniform(i, 1e-4f);
-  auto linear = [&](std::size_t weights, std::size_t count, std::size_t bias, std::size_t bias_count, int fan_in) {
+  auto linear = [&](std::size_t weights, std::size_t count, std::size_t bias,
+                    std::size_t bias_count, int fan_in) {
     const float bound = 1.0f / std::sqrt(static_cast<float>(fan_in));
     for (std::size_t i = 0; i < count; ++i) p[weights + i] = uniform(weights + i, bound);
     for (std::size_t i = 0; i < bias_count; ++i) p[bias + i] = uniform(bias + i, bound);
   };
   linear(l.w_in(), static_cast<std::size_t>(l.inputs) * l.width, l.b_in(), l.width, l.inputs);
   for (int h = 1; h < l.hidden_layers; ++h) {
-    linear(l.w_hidden(h), static_cast<std::size_t>(l.width) * l.width, l.b_hidden(h), l.width, l.width);
+    linear(l.w_hidden(h), static_cast<std::size_t>(l.width) * l.width, l.b_hidden(h), l.width,
+           l.width);
   }
   linear(l.w_out(), l.width, l.b_out(), 1, l.width);
   for (std::size_t e = 0; e < l.elements; ++e) {

@@ -15,10 +15,10 @@ namespace riner::model {
 
 // Host mirror of GridLevel in kernels/hash_grid.cl (four 4-byte members).
 struct GridLevel {
-  float scale;              // positions map to x * scale + 0.5 in grid units
-  std::uint32_t resolution; // vertices per axis
-  std::uint32_t offset;     // first float of the level in the parameter buffer
-  std::uint32_t hashed;     // 1: index = spatial hash mod table size; 0: dense
+  float scale;               // positions map to x * scale + 0.5 in grid units
+  std::uint32_t resolution;  // vertices per axis
+  std::uint32_t offset;      // first float of the level in the parameter buffer
+  std::uint32_t hashed;      // 1: index = spatial hash mod table size; 0: dense
 };
 static_assert(sizeof(GridLevel) == 16);
 
@@ -43,7 +43,9 @@ struct ParameterLayout {
   std::size_t w_in() const { return mlp_offset; }
   std::size_t b_in() const { return w_in() + static_cast<std::size_t>(inputs) * width; }
   std::size_t w_hidden(int layer) const;  // layer = 1 .. hidden_layers - 1
-  std::size_t b_hidden(int layer) const { return w_hidden(layer) + static_cast<std::size_t>(width) * width; }
+  std::size_t b_hidden(int layer) const {
+    return w_hidden(layer) + static_cast<std::size_t>(width) * width;
+  }
   std::size_t w_out() const;
   std::size_t b_out() const { return w_out() + static_cast<std::size_t>(width); }
 };

@@ -32,9 +32,11 @@ std::vector<RaySegment> ray_segments(const Geometry& g, double spacing_mm, bool 
     out = RaySegment{};
     if (s.empty()) continue;
     const double length = s.length();
-    const auto count = static_cast<std::uint32_t>(std::max(1.0, std::ceil(length / spacing_mm - 1e-9)));
+    const auto count =
+        static_cast<std::uint32_t>(std::max(1.0, std::ceil(length / spacing_mm - 1e-9)));
     const double dx = length / count;
-    const double p[3] = {ray.origin.x + s.enter * ray.direction.x, ray.origin.y + s.enter * ray.direction.y,
+    const double p[3] = {ray.origin.x + s.enter * ray.direction.x,
+                         ray.origin.y + s.enter * ray.direction.y,
                          ray.origin.z + s.enter * ray.direction.z};
     const double d[3] = {ray.direction.x, ray.direction.y, ray.direction.z};
     for (int a = 0; a < 3; ++a) {

@@ -15,9 +15,9 @@ namespace riner::model {
 
 // Host mirror of the float8 a kernel reads per ray.
 struct RaySegment {
-  float start[3];  // normalised position where the sampled part begins
-  float step[3];   // normalised advance per sample
-  float dx;        // mm per sample: the ray sum is sum(mu) * dx
+  float start[3];       // normalised position where the sampled part begins
+  float step[3];        // normalised advance per sample
+  float dx;             // mm per sample: the ray sum is sum(mu) * dx
   std::uint32_t count;  // samples (0: the ray misses the region)
 };
 static_assert(sizeof(RaySegment) == 32);

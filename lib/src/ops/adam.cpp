@@ -25,7 +25,8 @@ void AdamOp::reset() {
   v_.write(zeros);
 }
 
-void AdamOp::step(const AdamSettings& s, int step, cl::Buffer<float>& params, cl::Buffer<float>& partials) {
+void AdamOp::step(const AdamSettings& s, int step, cl::Buffer<float>& params,
+                  cl::Buffer<float>& partials) {
   if (params.size() != n_params_ || partials.size() != n_params_ * n_partials_) {
     throw Error("adam_step: buffer sizes do not match");
   }

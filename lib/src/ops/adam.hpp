@@ -26,7 +26,8 @@ class AdamOp {
   AdamOp(cl::Context& context, std::size_t n_params, std::size_t n_partials);
 
   // step counts from 1; partials holds n_partials gradients of n_params each (zeroed after).
-  void step(const AdamSettings& settings, int step, cl::Buffer<float>& params, cl::Buffer<float>& partials);
+  void step(const AdamSettings& settings, int step, cl::Buffer<float>& params,
+            cl::Buffer<float>& partials);
 
   // Back to fresh moments.
   void reset();

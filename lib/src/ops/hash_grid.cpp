@@ -16,7 +16,8 @@ HashGridOp::HashGridOp(cl::Context& context, const model::ParameterLayout& layou
 void HashGridOp::forward(const cl::Buffer<float>& params, const cl::Buffer<float>& positions,
                          cl::Buffer<float>& features) {
   const auto n = static_cast<cl_uint>(positions.size() / layout_.dims);
-  if (features.size() != n * static_cast<std::size_t>(layout_.inputs) || params.size() < layout_.grid_params) {
+  if (features.size() != n * static_cast<std::size_t>(layout_.inputs) ||
+      params.size() < layout_.grid_params) {
     throw Error("hash_grid_forward: buffer sizes do not match the layout");
   }
   forward_.set_args(n, levels_, params, positions, features);
@@ -26,7 +27,8 @@ void HashGridOp::forward(const cl::Buffer<float>& params, const cl::Buffer<float
 void HashGridOp::backward(const cl::Buffer<float>& positions, const cl::Buffer<float>& d_features,
                           cl::Buffer<float>& grad) {
   const auto n = static_cast<cl_uint>(positions.size() / layout_.dims);
-  if (d_features.size() != n * static_cast<std::size_t>(layout_.inputs) || grad.size() < layout_.grid_params) {
+  if (d_features.size() != n * static_cast<std::size_t>(layout_.inputs) ||
+      grad.size() < layout_.grid_params) {
     throw Error("hash_grid_backward: buffer sizes do not match the layout");
   }
   backward_.set_args(n, levels_, positions, d_features, grad);

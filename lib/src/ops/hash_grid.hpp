@@ -15,9 +15,11 @@ class HashGridOp {
   HashGridOp(cl::Context& context, const model::ParameterLayout& layout);
 
   // features [n][inputs] of positions [n][dims], reading the tables in params.
-  void forward(const cl::Buffer<float>& params, const cl::Buffer<float>& positions, cl::Buffer<float>& features);
+  void forward(const cl::Buffer<float>& params, const cl::Buffer<float>& positions,
+               cl::Buffer<float>& features);
   // grad += the gradient of sum(d_features * features) (grad is not cleared).
-  void backward(const cl::Buffer<float>& positions, const cl::Buffer<float>& d_features, cl::Buffer<float>& grad);
+  void backward(const cl::Buffer<float>& positions, const cl::Buffer<float>& d_features,
+                cl::Buffer<float>& grad);
 
  private:
   cl::Context& context_;

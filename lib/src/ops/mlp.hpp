@@ -15,11 +15,13 @@ class MlpOp {
   MlpOp(cl::Context& context, const model::ParameterLayout& layout);
 
   // outputs [n] of inputs [n][inputs]; params is the whole parameter buffer.
-  void forward(const cl::Buffer<float>& params, const cl::Buffer<float>& inputs, cl::Buffer<float>& outputs);
+  void forward(const cl::Buffer<float>& params, const cl::Buffer<float>& inputs,
+               cl::Buffer<float>& outputs);
   // grad (whole buffer, not cleared) += weight gradient of sum(d_outputs * outputs);
   // d_inputs [n][inputs] = d_outputs * doutput/dinput.
   void backward(const cl::Buffer<float>& params, const cl::Buffer<float>& inputs,
-                const cl::Buffer<float>& d_outputs, cl::Buffer<float>& grad, cl::Buffer<float>& d_inputs);
+                const cl::Buffer<float>& d_outputs, cl::Buffer<float>& grad,
+                cl::Buffer<float>& d_inputs);
 
  private:
   cl::Context& context_;

@@ -12,6 +12,7 @@ namespace riner::ops {
 // "-D DIMS=2 -D N_LEVELS=8 ..."; atomic adds -D ATOMIC_GRADIENTS.
 std::string model_build_options(const model::ParameterLayout& layout, bool atomic_gradients);
 
-cl::Buffer<model::GridLevel> upload_levels(cl::Context& context, const model::ParameterLayout& layout);
+cl::Buffer<model::GridLevel> upload_levels(cl::Context& context,
+                                           const model::ParameterLayout& layout);
 
 }  // namespace riner::ops

@@ -24,29 +24,30 @@ RinerStepOp::RinerStepOp(cl::Context& context, const model::ParameterLayout& lay
 void RinerStepOp::step(const StepArgs& a, cl_uint n_lanes, const cl::Buffer<float>& params,
                        cl::Buffer<float>& grad, cl::Buffer<float>& loss) {
   const std::size_t gradients = atomic_ ? 1 : n_lanes;
-  if (params.size() != layout_.total || grad.size() != gradients * layout_.total || loss.size() < 2 ||
-      a.rays->size() < a.n_batch || sums_.size() < a.n_batch) {
+  if (params.size() != layout_.total || grad.size() != gradients * layout_.total ||
+      loss.size() < 2 || a.rays->size() < a.n_batch || sums_.size() < a.n_batch) {
     throw Error("riner_step: buffer sizes do not match the layout");
   }
   const auto mlp = static_cast<cl_uint>(layout_.mlp_offset);
   const auto jitter = static_cast<cl_int>(a.jitter);
   // Lanes are independent work-groups of one work-item: on a CPU each runs as plain code.
-  forward_.set_args(n_lanes, a.n_batch, *a.rays, *a.segments, levels_, *a.level_weights, params, mlp, a.seed,
-                    a.step, jitter, sums_);
+  forward_.set_args(n_lanes, a.n_batch, *a.rays, *a.segments, levels_, *a.level_weights, params,
+                    mlp, a.seed, a.step, jitter, sums_);
   context_.launch(forward_, n_lanes, 1);
   loss_.set_args(a.n_batch, *a.rays, sums_, *a.rho, *a.weights, a.elements_per_view, params,
-                 static_cast<cl_uint>(layout_.alpha_offset), static_cast<cl_uint>(layout_.beta_offset),
-                 a.n_elements, *a.elements, a.lambda, a.relative_threshold, a.data_weight, a.block_first,
-                 a.block_views, a.block_elements, a.ring_lambda, grad, d_sums_, loss, scratch_);
+                 static_cast<cl_uint>(layout_.alpha_offset),
+                 static_cast<cl_uint>(layout_.beta_offset), a.n_elements, *a.elements, a.lambda,
+                 a.relative_threshold, a.data_weight, a.block_first, a.block_views,
+                 a.block_elements, a.ring_lambda, grad, d_sums_, loss, scratch_);
   context_.launch(loss_, 1, 1);
   const auto stride = static_cast<cl_uint>(atomic_ ? 0 : layout_.total);
-  backward_.set_args(n_lanes, a.n_batch, *a.rays, *a.segments, levels_, *a.level_weights, params, grad, stride,
-                     mlp, a.seed, a.step, jitter, d_sums_);
+  backward_.set_args(n_lanes, a.n_batch, *a.rays, *a.segments, levels_, *a.level_weights, params,
+                     grad, stride, mlp, a.seed, a.step, jitter, d_sums_);
   context_.launch(backward_, n_lanes, 1);
 }
 
-void RinerStepOp::evaluate(cl_uint first, cl_uint n, const std::vector<std::size_t>& shape, float voxel_mm,
-                           float extent_mm, const cl::Buffer<float>& level_weights,
+void RinerStepOp::evaluate(cl_uint first, cl_uint n, const std::vector<std::size_t>& shape,
+                           float voxel_mm, float extent_mm, const cl::Buffer<float>& level_weights,
                            const cl::Buffer<float>& params, cl::Buffer<float>& out) {
   const std::size_t rank = shape.size();
   const auto nx = static_cast<cl_uint>(shape[rank - 1]);

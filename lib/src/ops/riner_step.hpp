@@ -35,17 +35,18 @@ struct StepArgs {
 class RinerStepOp {
  public:
   // atomic: one shared gradient (lanes = rays); otherwise lanes own partial gradients.
-  RinerStepOp(cl::Context& context, const model::ParameterLayout& layout, bool atomic, std::size_t max_batch);
+  RinerStepOp(cl::Context& context, const model::ParameterLayout& layout, bool atomic,
+              std::size_t max_batch);
 
   // Adds the step's gradient into grad (n_lanes partial gradients of layout.total each, or
   // one when atomic); loss[0] = data term, loss[1] = penalties.
-  void step(const StepArgs& args, cl_uint n_lanes, const cl::Buffer<float>& params, cl::Buffer<float>& grad,
-            cl::Buffer<float>& loss);
+  void step(const StepArgs& args, cl_uint n_lanes, const cl::Buffer<float>& params,
+            cl::Buffer<float>& grad, cl::Buffer<float>& loss);
 
   // out[first .. first + n) = mu at the centres of voxels of the grid [nz][ny][nx].
-  void evaluate(cl_uint first, cl_uint n, const std::vector<std::size_t>& volume_shape, float voxel_mm,
-                float extent_mm, const cl::Buffer<float>& level_weights, const cl::Buffer<float>& params,
-                cl::Buffer<float>& out);
+  void evaluate(cl_uint first, cl_uint n, const std::vector<std::size_t>& volume_shape,
+                float voxel_mm, float extent_mm, const cl::Buffer<float>& level_weights,
+                const cl::Buffer<float>& params, cl::Buffer<float>& out);
 
  private:
   cl::Context& context_;

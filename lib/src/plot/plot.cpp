@@ -18,22 +18,30 @@ struct Glyph {
   unsigned char rows[7];
 };
 constexpr Glyph kFont[] = {
-    {'0', {14, 17, 19, 21, 25, 17, 14}}, {'1', {4, 12, 4, 4, 4, 4, 14}},   {'2', {14, 17, 1, 2, 4, 8, 31}},
-    {'3', {30, 1, 1, 14, 1, 1, 30}},     {'4', {2, 6, 10, 18, 31, 2, 2}},  {'5', {31, 16, 30, 1, 1, 17, 14}},
-    {'6', {6, 8, 16, 30, 17, 17, 14}},   {'7', {31, 1, 2, 4, 8, 8, 8}},    {'8', {14, 17, 17, 14, 17, 17, 14}},
-    {'9', {14, 17, 17, 15, 1, 2, 12}},   {'.', {0, 0, 0, 0, 0, 12, 12}},   {'-', {0, 0, 0, 31, 0, 0, 0}},
-    {'+', {0, 4, 4, 31, 4, 4, 0}},       {'/', {1, 1, 2, 4, 8, 16, 16}},   {'(', {2, 4, 8, 8, 8, 4, 2}},
-    {')', {8, 4, 2, 2, 2, 4, 8}},        {':', {0, 12, 12, 0, 12, 12, 0}}, {'=', {0, 0, 31, 0, 31, 0, 0}},
-    {'%', {24, 25, 2, 4, 8, 19, 3}},     {',', {0, 0, 0, 0, 12, 4, 8}},    {'<', {2, 4, 8, 16, 8, 4, 2}},
-    {'>', {8, 4, 2, 1, 2, 4, 8}},        {'_', {0, 0, 0, 0, 0, 0, 31}},    {'a', {0, 0, 14, 1, 15, 17, 15}},
-    {'b', {16, 16, 30, 17, 17, 17, 30}}, {'c', {0, 0, 14, 16, 16, 17, 14}}, {'d', {1, 1, 15, 17, 17, 17, 15}},
-    {'e', {0, 0, 14, 17, 31, 16, 14}},   {'f', {6, 9, 8, 28, 8, 8, 8}},    {'g', {0, 15, 17, 17, 15, 1, 14}},
-    {'h', {16, 16, 22, 25, 17, 17, 17}}, {'i', {4, 0, 12, 4, 4, 4, 14}},   {'j', {2, 0, 6, 2, 2, 18, 12}},
-    {'k', {16, 16, 18, 20, 24, 20, 18}}, {'l', {12, 4, 4, 4, 4, 4, 14}},   {'m', {0, 0, 26, 21, 21, 17, 17}},
-    {'n', {0, 0, 22, 25, 17, 17, 17}},   {'o', {0, 0, 14, 17, 17, 17, 14}}, {'p', {0, 0, 30, 17, 30, 16, 16}},
-    {'q', {0, 0, 13, 19, 15, 1, 1}},     {'r', {0, 0, 22, 25, 16, 16, 16}}, {'s', {0, 0, 14, 16, 14, 1, 30}},
-    {'t', {8, 8, 28, 8, 8, 9, 6}},       {'u', {0, 0, 17, 17, 17, 19, 13}}, {'v', {0, 0, 17, 17, 17, 10, 4}},
-    {'w', {0, 0, 17, 17, 21, 21, 10}},   {'x', {0, 0, 17, 10, 4, 10, 17}}, {'y', {0, 0, 17, 17, 15, 1, 14}},
+    {'0', {14, 17, 19, 21, 25, 17, 14}}, {'1', {4, 12, 4, 4, 4, 4, 14}},
+    {'2', {14, 17, 1, 2, 4, 8, 31}},     {'3', {30, 1, 1, 14, 1, 1, 30}},
+    {'4', {2, 6, 10, 18, 31, 2, 2}},     {'5', {31, 16, 30, 1, 1, 17, 14}},
+    {'6', {6, 8, 16, 30, 17, 17, 14}},   {'7', {31, 1, 2, 4, 8, 8, 8}},
+    {'8', {14, 17, 17, 14, 17, 17, 14}}, {'9', {14, 17, 17, 15, 1, 2, 12}},
+    {'.', {0, 0, 0, 0, 0, 12, 12}},      {'-', {0, 0, 0, 31, 0, 0, 0}},
+    {'+', {0, 4, 4, 31, 4, 4, 0}},       {'/', {1, 1, 2, 4, 8, 16, 16}},
+    {'(', {2, 4, 8, 8, 8, 4, 2}},        {')', {8, 4, 2, 2, 2, 4, 8}},
+    {':', {0, 12, 12, 0, 12, 12, 0}},    {'=', {0, 0, 31, 0, 31, 0, 0}},
+    {'%', {24, 25, 2, 4, 8, 19, 3}},     {',', {0, 0, 0, 0, 12, 4, 8}},
+    {'<', {2, 4, 8, 16, 8, 4, 2}},       {'>', {8, 4, 2, 1, 2, 4, 8}},
+    {'_', {0, 0, 0, 0, 0, 0, 31}},       {'a', {0, 0, 14, 1, 15, 17, 15}},
+    {'b', {16, 16, 30, 17, 17, 17, 30}}, {'c', {0, 0, 14, 16, 16, 17, 14}},
+    {'d', {1, 1, 15, 17, 17, 17, 15}},   {'e', {0, 0, 14, 17, 31, 16, 14}},
+    {'f', {6, 9, 8, 28, 8, 8, 8}},       {'g', {0, 15, 17, 17, 15, 1, 14}},
+    {'h', {16, 16, 22, 25, 17, 17, 17}}, {'i', {4, 0, 12, 4, 4, 4, 14}},
+    {'j', {2, 0, 6, 2, 2, 18, 12}},      {'k', {16, 16, 18, 20, 24, 20, 18}},
+    {'l', {12, 4, 4, 4, 4, 4, 14}},      {'m', {0, 0, 26, 21, 21, 17, 17}},
+    {'n', {0, 0, 22, 25, 17, 17, 17}},   {'o', {0, 0, 14, 17, 17, 17, 14}},
+    {'p', {0, 0, 30, 17, 30, 16, 16}},   {'q', {0, 0, 13, 19, 15, 1, 1}},
+    {'r', {0, 0, 22, 25, 16, 16, 16}},   {'s', {0, 0, 14, 16, 14, 1, 30}},
+    {'t', {8, 8, 28, 8, 8, 9, 6}},       {'u', {0, 0, 17, 17, 17, 19, 13}},
+    {'v', {0, 0, 17, 17, 17, 10, 4}},    {'w', {0, 0, 17, 17, 21, 21, 10}},
+    {'x', {0, 0, 17, 10, 4, 10, 17}},    {'y', {0, 0, 17, 17, 15, 1, 14}},
     {'z', {0, 0, 31, 2, 4, 8, 31}},
 };
 
@@ -46,7 +54,8 @@ class Canvas {
     std::memcpy(&rgb_[(static_cast<std::size_t>(y) * w_ + x) * 3], c.data(), 3);
   }
 
-  void line(double x0, double y0, double x1, double y1, std::array<unsigned char, 3> c, bool dashed = false) {
+  void line(double x0, double y0, double x1, double y1, std::array<unsigned char, 3> c,
+            bool dashed = false) {
     const int steps = static_cast<int>(std::max(std::fabs(x1 - x0), std::fabs(y1 - y0))) + 1;
     for (int i = 0; i <= steps; ++i) {
       if (dashed && (i / 4) % 2) continue;
@@ -84,7 +93,8 @@ class Canvas {
 
 std::string tick_label(double v, double step) {
   char buf[32];
-  const int decimals = step >= 1.0 ? 0 : std::min(6, static_cast<int>(std::ceil(-std::log10(step))));
+  const int decimals =
+      step >= 1.0 ? 0 : std::min(6, static_cast<int>(std::ceil(-std::log10(step))));
   std::snprintf(buf, sizeof(buf), "%.*f", decimals, v);
   return buf;
 }
@@ -134,19 +144,22 @@ void write_plot_png(const std::filesystem::path& path, const LinePlot& plot) {
   for (double y = std::ceil(y_lo / y_step) * y_step; y <= y_hi; y += y_step) {
     canvas.line(left, py(y), right, py(y), grey);
     const std::string label = tick_label(y, y_step);
-    canvas.text(left - 6 - 6 * static_cast<int>(label.size()), static_cast<int>(py(y)) - 3, label, black);
+    canvas.text(left - 6 - 6 * static_cast<int>(label.size()), static_cast<int>(py(y)) - 3, label,
+                black);
   }
   const double x_step = nice_step(x_hi - x_lo, 8);
   for (double x = std::ceil(x_lo / x_step) * x_step; x <= x_hi; x += x_step) {
     canvas.line(px(x), bottom, px(x), bottom + 4, black);
     const std::string label = tick_label(x, x_step);
-    canvas.text(static_cast<int>(px(x)) - 3 * static_cast<int>(label.size()), bottom + 8, label, black);
+    canvas.text(static_cast<int>(px(x)) - 3 * static_cast<int>(label.size()), bottom + 8, label,
+                black);
   }
   canvas.line(left, top, left, bottom, black);
   canvas.line(left, bottom, right, bottom, black);
   for (const auto& [y, label] : plot.horizontal_lines) {
     canvas.line(left, py(y), right, py(y), dark, true);
-    canvas.text(right - 6 * static_cast<int>(label.size()) - 2, static_cast<int>(py(y)) - 10, label, dark);
+    canvas.text(right - 6 * static_cast<int>(label.size()) - 2, static_cast<int>(py(y)) - 10, label,
+                dark);
   }
   for (const PlotSeries& s : plot.series) {
     for (std::size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
@@ -159,12 +172,14 @@ void write_plot_png(const std::filesystem::path& path, const LinePlot& plot) {
           }
         }
       } else if (i > 0 && std::isfinite(s.y[i - 1])) {
-        canvas.line(px(s.x[i - 1]), py(std::clamp(s.y[i - 1], y_lo, y_hi)), px(s.x[i]), py(y), s.color);
+        canvas.line(px(s.x[i - 1]), py(std::clamp(s.y[i - 1], y_lo, y_hi)), px(s.x[i]), py(y),
+                    s.color);
       }
     }
   }
   canvas.text(left, 10, plot.title, black);
-  canvas.text((left + right) / 2 - 3 * static_cast<int>(plot.x_label.size()), plot.height - 16, plot.x_label, black);
+  canvas.text((left + right) / 2 - 3 * static_cast<int>(plot.x_label.size()), plot.height - 16,
+              plot.x_label, black);
   canvas.text(6, 10, plot.y_label, black);
   // Legend, top right.
   int legend_y = top + 6;
@@ -175,7 +190,8 @@ void write_plot_png(const std::filesystem::path& path, const LinePlot& plot) {
     canvas.text(x + 18, legend_y, s.label, black);
     legend_y += 12;
   }
-  write_png_rgb(path, canvas.rgb(), static_cast<std::size_t>(plot.height), static_cast<std::size_t>(plot.width));
+  write_png_rgb(path, canvas.rgb(), static_cast<std::size_t>(plot.height),
+                static_cast<std::size_t>(plot.width));
 }
 
 }  // namespace riner

@@ -21,7 +21,7 @@ struct AdamSettings {
 };
 
 // step counts from 1.
-void adam_step(const AdamSettings& s, int step, const std::vector<double>& grad, std::vector<double>& params,
-               std::vector<double>& m, std::vector<double>& v);
+void adam_step(const AdamSettings& s, int step, const std::vector<double>& grad,
+               std::vector<double>& params, std::vector<double>& m, std::vector<double>& v);
 
 }  // namespace riner::ref

@@ -35,7 +35,8 @@ void for_each_vertex(const model::ParameterLayout& l, int level, const double* p
 
 }  // namespace
 
-std::uint32_t hash_grid_index(const model::ParameterLayout& l, int level, const std::uint32_t* coords) {
+std::uint32_t hash_grid_index(const model::ParameterLayout& l, int level,
+                              const std::uint32_t* coords) {
   const model::GridLevel& g = l.grid[static_cast<std::size_t>(level)];
   std::uint32_t index = 0;
   if (g.hashed) {
@@ -72,7 +73,8 @@ void hash_grid_scatter(const model::ParameterLayout& l, const double* pos, const
   }
 }
 
-std::vector<float> hash_grid_forward(const model::ParameterLayout& l, const std::vector<float>& params,
+std::vector<float> hash_grid_forward(const model::ParameterLayout& l,
+                                     const std::vector<float>& params,
                                      const std::vector<float>& positions) {
   const std::vector<double> p(params.begin(), params.end());
   const std::size_t n = positions.size() / static_cast<std::size_t>(l.dims);
@@ -87,7 +89,8 @@ std::vector<float> hash_grid_forward(const model::ParameterLayout& l, const std:
   return out;
 }
 
-std::vector<double> hash_grid_backward(const model::ParameterLayout& l, const std::vector<float>& positions,
+std::vector<double> hash_grid_backward(const model::ParameterLayout& l,
+                                       const std::vector<float>& positions,
                                        const std::vector<float>& d_features) {
   std::vector<double> grad(l.total, 0.0);
   const std::size_t n = positions.size() / static_cast<std::size_t>(l.dims);
@@ -95,7 +98,8 @@ std::vector<double> hash_grid_backward(const model::ParameterLayout& l, const st
   for (std::size_t i = 0; i < n; ++i) {
     double pos[3] = {0, 0, 0};
     for (int k = 0; k < l.dims; ++k) pos[k] = positions[i * l.dims + k];
-    for (int k = 0; k < l.inputs; ++k) d[static_cast<std::size_t>(k)] = d_features[i * l.inputs + k];
+    for (int k = 0; k < l.inputs; ++k)
+      d[static_cast<std::size_t>(k)] = d_features[i * l.inputs + k];
     hash_grid_scatter(l, pos, d.data(), grad.data());
   }
   return grad;

@@ -18,13 +18,16 @@ void hash_grid_scatter(const model::ParameterLayout& l, const double* pos, const
                        double* grad);
 
 // The parameter index of vertex `coords` at `level` (feature 0).
-std::uint32_t hash_grid_index(const model::ParameterLayout& l, int level, const std::uint32_t* coords);
+std::uint32_t hash_grid_index(const model::ParameterLayout& l, int level,
+                              const std::uint32_t* coords);
 
 // Batched, fp32 at the boundary like the device op: features [n][inputs].
-std::vector<float> hash_grid_forward(const model::ParameterLayout& l, const std::vector<float>& params,
+std::vector<float> hash_grid_forward(const model::ParameterLayout& l,
+                                     const std::vector<float>& params,
                                      const std::vector<float>& positions);
 // Gradient of sum(d_features * features) with respect to every parameter (zero outside the grid).
-std::vector<double> hash_grid_backward(const model::ParameterLayout& l, const std::vector<float>& positions,
+std::vector<double> hash_grid_backward(const model::ParameterLayout& l,
+                                       const std::vector<float>& positions,
                                        const std::vector<float>& d_features);
 
 }  // namespace riner::ref

@@ -18,12 +18,14 @@ void dense_relu(const double* w, const double* b, const double* x, int rows, int
 
 }  // namespace
 
-double mlp_forward(const model::ParameterLayout& l, const double* p, const double* input, MlpTrace* trace) {
+double mlp_forward(const model::ParameterLayout& l, const double* p, const double* input,
+                   MlpTrace* trace) {
   std::vector<std::vector<double>> hidden(static_cast<std::size_t>(l.hidden_layers),
                                           std::vector<double>(static_cast<std::size_t>(l.width)));
   dense_relu(p + l.w_in(), p + l.b_in(), input, l.inputs, l.width, hidden[0].data());
   for (int h = 1; h < l.hidden_layers; ++h) {
-    dense_relu(p + l.w_hidden(h), p + l.b_hidden(h), hidden[h - 1].data(), l.width, l.width, hidden[h].data());
+    dense_relu(p + l.w_hidden(h), p + l.b_hidden(h), hidden[h - 1].data(), l.width, l.width,
+               hidden[h].data());
   }
   double out = p[l.b_out()];
   const std::vector<double>& last = hidden.back();
@@ -35,15 +37,16 @@ double mlp_forward(const model::ParameterLayout& l, const double* p, const doubl
   return out;
 }
 
-void mlp_backward(const model::ParameterLayout& l, const double* p, const double* input, const MlpTrace& trace,
-                  double d_output, double* grad, double* d_input) {
+void mlp_backward(const model::ParameterLayout& l, const double* p, const double* input,
+                  const MlpTrace& trace, double d_output, double* grad, double* d_input) {
   const int w = l.width;
   std::vector<double> delta(static_cast<std::size_t>(w));
   const std::vector<double>& last = trace.hidden.back();
   for (int j = 0; j < w; ++j) {
     grad[l.w_out() + j] += d_output * last[static_cast<std::size_t>(j)];
     // Through the ReLU: zero where the unit was off.
-    delta[static_cast<std::size_t>(j)] = last[static_cast<std::size_t>(j)] > 0.0 ? d_output * p[l.w_out() + j] : 0.0;
+    delta[static_cast<std::size_t>(j)] =
+        last[static_cast<std::size_t>(j)] > 0.0 ? d_output * p[l.w_out() + j] : 0.0;
   }
   grad[l.b_out()] += d_output;
   for (int h = l.hidden_layers - 1; h >= 1; --h) {
@@ -51,19 +54,24 @@ void mlp_backward(const model::ParameterLayout& l, const double* p, const double
     std::vector<double> next(static_cast<std::size_t>(w), 0.0);
     for (int i = 0; i < w; ++i) {
       for (int j = 0; j < w; ++j) {
-        grad[l.w_hidden(h) + static_cast<std::size_t>(i) * w + j] += below[static_cast<std::size_t>(i)] * delta[static_cast<std::size_t>(j)];
-        next[static_cast<std::size_t>(i)] += p[l.w_hidden(h) + static_cast<std::size_t>(i) * w + j] * delta[static_cast<std::size_t>(j)];
+        grad[l.w_hidden(h) + static_cast<std::size_t>(i) * w + j] +=
+            below[static_cast<std::size_t>(i)] * delta[static_cast<std::size_t>(j)];
+        next[static_cast<std::size_t>(i)] +=
+            p[l.w_hidden(h) + static_cast<std::size_t>(i) * w + j] *
+            delta[static_cast<std::size_t>(j)];
       }
     }
     for (int j = 0; j < w; ++j) grad[l.b_hidden(h) + j] += delta[static_cast<std::size_t>(j)];
     for (int i = 0; i < w; ++i) {
-      delta[static_cast<std::size_t>(i)] = below[static_cast<std::size_t>(i)] > 0.0 ? next[static_cast<std::size_t>(i)] : 0.0;
+      delta[static_cast<std::size_t>(i)] =
+          below[static_cast<std::size_t>(i)] > 0.0 ? next[static_cast<std::size_t>(i)] : 0.0;
     }
   }
   for (int i = 0; i < l.inputs; ++i) {
     double s = 0.0;
     for (int j = 0; j < w; ++j) {
-      grad[l.w_in() + static_cast<std::size_t>(i) * w + j] += input[i] * delta[static_cast<std::size_t>(j)];
+      grad[l.w_in() + static_cast<std::size_t>(i) * w + j] +=
+          input[i] * delta[static_cast<std::size_t>(j)];
       s += p[l.w_in() + static_cast<std::size_t>(i) * w + j] * delta[static_cast<std::size_t>(j)];
     }
     if (d_input != nullptr) d_input[i] = s;
@@ -71,7 +79,8 @@ void mlp_backward(const model::ParameterLayout& l, const double* p, const double
   for (int j = 0; j < w; ++j) grad[l.b_in() + j] += delta[static_cast<std::size_t>(j)];
 }
 
-std::vector<float> mlp_forward_batch(const model::ParameterLayout& l, const std::vector<float>& params,
+std::vector<float> mlp_forward_batch(const model::ParameterLayout& l,
+                                     const std::vector<float>& params,
                                      const std::vector<float>& inputs) {
   const std::vector<double> p(params.begin(), params.end());
   const std::size_t n = inputs.size() / static_cast<std::size_t>(l.inputs);
@@ -84,8 +93,10 @@ std::vector<float> mlp_forward_batch(const model::ParameterLayout& l, const std:
   return out;
 }
 
-std::vector<double> mlp_backward_batch(const model::ParameterLayout& l, const std::vector<float>& params,
-                                       const std::vector<float>& inputs, const std::vector<float>& d_out,
+std::vector<double> mlp_backward_batch(const model::ParameterLayout& l,
+                                       const std::vector<float>& params,
+                                       const std::vector<float>& inputs,
+                                       const std::vector<float>& d_out,
                                        std::vector<double>* d_inputs) {
   const std::vector<double> p(params.begin(), params.end());
   const std::size_t n = d_out.size();

@@ -22,11 +22,14 @@ void mlp_backward(const model::ParameterLayout& l, const double* params, const d
                   const MlpTrace& trace, double d_output, double* grad, double* d_input);
 
 // Batched, fp32 at the boundary: outputs [n] from inputs [n][inputs].
-std::vector<float> mlp_forward_batch(const model::ParameterLayout& l, const std::vector<float>& params,
+std::vector<float> mlp_forward_batch(const model::ParameterLayout& l,
+                                     const std::vector<float>& params,
                                      const std::vector<float>& inputs);
 // Gradient over all parameters of sum(d_out * out), and d_inputs [n][inputs].
-std::vector<double> mlp_backward_batch(const model::ParameterLayout& l, const std::vector<float>& params,
-                                       const std::vector<float>& inputs, const std::vector<float>& d_out,
+std::vector<double> mlp_backward_batch(const model::ParameterLayout& l,
+                                       const std::vector<float>& params,
+                                       const std::vector<float>& inputs,
+                                       const std::vector<float>& d_out,
                                        std::vector<double>* d_inputs);
 
 }  // namespace riner::ref

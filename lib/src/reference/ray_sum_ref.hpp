@@ -11,7 +11,7 @@ constexpr double kAlphaEpsilon = 1e-8;
 struct RayLoss {
   double rho_hat = 0.0;
   double loss = 0.0;
-  double d_sum = 0.0;     // dloss / d(sum(mu) dx)
+  double d_sum = 0.0;  // dloss / d(sum(mu) dx)
   double d_alpha0 = 0.0;
   double d_beta0 = 0.0;
 };

@@ -11,18 +11,21 @@
 namespace riner::ref {
 
 float sample_jitter(std::uint32_t seed, std::uint32_t step, std::uint32_t ray, std::uint32_t k) {
-  return model::uniform24(model::hash32(k ^ model::hash_keys(model::kJitterStream, seed, step, ray)));
+  return model::uniform24(
+      model::hash32(k ^ model::hash_keys(model::kJitterStream, seed, step, ray)));
 }
 
-void scale_levels(const model::ParameterLayout& l, const std::vector<float>& level_weights, double* values) {
+void scale_levels(const model::ParameterLayout& l, const std::vector<float>& level_weights,
+                  double* values) {
   if (level_weights.empty()) return;
   for (int level = 0; level < l.levels; ++level) {
-    for (int f = 0; f < l.features; ++f) values[level * l.features + f] *= level_weights[static_cast<std::size_t>(level)];
+    for (int f = 0; f < l.features; ++f)
+      values[level * l.features + f] *= level_weights[static_cast<std::size_t>(level)];
   }
 }
 
-StepResult riner_step(const StepInputs& in, const model::Batch& batch, const std::vector<double>& params,
-                      bool with_gradient) {
+StepResult riner_step(const StepInputs& in, const model::Batch& batch,
+                      const std::vector<double>& params, bool with_gradient) {
   const model::ParameterLayout& l = *in.layout;
   const std::size_t n = batch.rays.size();
   auto position = [&](std::uint32_t ray, std::uint32_t k, double pos[3]) {
@@ -54,16 +57,18 @@ StepResult riner_step(const StepInputs& in, const model::Batch& batch, const std
   StepResult result;
   if (with_gradient) result.grad.assign(l.total, 0.0);
   std::vector<double> d_sums(n, 0.0);
-  double scale = 1.0;
+  double penalty_weight = in.lambda;
   if (in.relative_beta_threshold > 0.0 && n > 0) {
     std::vector<double> mismatch(n);
     for (std::size_t b = 0; b < n; ++b) {
       const std::uint32_t ray = batch.rays[b];
-      mismatch[b] = ray_mismatch(sums[b], params[l.alpha_offset + ray % in.elements_per_view], (*in.measurement)[ray]);
+      mismatch[b] = ray_mismatch(sums[b], params[l.alpha_offset + ray % in.elements_per_view],
+                                 (*in.measurement)[ray]);
     }
-    std::nth_element(mismatch.begin(), mismatch.begin() + static_cast<long>((n - 1) / 2), mismatch.end());
+    std::nth_element(mismatch.begin(), mismatch.begin() + static_cast<long>((n - 1) / 2),
+                     mismatch.end());
     const double median = mismatch[(n - 1) / 2];
-    scale = 2.0 * in.lambda / (in.data_weight * in.relative_beta_threshold * std::max(median, 1e-3));
+    penalty_weight = 0.5 * in.data_weight * in.relative_beta_threshold * std::max(median, 1e-3);
   }
   for (std::size_t b = 0; b < n; ++b) {
     const std::uint32_t ray = batch.rays[b];
@@ -71,15 +76,15 @@ StepResult riner_step(const StepInputs& in, const model::Batch& batch, const std
     const RayLoss rl = ray_loss(sums[b], params[l.alpha_offset + e], params[l.beta_offset + e],
                                 (*in.measurement)[ray], batch.weights[b]);
     result.data_loss += rl.loss;
-    d_sums[b] = scale * rl.d_sum;
+    d_sums[b] = rl.d_sum;
     if (with_gradient) {
-      result.grad[l.alpha_offset + e] += scale * rl.d_alpha0;
-      result.grad[l.beta_offset + e] += scale * rl.d_beta0;
+      result.grad[l.alpha_offset + e] += rl.d_alpha0;
+      result.grad[l.beta_offset + e] += rl.d_beta0;
     }
   }
   for (std::uint32_t e : batch.elements) {
     double d_beta0 = 0.0;
-    result.penalty += beta_penalty(params[l.beta_offset + e], in.lambda, &d_beta0);
+    result.penalty += beta_penalty(params[l.beta_offset + e], penalty_weight, &d_beta0);
     if (with_gradient) result.grad[l.beta_offset + e] += d_beta0;
   }
   result.penalty += ring_prior(batch, sums, in.ring_lambda, &d_sums);
@@ -103,7 +108,8 @@ StepResult riner_step(const StepInputs& in, const model::Batch& batch, const std
             scale_levels(l, in.level_weights, features.data());
             MlpTrace trace;
             mlp_forward(l, params.data(), features.data(), &trace);
-            mlp_backward(l, params.data(), features.data(), trace, d_mu, grad.data(), d_features.data());
+            mlp_backward(l, params.data(), features.data(), trace, d_mu, grad.data(),
+                         d_features.data());
             scale_levels(l, in.level_weights, d_features.data());
             hash_grid_scatter(l, pos, d_features.data(), grad.data());
           }
@@ -142,8 +148,10 @@ double ring_prior(const model::Batch& batch, const std::vector<double>& sums, do
   return penalty;
 }
 
-std::vector<float> field_evaluate(const model::ParameterLayout& l, const std::vector<double>& params,
-                                  const std::vector<float>& positions, const std::vector<float>& level_weights) {
+std::vector<float> field_evaluate(const model::ParameterLayout& l,
+                                  const std::vector<double>& params,
+                                  const std::vector<float>& positions,
+                                  const std::vector<float>& level_weights) {
   const std::size_t n = positions.size() / static_cast<std::size_t>(l.dims);
   std::vector<float> out(n);
   util::parallel_for(n, [&](std::size_t begin, std::size_t end) {

@@ -33,8 +33,8 @@ struct StepResult {
   std::vector<double> grad;  // over the whole parameter buffer
 };
 
-StepResult riner_step(const StepInputs& in, const model::Batch& batch, const std::vector<double>& params,
-                      bool with_gradient = true);
+StepResult riner_step(const StepInputs& in, const model::Batch& batch,
+                      const std::vector<double>& params, bool with_gradient = true);
 
 // The ring prior of kernels/riner_step.cl on the batch's views x elements block: returns its
 // value and adds its gradient with respect to the ray sums into d_sums (when not null).
@@ -45,10 +45,13 @@ double ring_prior(const model::Batch& batch, const std::vector<double>& sums, do
 float sample_jitter(std::uint32_t seed, std::uint32_t step, std::uint32_t ray, std::uint32_t k);
 
 // mu at normalised positions [n][dims] (evaluation of the trained field).
-std::vector<float> field_evaluate(const model::ParameterLayout& l, const std::vector<double>& params,
-                                  const std::vector<float>& positions, const std::vector<float>& level_weights);
+std::vector<float> field_evaluate(const model::ParameterLayout& l,
+                                  const std::vector<double>& params,
+                                  const std::vector<float>& positions,
+                                  const std::vector<float>& level_weights);
 
 // Multiplies level l's values by level_weights[l] (no-op when empty).
-void scale_levels(const model::ParameterLayout& l, const std::vector<float>& level_weights, double* values);
+void scale_levels(const model::ParameterLayout& l, const std::vector<float>& level_weights,
+                  double* values);
 
 }  // namespace riner::ref

@@ -54,11 +54,13 @@ class OpenclTrainer final : public Trainer {
         max_batch_(model::BatchSampler(setup.scan.geometry, setup.config.training).rays_per_step()),
         lanes_(atomic_ ? static_cast<cl_uint>(max_batch_) : partitioned_lanes(device_.info())),
         gradients_(atomic_ ? 1 : lanes_),
-        params_(ctx_, std::span<const float>(model::initial_parameters(setup.layout, setup.config.training.seed))),
+        params_(ctx_, std::span<const float>(
+                          model::initial_parameters(setup.layout, setup.config.training.seed))),
         grad_(ctx_, gradients_ * setup.layout.total),
         loss_(ctx_, 2),
         history_(ctx_, static_cast<std::size_t>(kHistoryBlock) * 2),
-        segments_(ctx_, std::span<const cl_float8>(segment_table(setup.segments)), CL_MEM_READ_ONLY),
+        segments_(ctx_, std::span<const cl_float8>(segment_table(setup.segments)),
+                  CL_MEM_READ_ONLY),
         rho_(ctx_, std::span<const float>(setup.scan.measurement.data), CL_MEM_READ_ONLY),
         rays_(ctx_, max_batch_),
         elements_(ctx_, max_batch_),
@@ -98,8 +100,8 @@ class OpenclTrainer final : public Trainer {
     args.ring_lambda = static_cast<float>(t.ring_lambda);
     step_op_.step(args, lanes_, params_, grad_, loss_);
     const AdamRates rates = setup_.adam_rates(index);
-    adam_.step({rates.field, setup_.layout.alpha_offset, rates.alpha, setup_.layout.beta_offset, rates.beta,
-                t.adam_beta1, t.adam_beta2, t.adam_epsilon},
+    adam_.step({rates.field, setup_.layout.alpha_offset, rates.alpha, setup_.layout.beta_offset,
+                rates.beta, t.adam_beta1, t.adam_beta2, t.adam_epsilon},
                index + 1, params_, grad_);
     loss_.copy_to(history_, pending_.size() * 2);
     pending_.push_back({index, 0.0, 0.0, rates.field});
@@ -124,8 +126,9 @@ class OpenclTrainer final : public Trainer {
     const model::SamplingDomain domain = model::sampling_domain(g);
     constexpr std::size_t kChunk = std::size_t{1} << 20;
     for (std::size_t first = 0; first < n; first += kChunk) {
-      step_op_.evaluate(static_cast<cl_uint>(first), static_cast<cl_uint>(std::min(kChunk, n - first)),
-                        g.volume_shape, static_cast<float>(g.voxel_mm), static_cast<float>(domain.extent_mm),
+      step_op_.evaluate(static_cast<cl_uint>(first),
+                        static_cast<cl_uint>(std::min(kChunk, n - first)), g.volume_shape,
+                        static_cast<float>(g.voxel_mm), static_cast<float>(domain.extent_mm),
                         level_weights_, params_, out);
     }
     return out.read();

@@ -18,7 +18,8 @@ struct Reconstructor::Impl {
   std::vector<LossRecord> history;
 
   Impl(Scan scan, RinerConfig config)
-      : setup(std::move(scan), std::move(config)), sampler(setup.scan.geometry, setup.config.training) {}
+      : setup(std::move(scan), std::move(config)),
+        sampler(setup.scan.geometry, setup.config.training) {}
 
   void drain() {
     for (LossRecord& r : trainer->drain_losses()) {

@@ -10,7 +10,8 @@ namespace {
 class ReferenceTrainer final : public Trainer {
  public:
   explicit ReferenceTrainer(const TrainingSetup& setup) : setup_(setup) {
-    const std::vector<float> init = model::initial_parameters(setup.layout, setup.config.training.seed);
+    const std::vector<float> init =
+        model::initial_parameters(setup.layout, setup.config.training.seed);
     params_.assign(init.begin(), init.end());
     m_.assign(params_.size(), 0.0);
     v_.assign(params_.size(), 0.0);
@@ -32,8 +33,8 @@ class ReferenceTrainer final : public Trainer {
     const ref::StepResult r = ref::riner_step(inputs_, batch, params_);
     const TrainingConfig& t = setup_.config.training;
     const AdamRates rates = setup_.adam_rates(index);
-    ref::adam_step({rates.field, setup_.layout.alpha_offset, rates.alpha, setup_.layout.beta_offset, rates.beta,
-                    t.adam_beta1, t.adam_beta2, t.adam_epsilon},
+    ref::adam_step({rates.field, setup_.layout.alpha_offset, rates.alpha, setup_.layout.beta_offset,
+                    rates.beta, t.adam_beta1, t.adam_beta2, t.adam_epsilon},
                    index + 1, r.grad, params_, m_, v_);
     losses_.push_back({index, r.data_loss, r.penalty, rates.field});
     steps_ = index + 1;

@@ -47,18 +47,24 @@ void check_keys(const json& obj, const char* section, std::initializer_list<cons
 
 const char* data_term_name(DataTerm t) {
   switch (t) {
-    case DataTerm::kElementMean: return "element-mean";
-    case DataTerm::kMean: return "mean";
-    case DataTerm::kSum: return "sum";
+    case DataTerm::kElementMean:
+      return "element-mean";
+    case DataTerm::kMean:
+      return "mean";
+    case DataTerm::kSum:
+      return "sum";
   }
   return "unknown";
 }
 
 const char* sampler_name(Sampler s) {
   switch (s) {
-    case Sampler::kUniform: return "uniform";
-    case Sampler::kViewsTimesElements: return "views-x-elements";
-    case Sampler::kMixed: return "mixed";
+    case Sampler::kUniform:
+      return "uniform";
+    case Sampler::kViewsTimesElements:
+      return "views-x-elements";
+    case Sampler::kMixed:
+      return "mixed";
   }
   return "unknown";
 }
@@ -67,20 +73,28 @@ void RinerConfig::validate() const {
   const EncodingConfig& e = encoding;
   require(e.levels >= 1 && e.levels <= 32, "encoding.levels must be in 1..32");
   require(e.features >= 1 && e.features <= 8, "encoding.features must be in 1..8");
-  require(e.log2_table_size >= 4 && e.log2_table_size <= 26, "encoding.log2_table_size must be in 4..26");
-  require(e.base_resolution >= 2 && e.base_resolution <= 65536, "encoding.base_resolution must be in 2..65536");
-  require(e.finest_resolution >= e.base_resolution && e.finest_resolution <= 1 << 20,
-          "encoding.finest_resolution must be >= base_resolution and <= 2^20");
+  require(e.log2_table_size >= 4 && e.log2_table_size <= 26,
+          "encoding.log2_table_size must be in 4..26");
+  require(e.base_resolution >= 2 && e.base_resolution <= 65536,
+          "encoding.base_resolution must be in 2..65536");
+  require(
+      e.finest_resolution == 0 ||
+          (e.finest_resolution >= e.base_resolution && e.finest_resolution <= 1 << 20),
+      "encoding.finest_resolution must be 0 (the grid's size) or >= base_resolution and <= 2^20");
   require(network.width >= 16 && network.width <= 256 && network.width % 16 == 0,
           "network.width must be a multiple of 16 in 16..256");
-  require(network.hidden_layers >= 1 && network.hidden_layers <= 4, "network.hidden_layers must be in 1..4");
+  require(network.hidden_layers >= 1 && network.hidden_layers <= 4,
+          "network.hidden_layers must be in 1..4");
   const TrainingConfig& t = training;
   require(t.steps >= 0 && t.steps <= 10000000, "training.steps must be in 0..10^7");
-  require(t.rays_per_step >= 1 && t.rays_per_step <= 1 << 20, "training.rays_per_step must be in 1..2^20");
-  require(t.views_per_step >= 1 && t.views_per_step <= 1 << 16, "training.views_per_step must be in 1..65536");
+  require(t.rays_per_step >= 1 && t.rays_per_step <= 1 << 20,
+          "training.rays_per_step must be in 1..2^20");
+  require(t.views_per_step >= 1 && t.views_per_step <= 1 << 16,
+          "training.views_per_step must be in 1..65536");
   require(t.elements_per_step >= 1 && t.elements_per_step <= 1 << 16,
           "training.elements_per_step must be in 1..65536");
-  require(t.sample_spacing > 0.01 && t.sample_spacing <= 100.0, "training.sample_spacing must be in (0.01, 100] voxels");
+  require(t.sample_spacing > 0.01 && t.sample_spacing <= 100.0,
+          "training.sample_spacing must be in (0.01, 100] voxels");
   require(t.learning_rate > 0.0 && t.learning_rate < 10.0 && std::isfinite(t.learning_rate),
           "training.learning_rate must be in (0, 10)");
   require(t.lr_decay_steps >= 1, "training.lr_decay_steps must be >= 1");
@@ -88,16 +102,20 @@ void RinerConfig::validate() const {
   require(t.adam_beta1 >= 0.0 && t.adam_beta1 < 1.0, "training.adam_beta1 must be in [0, 1)");
   require(t.adam_beta2 >= 0.0 && t.adam_beta2 < 1.0, "training.adam_beta2 must be in [0, 1)");
   require(t.adam_epsilon > 0.0 && t.adam_epsilon < 1.0, "training.adam_epsilon must be in (0, 1)");
-  require(t.lambda >= 0.0 && t.lambda < 1e6 && std::isfinite(t.lambda), "training.lambda must be >= 0");
-  require(t.alpha_lr_scale >= 0.0 && t.alpha_lr_scale < 1e3, "training.alpha_lr_scale must be in [0, 1000)");
-  require(t.beta_lr_scale >= 0.0 && t.beta_lr_scale < 1e3, "training.beta_lr_scale must be in [0, 1000)");
+  require(t.lambda >= 0.0 && t.lambda < 1e6 && std::isfinite(t.lambda),
+          "training.lambda must be >= 0");
+  require(t.alpha_lr_scale >= 0.0 && t.alpha_lr_scale < 1e3,
+          "training.alpha_lr_scale must be in [0, 1000)");
+  require(t.beta_lr_scale >= 0.0 && t.beta_lr_scale < 1e3,
+          "training.beta_lr_scale must be in [0, 1000)");
   require(t.alpha_warmup_steps >= 0, "training.alpha_warmup_steps must be >= 0");
   require(t.beta_warmup_steps >= 0, "training.beta_warmup_steps must be >= 0");
   require(t.level_warmup_steps >= 0, "training.level_warmup_steps must be >= 0");
   require(t.ring_lambda >= 0.0 && t.ring_lambda < 1e9 && std::isfinite(t.ring_lambda),
           "training.ring_lambda must be >= 0");
   require(t.ring_lambda == 0.0 || (t.sampler != Sampler::kUniform && t.elements_per_step >= 3),
-          "training.ring_lambda needs the views-x-elements or mixed sampler with elements_per_step >= 3");
+          "training.ring_lambda needs the views-x-elements or mixed sampler with elements_per_step "
+          ">= 3");
   require(t.relative_beta_threshold >= 0.0 && t.relative_beta_threshold < 1e6,
           "training.relative_beta_threshold must be >= 0");
   require(t.data_weight > 0.0 && t.data_weight < 1e6 && std::isfinite(t.data_weight),
@@ -115,7 +133,8 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
     check_keys(root, "config", {"encoding", "network", "training", "engine"});
     if (root.contains("encoding")) {
       const json& e = root["encoding"];
-      check_keys(e, "encoding", {"levels", "features", "log2_table_size", "base_resolution", "finest_resolution"});
+      check_keys(e, "encoding",
+                 {"levels", "features", "log2_table_size", "base_resolution", "finest_resolution"});
       read(e, "encoding", "levels", encoding.levels);
       read(e, "encoding", "features", encoding.features);
       read(e, "encoding", "log2_table_size", encoding.log2_table_size);
@@ -131,10 +150,31 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
     if (root.contains("training")) {
       const json& t = root["training"];
       check_keys(t, "training",
-                 {"steps", "sampler", "rays_per_step", "views_per_step", "elements_per_step", "sample_spacing",
-                  "jitter", "circle_region", "learning_rate", "lr_decay_steps", "lr_decay", "adam_beta1",
-                  "adam_beta2", "adam_epsilon", "lambda", "alpha_lr_scale", "beta_lr_scale", "alpha_warmup_steps", "beta_warmup_steps", "level_warmup_steps", "ring_lambda",
-                  "data_term", "data_weight", "relative_beta_threshold", "seed"});
+                 {"steps",
+                  "sampler",
+                  "rays_per_step",
+                  "views_per_step",
+                  "elements_per_step",
+                  "sample_spacing",
+                  "jitter",
+                  "circle_region",
+                  "learning_rate",
+                  "lr_decay_steps",
+                  "lr_decay",
+                  "adam_beta1",
+                  "adam_beta2",
+                  "adam_epsilon",
+                  "lambda",
+                  "alpha_lr_scale",
+                  "beta_lr_scale",
+                  "alpha_warmup_steps",
+                  "beta_warmup_steps",
+                  "level_warmup_steps",
+                  "ring_lambda",
+                  "data_term",
+                  "data_weight",
+                  "relative_beta_threshold",
+                  "seed"});
       read(t, "training", "steps", training.steps);
       if (t.contains("sampler")) {
         require(t["sampler"].is_string(), "training.sampler must be a string");
@@ -196,41 +236,40 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
 }
 
 std::string RinerConfig::to_json() const {
-  json root = {
-      {"encoding",
-       {{"levels", encoding.levels},
-        {"features", encoding.features},
-        {"log2_table_size", encoding.log2_table_size},
-        {"base_resolution", encoding.base_resolution},
-        {"finest_resolution", encoding.finest_resolution}}},
-      {"network", {{"width", network.width}, {"hidden_layers", network.hidden_layers}}},
-      {"training",
-       {{"steps", training.steps},
-        {"sampler", sampler_name(training.sampler)},
-        {"rays_per_step", training.rays_per_step},
-        {"views_per_step", training.views_per_step},
-        {"elements_per_step", training.elements_per_step},
-        {"sample_spacing", training.sample_spacing},
-        {"jitter", training.jitter},
-        {"circle_region", training.circle_region},
-        {"learning_rate", training.learning_rate},
-        {"lr_decay_steps", training.lr_decay_steps},
-        {"lr_decay", training.lr_decay},
-        {"adam_beta1", training.adam_beta1},
-        {"adam_beta2", training.adam_beta2},
-        {"adam_epsilon", training.adam_epsilon},
-        {"lambda", training.lambda},
-        {"data_term", data_term_name(training.data_term)},
-        {"data_weight", training.data_weight},
-        {"relative_beta_threshold", training.relative_beta_threshold},
-        {"alpha_lr_scale", training.alpha_lr_scale},
-        {"beta_lr_scale", training.beta_lr_scale},
-        {"alpha_warmup_steps", training.alpha_warmup_steps},
-        {"beta_warmup_steps", training.beta_warmup_steps},
-        {"level_warmup_steps", training.level_warmup_steps},
-        {"ring_lambda", training.ring_lambda},
-        {"seed", training.seed}}},
-      {"engine", engine_name(engine)}};
+  json root = {{"encoding",
+                {{"levels", encoding.levels},
+                 {"features", encoding.features},
+                 {"log2_table_size", encoding.log2_table_size},
+                 {"base_resolution", encoding.base_resolution},
+                 {"finest_resolution", encoding.finest_resolution}}},
+               {"network", {{"width", network.width}, {"hidden_layers", network.hidden_layers}}},
+               {"training",
+                {{"steps", training.steps},
+                 {"sampler", sampler_name(training.sampler)},
+                 {"rays_per_step", training.rays_per_step},
+                 {"views_per_step", training.views_per_step},
+                 {"elements_per_step", training.elements_per_step},
+                 {"sample_spacing", training.sample_spacing},
+                 {"jitter", training.jitter},
+                 {"circle_region", training.circle_region},
+                 {"learning_rate", training.learning_rate},
+                 {"lr_decay_steps", training.lr_decay_steps},
+                 {"lr_decay", training.lr_decay},
+                 {"adam_beta1", training.adam_beta1},
+                 {"adam_beta2", training.adam_beta2},
+                 {"adam_epsilon", training.adam_epsilon},
+                 {"lambda", training.lambda},
+                 {"data_term", data_term_name(training.data_term)},
+                 {"data_weight", training.data_weight},
+                 {"relative_beta_threshold", training.relative_beta_threshold},
+                 {"alpha_lr_scale", training.alpha_lr_scale},
+                 {"beta_lr_scale", training.beta_lr_scale},
+                 {"alpha_warmup_steps", training.alpha_warmup_steps},
+                 {"beta_warmup_steps", training.beta_warmup_steps},
+                 {"level_warmup_steps", training.level_warmup_steps},
+                 {"ring_lambda", training.ring_lambda},
+                 {"seed", training.seed}}},
+               {"engine", engine_name(engine)}};
   return root.dump(1) + "\n";
 }
 

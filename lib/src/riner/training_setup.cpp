@@ -12,11 +12,19 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c) : scan(std::move(s)), config
   check_scan(scan);
   const Geometry& g = scan.geometry;
   elements_per_view = g.n_u * (g.is_3d() ? g.n_v : 1);
-  layout = model::make_layout(g.is_3d() ? 3 : 2, config.encoding, config.network, elements_per_view);
-  segments = model::ray_segments(g, config.training.sample_spacing * g.voxel_mm, config.training.circle_region);
+  if (config.encoding.finest_resolution == 0) {
+    const std::size_t largest = *std::max_element(g.volume_shape.begin(), g.volume_shape.end());
+    config.encoding.finest_resolution =
+        std::max(config.encoding.base_resolution, static_cast<int>(largest));
+  }
+  layout =
+      model::make_layout(g.is_3d() ? 3 : 2, config.encoding, config.network, elements_per_view);
+  segments = model::ray_segments(g, config.training.sample_spacing * g.voxel_mm,
+                                 config.training.circle_region);
   std::size_t hit = 0;
   for (const model::RaySegment& segment : segments) hit += segment.count > 0;
-  if (hit == 0) throw InputError("no detector ray crosses the reconstruction grid: check the geometry");
+  if (hit == 0)
+    throw InputError("no detector ray crosses the reconstruction grid: check the geometry");
   seed = static_cast<std::uint32_t>(config.training.seed ^ (config.training.seed >> 32));
 }
 
