@@ -38,7 +38,8 @@ SampleType parse_kind(char kind, int bytes, const std::string& descr,
 }
 
 NpyHeader parse_header(const std::string& dict, const std::filesystem::path& path) {
-  static const std::regex descr_re(R"('descr'\s*:\s*'([<>|=])([a-zA-Z])(\d+)')");
+  // At most two digits of item size: anything longer is not a dtype riner reads anyway.
+  static const std::regex descr_re(R"('descr'\s*:\s*'([<>|=])([a-zA-Z])(\d{1,2})')");
   static const std::regex fortran_re(R"('fortran_order'\s*:\s*(True|False))");
   static const std::regex shape_re(R"('shape'\s*:\s*\(([^)]*)\))");
   std::smatch m;

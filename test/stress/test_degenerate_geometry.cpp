@@ -1,0 +1,67 @@
+// Degenerate and extreme geometries: a clear error or a correct result, never a crash.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <string>
+
+#include "riner/error.hpp"
+#include "riner/fbp.hpp"
+#include "riner/projector.hpp"
+#include "riner/reconstructor.hpp"
+#include "support/fixture.hpp"
+#include "support/geometries.hpp"
+
+namespace {
+
+riner::Scan ones(const riner::Geometry& g) { return {riner::Array(g.measurement_shape(), 0.5f), g, 0}; }
+
+// Either runs to finite results or throws riner::Error; anything else fails the test.
+void survives(const riner::Geometry& g) {
+  try {
+    riner::FbpOptions options;
+    options.device = riner::test::device();
+    for (float v : riner::fbp(ones(g), options).data) REQUIRE(std::isfinite(v));
+    const riner::Projector p(g, riner::Engine::kOpenCL, riner::test::device());
+    for (float v : p.project(riner::Array(g.volume_shape, 0.01f)).data) REQUIRE(std::isfinite(v));
+    riner::RinerConfig c;
+    c.training.steps = 20;
+    c.training.rays_per_step = 16;
+    riner::Reconstructor r(ones(g), c, riner::test::device());
+    r.run();
+    for (float v : r.image().data) REQUIRE(std::isfinite(v));
+  } catch (const riner::Error& e) {
+    MESSAGE((std::string(riner::geometry_type_name(g.type)) + ": " + e.what()));
+  }
+}
+
+}  // namespace
+
+TEST_SUITE("degenerate_geometry") {
+  TEST_CASE("one view, one element, one voxel row") {
+    using riner::GeometryType;
+    survives(riner::test::make_geometry(GeometryType::kParallel2d, 1, 16, 1, {16, 16}, 1.0, 1.0));
+    survives(riner::test::make_geometry(GeometryType::kFan2d, 8, 1, 1, {16, 16}, 1.0, 1.0));
+    survives(riner::test::make_geometry(GeometryType::kParallel2d, 8, 16, 1, {1, 16}, 1.0, 1.0));
+    survives(riner::test::make_geometry(GeometryType::kCone3d, 1, 9, 1, {1, 8, 8}, 1.0, 1.0));
+  }
+
+  TEST_CASE("tiny and huge pitch, an offset beyond the field of view") {
+    using riner::GeometryType;
+    survives(riner::test::make_geometry(GeometryType::kFan2d, 12, 32, 1, {16, 16}, 1e-6, 1.0));
+    survives(riner::test::make_geometry(GeometryType::kFan2d, 12, 32, 1, {16, 16}, 1e6, 1.0));
+    riner::Geometry off = riner::test::make_geometry(GeometryType::kParallel2d, 12, 32, 1, {16, 16}, 1.0, 1.0);
+    off.offset_u = 1000.0;
+    CHECK_THROWS_WITH_AS(riner::Reconstructor(ones(off), riner::RinerConfig(), riner::test::device()),
+                         doctest::Contains("no detector ray crosses the reconstruction grid"), riner::InputError);
+    survives(off);
+  }
+
+  TEST_CASE("a source inside the volume is refused with the reason") {
+    riner::Geometry g = riner::test::make_geometry(riner::GeometryType::kFan2d, 12, 32, 1, {64, 64}, 1.0, 1.0);
+    g.source_origin_mm = 20.0;
+    CHECK_THROWS_WITH_AS(g.validate(), doctest::Contains("puts the source inside the reconstruction grid"),
+                         riner::InputError);
+    CHECK_THROWS_AS(riner::fbp(ones(g)), riner::InputError);
+    CHECK_THROWS_AS(riner::Reconstructor(ones(g), riner::RinerConfig(), riner::test::device()), riner::InputError);
+  }
+}
