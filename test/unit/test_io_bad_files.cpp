@@ -119,6 +119,10 @@ TEST_SUITE("io_bad_files") {
                  "dim[0] = 8 is not in 1..7");
     expect_error(dir, "type.nii", riner::test::make_nifti({4, 5}, 32, 64, 1, 0, floats(40)),
                  "unsupported NIfTI datatype code 32");
+    // Found by fuzz_nifti: vox_offset 0 means 352, beyond a file that ends inside 348..351.
+    std::string no_data = good.substr(0, 350);
+    no_data.replace(108, 4, std::string(4, '\0'));
+    expect_error(dir, "no_data.nii", no_data, "ends at byte 350, before its data starts at byte 352");
   }
 
   TEST_CASE("tiff") {

@@ -113,6 +113,10 @@ ArrayFile read_nifti(const std::filesystem::path& path) {
     }
   }
   const std::size_t start = static_cast<std::size_t>(vox_offset);
+  if (start > bytes.size()) {  // vox_offset 0 defaults to 352, past a 348..351-byte file
+    throw InputError(prefix(path) + "ends at byte " + std::to_string(bytes.size()) +
+                     ", before its data starts at byte " + std::to_string(start));
+  }
 
   ArrayFile file;
   file.format = FileFormat::kNifti;
