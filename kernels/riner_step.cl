@@ -1,13 +1,17 @@
 // riner_step.cl: one training step of Riner in three kernels, and the trained field's evaluation.
-//   riner_step_forward(n_lanes, n_batch, rays, segments, levels, level_weights, params,
-//                      mlp_offset, seed, step, jitter, sums)
-//     one work-item per lane; lane l takes the batch's rays l, l + n_lanes, ... (interleaved, so
-//     lanes get similar work). sums[b] = sum over ray b's samples of mu * dx.
-//   riner_step_loss(n_batch, rays, sums, rho, weights, elements_per_view, params, alpha_offset,
+//   riner_step_forward(n_samples, sample_rays, offsets, rays, segments, levels, level_weights,
+//                      params, mlp_offset, seed, step, jitter, mu_dx, cache, cache_stride)
+//     one work-item per sample of the batch (batch ray b = sample_rays[i] owns samples
+//     offsets[b] .. offsets[b + 1]): mu_dx[i] = mu * dx at the sample, and its encoded features
+//     and hidden activations (SAMPLE_CACHE values, value v at cache[v * cache_stride + i]),
+//     which the backward pass reads back instead of recomputing them. Per sample rather than per ray so that the work-items of a work-group
+//     run in lock step (the SIMD lanes of a CPU, the warps of a GPU).
+//   riner_step_loss(n_batch, offsets, mu_dx, rays, sums, rho, weights, elements_per_view, params, alpha_offset,
 //                   beta_offset, n_elements, elements, lambda, relative_threshold, data_weight,
 //                   block_first, block_views, block_elements, ring_lambda, grad, d_sums, loss,
 //                   scratch)
-//     one work-item, over the batch in order (deterministic): each ray's loss (ray_sum.cl) and
+//     one work-item, over the batch in order (deterministic): each ray's sum of mu dx into
+//     sums[b] (in sample order), each ray's loss (ray_sum.cl) and
 //     its gradient d_sums[b] with respect to sums[b]; alpha0/beta0 gradients into grad; the
 //     -lambda beta^2 term of the batch's elements; and, when ring_lambda > 0, the ring prior on
 //     the views x elements block (below). loss[0] = data term, loss[1] = penalties.
@@ -16,10 +20,12 @@
 //     (scratch float[n_batch] holds the mismatches): the beta penalty then switches an element
 //     off when its rays miss by more than relative_threshold times the batch's typical ray,
 //     whatever the object and however far training has come.
-//   riner_step_backward(n_lanes, n_batch, rays, segments, levels, level_weights, params, grad,
-//                       lane_stride, mlp_offset, seed, step, jitter, d_sums)
-//     one work-item per lane as in forward: recomputes each sample's encoding and activations
-//     and back-propagates d_sums[b] * dx into grad + lane * lane_stride (lane_stride = 0 with
+//   riner_step_backward(n_lanes, n_batch, offsets, rays, segments, levels, level_weights,
+//                       params, grad, lane_stride, mlp_offset, seed, step, jitter, d_sums, cache,
+//                       cache_stride)
+//     one work-item per lane; lane l takes the batch's rays l, l + n_lanes, ... (interleaved, so
+//     lanes get similar work) and back-propagates d_sums[b] * dx through each sample's cached
+//     features and activations into grad + lane * lane_stride (lane_stride = 0 with
 //     -D ATOMIC_GRADIENTS: one shared gradient).
 //   field_evaluate(n, first, nx, ny, nz, voxel, extent, levels, level_weights, params,
 //                  mlp_offset, out)
@@ -57,29 +63,33 @@ inline void segment_sample(float8 s, uint k, float u, float* pos) {
 #endif
 }
 
-__kernel void riner_step_forward(const uint n_lanes, const uint n_batch, __global const uint* rays,
-                                 __global const float8* segments, __constant const GridLevel* levels,
-                                 __global const float* level_weights, __global const float* params,
-                                 const uint mlp_offset, const uint seed, const uint step, const int jitter,
-                                 __global float* sums) {
-  const uint lane = get_global_id(0);
-  if (lane >= n_lanes) return;
-  __global const float* mlp = params + mlp_offset;
+// Floats cached per sample between the forward and the backward pass.
+#define SAMPLE_CACHE (N_ENCODED + MLP_HIDDEN * MLP_WIDTH)
+
+__kernel void riner_step_forward(const uint n_samples, __global const uint* sample_rays,
+                                 __global const uint* offsets, __global const uint* rays, __global const float8* segments,
+                                 __constant const GridLevel* levels, __global const float* level_weights,
+                                 __global const float* params, const uint mlp_offset, const uint seed,
+                                 const uint step, const int jitter, __global float* mu_dx,
+                                 __global float* cache, const uint cache_stride) {
+  const uint i = get_global_id(0);
+  if (i >= n_samples) return;
+  const uint b = sample_rays[i];
+  const uint ray = rays[b];
+  const float8 s = segments[ray];
+  const uint k = i - offsets[b];
+  float pos[DIMS];
   float features[N_ENCODED];
   float act[MLP_HIDDEN][MLP_WIDTH];
-  float pos[DIMS];
-  for (uint b = lane; b < n_batch; b += n_lanes) {
-    const uint ray = rays[b];
-    const float8 s = segments[ray];
-    const uint count = as_uint(s.s7);
-    float sum = 0.0f;
-    for (uint k = 0; k < count; ++k) {
-      segment_sample(s, k, jitter ? sample_jitter(seed, step, ray, k) : 0.5f, pos);
-      hash_grid_encode(levels, params, pos, features);
-      scale_levels(level_weights, features);
-      sum += mlp_forward(mlp, features, act);
-    }
-    sums[b] = sum * s.s6;
+  segment_sample(s, k, jitter ? sample_jitter(seed, step, ray, k) : 0.5f, pos);
+  hash_grid_encode(levels, params, pos, features);
+  scale_levels(level_weights, features);
+  mu_dx[i] = mlp_forward(params + mlp_offset, features, act) * s.s6;
+  // Value v of sample i at cache[v * cache_stride + i]: neighbouring work-items store to
+  // neighbouring addresses.
+  for (int f = 0; f < N_ENCODED; ++f) cache[f * cache_stride + i] = features[f];
+  for (int h = 0; h < MLP_HIDDEN; ++h) {
+    for (int j = 0; j < MLP_WIDTH; ++j) cache[(N_ENCODED + h * MLP_WIDTH + j) * cache_stride + i] = act[h][j];
   }
 }
 
@@ -114,7 +124,8 @@ inline float select_kth(__global float* values, uint n, uint k) {
   return values[k];
 }
 
-__kernel void riner_step_loss(const uint n_batch, __global const uint* rays, __global const float* sums,
+__kernel void riner_step_loss(const uint n_batch, __global const uint* offsets, __global const float* mu_dx,
+                              __global const uint* rays, __global float* sums,
                               __global const float* rho, __global const float* weights,
                               const uint elements_per_view, __global const float* params,
                               const uint alpha_offset, const uint beta_offset, const uint n_elements,
@@ -123,6 +134,11 @@ __kernel void riner_step_loss(const uint n_batch, __global const uint* rays, __g
                               const uint block_elements, const float ring_lambda, __global float* grad,
                               __global float* d_sums, __global float* loss, __global float* scratch) {
   if (get_global_id(0) != 0) return;
+  for (uint b = 0; b < n_batch; ++b) {
+    float sum = 0.0f;
+    for (uint i = offsets[b]; i < offsets[b + 1]; ++i) sum += mu_dx[i];
+    sums[b] = sum;
+  }
   float penalty_weight = lambda;
   if (relative_threshold > 0.0f && n_batch > 0) {
     for (uint b = 0; b < n_batch; ++b) {
@@ -175,12 +191,13 @@ __kernel void riner_step_loss(const uint n_batch, __global const uint* rays, __g
   loss[1] = penalty;
 }
 
-__kernel void riner_step_backward(const uint n_lanes, const uint n_batch, __global const uint* rays,
-                                  __global const float8* segments, __constant const GridLevel* levels,
-                                  __global const float* level_weights, __global const float* params,
-                                  __global float* grad_all, const uint lane_stride, const uint mlp_offset,
-                                  const uint seed, const uint step, const int jitter,
-                                  __global const float* d_sums) {
+__kernel void riner_step_backward(const uint n_lanes, const uint n_batch, __global const uint* offsets,
+                                  __global const uint* rays, __global const float8* segments,
+                                  __constant const GridLevel* levels, __global const float* level_weights,
+                                  __global const float* params, __global float* grad_all, const uint lane_stride,
+                                  const uint mlp_offset, const uint seed, const uint step, const int jitter,
+                                  __global const float* d_sums, __global const float* cache,
+                                  const uint cache_stride) {
   const uint lane = get_global_id(0);
   if (lane >= n_lanes) return;
   __global float* grad = grad_all + lane * lane_stride;
@@ -194,14 +211,15 @@ __kernel void riner_step_backward(const uint n_lanes, const uint n_batch, __glob
     const float8 s = segments[ray];
     const float d_mu = d_sums[b] * s.s6;
     if (d_mu == 0.0f) continue;
-    const uint count = as_uint(s.s7);
-    for (uint k = 0; k < count; ++k) {
-      segment_sample(s, k, jitter ? sample_jitter(seed, step, ray, k) : 0.5f, pos);
-      hash_grid_encode(levels, params, pos, features);
-      scale_levels(level_weights, features);
-      mlp_forward(mlp, features, act);
+    for (uint i = offsets[b]; i < offsets[b + 1]; ++i) {
+      const uint k = i - offsets[b];
+      for (int f = 0; f < N_ENCODED; ++f) features[f] = cache[f * cache_stride + i];
+      for (int h = 0; h < MLP_HIDDEN; ++h) {
+        for (int j = 0; j < MLP_WIDTH; ++j) act[h][j] = cache[(N_ENCODED + h * MLP_WIDTH + j) * cache_stride + i];
+      }
       mlp_backward(mlp, grad + mlp_offset, features, act, d_mu, d_features);
       scale_levels(level_weights, d_features);
+      segment_sample(s, k, jitter ? sample_jitter(seed, step, ray, k) : 0.5f, pos);
       hash_grid_scatter(levels, grad, pos, d_features);
     }
   }

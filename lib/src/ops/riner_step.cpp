@@ -1,9 +1,15 @@
 #include "ops/riner_step.hpp"
 
+#include <algorithm>
+
 #include "ops/model_program.hpp"
 #include "riner/error.hpp"
 
 namespace riner::ops {
+
+namespace {
+constexpr std::size_t kForwardGroup = 64;
+}  // namespace
 
 RinerStepOp::RinerStepOp(cl::Context& context, const model::ParameterLayout& layout, bool atomic,
                          std::size_t max_batch)
@@ -30,19 +36,34 @@ void RinerStepOp::step(const StepArgs& a, cl_uint n_lanes, const cl::Buffer<floa
   }
   const auto mlp = static_cast<cl_uint>(layout_.mlp_offset);
   const auto jitter = static_cast<cl_int>(a.jitter);
-  // Lanes are independent work-groups of one work-item: on a CPU each runs as plain code.
-  forward_.set_args(n_lanes, a.n_batch, *a.rays, *a.segments, levels_, *a.level_weights, params,
-                    mlp, a.seed, a.step, jitter, sums_);
-  context_.launch(forward_, n_lanes, 1);
-  loss_.set_args(a.n_batch, *a.rays, sums_, *a.rho, *a.weights, a.elements_per_view, params,
-                 static_cast<cl_uint>(layout_.alpha_offset),
+  const std::size_t cache_floats = static_cast<std::size_t>(layout_.inputs) +
+                                   static_cast<std::size_t>(layout_.hidden_layers) * layout_.width;
+  if (mu_dx_.size() < a.n_samples || mu_dx_.size() == 0) {
+    const std::size_t capacity = std::max<std::size_t>(1, a.n_samples + a.n_samples / 4);
+    mu_dx_ = cl::Buffer<float>(context_, capacity);
+    cache_ = cl::Buffer<float>(context_, capacity * cache_floats);
+    cache_stride_ = capacity;
+  }
+  const auto stride_samples = static_cast<cl_uint>(cache_stride_);
+  if (a.n_samples > 0) {
+    forward_.set_args(a.n_samples, *a.sample_rays, *a.offsets, *a.rays, *a.segments, levels_,
+                      *a.level_weights, params, mlp, a.seed, a.step, jitter, mu_dx_, cache_,
+                      stride_samples);
+    // A fixed work-group size: the sample count changes every step, and PoCL compiles a kernel
+    // variant for every distinct work-group size it is asked for.
+    context_.launch(forward_, a.n_samples, kForwardGroup);
+  }
+  loss_.set_args(a.n_batch, *a.offsets, mu_dx_, *a.rays, sums_, *a.rho, *a.weights,
+                 a.elements_per_view, params, static_cast<cl_uint>(layout_.alpha_offset),
                  static_cast<cl_uint>(layout_.beta_offset), a.n_elements, *a.elements, a.lambda,
                  a.relative_threshold, a.data_weight, a.block_first, a.block_views,
                  a.block_elements, a.ring_lambda, grad, d_sums_, loss, scratch_);
   context_.launch(loss_, 1, 1);
+  // Lanes are independent work-groups of one work-item: on a CPU each runs as plain code.
   const auto stride = static_cast<cl_uint>(atomic_ ? 0 : layout_.total);
-  backward_.set_args(n_lanes, a.n_batch, *a.rays, *a.segments, levels_, *a.level_weights, params,
-                     grad, stride, mlp, a.seed, a.step, jitter, d_sums_);
+  backward_.set_args(n_lanes, a.n_batch, *a.offsets, *a.rays, *a.segments, levels_,
+                     *a.level_weights, params, grad, stride, mlp, a.seed, a.step, jitter, d_sums_,
+                     cache_, stride_samples);
   context_.launch(backward_, n_lanes, 1);
 }
 

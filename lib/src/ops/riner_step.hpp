@@ -12,12 +12,16 @@ namespace riner::ops {
 
 struct StepArgs {
   const cl::Buffer<cl_uint>* rays;         // the batch's ray ids
+  const cl::Buffer<cl_uint>* offsets;      // n_batch + 1: batch ray b owns samples
+                                           // offsets[b] .. offsets[b + 1] (its segment count)
+  const cl::Buffer<cl_uint>* sample_rays;  // n_samples: the batch ray of each sample
   const cl::Buffer<cl_float8>* segments;   // every ray of the scan
   const cl::Buffer<float>* rho;            // every ray of the scan
   const cl::Buffer<float>* weights;        // data-term weight per batch ray
   const cl::Buffer<float>* level_weights;  // per encoding level
   const cl::Buffer<cl_uint>* elements;     // the batch's distinct elements
   cl_uint n_batch;
+  cl_uint n_samples;  // offsets[n_batch]
   cl_uint n_elements;
   cl_uint elements_per_view;
   cl_uint seed;
@@ -35,6 +39,7 @@ struct StepArgs {
 class RinerStepOp {
  public:
   // atomic: one shared gradient (lanes = rays); otherwise lanes own partial gradients.
+  // The per-sample buffers grow to the largest batch seen.
   RinerStepOp(cl::Context& context, const model::ParameterLayout& layout, bool atomic,
               std::size_t max_batch);
 
@@ -56,6 +61,9 @@ class RinerStepOp {
   cl::Buffer<float> sums_;
   cl::Buffer<float> d_sums_;
   cl::Buffer<float> scratch_;
+  cl::Buffer<float> mu_dx_;  // per sample
+  cl::Buffer<float> cache_;  // per sample: features and activations (SAMPLE_CACHE floats)
+  std::size_t cache_stride_ = 0;
   std::shared_ptr<const cl::Program> program_;
   cl::Kernel forward_;
   cl::Kernel loss_;

@@ -63,6 +63,7 @@ class OpenclTrainer final : public Trainer {
                   CL_MEM_READ_ONLY),
         rho_(ctx_, std::span<const float>(setup.scan.measurement.data), CL_MEM_READ_ONLY),
         rays_(ctx_, max_batch_),
+        offsets_(ctx_, max_batch_ + 1),
         elements_(ctx_, max_batch_),
         weights_(ctx_, max_batch_),
         level_weights_(ctx_, static_cast<std::size_t>(setup.layout.levels)),
@@ -75,17 +76,33 @@ class OpenclTrainer final : public Trainer {
   void step(int index, const model::Batch& batch) override {
     const TrainingConfig& t = setup_.config.training;
     rays_.write(batch.rays);
+    offsets_host_.resize(batch.rays.size() + 1);
+    offsets_host_[0] = 0;
+    for (std::size_t b = 0; b < batch.rays.size(); ++b)
+      offsets_host_[b + 1] = offsets_host_[b] + setup_.segments[batch.rays[b]].count;
+    offsets_.write(offsets_host_);
+    sample_rays_host_.resize(offsets_host_.back());
+    for (std::size_t b = 0; b < batch.rays.size(); ++b) {
+      std::fill(sample_rays_host_.begin() + offsets_host_[b],
+                sample_rays_host_.begin() + offsets_host_[b + 1], static_cast<cl_uint>(b));
+    }
+    if (sample_rays_.size() < sample_rays_host_.size())
+      sample_rays_ = cl::Buffer<cl_uint>(ctx_, sample_rays_host_.size() * 5 / 4 + 1);
+    sample_rays_.write(sample_rays_host_);
     elements_.write(batch.elements);
     weights_.write(batch.weights);
     set_level_weights(setup_.level_weights(index));
     ops::StepArgs args{};
     args.rays = &rays_;
+    args.offsets = &offsets_;
+    args.sample_rays = &sample_rays_;
     args.segments = &segments_;
     args.rho = &rho_;
     args.weights = &weights_;
     args.level_weights = &level_weights_;
     args.elements = &elements_;
     args.n_batch = static_cast<cl_uint>(batch.rays.size());
+    args.n_samples = offsets_host_.back();
     args.n_elements = static_cast<cl_uint>(batch.elements.size());
     args.elements_per_view = static_cast<cl_uint>(setup_.elements_per_view);
     args.seed = setup_.seed;
@@ -171,6 +188,10 @@ class OpenclTrainer final : public Trainer {
   cl::Buffer<cl_float8> segments_;
   cl::Buffer<float> rho_;
   cl::Buffer<cl_uint> rays_;
+  cl::Buffer<cl_uint> offsets_;
+  std::vector<cl_uint> offsets_host_;
+  cl::Buffer<cl_uint> sample_rays_;
+  std::vector<cl_uint> sample_rays_host_;
   cl::Buffer<cl_uint> elements_;
   cl::Buffer<float> weights_;
   cl::Buffer<float> level_weights_;
