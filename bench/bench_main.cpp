@@ -51,13 +51,17 @@ int main(int argc, char** argv) {
     ran = true;
     try {
       for (const riner::bench::Result& r : c.fn(options)) {
-        std::printf("%-20s %s\n", r.case_name.c_str(), r.fields.dump().c_str());
+        if (r.line.empty())
+          std::printf("%-20s %s\n", r.case_name.c_str(), r.fields.dump().c_str());
+        else
+          std::printf("%s\n", r.line.c_str());
+        std::fflush(stdout);
         if (!options.json_path.empty()) {
           nlohmann::json line = r.fields;
           line["case"] = r.case_name;
           line["size"] = options.size;
           line["meta"] =
-              riner::bench::metadata(riner::Device::open(options.device).info().full_name());
+              riner::bench::metadata(riner::Device::open(options.device).info(), options);
           std::ofstream(options.json_path, std::ios::app) << line.dump() << "\n";
         }
       }

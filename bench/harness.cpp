@@ -3,6 +3,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cstdarg>
+#include <cstdio>
 #include <cmath>
 #include <ctime>
 #include <numeric>
@@ -16,11 +18,48 @@ Stats Stats::of(std::vector<double> s) {
   st.min = s.front();
   st.max = s.back();
   st.median = s.size() % 2 ? s[s.size() / 2] : 0.5 * (s[s.size() / 2 - 1] + s[s.size() / 2]);
+  auto quantile = [&](double q) {
+    const double at = q * static_cast<double>(s.size() - 1);
+    const std::size_t i = static_cast<std::size_t>(at);
+    const double f = at - static_cast<double>(i);
+    return i + 1 < s.size() ? s[i] * (1.0 - f) + s[i + 1] * f : s[i];
+  };
+  st.q25 = quantile(0.25);
+  st.q75 = quantile(0.75);
   st.mean = std::accumulate(s.begin(), s.end(), 0.0) / static_cast<double>(s.size());
   double var = 0;
   for (double v : s) var += (v - st.mean) * (v - st.mean);
   st.stddev = s.size() > 1 ? std::sqrt(var / static_cast<double>(s.size() - 1)) : 0.0;
   return st;
+}
+
+std::string format(const char* fmt, ...) {
+  va_list args;
+  va_start(args, fmt);
+  char buf[1024];
+  std::vsnprintf(buf, sizeof(buf), fmt, args);
+  va_end(args);
+  return buf;
+}
+
+nlohmann::json Stats::to_json() const {
+  return {{"min", min}, {"q25", q25}, {"median", median}, {"q75", q75}, {"max", max},
+          {"mean", mean}, {"stddev", stddev}};
+}
+
+std::string Options::get(const std::string& key, const std::string& fallback) const {
+  const auto it = extra.find(key);
+  return it == extra.end() ? fallback : it->second;
+}
+
+int Options::get_int(const std::string& key, int fallback) const {
+  const auto it = extra.find(key);
+  return it == extra.end() ? fallback : std::stoi(it->second);
+}
+
+double Options::get_double(const std::string& key, double fallback) const {
+  const auto it = extra.find(key);
+  return it == extra.end() ? fallback : std::stod(it->second);
 }
 
 static std::vector<CaseEntry>& registry() {
@@ -41,7 +80,7 @@ double time_ms(const std::function<void()>& fn) {
       .count();
 }
 
-nlohmann::json metadata(const std::string& device_name) {
+nlohmann::json metadata(const DeviceInfo& device, const Options& options) {
   char date[32];
   const std::time_t now = std::time(nullptr);
   std::strftime(date, sizeof(date), "%Y-%m-%dT%H:%M:%SZ", std::gmtime(&now));
@@ -60,7 +99,14 @@ nlohmann::json metadata(const std::string& device_name) {
           {"git", revision},
           {"host", host},
           {"cores", sysconf(_SC_NPROCESSORS_ONLN)},
-          {"device", device_name}};
+          {"device", device.full_name()},
+          {"driver", device.driver_version},
+          {"settings",
+           {{"size", options.size},
+            {"runs", options.runs},
+            {"warmup", options.warmup},
+            {"device", options.device},
+            {"options", options.extra}}}};
 }
 
 }  // namespace riner::bench

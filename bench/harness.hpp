@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "riner/device.hpp"
+
 namespace riner::bench {
 
 struct Options {
@@ -18,18 +20,31 @@ struct Options {
   std::string json_path;                     // JSON lines appended here when set
   std::string self;                          // argv[0], for cases that time fresh processes
   std::map<std::string, std::string> extra;  // --key=value options a case understands
+
+  // A case's own option (--key=value), or the fallback.
+  std::string get(const std::string& key, const std::string& fallback) const;
+  int get_int(const std::string& key, int fallback) const;
+  double get_double(const std::string& key, double fallback) const;
 };
 
 struct Stats {
   double min = 0, median = 0, mean = 0, stddev = 0, max = 0;
+  double q25 = 0, q75 = 0;  // quartiles (linear interpolation)
   static Stats of(std::vector<double> samples);
+  nlohmann::json to_json() const;
 };
 
 // One result row: printed as a table line and written as one JSON object.
 struct Result {
+  Result(std::string case_name_, nlohmann::json fields_, std::string line_ = "")
+      : case_name(std::move(case_name_)), fields(std::move(fields_)), line(std::move(line_)) {}
   std::string case_name;
   nlohmann::json fields;  // everything measured, in the case's own units
+  std::string line;       // a table row for stdout; the fields are printed when empty
 };
+
+// printf into a std::string (for table rows).
+std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 
 using CaseFn = std::function<std::vector<Result>(const Options&)>;
 
@@ -45,8 +60,9 @@ const std::vector<CaseEntry>& cases();
 // Wall-clock milliseconds of fn().
 double time_ms(const std::function<void()>& fn);
 
-// Metadata stamped on every JSON line: date, git revision, host, device.
-nlohmann::json metadata(const std::string& device_name);
+// Metadata stamped on every JSON line: date, git revision, host, device and driver, and the
+// harness settings of the run.
+nlohmann::json metadata(const DeviceInfo& device, const Options& options);
 
 }  // namespace riner::bench
 

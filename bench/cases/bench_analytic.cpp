@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "harness.hpp"
+#include "scenes.hpp"
 #include "riner/fbp.hpp"
 #include "riner/io.hpp"
 #include "riner/metrics.hpp"
@@ -86,23 +87,16 @@ std::vector<Result> projector_accuracy(const Options& options) {
 
 // FBP on the paper protocol for each DeepLesion slice: clean and ring-corrupted.
 std::vector<Result> fbp_deeplesion(const Options& options) {
-  const std::string dir =
-      options.extra.count("data") ? options.extra.at("data") : "../shared/data/deeplesion";
   riner::Device device = riner::Device::open(options.device);
   const riner::Geometry g = riner::preset_geometry("fan2d-paper");
   const riner::Projector projector(g, riner::Engine::kOpenCL, device);
   riner::FbpOptions fbp_options;
   fbp_options.device = device;
   std::vector<Result> results;
-  for (int slice = 0; slice < 10; ++slice) {
-    const std::filesystem::path path = dir + "/slice_" + std::to_string(slice) + ".nii";
-    if (!std::filesystem::exists(path))
-      throw std::runtime_error(path.string() + " not found (use --data=DIR)");
-    riner::Array truth = riner::read_array(path).array;
-    for (float& v : truth.data) v *= 0.1f;  // cm^-1 -> mm^-1
-    riner::RingModel model;
-    model.seed = static_cast<std::uint64_t>(slice);
-    const riner::SimulatedScan sim = riner::simulate(truth, projector, model);
+  for (int slice = 0; slice < (options.size == "tiny" ? 1 : 10); ++slice) {
+    const riner::bench::RingScene scene = riner::bench::paper_scene(options, slice, projector);
+    const riner::SimulatedScan& sim = scene.sim;
+    const riner::Array& truth = sim.ground_truth;
     riner::Array clean_image;
     const double ms = riner::bench::time_ms([&] {
       clean_image = riner::fbp(riner::Scan{sim.clean, g, 0}, fbp_options);
@@ -111,7 +105,7 @@ std::vector<Result> fbp_deeplesion(const Options& options) {
     const riner::ImageMetrics rings =
         riner::compare_images(riner::fbp(sim.scan, fbp_options), truth);
     results.push_back({"fbp_deeplesion",
-                       {{"slice", slice},
+                       {{"scene", scene.name},
                         {"clean_psnr", clean.psnr},
                         {"clean_ssim", clean.ssim},
                         {"rings_psnr", rings.psnr},
@@ -159,7 +153,7 @@ std::vector<Result> fdk_shepp_logan(const Options& options) {
       }
     }
   }
-  const std::string out = options.extra.count("out") ? options.extra.at("out") : ".";
+  const std::string out = options.get("out", ".");
   riner::write_png(out + "/fdk_shepp_logan_128.png", panel, riner::Window{0.0f, 0.04f});
   return {{"fdk_shepp_logan",
            {{"grid", g.volume_shape},

@@ -8,6 +8,7 @@
 #include <iterator>
 
 #include "harness.hpp"
+#include "scenes.hpp"
 #include "riner/fbp.hpp"
 #include "riner/io.hpp"
 #include "riner/metrics.hpp"
@@ -20,31 +21,6 @@ namespace {
 
 using riner::bench::Options;
 using riner::bench::Result;
-
-std::string option(const Options& o, const std::string& key, const std::string& fallback) {
-  auto it = o.extra.find(key);
-  return it == o.extra.end() ? fallback : it->second;
-}
-
-// --config=FILE or inline JSON, then --steps.
-riner::RinerConfig config_from(const Options& o) {
-  riner::RinerConfig config;
-  const std::string c = option(o, "config", "");
-  if (!c.empty()) {
-    if (std::filesystem::exists(c)) {
-      std::ifstream f(c);
-      config.update_from_json(
-          std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()), c);
-    } else {
-      config.update_from_json(c, "--config");
-    }
-  }
-  if (o.size == "tiny") config.training.steps = 300;
-  const std::string steps = option(o, "steps", "");
-  if (!steps.empty()) config.training.steps = std::stoi(steps);
-  config.engine = riner::parse_engine(option(o, "engine", "opencl"));
-  return config;
-}
 
 // Trains with metric checkpoints every `every` steps; returns the final metrics.
 nlohmann::json train_and_measure(riner::Reconstructor& r, const riner::Array& truth, int every,
@@ -62,31 +38,24 @@ nlohmann::json train_and_measure(riner::Reconstructor& r, const riner::Array& tr
 }
 
 std::vector<Result> riner_deeplesion(const Options& o) {
-  const std::string dir = option(o, "data", "../shared/data/deeplesion");
-  const int first = std::stoi(option(o, "first", "0"));
-  const int last = std::stoi(option(o, "last", o.size == "tiny" ? "0" : "9"));
-  const int every = std::stoi(option(o, "checkpoint", "1000"));
-  const std::string png_dir = option(o, "png", "");
-  const riner::RinerConfig config = config_from(o);
+  const int first = o.get_int("first", 0);
+  const int last = o.get_int("last", o.size == "tiny" ? first : 9);
+  const int every = o.get_int("checkpoint", 1000);
+  const std::string png_dir = o.get("png", "");
+  const riner::RinerConfig config = riner::bench::config_from(o);
   riner::Device device = riner::Device::open(o.device);
-  const riner::Geometry g = riner::preset_geometry("fan2d-paper");
-  const riner::Projector projector(g, riner::Engine::kOpenCL, device);
+  const riner::Projector projector(riner::preset_geometry("fan2d-paper"), riner::Engine::kOpenCL,
+                                   device);
   riner::FbpOptions fbp_options;
   fbp_options.device = device;
   std::vector<Result> results;
   for (int slice = first; slice <= last; ++slice) {
-    const std::filesystem::path path = dir + "/slice_" + std::to_string(slice) + ".nii";
-    if (!std::filesystem::exists(path))
-      throw std::runtime_error(path.string() + " not found (--data=DIR)");
-    riner::Array truth = riner::read_array(path).array;
-    for (float& v : truth.data) v *= 0.1f;  // 1/cm -> 1/mm (METHOD.md section 4)
-    riner::RingModel model;
-    model.seed = static_cast<std::uint64_t>(slice);
-    const riner::SimulatedScan sim = riner::simulate(truth, projector, model);
-    const riner::Array fbp_image = riner::fbp(sim.scan, fbp_options);
+    const riner::bench::RingScene scene = riner::bench::paper_scene(o, slice, projector);
+    const riner::Array& truth = scene.sim.ground_truth;
+    const riner::Array fbp_image = riner::fbp(scene.sim.scan, fbp_options);
     const riner::ImageMetrics fbp = riner::compare_images(fbp_image, truth);
 
-    riner::Reconstructor r(sim.scan, config,
+    riner::Reconstructor r(scene.sim.scan, config,
                            config.engine == riner::Engine::kOpenCL
                                ? std::optional<riner::Device>(device)
                                : std::nullopt);
@@ -94,31 +63,9 @@ std::vector<Result> riner_deeplesion(const Options& o) {
     train_and_measure(r, truth, every, &curve);
     const riner::Array image = r.image();
     const riner::ImageMetrics m = riner::compare_images(image, truth);
-    const riner::Array alpha = r.alpha();
-    const riner::Array beta = r.beta();
-    double alpha_error = 0.0;
-    int live = 0;
-    int live_off = 0;
-    nlohmann::json dead = nlohmann::json::array();
-    for (std::size_t e = 0; e < alpha.size(); ++e) {
-      if (sim.alpha.data[e] > 0.0f) {
-        alpha_error += std::fabs(alpha.data[e] - sim.alpha.data[e]);
-        ++live;
-        live_off += beta.data[e] < 0.5f;
-        continue;
-      }
-      // A dead element whose rays barely cross the object cannot be told from a live one.
-      double clean_mean = 0.0;
-      for (std::size_t v = 0; v < g.n_views(); ++v) clean_mean += sim.clean(v, e);
-      clean_mean /= static_cast<double>(g.n_views());
-      dead.push_back({{"element", e},
-                      {"beta", beta.data[e]},
-                      {"flagged", beta.data[e] < 0.5f},
-                      {"clean_mean", clean_mean}});
-    }
     const riner::TrainingStats st = r.stats();
     if (!png_dir.empty()) {
-      const std::size_t n = 256;
+      const std::size_t n = truth.shape[0];
       riner::Array panel({n, 3 * n});
       for (std::size_t i = 0; i < n; ++i) {
         for (std::size_t k = 0; k < n; ++k) {
@@ -130,23 +77,22 @@ std::vector<Result> riner_deeplesion(const Options& o) {
       riner::write_png(png_dir + "/deeplesion_slice" + std::to_string(slice) + ".png", panel,
                        riner::Window{0.0f, 0.035f});
     }
-    results.push_back({"riner_deeplesion",
-                       {{"slice", slice},
-                        {"psnr", m.psnr},
-                        {"ssim", m.ssim},
-                        {"fbp_psnr", fbp.psnr},
-                        {"fbp_ssim", fbp.ssim},
-                        {"alpha_mae_live", alpha_error / live},
-                        {"live_switched_off", live_off},
-                        {"dead", dead},
-                        {"seconds", st.seconds},
-                        {"steps", st.steps},
-                        {"samples_per_second", st.samples / st.seconds},
-                        {"engine", st.engine},
-                        {"curve", curve},
-                        {"config", nlohmann::json::parse(config.to_json())}}});
-    std::fprintf(stderr, "slice %d: PSNR %.2f SSIM %.4f (FBP %.2f) in %.1fs\n", slice, m.psnr,
-                 m.ssim, fbp.psnr, st.seconds);
+    nlohmann::json fields = riner::bench::detector_accuracy(r.alpha(), r.beta(), scene.sim);
+    fields.update({{"scene", scene.name},
+                   {"slice", slice},
+                   {"psnr", m.psnr},
+                   {"ssim", m.ssim},
+                   {"fbp_psnr", fbp.psnr},
+                   {"fbp_ssim", fbp.ssim},
+                   {"seconds", st.seconds},
+                   {"steps", st.steps},
+                   {"samples_per_second", st.samples / st.seconds},
+                   {"engine", st.engine},
+                   {"curve", curve},
+                   {"config", nlohmann::json::parse(config.to_json())}});
+    results.push_back({"riner_deeplesion", fields});
+    std::fprintf(stderr, "%s: PSNR %.2f SSIM %.4f (FBP %.2f) in %.1fs\n", scene.name.c_str(),
+                 m.psnr, m.ssim, fbp.psnr, st.seconds);
   }
   return results;
 }
@@ -174,10 +120,10 @@ std::vector<Result> riner_parallel_shepp_logan(const Options& o) {
   riner::FbpOptions fbp_options;
   fbp_options.device = riner::Device::open(o.device);
   const riner::ImageMetrics fbp = riner::compare_images(riner::fbp(scan, fbp_options), truth);
-  const riner::RinerConfig config = config_from(o);
+  const riner::RinerConfig config = riner::bench::config_from(o);
   riner::Reconstructor r(scan, config, fbp_options.device);
   std::vector<nlohmann::json> curve;
-  train_and_measure(r, truth, std::stoi(option(o, "checkpoint", "2000")), &curve);
+  train_and_measure(r, truth, o.get_int("checkpoint", 2000), &curve);
   const riner::ImageMetrics m = riner::compare_images(r.image(), truth);
   return {{"riner_parallel_shepp_logan",
            {{"psnr", m.psnr},
@@ -199,14 +145,14 @@ namespace {
 
 // A real scan (neutron360 by default): FBP and Riner side by side, ring index of each.
 std::vector<Result> riner_real_scan(const Options& o) {
-  const std::string scan_path = option(o, "scan", "../shared/data/neutron360/sino.npy");
-  const std::string png = option(o, "png", "");
+  const std::string scan_path = o.get("scan", "../shared/data/neutron360/sino.npy");
+  const std::string png = o.get("png", "");
   riner::Scan scan = riner::load_scan(scan_path);
   riner::Device device = riner::Device::open(o.device);
   riner::FbpOptions fbp_options;
   fbp_options.device = device;
   const riner::Array fbp_image = riner::fbp(scan, fbp_options);
-  const riner::RinerConfig config = config_from(o);
+  const riner::RinerConfig config = riner::bench::config_from(o);
   riner::Reconstructor r(scan, config, device);
   r.run();
   const riner::Array image = r.image();

@@ -1,0 +1,35 @@
+// What the Riner benchmarks reconstruct: the DeepLesion slices simulated by the paper protocol
+// (METHOD.md section 4) when ../shared is present, else built-in Shepp-Logan ring scans in the
+// same geometry, plus the settings and detector scores every Riner case shares.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "harness.hpp"
+#include "riner/projector.hpp"
+#include "riner/riner_config.hpp"
+#include "riner/simulate.hpp"
+
+namespace riner::bench {
+
+struct RingScene {
+  std::string name;  // "deeplesion/slice_3" or "shepp-logan/seed_3"
+  SimulatedScan sim;
+};
+
+// --data=DIR (default ../shared/data/deeplesion; "builtin" for the phantoms). Falls back to the
+// phantoms, with a note on stderr, only when the default folder is missing.
+bool uses_deeplesion(const Options& o);
+// Scene `index` (a slice index, also the ring seed) in the fan2d-paper geometry.
+RingScene paper_scene(const Options& o, int index, const Projector& projector);
+
+// The defaults, then --config=FILE|JSON, then --steps, then --engine.
+RinerConfig config_from(const Options& o);
+
+// How well alpha and beta match the truth: mean |alpha err| over live elements, dead elements
+// flagged (beta < 0.5) among those whose rays cross the object (clean column mean >= 0.1,
+// elsewhere flagging is moot), live elements switched off, and each dead element's details.
+nlohmann::json detector_accuracy(const Array& alpha, const Array& beta, const SimulatedScan& sim);
+
+}  // namespace riner::bench
