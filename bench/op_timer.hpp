@@ -13,9 +13,9 @@
 namespace riner::bench {
 
 struct OpTiming {
-  Stats wall_ms;                            // per run, host wall clock until the queue is done
-  Stats device_ms;                          // per run, sum of the kernels' device times
-  std::map<std::string, Stats> kernel_ms;   // per run, per kernel name (summed over launches)
+  Stats wall_ms;                           // per run, host wall clock until the queue is done
+  Stats device_ms;                         // per run, sum of the kernels' device times
+  std::map<std::string, Stats> kernel_ms;  // per run, per kernel name (summed over launches)
   nlohmann::json to_json() const;
 };
 

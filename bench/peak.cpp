@@ -1,7 +1,7 @@
 #include "peak.hpp"
 
-#include <Eigen/Dense>
 #include <clblast.h>
+#include <Eigen/Dense>
 
 #include <stdexcept>
 #include <thread>
@@ -9,8 +9,8 @@
 
 #include "cl/buffer.hpp"
 #include "cl/context.hpp"
-#include "ops/vector_ops.hpp"
 #include "op_timer.hpp"
+#include "ops/vector_ops.hpp"
 
 namespace riner::bench {
 
@@ -52,8 +52,8 @@ double clblast_gemm_ms(const Device& device, std::size_t m, std::size_t n, std::
   cl_command_queue queue = ctx.queue();
   auto gemm = [&] {
     const clblast::StatusCode status = clblast::Gemm<float>(
-        clblast::Layout::kRowMajor, clblast::Transpose::kNo, clblast::Transpose::kNo, m, n, k,
-        1.0f, a.get(), 0, k, b.get(), 0, n, 0.0f, c.get(), 0, n, &queue);
+        clblast::Layout::kRowMajor, clblast::Transpose::kNo, clblast::Transpose::kNo, m, n, k, 1.0f,
+        a.get(), 0, k, b.get(), 0, n, 0.0f, c.get(), 0, n, &queue);
     if (status != clblast::StatusCode::kSuccess)
       throw std::runtime_error("CLBlast SGEMM failed with status " +
                                std::to_string(static_cast<int>(status)));
@@ -87,8 +87,7 @@ Peaks measure_peaks(const Device& device, const Options& o) {
                {"host_gemm", "Eigen " + std::to_string(EIGEN_WORLD_VERSION) + "." +
                                  std::to_string(EIGEN_MAJOR_VERSION) + "." +
                                  std::to_string(EIGEN_MINOR_VERSION) + ", " +
-                                 std::to_string(std::thread::hardware_concurrency()) +
-                                 " threads"},
+                                 std::to_string(std::thread::hardware_concurrency()) + " threads"},
                {"device_gemm", "CLBlast SGEMM"},
                {"bandwidth_floats", count}};
   return p;

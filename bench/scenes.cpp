@@ -92,10 +92,8 @@ nlohmann::json detector_accuracy(const Array& alpha, const Array& beta, const Si
       ++dead_crossing;
       dead_flagged += flagged;
     }
-    dead.push_back({{"element", e},
-                    {"beta", beta.data[e]},
-                    {"flagged", flagged},
-                    {"clean_mean", clean_mean}});
+    dead.push_back(
+        {{"element", e}, {"beta", beta.data[e]}, {"flagged", flagged}, {"clean_mean", clean_mean}});
   }
   return {{"alpha_mae_live", live > 0 ? alpha_error / live : 0.0},
           {"dead_crossing", dead_crossing},

@@ -7,8 +7,8 @@
 // (input and weight gradients); hash-grid forward 2^d corners x (d + 2 F) per level, backward
 // 2^d x 2 F per level. Bytes are the compulsory traffic (each operand read or written once).
 #include <cmath>
-#include <cstdlib>
 #include <cstdio>
+#include <cstdlib>
 #include <random>
 
 #include "cl/buffer.hpp"
@@ -42,8 +42,8 @@ struct Throughput {
 };
 
 // One row: the timing, throughput against device time (wall when the device reports none).
-Result row(const std::string& op, const std::string& shape, const OpTiming& t,
-           const Throughput& w, const Peaks& peaks) {
+Result row(const std::string& op, const std::string& shape, const OpTiming& t, const Throughput& w,
+           const Peaks& peaks) {
   const double ms = t.device_ms.median > 0.0 ? t.device_ms.median : t.wall_ms.median;
   nlohmann::json f = t.to_json();
   f["op"] = op;
@@ -105,16 +105,18 @@ void model_ops(const riner::Device& device, const Options& o, const Peaks& peaks
     config.network.width = width;
     const riner::model::ParameterLayout l =
         riner::model::make_layout(2, config.encoding, config.network, 768);
-    riner::cl::Buffer<float> params(ctx, std::span<const float>(riner::model::initial_parameters(l, 1)));
+    riner::cl::Buffer<float> params(ctx,
+                                    std::span<const float>(riner::model::initial_parameters(l, 1)));
     riner::cl::Buffer<float> grad(ctx, std::vector<float>(l.total, 0.0f));
     riner::cl::Buffer<float> positions(ctx, std::span<const float>(uniform(2 * n, 0.0f, 1.0f, 2)));
     riner::cl::Buffer<float> features(ctx, n * l.inputs);
-    riner::cl::Buffer<float> d_features(ctx, std::span<const float>(uniform(n * l.inputs, -1.0f, 1.0f, 3)));
+    riner::cl::Buffer<float> d_features(
+        ctx, std::span<const float>(uniform(n * l.inputs, -1.0f, 1.0f, 3)));
     riner::cl::Buffer<float> mu(ctx, n);
     riner::cl::Buffer<float> d_mu(ctx, std::span<const float>(uniform(n, -1.0f, 1.0f, 4)));
     riner::cl::Buffer<float> d_inputs(ctx, n * l.inputs);
-    const std::string shape = std::to_string(n) + " x " + std::to_string(l.inputs) + " -> " +
-                              std::to_string(width);
+    const std::string shape =
+        std::to_string(n) + " x " + std::to_string(l.inputs) + " -> " + std::to_string(width);
     if (width == 16) {
       riner::ops::HashGridOp grid(ctx, l);
       const double lookups = static_cast<double>(n) * l.levels * 4;
@@ -128,8 +130,8 @@ void model_ops(const riner::Device& device, const Options& o, const Peaks& peaks
                          {lookups, "lookups/s", n * grid_backward_flops(l), 0.0}, peaks));
     }
     riner::ops::MlpOp mlp(ctx, l);
-    OpTiming t = riner::bench::time_op(device, warmup, runs,
-                                       [&] { mlp.forward(params, d_features, mu); });
+    OpTiming t =
+        riner::bench::time_op(device, warmup, runs, [&] { mlp.forward(params, d_features, mu); });
     out->push_back(row("mlp_forward", shape, t,
                        {static_cast<double>(n), "samples/s", n * mlp_forward_flops(l), 0.0},
                        peaks));
@@ -195,13 +197,14 @@ void training_step(const riner::Device& device, const Options& o, const Peaks& p
   const OpTiming t = riner::bench::time_op(device, 0, steps, [&] { r.step(1); });
   const riner::TrainingStats after = r.stats();
   const double samples = (after.samples - before.samples) / steps;  // forward + backward
-  const riner::model::ParameterLayout l = riner::model::make_layout(
-      2, config.encoding, config.network, scene.sim.scan.geometry.n_u);
+  const riner::model::ParameterLayout l =
+      riner::model::make_layout(2, config.encoding, config.network, scene.sim.scan.geometry.n_u);
   // Forward, then the backward pass recomputing the forward before its own work.
   const double flops = samples * (2.0 * (grid_forward_flops(l) + mlp_forward_flops(l)) +
                                   2.0 * mlp_forward_flops(l) + grid_backward_flops(l));
-  out->push_back(row("training_step (" + after.gradient_mode + ")", std::to_string(config.training.rays_per_step) + " rays, " +
-                                          std::to_string(static_cast<long>(samples)) + " samples",
+  out->push_back(row("training_step (" + after.gradient_mode + ")",
+                     std::to_string(config.training.rays_per_step) + " rays, " +
+                         std::to_string(static_cast<long>(samples)) + " samples",
                      t, {samples, "samples/s", flops, 0.0}, peaks));
   if (!gradients.empty()) return;  // the split and the field: for the default mode only
   const double params = static_cast<double>(after.parameters);
@@ -209,7 +212,8 @@ void training_step(const riner::Device& device, const Options& o, const Peaks& p
     OpTiming k;
     k.wall_ms = k.device_ms = stats;
     Throughput w{samples, "samples/s", 0.0, 0.0};
-    if (kernel == "riner_step_loss") w = {double(config.training.rays_per_step), "rays/s", 0.0, 0.0};
+    if (kernel == "riner_step_loss")
+      w = {double(config.training.rays_per_step), "rays/s", 0.0, 0.0};
     if (kernel == "adam_step") {
       // Reads params, m, v and one partial gradient per compute unit; writes params, m, v and
       // the zeroed partials.
@@ -221,9 +225,9 @@ void training_step(const riner::Device& device, const Options& o, const Peaks& p
   // The field on the 512^2 grid (chunked field_evaluate).
   const OpTiming e = riner::bench::time_op(device, 1, o.size == "tiny" ? 1 : 5, [&] { r.image(); });
   const double pixels = 512.0 * 512.0;
-  out->push_back(row("field_evaluate", "512 x 512", e,
-                     {pixels, "pixels/s", pixels * (grid_forward_flops(l) + mlp_forward_flops(l)), 0.0},
-                     peaks));
+  out->push_back(row(
+      "field_evaluate", "512 x 512", e,
+      {pixels, "pixels/s", pixels * (grid_forward_flops(l) + mlp_forward_flops(l)), 0.0}, peaks));
 }
 
 // Geometry-side ops: ray clipping on the host, projector, adjoint and FBP on the device.
@@ -237,20 +241,24 @@ void geometry_ops(const riner::Device& device, const Options& o, const Peaks& pe
     ms.push_back(riner::bench::time_ms([&] { riner::model::ray_segments(g, g.voxel_mm, false); }));
   OpTiming host;
   host.wall_ms = riner::bench::Stats::of(ms);
-  out->push_back(row("ray_segments (host)", "fan2d-paper", host, {rays, "rays/s", 0.0, 0.0}, peaks));
+  out->push_back(
+      row("ray_segments (host)", "fan2d-paper", host, {rays, "rays/s", 0.0, 0.0}, peaks));
 
   const riner::Projector projector(g, riner::Engine::kOpenCL, device);
   const riner::Array image(g.volume_shape, 0.01f);
   const riner::Array sinogram(std::vector<std::size_t>{g.n_views(), g.n_u}, 1.0f);
   OpTiming t = riner::bench::time_op(device, 1, runs, [&] { projector.project(image); });
-  out->push_back(row("project (Joseph)", "512^2 -> 1000 x 768", t, {rays, "rays/s", 0.0, 0.0}, peaks));
+  out->push_back(
+      row("project (Joseph)", "512^2 -> 1000 x 768", t, {rays, "rays/s", 0.0, 0.0}, peaks));
   t = riner::bench::time_op(device, 1, runs, [&] { projector.adjoint(sinogram); });
-  out->push_back(row("backproject (adjoint)", "1000 x 768 -> 512^2", t, {rays, "rays/s", 0.0, 0.0}, peaks));
+  out->push_back(
+      row("backproject (adjoint)", "1000 x 768 -> 512^2", t, {rays, "rays/s", 0.0, 0.0}, peaks));
   riner::FbpOptions fbp_options;
   fbp_options.device = device;
   const riner::Scan scan{sinogram, g, 0};
   t = riner::bench::time_op(device, 1, runs, [&] { riner::fbp(scan, fbp_options); });
-  out->push_back(row("fbp (Ram-Lak)", "1000 x 768 -> 512^2", t, {1.0, "images/s", 0.0, 0.0}, peaks));
+  out->push_back(
+      row("fbp (Ram-Lak)", "1000 x 768 -> 512^2", t, {1.0, "images/s", 0.0, 0.0}, peaks));
 }
 
 std::vector<Result> peak(const Options& o) {

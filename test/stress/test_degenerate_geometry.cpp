@@ -13,7 +13,9 @@
 
 namespace {
 
-riner::Scan ones(const riner::Geometry& g) { return {riner::Array(g.measurement_shape(), 0.5f), g, 0}; }
+riner::Scan ones(const riner::Geometry& g) {
+  return {riner::Array(g.measurement_shape(), 0.5f), g, 0};
+}
 
 // Either runs to finite results or throws riner::Error; anything else fails the test.
 void survives(const riner::Geometry& g) {
@@ -49,19 +51,24 @@ TEST_SUITE("degenerate_geometry") {
     using riner::GeometryType;
     survives(riner::test::make_geometry(GeometryType::kFan2d, 12, 32, 1, {16, 16}, 1e-6, 1.0));
     survives(riner::test::make_geometry(GeometryType::kFan2d, 12, 32, 1, {16, 16}, 1e6, 1.0));
-    riner::Geometry off = riner::test::make_geometry(GeometryType::kParallel2d, 12, 32, 1, {16, 16}, 1.0, 1.0);
+    riner::Geometry off =
+        riner::test::make_geometry(GeometryType::kParallel2d, 12, 32, 1, {16, 16}, 1.0, 1.0);
     off.offset_u = 1000.0;
-    CHECK_THROWS_WITH_AS(riner::Reconstructor(ones(off), riner::RinerConfig(), riner::test::device()),
-                         doctest::Contains("no detector ray crosses the reconstruction grid"), riner::InputError);
+    CHECK_THROWS_WITH_AS(
+        riner::Reconstructor(ones(off), riner::RinerConfig(), riner::test::device()),
+        doctest::Contains("no detector ray crosses the reconstruction grid"), riner::InputError);
     survives(off);
   }
 
   TEST_CASE("a source inside the volume is refused with the reason") {
-    riner::Geometry g = riner::test::make_geometry(riner::GeometryType::kFan2d, 12, 32, 1, {64, 64}, 1.0, 1.0);
+    riner::Geometry g =
+        riner::test::make_geometry(riner::GeometryType::kFan2d, 12, 32, 1, {64, 64}, 1.0, 1.0);
     g.source_origin_mm = 20.0;
-    CHECK_THROWS_WITH_AS(g.validate(), doctest::Contains("puts the source inside the reconstruction grid"),
+    CHECK_THROWS_WITH_AS(g.validate(),
+                         doctest::Contains("puts the source inside the reconstruction grid"),
                          riner::InputError);
     CHECK_THROWS_AS(riner::fbp(ones(g)), riner::InputError);
-    CHECK_THROWS_AS(riner::Reconstructor(ones(g), riner::RinerConfig(), riner::test::device()), riner::InputError);
+    CHECK_THROWS_AS(riner::Reconstructor(ones(g), riner::RinerConfig(), riner::test::device()),
+                    riner::InputError);
   }
 }

@@ -50,7 +50,7 @@ TEST_SUITE("extreme_training") {
       CHECK(all_finite(beta));
       double mean = 0.0;
       for (float b : beta.data) mean += b / static_cast<double>(beta.size());
-      if (lambda == 0.0) CHECK(mean < 0.3);   // the trivial solution the penalty exists to stop
+      if (lambda == 0.0) CHECK(mean < 0.3);  // the trivial solution the penalty exists to stop
       if (lambda > 0.0) CHECK(mean > 0.99);
     }
   }

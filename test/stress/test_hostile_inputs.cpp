@@ -64,7 +64,8 @@ double fit_error(const riner::Reconstructor& r, const riner::Scan& scan) {
 TEST_SUITE("hostile_inputs") {
   TEST_CASE("NaN, +inf, -inf, zeros, negatives, 1e30 and denormals scattered in the data") {
     riner::test::TinyProblem t = riner::test::tiny_problem(11);
-    const float specials[] = {NAN, INFINITY, -INFINITY, 0.0f, -3.0f, 1e30f, -1e30f, FLT_TRUE_MIN, 1e-40f};
+    const float specials[] = {NAN,   INFINITY, -INFINITY,    0.0f,  -3.0f,
+                              1e30f, -1e30f,   FLT_TRUE_MIN, 1e-40f};
     for (std::size_t i = 0; i < t.scan.measurement.size(); i += 37) {
       t.scan.measurement.data[i] = specials[(i / 37) % 9];
     }

@@ -73,7 +73,8 @@ TEST_SUITE("io_bad_files") {
     expect_error(dir, "complex.npy", riner::test::make_npy("<c8", false, {2}, floats(4)),
                  "unsupported dtype '<c8' (riner reads float32/64, int8/16/32, uint8/16/32)");
     // Found by fuzz_npy: an item size too long for an int once escaped as std::out_of_range.
-    expect_error(dir, "long_descr.npy", riner::test::make_npy(">u2888888888888888888888", false, {2}, floats(1)),
+    expect_error(dir, "long_descr.npy",
+                 riner::test::make_npy(">u2888888888888888888888", false, {2}, floats(1)),
                  "header has no simple 'descr' (structured dtypes are not supported)");
     expect_error(dir, "scalar.npy", riner::test::make_npy("<f4", false, {}, floats(1)),
                  "holds a scalar, not an array");
@@ -122,7 +123,8 @@ TEST_SUITE("io_bad_files") {
     // Found by fuzz_nifti: vox_offset 0 means 352, beyond a file that ends inside 348..351.
     std::string no_data = good.substr(0, 350);
     no_data.replace(108, 4, std::string(4, '\0'));
-    expect_error(dir, "no_data.nii", no_data, "ends at byte 350, before its data starts at byte 352");
+    expect_error(dir, "no_data.nii", no_data,
+                 "ends at byte 350, before its data starts at byte 352");
   }
 
   TEST_CASE("tiff") {
