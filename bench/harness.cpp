@@ -3,10 +3,11 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdarg>
 #include <cstdio>
-#include <cmath>
 #include <ctime>
+#include <filesystem>
 #include <numeric>
 
 namespace riner::bench {
@@ -43,8 +44,14 @@ std::string format(const char* fmt, ...) {
 }
 
 nlohmann::json Stats::to_json() const {
-  return {{"min", min}, {"q25", q25}, {"median", median}, {"q75", q75}, {"max", max},
-          {"mean", mean}, {"stddev", stddev}};
+  return {{"min", min}, {"q25", q25},   {"median", median}, {"q75", q75},
+          {"max", max}, {"mean", mean}, {"stddev", stddev}};
+}
+
+std::string Options::output_dir(const std::string& key, const std::string& fallback) const {
+  const std::string dir = get(key, fallback);
+  if (!dir.empty()) std::filesystem::create_directories(dir);
+  return dir;
 }
 
 std::string Options::get(const std::string& key, const std::string& fallback) const {
@@ -87,7 +94,7 @@ nlohmann::json metadata(const DeviceInfo& device, const Options& options) {
   char host[256] = {0};
   gethostname(host, sizeof(host) - 1);
   std::string revision = "unknown";
-  if (FILE* pipe = popen("git rev-parse --short HEAD 2>/dev/null", "r")) {
+  if (FILE* pipe = popen("git describe --always --dirty 2>/dev/null", "r")) {
     char buf[64] = {0};
     if (std::fgets(buf, sizeof(buf), pipe) != nullptr) {
       revision = buf;

@@ -25,6 +25,9 @@ struct Options {
   std::string get(const std::string& key, const std::string& fallback) const;
   int get_int(const std::string& key, int fallback) const;
   double get_double(const std::string& key, double fallback) const;
+  // The folder --key names, created up front so that an hour-long case does not fail at
+  // its last write; empty when the option is absent and fallback is empty.
+  std::string output_dir(const std::string& key, const std::string& fallback) const;
 };
 
 struct Stats {

@@ -4,13 +4,13 @@
 #include <filesystem>
 
 #include "harness.hpp"
-#include "scenes.hpp"
 #include "riner/fbp.hpp"
 #include "riner/io.hpp"
 #include "riner/metrics.hpp"
 #include "riner/phantom.hpp"
 #include "riner/projector.hpp"
 #include "riner/simulate.hpp"
+#include "scenes.hpp"
 
 namespace {
 
@@ -153,7 +153,7 @@ std::vector<Result> fdk_shepp_logan(const Options& options) {
       }
     }
   }
-  const std::string out = options.get("out", ".");
+  const std::string out = options.output_dir("out", ".");
   riner::write_png(out + "/fdk_shepp_logan_128.png", panel, riner::Window{0.0f, 0.04f});
   return {{"fdk_shepp_logan",
            {{"grid", g.volume_shape},

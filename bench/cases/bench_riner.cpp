@@ -8,7 +8,6 @@
 #include <iterator>
 
 #include "harness.hpp"
-#include "scenes.hpp"
 #include "riner/fbp.hpp"
 #include "riner/io.hpp"
 #include "riner/metrics.hpp"
@@ -16,6 +15,7 @@
 #include "riner/reconstructor.hpp"
 #include "riner/scan.hpp"
 #include "riner/simulate.hpp"
+#include "scenes.hpp"
 
 namespace {
 
@@ -41,7 +41,7 @@ std::vector<Result> riner_deeplesion(const Options& o) {
   const int first = o.get_int("first", 0);
   const int last = o.get_int("last", o.size == "tiny" ? first : 9);
   const int every = o.get_int("checkpoint", 1000);
-  const std::string png_dir = o.get("png", "");
+  const std::string png_dir = o.output_dir("png", "");
   const riner::RinerConfig config = riner::bench::config_from(o);
   riner::Device device = riner::Device::open(o.device);
   const riner::Projector projector(riner::preset_geometry("fan2d-paper"), riner::Engine::kOpenCL,

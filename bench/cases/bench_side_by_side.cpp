@@ -110,8 +110,8 @@ std::vector<Result> side_by_side(const Options& o) {
   const int last = o.get_int("last", o.size == "tiny" ? first : 9);
   const int every = o.get_int("checkpoint", o.size == "tiny" ? 50 : 250);
   const double reference_budget = o.get_double("reference_seconds", o.size == "tiny" ? 5 : 120);
-  const std::vector<double> targets = parse_list(o.get("targets", "28,30,32,33"));
-  const std::string out_dir = o.get("out", "");
+  const std::vector<double> targets = parse_list(o.get("targets", "28,30,32,33,34"));
+  const std::string out_dir = o.output_dir("out", "");
   riner::RinerConfig config = riner::bench::config_from(o);
   riner::Device device = riner::Device::open(o.device);
   const riner::Projector projector(riner::preset_geometry("fan2d-paper"), riner::Engine::kOpenCL,
@@ -136,22 +136,26 @@ std::vector<Result> side_by_side(const Options& o) {
   for (int index = first; index <= last; ++index, ++scenes) {
     const riner::bench::RingScene scene = riner::bench::paper_scene(o, index, projector);
     riner::Array fbp_image;
-    const double ms = riner::bench::time_ms([&] { fbp_image = riner::fbp(scene.sim.scan, fbp_options); });
+    const double ms =
+        riner::bench::time_ms([&] { fbp_image = riner::fbp(scene.sim.scan, fbp_options); });
     const riner::ImageMetrics fbp = riner::compare_images(fbp_image, scene.sim.ground_truth);
     fbp_psnr += fbp.psnr;
     fbp_ssim += fbp.ssim;
     fbp_ms += ms;
-    results.push_back({"side_by_side",
-                       {{"scene", scene.name}, {"engine", "fbp"}, {"psnr", fbp.psnr},
-                        {"ssim", fbp.ssim}, {"seconds", ms * 1e-3}},
-                       riner::bench::format("%-22s %-10s %8s %6.2f dB  SSIM %.3f  %7.2f s",
-                                            scene.name.c_str(), "fbp", "", fbp.psnr, fbp.ssim,
-                                            ms * 1e-3)});
+    results.push_back(
+        {"side_by_side",
+         {{"scene", scene.name},
+          {"engine", "fbp"},
+          {"psnr", fbp.psnr},
+          {"ssim", fbp.ssim},
+          {"seconds", ms * 1e-3}},
+         riner::bench::format("%-22s %-10s %8s %6.2f dB  SSIM %.3f  %7.2f s", scene.name.c_str(),
+                              "fbp", "", fbp.psnr, fbp.ssim, ms * 1e-3)});
     for (EngineRun& e : engines) {
       config.engine = e.engine;
-      riner::Reconstructor r(scene.sim.scan, config,
-                             e.engine == riner::Engine::kOpenCL ? std::optional(device)
-                                                                : std::nullopt);
+      riner::Reconstructor r(
+          scene.sim.scan, config,
+          e.engine == riner::Engine::kOpenCL ? std::optional(device) : std::nullopt);
       std::vector<Checkpoint> curve = train(r, scene, every, e.budget);
       const riner::TrainingStats st = r.stats();
       e.samples_per_second += st.samples / st.seconds;
@@ -170,14 +174,15 @@ std::vector<Result> side_by_side(const Options& o) {
             {"detector", end.detector},
             {"curve", to_json(curve)},
             {"config", nlohmann::json::parse(config.to_json())}},
-           riner::bench::format("%-22s %-10s %8d %6.2f dB  SSIM %.3f  %7.2f s  %.3g samples/s  "
-                                "alpha MAE %.4f  dead %d/%d  live off %d",
-                                scene.name.c_str(), e.name.c_str(), end.step, end.psnr, end.ssim,
-                                end.seconds, st.samples / st.seconds,
-                                end.detector["alpha_mae_live"].get<double>(),
-                                end.detector["dead_flagged"].get<int>(),
-                                end.detector["dead_crossing"].get<int>(),
-                                end.detector["live_switched_off"].get<int>())});
+           riner::bench::format(
+               "%-22s %-10s %8d %6.2f dB  SSIM %.3f  %7.2f s  %.3g samples/s  "
+               "alpha MAE %.4f  dead %d/%d  live off %d",
+               scene.name.c_str(), e.name.c_str(), end.step, end.psnr, end.ssim, end.seconds,
+               st.samples / st.seconds, end.detector["alpha_mae_live"].get<double>(),
+               end.detector["dead_flagged"].get<int>(), end.detector["dead_crossing"].get<int>(),
+               end.detector["live_switched_off"].get<int>())});
+      std::fprintf(stderr, "%s, %s: %.2f dB at step %d, %.1f s\n", scene.name.c_str(),
+                   e.name.c_str(), end.psnr, end.step, end.seconds);
       e.curves.push_back(std::move(curve));
     }
   }
@@ -202,7 +207,8 @@ std::vector<Result> side_by_side(const Options& o) {
     std::string target_text;
     for (double t : targets) {
       const double s = seconds_to(mean, t);
-      to_target[riner::bench::format("%g", t)] = std::isnan(s) ? nlohmann::json() : nlohmann::json(s);
+      to_target[riner::bench::format("%g", t)] =
+          std::isnan(s) ? nlohmann::json() : nlohmann::json(s);
       target_text += std::isnan(s) ? riner::bench::format("  %g dB: -", t)
                                    : riner::bench::format("  %g dB: %.1f s", t, s);
     }
@@ -230,7 +236,10 @@ std::vector<Result> side_by_side(const Options& o) {
                               e.samples_per_second / scenes, target_text.c_str())});
   }
   results.push_back({"side_by_side",
-                     {{"scene", "mean"}, {"engine", "fbp"}, {"psnr", fbp_psnr}, {"ssim", fbp_ssim},
+                     {{"scene", "mean"},
+                      {"engine", "fbp"},
+                      {"psnr", fbp_psnr},
+                      {"ssim", fbp_ssim},
                       {"seconds", fbp_ms * 1e-3 / scenes}},
                      riner::bench::format("%-22s %-10s %8s %6.2f dB  SSIM %.3f  %7.2f s", "mean",
                                           "fbp", "", fbp_psnr, fbp_ssim, fbp_ms * 1e-3 / scenes)});

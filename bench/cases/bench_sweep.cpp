@@ -62,7 +62,7 @@ std::vector<Result> sweep(const Options& o) {
   const int first = o.get_int("first", 0);
   const int last = o.get_int("last", o.size == "tiny" ? first : 1);
   const int every = o.get_int("checkpoint", o.size == "tiny" ? 100 : 1000);
-  const std::string out_dir = o.get("out", "");
+  const std::string out_dir = o.output_dir("out", "");
   const riner::RinerConfig defaults = riner::bench::config_from(o);
 
   std::vector<Result> results;
@@ -71,7 +71,7 @@ std::vector<Result> sweep(const Options& o) {
   plot.x_label = "training time (s)";
   plot.y_label = "PSNR (dB)";
   const std::array<unsigned char, 3> palette[] = {
-      {31, 119, 180}, {255, 127, 14}, {44, 160, 44},  {214, 39, 40},  {148, 103, 189},
+      {31, 119, 180}, {255, 127, 14},  {44, 160, 44},   {214, 39, 40},  {148, 103, 189},
       {140, 86, 75},  {227, 119, 194}, {127, 127, 127}, {188, 189, 34}, {23, 190, 207}};
   int variant_index = 0;
   for (const nlohmann::json& v : sweep["variants"]) {
@@ -82,8 +82,8 @@ std::vector<Result> sweep(const Options& o) {
     if (o.size == "tiny") config.training.steps = std::min(config.training.steps, 200);
     config.validate();
     riner::Device device = riner::Device::open(v.value("device", o.device));
-    const riner::Projector projector(riner::preset_geometry("fan2d-paper"),
-                                     riner::Engine::kOpenCL, device);
+    const riner::Projector projector(riner::preset_geometry("fan2d-paper"), riner::Engine::kOpenCL,
+                                     device);
     std::vector<Point> mean;
     int scenes = 0;
     for (int index = first; index <= last; ++index, ++scenes) {
@@ -104,16 +104,18 @@ std::vector<Result> sweep(const Options& o) {
                          {"psnr", m.psnr},
                          {"ssim", m.ssim}});
       }
-      results.push_back({"sweep",
-                         {{"variant", name},
-                          {"scene", scene.name},
-                          {"device", r.stats().device},
-                          {"samples_per_second", r.stats().samples / r.stats().seconds},
-                          {"curve", curve},
-                          {"config", nlohmann::json::parse(config.to_json())}},
-                         riner::bench::format("%-28s %-22s %6.2f dB  %7.1f s", name.c_str(),
-                                              scene.name.c_str(), curve.back()["psnr"].get<double>(),
-                                              r.stats().seconds)});
+      std::fprintf(stderr, "sweep: %s on %s: %.2f dB in %.1f s\n", name.c_str(), scene.name.c_str(),
+                   curve.back()["psnr"].get<double>(), r.stats().seconds);
+      results.push_back(
+          {"sweep",
+           {{"variant", name},
+            {"scene", scene.name},
+            {"device", r.stats().device},
+            {"samples_per_second", r.stats().samples / r.stats().seconds},
+            {"curve", curve},
+            {"config", nlohmann::json::parse(config.to_json())}},
+           riner::bench::format("%-28s %-22s %6.2f dB  %7.1f s", name.c_str(), scene.name.c_str(),
+                                curve.back()["psnr"].get<double>(), r.stats().seconds)});
     }
     riner::PlotSeries series;
     series.label = name;
@@ -125,15 +127,16 @@ std::vector<Result> sweep(const Options& o) {
       p.ssim /= scenes;
       series.x.push_back(p.seconds);
       series.y.push_back(p.psnr);
-      curve.push_back({{"step", p.step}, {"seconds", p.seconds}, {"psnr", p.psnr}, {"ssim", p.ssim}});
+      curve.push_back(
+          {{"step", p.step}, {"seconds", p.seconds}, {"psnr", p.psnr}, {"ssim", p.ssim}});
       all.push_back(p);
     }
     plot.series.push_back(series);
-    results.push_back({"sweep",
-                       {{"variant", name}, {"scene", "mean"}, {"scenes", scenes}, {"curve", curve}},
-                       riner::bench::format("%-28s %-22s %6.2f dB  %7.1f s  (SSIM %.3f)",
-                                            name.c_str(), "mean", mean.back().psnr,
-                                            mean.back().seconds, mean.back().ssim)});
+    results.push_back(
+        {"sweep",
+         {{"variant", name}, {"scene", "mean"}, {"scenes", scenes}, {"curve", curve}},
+         riner::bench::format("%-28s %-22s %6.2f dB  %7.1f s  (SSIM %.3f)", name.c_str(), "mean",
+                              mean.back().psnr, mean.back().seconds, mean.back().ssim)});
     ++variant_index;
   }
 
@@ -147,8 +150,11 @@ std::vector<Result> sweep(const Options& o) {
   for (const Point& p : front) {
     front_series.x.push_back(p.seconds);
     front_series.y.push_back(p.psnr);
-    front_json.push_back(
-        {{"variant", p.variant}, {"step", p.step}, {"seconds", p.seconds}, {"psnr", p.psnr}, {"ssim", p.ssim}});
+    front_json.push_back({{"variant", p.variant},
+                          {"step", p.step},
+                          {"seconds", p.seconds},
+                          {"psnr", p.psnr},
+                          {"ssim", p.ssim}});
     text += riner::bench::format("\n  %7.1f s  %6.2f dB  SSIM %.3f  %s @ %d steps", p.seconds,
                                  p.psnr, p.ssim, p.variant.c_str(), p.step);
   }
@@ -167,5 +173,4 @@ std::vector<Result> sweep(const Options& o) {
 
 }  // namespace
 
-RINER_BENCH_CASE(sweep, "settings sweep: Pareto front of PSNR against time (--sweep=FILE)",
-                 sweep);
+RINER_BENCH_CASE(sweep, "settings sweep: Pareto front of PSNR against time (--sweep=FILE)", sweep);
