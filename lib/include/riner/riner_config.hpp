@@ -24,7 +24,7 @@ struct EncodingConfig {
 
 // input (levels * features) -> [width, ReLU] x hidden_layers -> 1, linear output.
 struct NetworkConfig {
-  int width = 16;  // a multiple of 16 (the kernels hold hidden layers in float16 vectors)
+  int width = 32;  // a multiple of 16 (the kernels hold hidden layers in float16 vectors)
   int hidden_layers = 1;
 };
 
@@ -44,10 +44,10 @@ enum class Sampler {
 struct TrainingConfig {
   int steps = 12000;
   Sampler sampler = Sampler::kUniform;
-  int rays_per_step = 80;       // uniform sampler
+  int rays_per_step = 160;      // uniform sampler
   int views_per_step = 40;      // views x elements sampler
   int elements_per_step = 2;    // views x elements sampler: adjacent elements
-  double sample_spacing = 1.0;  // along each ray, in voxels (the paper's fixed interval)
+  double sample_spacing = 2.0;  // along each ray, in voxels (the paper uses a fixed interval)
   bool jitter = false;          // stratified random offsets while training (midpoints if off)
   bool circle_region = false;   // sample the inscribed circle instead of the whole grid
   double learning_rate = 1e-3;
