@@ -175,6 +175,11 @@ TEST_SUITE("io_bad_files") {
                        ": sidecar says [3, 3] float32 from byte 0 but the file has 24 bytes");
     expect_sidecar(R"({"dtype": "float32", "shape": [2, 3], "byte_order": "middle"})",
                    sidecar + ": \"byte_order\" must be little or big");
+    // Found by fuzz_raw: a non-string "order" escaped as nlohmann's type_error.
+    expect_sidecar(R"({"dtype": "float32", "shape": [2, 3], "order": 8})",
+                   sidecar + ": \"order\" must be a string");
+    expect_sidecar(R"({"dtype": "float32", "shape": [2, 3], "byte_order": null})",
+                   sidecar + ": \"byte_order\" must be a string");
   }
 
   TEST_CASE("a NaN-filled measurement is refused as a scan") {

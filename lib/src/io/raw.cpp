@@ -44,9 +44,15 @@ ArrayFile read_raw(const std::filesystem::path& path) {
     }
     shape.push_back(d.get<std::size_t>());
   }
-  const std::string order = meta.value("byte_order", std::string("little"));
+  // json::value throws its own type_error on a non-string; name the field instead.
+  auto text = [&](const char* key, const char* fallback) {
+    if (!meta.contains(key)) return std::string(fallback);
+    if (!meta[key].is_string()) throw bad("\"" + std::string(key) + "\" must be a string");
+    return meta[key].get<std::string>();
+  };
+  const std::string order = text("byte_order", "little");
   if (order != "little" && order != "big") throw bad("\"byte_order\" must be little or big");
-  const std::string layout = meta.value("order", std::string("C"));
+  const std::string layout = text("order", "C");
   if (layout != "C" && layout != "F") throw bad("\"order\" must be C or F");
   std::size_t offset = 0;
   if (meta.contains("offset_bytes")) {
