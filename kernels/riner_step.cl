@@ -8,8 +8,8 @@
 //     run in lock step (the SIMD lanes of a CPU, the warps of a GPU).
 //   riner_step_loss(n_batch, offsets, mu_dx, rays, sums, rho, weights, elements_per_view, params, alpha_offset,
 //                   beta_offset, n_elements, elements, lambda, relative_threshold, data_weight,
-//                   block_first, block_views, block_elements, ring_lambda, grad, d_sums, loss,
-//                   scratch)
+//                   block_first, block_views, block_elements, ring_lambda, hold_valid_beta,
+//                   invalid_readings, grad, d_sums, loss, scratch)
 //     one work-item, over the batch in order (deterministic): each ray's sum of mu dx into
 //     sums[b] (in sample order), each ray's loss (ray_sum.cl) and
 //     its gradient d_sums[b] with respect to sums[b]; alpha0/beta0 gradients into grad; the
@@ -20,6 +20,8 @@
 //     (scratch float[n_batch] holds the mismatches): the beta penalty then switches an element
 //     off when its rays miss by more than relative_threshold times the batch's typical ray,
 //     whatever the object and however far training has come.
+//     When hold_valid_beta != 0, beta0 of every element without invalid readings
+//     (invalid_readings[e] == 0) gets no gradient: held during the beta warm-up.
 //   riner_step_backward(n_lanes, n_batch, offsets, rays, segments, levels, level_weights,
 //                       params, grad, lane_stride, mlp_offset, seed, step, jitter, d_sums, cache,
 //                       cache_stride)
@@ -131,7 +133,9 @@ __kernel void riner_step_loss(const uint n_batch, __global const uint* offsets, 
                               const uint alpha_offset, const uint beta_offset, const uint n_elements,
                               __global const uint* elements, const float lambda, const float relative_threshold,
                               const float data_weight, const uint block_first, const uint block_views,
-                              const uint block_elements, const float ring_lambda, __global float* grad,
+                              const uint block_elements, const float ring_lambda,
+                              const uint hold_valid_beta, __global const uint* invalid_readings,
+                              __global float* grad,
                               __global float* d_sums, __global float* loss, __global float* scratch) {
   if (get_global_id(0) != 0) return;
   for (uint b = 0; b < n_batch; ++b) {
@@ -159,13 +163,14 @@ __kernel void riner_step_loss(const uint n_batch, __global const uint* offsets, 
                      &d_alpha0, &d_beta0);
     d_sums[b] = d_sum;
     GRAD_ADD(&grad[alpha_offset + e], d_alpha0);
-    GRAD_ADD(&grad[beta_offset + e], d_beta0);
+    if (!hold_valid_beta || invalid_readings[e] != 0) GRAD_ADD(&grad[beta_offset + e], d_beta0);
   }
   float penalty = 0.0f;
   for (uint i = 0; i < n_elements; ++i) {
     float d_beta0;
     penalty += beta_penalty(params[beta_offset + elements[i]], penalty_weight, &d_beta0);
-    GRAD_ADD(&grad[beta_offset + elements[i]], d_beta0);
+    if (!hold_valid_beta || invalid_readings[elements[i]] != 0)
+      GRAD_ADD(&grad[beta_offset + elements[i]], d_beta0);
   }
   if (ring_lambda > 0.0f && block_views > 0 && block_elements >= 3) {
     // r_e for the inner elements e = 1 .. E - 2, then its gradient on every block sum.

@@ -47,6 +47,7 @@ inline RinerConfig tiny_config() {
   c.training.rays_per_step = 64;
   c.training.learning_rate = 3e-3;
   c.training.lr_decay_steps = 500;
+  c.training.beta_warmup_steps = 0;  // scaled to these short runs, like the decay: none
   return c;
 }
 

@@ -57,13 +57,15 @@ struct TrainingConfig {
   double adam_beta2 = 0.99;
   double adam_epsilon = 1e-15;
   double lambda = 0.01;  // weight of the -beta^2 term
-  // alpha0 and beta0 learn at learning_rate times these scales, and stay at their initial
-  // values for their first warm-up steps (beta: while the image is still far off every
-  // element's residual is large, and beta would switch live elements off).
+  // alpha0 and beta0 learn at learning_rate times these scales. alpha0 stays at its initial
+  // value for alpha_warmup_steps. beta0 of an element with no invalid (non-finite) reading
+  // stays put for beta_warmup_steps: while the image is still far off, every element's
+  // residual is large and beta would switch live elements off, most where rays are longest;
+  // an element with invalid readings learns from the start (the readings are the evidence).
   double alpha_lr_scale = 1.0;
   double beta_lr_scale = 3.0;
   int alpha_warmup_steps = 0;
-  int beta_warmup_steps = 0;
+  int beta_warmup_steps = 3000;
   // Coarse to fine: when > 0, level l >= 1 of the encoding fades in over steps
   // [(l - 1) k, l k] with k = level_warmup_steps (its features are scaled by 0 .. 1), so the
   // image can hold fine structure, rings included, only after alpha has had time to explain

@@ -57,7 +57,8 @@ void RinerStepOp::step(const StepArgs& a, cl_uint n_lanes, const cl::Buffer<floa
                  a.elements_per_view, params, static_cast<cl_uint>(layout_.alpha_offset),
                  static_cast<cl_uint>(layout_.beta_offset), a.n_elements, *a.elements, a.lambda,
                  a.relative_threshold, a.data_weight, a.block_first, a.block_views,
-                 a.block_elements, a.ring_lambda, grad, d_sums_, loss, scratch_);
+                 a.block_elements, a.ring_lambda, static_cast<cl_uint>(a.hold_valid_beta),
+                 *a.invalid_readings, grad, d_sums_, loss, scratch_);
   context_.launch(loss_, 1, 1);
   // Lanes are independent work-groups of one work-item: on a CPU each runs as plain code.
   const auto stride = static_cast<cl_uint>(atomic_ ? 0 : layout_.total);

@@ -34,6 +34,10 @@ struct StepArgs {
   cl_uint block_views;
   cl_uint block_elements;
   float ring_lambda;
+  bool hold_valid_beta;                         // beta warm-up: see invalid_readings
+  const cl::Buffer<cl_uint>* invalid_readings;  // per element: its non-finite readings; while
+                                                // hold_valid_beta, beta0 of elements with none
+                                                // gets no gradient
 };
 
 class RinerStepOp {

@@ -70,6 +70,9 @@ StepResult riner_step(const StepInputs& in, const model::Batch& batch,
     const double median = mismatch[(n - 1) / 2];
     penalty_weight = 0.5 * in.data_weight * in.relative_beta_threshold * std::max(median, 1e-3);
   }
+  const auto beta_learns = [&](std::size_t e) {
+    return !in.hold_valid_beta || (*in.invalid_readings)[e] != 0;
+  };
   for (std::size_t b = 0; b < n; ++b) {
     const std::uint32_t ray = batch.rays[b];
     const std::size_t e = ray % in.elements_per_view;
@@ -79,13 +82,13 @@ StepResult riner_step(const StepInputs& in, const model::Batch& batch,
     d_sums[b] = rl.d_sum;
     if (with_gradient) {
       result.grad[l.alpha_offset + e] += rl.d_alpha0;
-      result.grad[l.beta_offset + e] += rl.d_beta0;
+      if (beta_learns(e)) result.grad[l.beta_offset + e] += rl.d_beta0;
     }
   }
   for (std::uint32_t e : batch.elements) {
     double d_beta0 = 0.0;
     result.penalty += beta_penalty(params[l.beta_offset + e], penalty_weight, &d_beta0);
-    if (with_gradient) result.grad[l.beta_offset + e] += d_beta0;
+    if (with_gradient && beta_learns(e)) result.grad[l.beta_offset + e] += d_beta0;
   }
   result.penalty += ring_prior(batch, sums, in.ring_lambda, &d_sums);
   if (!with_gradient) return result;

@@ -25,6 +25,10 @@ struct StepInputs {
   double relative_beta_threshold = 0.0;  // see riner_step.cl, riner_step_loss
   double data_weight = 1.0;
   std::vector<float> level_weights;  // per encoding level (empty: all 1)
+  // Beta warm-up (riner_step.cl): while hold_valid_beta, beta0 of every element with no
+  // invalid reading (invalid_readings[e] == 0) gets no gradient.
+  bool hold_valid_beta = false;
+  const std::vector<std::uint32_t>* invalid_readings = nullptr;
 };
 
 struct StepResult {

@@ -62,6 +62,7 @@ class OpenclTrainer final : public Trainer {
         segments_(ctx_, std::span<const cl_float8>(segment_table(setup.segments)),
                   CL_MEM_READ_ONLY),
         rho_(ctx_, std::span<const float>(setup.scan.measurement.data), CL_MEM_READ_ONLY),
+        invalid_readings_(ctx_, std::span<const cl_uint>(setup.invalid_readings), CL_MEM_READ_ONLY),
         rays_(ctx_, max_batch_),
         offsets_(ctx_, max_batch_ + 1),
         elements_(ctx_, max_batch_),
@@ -115,6 +116,8 @@ class OpenclTrainer final : public Trainer {
     args.block_views = batch.block_views;
     args.block_elements = batch.block_elements;
     args.ring_lambda = static_cast<float>(t.ring_lambda);
+    args.hold_valid_beta = setup_.hold_valid_beta(index);
+    args.invalid_readings = &invalid_readings_;
     step_op_.step(args, lanes_, params_, grad_, loss_);
     const AdamRates rates = setup_.adam_rates(index);
     adam_.step({rates.field, setup_.layout.alpha_offset, rates.alpha, setup_.layout.beta_offset,
@@ -187,6 +190,7 @@ class OpenclTrainer final : public Trainer {
   cl::Buffer<float> history_;
   cl::Buffer<cl_float8> segments_;
   cl::Buffer<float> rho_;
+  cl::Buffer<cl_uint> invalid_readings_;
   cl::Buffer<cl_uint> rays_;
   cl::Buffer<cl_uint> offsets_;
   std::vector<cl_uint> offsets_host_;

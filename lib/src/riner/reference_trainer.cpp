@@ -25,11 +25,13 @@ class ReferenceTrainer final : public Trainer {
     inputs_.ring_lambda = setup_.config.training.ring_lambda;
     inputs_.relative_beta_threshold = setup_.config.training.relative_beta_threshold;
     inputs_.data_weight = setup_.config.training.data_weight;
+    inputs_.invalid_readings = &setup_.invalid_readings;
   }
 
   void step(int index, const model::Batch& batch) override {
     inputs_.step = static_cast<std::uint32_t>(index);
     inputs_.level_weights = setup_.level_weights(index);
+    inputs_.hold_valid_beta = setup_.hold_valid_beta(index);
     const ref::StepResult r = ref::riner_step(inputs_, batch, params_);
     const TrainingConfig& t = setup_.config.training;
     const AdamRates rates = setup_.adam_rates(index);

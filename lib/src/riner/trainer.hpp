@@ -28,11 +28,14 @@ struct TrainingSetup {
   std::vector<model::RaySegment> segments;
   std::size_t elements_per_view = 0;
   std::uint32_t seed = 0;
+  std::vector<std::uint32_t> invalid_readings;  // per element: its non-finite measurements
 
   TrainingSetup(Scan scan, RinerConfig config);
   double learning_rate(int step) const;
   // Adam settings of a step: the schedule for the field, alpha0 and beta0.
   AdamRates adam_rates(int step) const;
+  // Whether beta0 of the elements without invalid readings is held at this step (warm-up).
+  bool hold_valid_beta(int step) const { return step < config.training.beta_warmup_steps; }
   // Scale of each encoding level's features at a step (coarse to fine); all 1 when done.
   std::vector<float> level_weights(int step) const;
 };

@@ -26,6 +26,11 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c) : scan(std::move(s)), config
   if (hit == 0)
     throw InputError("no detector ray crosses the reconstruction grid: check the geometry");
   seed = static_cast<std::uint32_t>(config.training.seed ^ (config.training.seed >> 32));
+  invalid_readings.assign(elements_per_view, 0);
+  const std::vector<float>& rho = scan.measurement.data;
+  for (std::size_t ray = 0; ray < rho.size(); ++ray) {
+    if (!std::isfinite(rho[ray])) ++invalid_readings[ray % elements_per_view];
+  }
 }
 
 double TrainingSetup::learning_rate(int step) const {
@@ -47,8 +52,7 @@ std::vector<float> TrainingSetup::level_weights(int step) const {
 AdamRates TrainingSetup::adam_rates(int step) const {
   const TrainingConfig& t = config.training;
   const double lr = learning_rate(step);
-  return {lr, step < t.alpha_warmup_steps ? 0.0 : lr * t.alpha_lr_scale,
-          step < t.beta_warmup_steps ? 0.0 : lr * t.beta_lr_scale};
+  return {lr, step < t.alpha_warmup_steps ? 0.0 : lr * t.alpha_lr_scale, lr * t.beta_lr_scale};
 }
 
 }  // namespace riner::detail
