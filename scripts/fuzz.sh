@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Builds riner with clang, ASan and UBSan, and runs every libFuzzer target for the given number
-# of seconds each (default 600) from its seed corpus; findings land in build-fuzz/findings/.
+# Builds riner with clang, ASan, UBSan and libFuzzer's coverage instrumentation (the library
+# too: without it the fuzzer sees only the harness), and runs every libFuzzer target for the
+# given number of seconds each (default 600) from its seed corpus; findings land in
+# build-fuzz/findings/.
 # Not part of CI.   usage: scripts/fuzz.sh [seconds] [target ...]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -14,7 +16,7 @@ if ! command -v clang++ >/dev/null; then
 fi
 cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
   -DRINER_BUILD_FUZZERS=ON -DRINER_BUILD_TESTS=OFF -DRINER_BUILD_BENCH=OFF -DRINER_BUILD_APPS=OFF \
-  -DRINER_SANITIZE=address,undefined
+  -DRINER_SANITIZE=address,undefined,fuzzer-no-link
 cmake --build build-fuzz -j "$(nproc)"
 mkdir -p build-fuzz/findings
 for t in "${targets[@]}"; do
