@@ -6,19 +6,11 @@
 #include <cstddef>
 #include <vector>
 
+#include "model/adam_settings.hpp"
+
 namespace riner::ref {
 
-struct AdamSettings {
-  double learning_rate = 1e-3;
-  // alpha0 and beta0 (from these offsets on) have learning rates of their own.
-  std::size_t alpha_offset = static_cast<std::size_t>(-1);
-  double alpha_learning_rate = 1e-3;
-  std::size_t beta_offset = static_cast<std::size_t>(-1);
-  double beta_learning_rate = 1e-3;
-  double beta1 = 0.9;
-  double beta2 = 0.999;
-  double epsilon = 1e-8;
-};
+using AdamSettings = model::AdamSettings;
 
 // step counts from 1.
 void adam_step(const AdamSettings& s, int step, const std::vector<double>& grad,
