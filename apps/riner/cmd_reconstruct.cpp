@@ -1,4 +1,6 @@
 // riner reconstruct: Riner on a scan: the image, the detector's response and mask, the loss.
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 
@@ -15,8 +17,20 @@ namespace riner::app {
 
 namespace {
 
+nlohmann::json ring_summary(const std::optional<AirRingCorrection>& rings) {
+  if (!rings) return {{"applied", false}};
+  double largest = 0.0;
+  for (double v : rings->profile) largest = std::max(largest, std::fabs(v));
+  return {{"applied", rings->measured_radii > 0},
+          {"measured_radii", rings->measured_radii},
+          {"radius_step_mm", rings->radius_step_mm},
+          {"air_pixels", rings->air_pixels},
+          {"largest_ring_per_mm", largest}};
+}
+
 RinerConfig config_from(const Args& args) {
-  RinerConfig config;
+  // --paper is the base the file and the other flags adjust.
+  RinerConfig config = args.is_set("paper") ? RinerConfig::paper() : RinerConfig();
   if (const std::string file = args.get("config"); !file.empty()) {
     config.update_from_json(read_text(file), file);
   }
@@ -30,7 +44,7 @@ RinerConfig config_from(const Args& args) {
   }
   if (auto v = args.maybe("lr"); v && !v->empty())
     config.training.learning_rate = args.number("lr");
-  if (args.is_set("paper")) config = RinerConfig::paper();
+  if (args.is_set("no-ring-correction")) config.rings.air_reference = false;
   config.engine = engine_from(args);
   config.validate();
   return config;
@@ -66,7 +80,9 @@ int run_reconstruct(int argc, char** argv, int first) {
       .option("lr", "RATE", "initial learning rate", "")
       .option("offset-px", "PX", "override the detector's centre-of-rotation offset", "")
       .option("report-every", "N", "steps between progress reports", "200")
-      .flag("paper", "use the paper's settings (L=10, T=2^10, F=8, width 128, 4000 steps, ...)");
+      .flag("paper", "use the paper's settings (L=10, T=2^10, F=8, width 128, 4000 steps, ...)")
+      .flag("no-ring-correction",
+            "write the trained field and alpha as they are (no air-referenced ring correction)");
   add_engine_flags(args);
   args.output_flags();
   if (!args.parse(argc, argv, first)) return 0;
@@ -102,12 +118,13 @@ int run_reconstruct(int argc, char** argv, int first) {
   }
 
   const Geometry& g = reconstructor.scan().geometry;
-  const Array image = reconstructor.image();
+  const std::optional<AirRingCorrection> rings = reconstructor.ring_correction();
+  const Array image = rings ? rings->image : reconstructor.field_image();
+  const Array alpha = rings ? rings->alpha : reconstructor.trained_alpha();
   const std::filesystem::path image_path = out / ("image." + format);
   write_array(image_path, image, {std::vector<double>(image.rank(), g.voxel_mm)});
   write_png(out / "image.png", image);
-  const std::vector<std::size_t> dead =
-      write_detector_outputs(out, reconstructor.alpha(), reconstructor.beta());
+  const std::vector<std::size_t> dead = write_detector_outputs(out, alpha, reconstructor.beta());
   write_history(out / "loss.csv", reconstructor.history());
   write_text(out / "config.json", config.to_json());
 
@@ -125,6 +142,7 @@ int run_reconstruct(int argc, char** argv, int first) {
       {"engine", stats.engine},
       {"device", stats.device},
       {"gradient_mode", stats.gradient_mode},
+      {"air_ring_correction", ring_summary(rings)},
       {"final_loss",
        reconstructor.history().empty() ? 0.0 : reconstructor.history().back().data_loss}};
   write_text(out / "summary.json", summary.dump(1) + "\n");

@@ -223,7 +223,8 @@ void training_step(const riner::Device& device, const Options& o, const Peaks& p
     out->push_back(row("  " + kernel, "per step", k, w, peaks));
   }
   // The field on the 512^2 grid (chunked field_evaluate).
-  const OpTiming e = riner::bench::time_op(device, 1, o.size == "tiny" ? 1 : 5, [&] { r.image(); });
+  const OpTiming e =
+      riner::bench::time_op(device, 1, o.size == "tiny" ? 1 : 5, [&] { r.field_image(); });
   const double pixels = 512.0 * 512.0;
   out->push_back(row(
       "field_evaluate", "512 x 512", e,

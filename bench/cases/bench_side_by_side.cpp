@@ -28,6 +28,8 @@ struct Checkpoint {
   double seconds = 0.0;
   double psnr = 0.0;
   double ssim = 0.0;
+  double field_psnr = 0.0;  // before the air-referenced ring correction
+  double field_ssim = 0.0;
   nlohmann::json detector;
 };
 
@@ -39,9 +41,14 @@ std::vector<Checkpoint> train(riner::Reconstructor& r, const riner::bench::RingS
   const int total = r.config().training.steps;
   while (r.steps_done() < total && r.stats().seconds < budget_s) {
     r.step(std::min(every, total - r.steps_done()));
-    const riner::ImageMetrics m = riner::compare_images(r.image(), scene.sim.ground_truth);
-    curve.push_back({r.steps_done(), r.stats().seconds, m.psnr, m.ssim,
-                     riner::bench::detector_accuracy(r.alpha(), r.beta(), scene.sim)});
+    const riner::Array field = r.field_image();
+    const std::optional<riner::AirRingCorrection> rings = r.ring_correction();
+    const riner::ImageMetrics m =
+        riner::compare_images(rings ? rings->image : field, scene.sim.ground_truth);
+    const riner::ImageMetrics f = riner::compare_images(field, scene.sim.ground_truth);
+    curve.push_back({r.steps_done(), r.stats().seconds, m.psnr, m.ssim, f.psnr, f.ssim,
+                     riner::bench::detector_accuracy(rings ? rings->alpha : r.trained_alpha(),
+                                                     r.beta(), scene.sim)});
   }
   return curve;
 }
@@ -50,7 +57,8 @@ nlohmann::json to_json(const std::vector<Checkpoint>& curve) {
   nlohmann::json out = nlohmann::json::array();
   for (const Checkpoint& c : curve) {
     nlohmann::json point = {
-        {"step", c.step}, {"seconds", c.seconds}, {"psnr", c.psnr}, {"ssim", c.ssim}};
+        {"step", c.step}, {"seconds", c.seconds},       {"psnr", c.psnr},
+        {"ssim", c.ssim}, {"field_psnr", c.field_psnr}, {"field_ssim", c.field_ssim}};
     for (const auto& [key, value] : c.detector.items()) {
       if (key != "dead") point[key] = value;  // the per-element details stay in the final row
     }
@@ -73,6 +81,8 @@ std::vector<Checkpoint> mean_curve(const std::vector<std::vector<Checkpoint>>& c
       m.seconds += c[i].seconds / curves.size();
       m.psnr += c[i].psnr / curves.size();
       m.ssim += c[i].ssim / curves.size();
+      m.field_psnr += c[i].field_psnr / curves.size();
+      m.field_ssim += c[i].field_ssim / curves.size();
       alpha += c[i].detector["alpha_mae_live"].get<double>() / curves.size();
     }
     m.detector = {{"alpha_mae_live", alpha}};
@@ -160,27 +170,31 @@ std::vector<Result> side_by_side(const Options& o) {
       const riner::TrainingStats st = r.stats();
       e.samples_per_second += st.samples / st.seconds;
       const Checkpoint& end = curve.back();
-      results.push_back(
-          {"side_by_side",
-           {{"scene", scene.name},
-            {"engine", e.name},
-            {"device", st.device},
-            {"gradient_mode", st.gradient_mode},
-            {"psnr", end.psnr},
-            {"ssim", end.ssim},
-            {"seconds", end.seconds},
-            {"steps", end.step},
-            {"samples_per_second", st.samples / st.seconds},
-            {"detector", end.detector},
-            {"curve", to_json(curve)},
-            {"config", nlohmann::json::parse(config.to_json())}},
-           riner::bench::format(
-               "%-22s %-10s %8d %6.2f dB  SSIM %.3f  %7.2f s  %.3g samples/s  "
-               "alpha MAE %.4f  dead %d/%d  live off %d",
-               scene.name.c_str(), e.name.c_str(), end.step, end.psnr, end.ssim, end.seconds,
-               st.samples / st.seconds, end.detector["alpha_mae_live"].get<double>(),
-               end.detector["dead_flagged"].get<int>(), end.detector["dead_crossing"].get<int>(),
-               end.detector["live_switched_off"].get<int>())});
+      results.push_back({"side_by_side",
+                         {{"scene", scene.name},
+                          {"engine", e.name},
+                          {"device", st.device},
+                          {"gradient_mode", st.gradient_mode},
+                          {"psnr", end.psnr},
+                          {"ssim", end.ssim},
+                          {"field_psnr", end.field_psnr},
+                          {"field_ssim", end.field_ssim},
+                          {"seconds", end.seconds},
+                          {"steps", end.step},
+                          {"samples_per_second", st.samples / st.seconds},
+                          {"detector", end.detector},
+                          {"curve", to_json(curve)},
+                          {"config", nlohmann::json::parse(config.to_json())}},
+                         riner::bench::format("%-22s %-10s %8d %6.2f dB  SSIM %.3f  (field %6.2f / "
+                                              "%.3f)  %7.2f s  %.3g samples/s  "
+                                              "alpha MAE %.4f  dead %d/%d  live off %d",
+                                              scene.name.c_str(), e.name.c_str(), end.step,
+                                              end.psnr, end.ssim, end.field_psnr, end.field_ssim,
+                                              end.seconds, st.samples / st.seconds,
+                                              end.detector["alpha_mae_live"].get<double>(),
+                                              end.detector["dead_flagged"].get<int>(),
+                                              end.detector["dead_crossing"].get<int>(),
+                                              end.detector["live_switched_off"].get<int>())});
       std::fprintf(stderr, "%s, %s: %.2f dB at step %d, %.1f s\n", scene.name.c_str(),
                    e.name.c_str(), end.psnr, end.step, end.seconds);
       e.curves.push_back(std::move(curve));
@@ -218,22 +232,25 @@ std::vector<Result> side_by_side(const Options& o) {
     }
     plot.series.push_back(series);
     const Checkpoint& end = mean.back();
-    results.push_back(
-        {"side_by_side",
-         {{"scene", "mean"},
-          {"engine", e.name},
-          {"scenes", scenes},
-          {"psnr", end.psnr},
-          {"ssim", end.ssim},
-          {"seconds", end.seconds},
-          {"steps", end.step},
-          {"alpha_mae_live", end.detector["alpha_mae_live"]},
-          {"samples_per_second", e.samples_per_second / scenes},
-          {"seconds_to_psnr", to_target},
-          {"curve", to_json(mean)}},
-         riner::bench::format("%-22s %-10s %8d %6.2f dB  SSIM %.3f  %7.2f s  %.3g samples/s |%s",
-                              "mean", e.name.c_str(), end.step, end.psnr, end.ssim, end.seconds,
-                              e.samples_per_second / scenes, target_text.c_str())});
+    results.push_back({"side_by_side",
+                       {{"scene", "mean"},
+                        {"engine", e.name},
+                        {"scenes", scenes},
+                        {"psnr", end.psnr},
+                        {"ssim", end.ssim},
+                        {"field_psnr", end.field_psnr},
+                        {"field_ssim", end.field_ssim},
+                        {"seconds", end.seconds},
+                        {"steps", end.step},
+                        {"alpha_mae_live", end.detector["alpha_mae_live"]},
+                        {"samples_per_second", e.samples_per_second / scenes},
+                        {"seconds_to_psnr", to_target},
+                        {"curve", to_json(mean)}},
+                       riner::bench::format("%-22s %-10s %8d %6.2f dB  SSIM %.3f  (field %6.2f / "
+                                            "%.3f)  %7.2f s  %.3g samples/s |%s",
+                                            "mean", e.name.c_str(), end.step, end.psnr, end.ssim,
+                                            end.field_psnr, end.field_ssim, end.seconds,
+                                            e.samples_per_second / scenes, target_text.c_str())});
   }
   results.push_back({"side_by_side",
                      {{"scene", "mean"},

@@ -4,6 +4,7 @@
 #include <sys/wait.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
@@ -126,5 +127,43 @@ TEST_SUITE("cli") {
     CHECK(clean.data == sino.data);  // no noise, ideal detector
     // The central ray crosses 256 mm of 0.02 / mm.
     CHECK(clean(0, 249) == doctest::Approx(256 * 0.02).epsilon(0.01));
+  }
+
+  TEST_CASE("reconstruct: the ring correction changes image and alpha by a ring, or not at all") {
+    riner::test::TempDir dir;
+    const std::string sim = (dir / "sim").string();
+    REQUIRE(riner_cli("simulate --quiet --seed 3 --out " + sim, dir).code == 0);
+    const std::string common = "reconstruct " + sim + "/sino.npy --steps 300 --seed 1 --json ";
+    const Run with = riner_cli(common + "--format npy --out " + (dir / "a").string(), dir);
+    const Run without =
+        riner_cli(common + "--format npy --no-ring-correction --out " + (dir / "b").string(), dir);
+    REQUIRE(with.code == 0);
+    REQUIRE(without.code == 0);
+    const auto rings = nlohmann::json::parse(with.out)["air_ring_correction"];
+    CHECK(rings["applied"] == true);
+    CHECK(rings["measured_radii"].get<int>() > 100);
+    CHECK(nlohmann::json::parse(without.out)["air_ring_correction"]["applied"] == false);
+    // Training is deterministic, so the images differ by the subtracted ring alone: no pixel
+    // by more than its largest value, and pixels at the same radius by the same amount.
+    const riner::Array a = riner::read_array(dir / "a" / "image.npy").array;
+    const riner::Array b = riner::read_array(dir / "b" / "image.npy").array;
+    const double largest = rings["largest_ring_per_mm"].get<double>();
+    CHECK(largest > 0.0);
+    double biggest_change = 0.0;
+    for (std::size_t p = 0; p < a.size(); ++p) {
+      biggest_change = std::max(biggest_change, std::fabs(double(a.data[p]) - b.data[p]));
+    }
+    CHECK(biggest_change == doctest::Approx(largest).epsilon(1e-3));
+    // Pixels (i, k), (k, 255 - i), (255 - i, 255 - k), (255 - k, i) lie on one circle.
+    for (std::size_t i = 0; i < 256; i += 7) {
+      for (std::size_t k = 0; k < 256; k += 5) {
+        const float d = a(i, k) - b(i, k);
+        CHECK(a(k, 255 - i) - b(k, 255 - i) == doctest::Approx(d).epsilon(1e-3).scale(1e-6));
+        CHECK(a(255 - i, 255 - k) - b(255 - i, 255 - k) ==
+              doctest::Approx(d).epsilon(1e-3).scale(1e-6));
+      }
+    }
+    CHECK(riner::read_array(dir / "a" / "alpha.npy").array.data !=
+          riner::read_array(dir / "b" / "alpha.npy").array.data);
   }
 }

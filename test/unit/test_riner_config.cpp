@@ -26,6 +26,7 @@ TEST_SUITE("riner_config") {
     CHECK(p.training.learning_rate == 1e-3);
     CHECK(p.training.lr_decay_steps == 1000);
     CHECK(p.training.data_term == riner::DataTerm::kSum);
+    CHECK_FALSE(p.rings.air_reference);  // riner's addition
     CHECK_NOTHROW(p.validate());
   }
 
@@ -36,6 +37,10 @@ TEST_SUITE("riner_config") {
     CHECK(c.network.width == 64);
     CHECK(c.training.sampler == riner::Sampler::kMixed);
     CHECK(c.encoding.levels == 8);  // untouched
+    c.update_from_json(R"({"rings": {"air_reference": false, "air_erosion_px": 5}})");
+    CHECK_FALSE(c.rings.air_reference);
+    CHECK(c.rings.air.erosion_px == 5);
+    CHECK(c.rings.air.air_fraction == riner::AirRingSettings{}.air_fraction);
     auto expect = [](const std::string& json, const std::string& message) {
       riner::RinerConfig cfg;
       try {
@@ -62,5 +67,8 @@ TEST_SUITE("riner_config") {
            "and <= 2^20");
     expect(R"({"engine": "gpu"})", "c.json: engine must be opencl or reference (got \"gpu\")");
     expect("[1, 2]", "c.json: config: config must be an object");
+    expect(R"({"rings": {"air_fraction": 1.5}})", "config: rings.air_fraction must be in (0, 1)");
+    expect(R"({"rings": {"air_reference": 1}})",
+           "c.json: config: rings.air_reference must be true or false");
   }
 }

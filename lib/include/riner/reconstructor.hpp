@@ -16,6 +16,7 @@
 #include "riner/array.hpp"
 #include "riner/device.hpp"
 #include "riner/riner_config.hpp"
+#include "riner/ring_correction.hpp"
 #include "riner/scan.hpp"
 
 namespace riner {
@@ -63,9 +64,17 @@ class Reconstructor {
   void run(const ProgressCallback& callback = {}, int report_every = 50);
 
   int steps_done() const;
-  Array image() const;  // the field at every voxel centre, mu in 1/mm
-  Array alpha() const;  // max(alpha0, 1e-8) per element: [n_u] in 2D, [n_v, n_u] in 3D
-  Array beta() const;   // sigmoid(beta0) per element; < 0.5 marks an element as dead
+  // The result: mu in 1/mm on the geometry's grid and the response per element ([n_u] in 2D,
+  // [n_v, n_u] in 3D). With config.rings.air_reference (2D), after the air-referenced ring
+  // correction, which changes the image and alpha together and keeps the data fit.
+  Array image() const;
+  Array alpha() const;
+  Array beta() const;  // sigmoid(beta0) per element; < 0.5 marks an element as dead
+  // What training alone gives: the field at every voxel centre and max(alpha0, 1e-8).
+  Array field_image() const;
+  Array trained_alpha() const;
+  // The correction image() and alpha() apply (std::nullopt when off or 3D).
+  std::optional<AirRingCorrection> ring_correction() const;
   std::vector<LossRecord> history() const;
   TrainingStats stats() const;
   const RinerConfig& config() const;

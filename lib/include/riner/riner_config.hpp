@@ -8,6 +8,7 @@
 #include <string_view>
 
 #include "riner/engine.hpp"
+#include "riner/ring_correction.hpp"
 
 namespace riner {
 
@@ -87,10 +88,18 @@ struct TrainingConfig {
   std::uint64_t seed = 0;
 };
 
+// After training, 2D: the air-referenced ring correction (riner/ring_correction.hpp) moves the
+// rings the data cannot tell from detector offsets out of the image wherever air shows them.
+struct RingCorrectionConfig {
+  bool air_reference = true;
+  AirRingSettings air;
+};
+
 struct RinerConfig {
   EncodingConfig encoding;
   NetworkConfig network;
   TrainingConfig training;
+  RingCorrectionConfig rings;
   Engine engine = Engine::kOpenCL;
 
   // InputError naming the first impossible setting.
@@ -102,7 +111,8 @@ struct RinerConfig {
   std::string to_json() const;
 
   // The paper's settings: L=10, T=2^10, F=8, N_min=2, b=2, width 128, 80 rays per step
-  // (40 views x 2 elements), lr 1e-3 halved every 1000 steps, 4000 steps, summed data term.
+  // (40 views x 2 elements), lr 1e-3 halved every 1000 steps, 4000 steps, summed data term;
+  // no air-referenced ring correction.
   static RinerConfig paper();
 };
 

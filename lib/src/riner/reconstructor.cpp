@@ -72,14 +72,31 @@ void Reconstructor::run(const ProgressCallback& callback, int report_every) {
 
 int Reconstructor::steps_done() const { return impl_->steps; }
 
-Array Reconstructor::image() const {
+Array Reconstructor::field_image() const {
   const Geometry& g = impl_->setup.scan.geometry;
   Array out(g.volume_shape);
   out.data = impl_->trainer->evaluate_grid();
   return out;
 }
 
+std::optional<AirRingCorrection> Reconstructor::ring_correction() const {
+  const RinerConfig& c = impl_->setup.config;
+  if (!c.rings.air_reference || impl_->setup.scan.geometry.is_3d()) return std::nullopt;
+  return correct_rings_from_air(field_image(), trained_alpha(), impl_->setup.scan.geometry,
+                                c.rings.air);
+}
+
+Array Reconstructor::image() const {
+  std::optional<AirRingCorrection> rings = ring_correction();
+  return rings ? std::move(rings->image) : field_image();
+}
+
 Array Reconstructor::alpha() const {
+  std::optional<AirRingCorrection> rings = ring_correction();
+  return rings ? std::move(rings->alpha) : trained_alpha();
+}
+
+Array Reconstructor::trained_alpha() const {
   const model::ParameterLayout& l = impl_->setup.layout;
   const std::vector<float> p = impl_->trainer->parameters();
   const Geometry& g = impl_->setup.scan.geometry;

@@ -120,6 +120,11 @@ void RinerConfig::validate() const {
           "training.relative_beta_threshold must be >= 0");
   require(t.data_weight > 0.0 && t.data_weight < 1e6 && std::isfinite(t.data_weight),
           "training.data_weight must be > 0");
+  const AirRingSettings& air = rings.air;
+  require(air.air_fraction > 0.0 && air.air_fraction < 1.0, "rings.air_fraction must be in (0, 1)");
+  require(air.erosion_px >= 0 && air.erosion_px <= 64, "rings.air_erosion_px must be in 0..64");
+  require(air.min_pixels >= 1 && air.min_pixels <= 1 << 20,
+          "rings.min_air_pixels must be in 1..2^20");
 }
 
 void RinerConfig::update_from_json(std::string_view text, std::string_view source) {
@@ -130,7 +135,7 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
     throw InputError(std::string(source) + ": invalid JSON: " + e.what());
   }
   try {
-    check_keys(root, "config", {"encoding", "network", "training", "engine"});
+    check_keys(root, "config", {"encoding", "network", "training", "rings", "engine"});
     if (root.contains("encoding")) {
       const json& e = root["encoding"];
       check_keys(e, "encoding",
@@ -223,6 +228,14 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
       read(t, "training", "ring_lambda", training.ring_lambda);
       read(t, "training", "seed", training.seed);
     }
+    if (root.contains("rings")) {
+      const json& r = root["rings"];
+      check_keys(r, "rings", {"air_reference", "air_fraction", "air_erosion_px", "min_air_pixels"});
+      read(r, "rings", "air_reference", rings.air_reference);
+      read(r, "rings", "air_fraction", rings.air.air_fraction);
+      read(r, "rings", "air_erosion_px", rings.air.erosion_px);
+      read(r, "rings", "min_air_pixels", rings.air.min_pixels);
+    }
     if (root.contains("engine")) {
       require(root["engine"].is_string(), "engine must be a string");
       engine = parse_engine(root["engine"].get<std::string>());
@@ -269,6 +282,11 @@ std::string RinerConfig::to_json() const {
                  {"level_warmup_steps", training.level_warmup_steps},
                  {"ring_lambda", training.ring_lambda},
                  {"seed", training.seed}}},
+               {"rings",
+                {{"air_reference", rings.air_reference},
+                 {"air_fraction", rings.air.air_fraction},
+                 {"air_erosion_px", rings.air.erosion_px},
+                 {"min_air_pixels", rings.air.min_pixels}}},
                {"engine", engine_name(engine)}};
   return root.dump(1) + "\n";
 }
@@ -291,6 +309,7 @@ RinerConfig RinerConfig::paper() {
   c.training.data_weight = 1.0;
   c.training.alpha_lr_scale = 1.0;
   c.training.beta_lr_scale = 1.0;
+  c.rings.air_reference = false;  // riner's addition, not the paper's
   return c;
 }
 

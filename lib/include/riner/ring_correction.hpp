@@ -1,0 +1,49 @@
+// Air-referenced ring correction: a step after training that moves rings from the image into
+// the detector response, where the data cannot tell them apart.
+//
+// A ring centred on the rotation axis adds the same amount to every view of one detector
+// element, exactly like a change of that element's response (README, "Rings and the detector
+// response"), so the data fit is the same for (image, alpha) and (image - G, alpha exp(-P G))
+// for any rotationally symmetric image G with per-element projections P G. Training settles
+// somewhere on that line; this step picks the point where the image's air is flat: for every
+// radius whose circle crosses enough air (pixels well below the object's values, away from
+// its edges), the ring's value there is the median of the air minus the image's overall air
+// level. Radii whose circles lie inside the object keep what training gave them.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "riner/array.hpp"
+#include "riner/geometry.hpp"
+
+namespace riner {
+
+struct AirRingSettings {
+  // Air: pixels below this fraction of the image's 99.5th percentile...
+  double air_fraction = 0.03;
+  // ...and at least this many pixels (|dx| + |dy|) from anything that is not air, so the
+  // partial-volume pixels at the object's edge stay out.
+  int erosion_px = 3;
+  // A radius (bins of half a pixel) is measured only when it has this many air pixels.
+  int min_pixels = 8;
+};
+
+struct AirRingCorrection {
+  Array image;  // the image minus the ring profile
+  Array alpha;  // the responses with the ring's projections folded in: same data fit
+  // Ring profile: value (1/mm) subtracted at radii bin * radius_step_mm; 0 where unmeasured.
+  std::vector<double> profile;
+  double radius_step_mm = 0.0;
+  std::size_t measured_radii = 0;  // bins with enough air
+  std::size_t air_pixels = 0;      // after erosion, in the final pass
+};
+
+// `image` on the 2D geometry's grid ([n_y, n_x]) and `alpha` with one value per detector
+// element. Returns the input unchanged (measured_radii = 0) when the image has too little air
+// or no positive values. Throws InputError for a 3D geometry or mismatched shapes.
+AirRingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
+                                         const Geometry& geometry,
+                                         const AirRingSettings& settings = {});
+
+}  // namespace riner

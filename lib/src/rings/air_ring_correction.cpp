@@ -1,0 +1,158 @@
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "riner/error.hpp"
+#include "riner/rays.hpp"
+#include "riner/ring_correction.hpp"
+
+namespace riner {
+
+namespace {
+
+// Refinement passes: each finds the air again in the image with the previous ring removed, so
+// air that a strong ring had pushed above the threshold comes back.
+constexpr int kPasses = 3;
+// Fewer air pixels than this in the whole image: nothing to reference the rings to.
+constexpr std::size_t kMinAirPixels = 64;
+
+float median_of(std::vector<float>& values) {
+  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), mid, values.end());
+  return *mid;
+}
+
+// Pixels of `mask` whose 4-neighbourhood, `steps` times over, holds only mask pixels; outside
+// the grid counts as air (the region beyond it is empty by definition).
+std::vector<char> erode(std::vector<char> mask, std::size_t ny, std::size_t nx, int steps) {
+  std::vector<char> next(mask.size());
+  for (int s = 0; s < steps; ++s) {
+    for (std::size_t i = 0; i < ny; ++i) {
+      for (std::size_t k = 0; k < nx; ++k) {
+        const std::size_t p = i * nx + k;
+        next[p] = mask[p] && (i == 0 || mask[p - nx]) && (i + 1 == ny || mask[p + nx]) &&
+                  (k == 0 || mask[p - 1]) && (k + 1 == nx || mask[p + 1]);
+      }
+    }
+    mask.swap(next);
+  }
+  return mask;
+}
+
+// Line integral of the piecewise-linear profile (nodes at bin * step mm) along `ray` inside the
+// grid: what the ring adds to that detector element in every view.
+double ring_projection(const std::vector<double>& profile, double step_mm, const Geometry& g,
+                       const Ray& ray) {
+  const Segment seg = clip_to_box(g, ray);
+  if (seg.empty()) return 0.0;
+  const double ds = 0.1 * g.voxel_mm;
+  const auto n = static_cast<std::size_t>(std::ceil(seg.length() / ds));
+  const double h = seg.length() / static_cast<double>(n);
+  double sum = 0.0;
+  for (std::size_t j = 0; j < n; ++j) {
+    const double t = seg.enter + (static_cast<double>(j) + 0.5) * h;
+    const double x = ray.origin.x + t * ray.direction.x;
+    const double y = ray.origin.y + t * ray.direction.y;
+    const double r = std::hypot(x, y) / step_mm;
+    const auto k = static_cast<std::size_t>(r);
+    if (k + 1 >= profile.size()) continue;
+    const double w = r - static_cast<double>(k);
+    sum += (1.0 - w) * profile[k] + w * profile[k + 1];
+  }
+  return sum * h;
+}
+
+}  // namespace
+
+AirRingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
+                                         const Geometry& geometry,
+                                         const AirRingSettings& settings) {
+  if (geometry.is_3d()) throw InputError("air ring correction: only 2D geometries");
+  if (image.shape != geometry.volume_shape) {
+    throw InputError("air ring correction: image shape " + shape_string(image.shape) +
+                     " is not the geometry's grid " + shape_string(geometry.volume_shape));
+  }
+  if (alpha.size() != geometry.n_u) {
+    throw InputError("air ring correction: alpha has " + std::to_string(alpha.size()) +
+                     " values for " + std::to_string(geometry.n_u) + " detector elements");
+  }
+  if (!(settings.air_fraction > 0.0 && settings.air_fraction < 1.0) || settings.erosion_px < 0 ||
+      settings.min_pixels < 1) {
+    throw InputError(
+        "air ring correction: air_fraction must be in (0, 1), erosion >= 0, "
+        "min_pixels >= 1");
+  }
+  AirRingCorrection out;
+  out.image = image;
+  out.alpha = alpha;
+  out.radius_step_mm = 0.5 * geometry.voxel_mm;
+  const std::size_t ny = image.shape[0];
+  const std::size_t nx = image.shape[1];
+  const std::size_t n = image.size();
+  for (float v : image.data) {
+    if (!std::isfinite(v)) return out;
+  }
+
+  std::vector<float> sorted = image.data;
+  const auto rank = static_cast<std::ptrdiff_t>(0.995 * static_cast<double>(n - 1));
+  std::nth_element(sorted.begin(), sorted.begin() + rank, sorted.end());
+  const double threshold = settings.air_fraction * sorted[static_cast<std::size_t>(rank)];
+  if (!(threshold > 0.0)) return out;
+
+  // Radius bin of every pixel centre (the rotation axis is the grid's centre).
+  std::vector<std::size_t> bin(n);
+  std::size_t bins = 0;
+  for (std::size_t i = 0; i < ny; ++i) {
+    for (std::size_t k = 0; k < nx; ++k) {
+      const Vec3 c = voxel_centre(geometry, static_cast<double>(k), static_cast<double>(i));
+      bin[i * nx + k] =
+          static_cast<std::size_t>(std::lround(std::hypot(c.x, c.y) / out.radius_step_mm));
+      bins = std::max(bins, bin[i * nx + k] + 1);
+    }
+  }
+
+  std::vector<double> profile(bins + 1, 0.0);  // one spare node for the interpolation
+  std::vector<std::vector<float>> air_by_bin(bins);
+  std::vector<float> air_values;
+  std::vector<char> measured(bins, 0);
+  for (int pass = 0; pass < kPasses; ++pass) {
+    std::vector<char> air(n);
+    for (std::size_t p = 0; p < n; ++p) air[p] = image.data[p] - profile[bin[p]] < threshold;
+    air = erode(std::move(air), ny, nx, settings.erosion_px);
+    air_values.clear();
+    for (auto& values : air_by_bin) values.clear();
+    for (std::size_t p = 0; p < n; ++p) {
+      if (!air[p]) continue;
+      air_values.push_back(image.data[p] - static_cast<float>(profile[bin[p]]));
+      air_by_bin[bin[p]].push_back(image.data[p]);
+    }
+    out.air_pixels = air_values.size();
+    if (air_values.size() < kMinAirPixels) {
+      std::fill(profile.begin(), profile.end(), 0.0);
+      std::fill(measured.begin(), measured.end(), 0);
+      break;
+    }
+    const double level = median_of(air_values);
+    for (std::size_t b = 0; b < bins; ++b) {
+      measured[b] = air_by_bin[b].size() >= static_cast<std::size_t>(settings.min_pixels);
+      profile[b] = measured[b] ? median_of(air_by_bin[b]) - level : 0.0;
+    }
+  }
+
+  for (std::size_t p = 0; p < n; ++p) {
+    out.image.data[p] = image.data[p] - static_cast<float>(profile[bin[p]]);
+  }
+  out.measured_radii = static_cast<std::size_t>(std::count(measured.begin(), measured.end(), 1));
+  if (out.measured_radii > 0) {
+    for (std::size_t e = 0; e < geometry.n_u; ++e) {
+      const double offset = ring_projection(profile, out.radius_step_mm, geometry,
+                                            detector_ray(geometry, 0, static_cast<double>(e)));
+      out.alpha.data[e] = static_cast<float>(alpha.data[e] * std::exp(-offset));
+    }
+  }
+  profile.pop_back();
+  out.profile = std::move(profile);
+  return out;
+}
+
+}  // namespace riner
