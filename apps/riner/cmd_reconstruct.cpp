@@ -21,8 +21,9 @@ nlohmann::json ring_summary(const std::optional<AirRingCorrection>& rings) {
   if (!rings) return {{"applied", false}};
   double largest = 0.0;
   for (double v : rings->profile) largest = std::max(largest, std::fabs(v));
-  return {{"applied", rings->measured_radii > 0},
+  return {{"applied", rings->applied},
           {"measured_radii", rings->measured_radii},
+          {"mean_response_change", rings->mean_response_change},
           {"radius_step_mm", rings->radius_step_mm},
           {"air_pixels", rings->air_pixels},
           {"largest_ring_per_mm", largest}};

@@ -64,14 +64,18 @@ std::vector<Result> riner_deeplesion(const Options& o) {
     const riner::Array image = r.image();
     const riner::ImageMetrics m = riner::compare_images(image, truth);
     const riner::TrainingStats st = r.stats();
+    const riner::Array field = r.field_image();
+    const riner::ImageMetrics fm = riner::compare_images(field, truth);
     if (!png_dir.empty()) {
+      // truth | FBP | the trained field | Riner (after the air-referenced ring correction)
       const std::size_t n = truth.shape[0];
-      riner::Array panel({n, 3 * n});
+      riner::Array panel({n, 4 * n});
       for (std::size_t i = 0; i < n; ++i) {
         for (std::size_t k = 0; k < n; ++k) {
           panel(i, k) = truth(i, k);
           panel(i, n + k) = fbp_image(i, k);
-          panel(i, 2 * n + k) = image(i, k);
+          panel(i, 2 * n + k) = field(i, k);
+          panel(i, 3 * n + k) = image(i, k);
         }
       }
       riner::write_png(png_dir + "/deeplesion_slice" + std::to_string(slice) + ".png", panel,
@@ -82,6 +86,8 @@ std::vector<Result> riner_deeplesion(const Options& o) {
                    {"slice", slice},
                    {"psnr", m.psnr},
                    {"ssim", m.ssim},
+                   {"field_psnr", fm.psnr},
+                   {"field_ssim", fm.ssim},
                    {"fbp_psnr", fbp.psnr},
                    {"fbp_ssim", fbp.ssim},
                    {"seconds", st.seconds},
@@ -91,8 +97,8 @@ std::vector<Result> riner_deeplesion(const Options& o) {
                    {"curve", curve},
                    {"config", nlohmann::json::parse(config.to_json())}});
     results.push_back({"riner_deeplesion", fields});
-    std::fprintf(stderr, "%s: PSNR %.2f SSIM %.4f (FBP %.2f) in %.1fs\n", scene.name.c_str(),
-                 m.psnr, m.ssim, fbp.psnr, st.seconds);
+    std::fprintf(stderr, "%s: PSNR %.2f SSIM %.4f (field %.2f / %.4f, FBP %.2f) in %.1fs\n",
+                 scene.name.c_str(), m.psnr, m.ssim, fm.psnr, fm.ssim, fbp.psnr, st.seconds);
   }
   return results;
 }
@@ -125,9 +131,14 @@ std::vector<Result> riner_parallel_shepp_logan(const Options& o) {
   std::vector<nlohmann::json> curve;
   train_and_measure(r, truth, o.get_int("checkpoint", 2000), &curve);
   const riner::ImageMetrics m = riner::compare_images(r.image(), truth);
+  const riner::ImageMetrics field = riner::compare_images(r.field_image(), truth);
+  std::fprintf(stderr, "parallel Shepp-Logan: PSNR %.2f SSIM %.4f (field %.2f / %.4f; FBP %.2f)\n",
+               m.psnr, m.ssim, field.psnr, field.ssim, fbp.psnr);
   return {{"riner_parallel_shepp_logan",
            {{"psnr", m.psnr},
             {"ssim", m.ssim},
+            {"field_psnr", field.psnr},
+            {"field_ssim", field.ssim},
             {"fbp_psnr", fbp.psnr},
             {"fbp_ssim", fbp.ssim},
             {"seconds", r.stats().seconds},
@@ -185,6 +196,7 @@ std::vector<Result> riner_real_scan(const Options& o) {
            {{"scan", scan_path},
             {"fbp_ring_index", riner::ring_index(fbp_image)},
             {"riner_ring_index", riner::ring_index(image)},
+            {"field_ring_index", riner::ring_index(r.field_image())},
             {"elements_switched_off", off},
             {"seconds", r.stats().seconds},
             {"steps", r.stats().steps}}}};

@@ -9,6 +9,12 @@
 // radius whose circle crosses enough air (pixels well below the object's values, away from
 // its edges), the ring's value there is the median of the air minus the image's overall air
 // level. Radii whose circles lie inside the object keep what training gave them.
+//
+// What it cannot see: a faint object that is itself rotationally symmetric about the axis (a
+// sample holder or container, below the air threshold) looks exactly like a ring. Erosion keeps
+// thin walls out of the air; a thick one would need a large change of the detector response
+// to explain, far beyond the 1-2% that training leaves, so a correction whose mean change of
+// ln(alpha) exceeds max_mean_response_change is not applied.
 #pragma once
 
 #include <cstddef>
@@ -27,11 +33,17 @@ struct AirRingSettings {
   int erosion_px = 3;
   // A radius (bins of half a pixel) is measured only when it has this many air pixels.
   int min_pixels = 8;
+  // Largest mean |change of ln(alpha)| over the elements that is still taken for a ring.
+  double max_mean_response_change = 0.03;
 };
 
 struct AirRingCorrection {
+  // Whether image and alpha were changed: false when no radius was measured or the change of
+  // the response was too large to be a ring (then both are the input).
+  bool applied = false;
   Array image;  // the image minus the ring profile
   Array alpha;  // the responses with the ring's projections folded in: same data fit
+  double mean_response_change = 0.0;  // mean |ln(alpha_new / alpha)| over the elements
   // Ring profile: value (1/mm) subtracted at radii bin * radius_step_mm; 0 where unmeasured.
   std::vector<double> profile;
   double radius_step_mm = 0.0;
@@ -40,8 +52,9 @@ struct AirRingCorrection {
 };
 
 // `image` on the 2D geometry's grid ([n_y, n_x]) and `alpha` with one value per detector
-// element. Returns the input unchanged (measured_radii = 0) when the image has too little air
-// or no positive values. Throws InputError for a 3D geometry or mismatched shapes.
+// element. Returns the input unchanged (applied = false) when the image has too little air, no
+// positive values, non-finite values, or the rings found would change the response too much.
+// Throws InputError for a 3D geometry or mismatched shapes.
 AirRingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
                                          const Geometry& geometry,
                                          const AirRingSettings& settings = {});

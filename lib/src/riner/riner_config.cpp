@@ -125,6 +125,8 @@ void RinerConfig::validate() const {
   require(air.erosion_px >= 0 && air.erosion_px <= 64, "rings.air_erosion_px must be in 0..64");
   require(air.min_pixels >= 1 && air.min_pixels <= 1 << 20,
           "rings.min_air_pixels must be in 1..2^20");
+  require(air.max_mean_response_change > 0.0 && air.max_mean_response_change <= 10.0,
+          "rings.max_mean_response_change must be in (0, 10]");
 }
 
 void RinerConfig::update_from_json(std::string_view text, std::string_view source) {
@@ -230,11 +232,14 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
     }
     if (root.contains("rings")) {
       const json& r = root["rings"];
-      check_keys(r, "rings", {"air_reference", "air_fraction", "air_erosion_px", "min_air_pixels"});
+      check_keys(r, "rings",
+                 {"air_reference", "air_fraction", "air_erosion_px", "min_air_pixels",
+                  "max_mean_response_change"});
       read(r, "rings", "air_reference", rings.air_reference);
       read(r, "rings", "air_fraction", rings.air.air_fraction);
       read(r, "rings", "air_erosion_px", rings.air.erosion_px);
       read(r, "rings", "min_air_pixels", rings.air.min_pixels);
+      read(r, "rings", "max_mean_response_change", rings.air.max_mean_response_change);
     }
     if (root.contains("engine")) {
       require(root["engine"].is_string(), "engine must be a string");
@@ -286,7 +291,8 @@ std::string RinerConfig::to_json() const {
                 {{"air_reference", rings.air_reference},
                  {"air_fraction", rings.air.air_fraction},
                  {"air_erosion_px", rings.air.erosion_px},
-                 {"min_air_pixels", rings.air.min_pixels}}},
+                 {"min_air_pixels", rings.air.min_pixels},
+                 {"max_mean_response_change", rings.air.max_mean_response_change}}},
                {"engine", engine_name(engine)}};
   return root.dump(1) + "\n";
 }

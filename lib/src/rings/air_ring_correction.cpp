@@ -77,10 +77,10 @@ AirRingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
                      " values for " + std::to_string(geometry.n_u) + " detector elements");
   }
   if (!(settings.air_fraction > 0.0 && settings.air_fraction < 1.0) || settings.erosion_px < 0 ||
-      settings.min_pixels < 1) {
+      settings.min_pixels < 1 || !(settings.max_mean_response_change > 0.0)) {
     throw InputError(
-        "air ring correction: air_fraction must be in (0, 1), erosion >= 0, "
-        "min_pixels >= 1");
+        "air ring correction: air_fraction must be in (0, 1), erosion >= 0, min_pixels >= 1, "
+        "max_mean_response_change > 0");
   }
   AirRingCorrection out;
   out.image = image;
@@ -139,15 +139,23 @@ AirRingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
     }
   }
 
-  for (std::size_t p = 0; p < n; ++p) {
-    out.image.data[p] = image.data[p] - static_cast<float>(profile[bin[p]]);
-  }
   out.measured_radii = static_cast<std::size_t>(std::count(measured.begin(), measured.end(), 1));
+  profile.back() = 0.0;
   if (out.measured_radii > 0) {
+    std::vector<double> change(geometry.n_u);
     for (std::size_t e = 0; e < geometry.n_u; ++e) {
-      const double offset = ring_projection(profile, out.radius_step_mm, geometry,
-                                            detector_ray(geometry, 0, static_cast<double>(e)));
-      out.alpha.data[e] = static_cast<float>(alpha.data[e] * std::exp(-offset));
+      change[e] = ring_projection(profile, out.radius_step_mm, geometry,
+                                  detector_ray(geometry, 0, static_cast<double>(e)));
+      out.mean_response_change += std::fabs(change[e]) / static_cast<double>(geometry.n_u);
+    }
+    out.applied = out.mean_response_change <= settings.max_mean_response_change;
+    if (out.applied) {
+      for (std::size_t p = 0; p < n; ++p) {
+        out.image.data[p] = image.data[p] - static_cast<float>(profile[bin[p]]);
+      }
+      for (std::size_t e = 0; e < geometry.n_u; ++e) {
+        out.alpha.data[e] = static_cast<float>(alpha.data[e] * std::exp(-change[e]));
+      }
     }
   }
   profile.pop_back();
