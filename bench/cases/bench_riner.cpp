@@ -166,7 +166,9 @@ std::vector<Result> riner_real_scan(const Options& o) {
   const riner::RinerConfig config = riner::bench::config_from(o);
   riner::Reconstructor r(scan, config, device);
   r.run();
-  const riner::Array image = r.image();
+  const riner::Array field = r.field_image();
+  const std::optional<riner::AirRingCorrection> rings = r.ring_correction();
+  const riner::Array image = rings ? rings->image : field;
   const riner::Array beta = r.beta();
   int off = 0;
   for (float b : beta.data) off += b < 0.5f;
@@ -182,6 +184,17 @@ std::vector<Result> riner_real_scan(const Options& o) {
     }
     const riner::Window w = riner::percentile_window(fbp_image, 1.0, 99.5);
     riner::write_png(png + "_fbp_riner.png", panel, w);
+    if (rings && rings->applied) {
+      // The trained field | after the air-referenced ring correction, a narrow window on the air.
+      for (std::size_t i = 0; i < ny; ++i) {
+        for (std::size_t k = 0; k < nx; ++k) {
+          panel(i, k) = field(i, k);
+          panel(i, nx + k) = image(i, k);
+        }
+      }
+      const riner::Window narrow = riner::percentile_window(field, 1.0, 90.0);
+      riner::write_png(png + "_field_corrected.png", panel, narrow);
+    }
     const std::size_t h = ny / 4, c0 = ny / 2 - h / 2, c1 = nx / 2 - h / 2;
     riner::Array zoom({2 * h, 4 * h});
     for (std::size_t i = 0; i < 2 * h; ++i) {
@@ -196,7 +209,9 @@ std::vector<Result> riner_real_scan(const Options& o) {
            {{"scan", scan_path},
             {"fbp_ring_index", riner::ring_index(fbp_image)},
             {"riner_ring_index", riner::ring_index(image)},
-            {"field_ring_index", riner::ring_index(r.field_image())},
+            {"field_ring_index", riner::ring_index(field)},
+            {"ring_correction_applied", rings && rings->applied},
+            {"ring_correction_response_change", rings ? rings->mean_response_change : 0.0},
             {"elements_switched_off", off},
             {"seconds", r.stats().seconds},
             {"steps", r.stats().steps}}}};

@@ -33,6 +33,8 @@ struct AirRingSettings {
   int erosion_px = 3;
   // A radius (bins of half a pixel) is measured only when it has this many air pixels.
   int min_pixels = 8;
+  // Gaussian smoothing of the measured ring profile across radius bins (sigma in bins; 0 off).
+  double smoothing_bins = 2.0;
   // Largest mean |change of ln(alpha)| over the elements that is still taken for a ring.
   double max_mean_response_change = 0.03;
 };

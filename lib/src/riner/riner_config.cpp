@@ -127,6 +127,8 @@ void RinerConfig::validate() const {
           "rings.min_air_pixels must be in 1..2^20");
   require(air.max_mean_response_change > 0.0 && air.max_mean_response_change <= 10.0,
           "rings.max_mean_response_change must be in (0, 10]");
+  require(air.smoothing_bins >= 0.0 && air.smoothing_bins <= 100.0,
+          "rings.smoothing_bins must be in [0, 100]");
 }
 
 void RinerConfig::update_from_json(std::string_view text, std::string_view source) {
@@ -234,12 +236,13 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
       const json& r = root["rings"];
       check_keys(r, "rings",
                  {"air_reference", "air_fraction", "air_erosion_px", "min_air_pixels",
-                  "max_mean_response_change"});
+                  "max_mean_response_change", "smoothing_bins"});
       read(r, "rings", "air_reference", rings.air_reference);
       read(r, "rings", "air_fraction", rings.air.air_fraction);
       read(r, "rings", "air_erosion_px", rings.air.erosion_px);
       read(r, "rings", "min_air_pixels", rings.air.min_pixels);
       read(r, "rings", "max_mean_response_change", rings.air.max_mean_response_change);
+      read(r, "rings", "smoothing_bins", rings.air.smoothing_bins);
     }
     if (root.contains("engine")) {
       require(root["engine"].is_string(), "engine must be a string");
@@ -292,7 +295,8 @@ std::string RinerConfig::to_json() const {
                  {"air_fraction", rings.air.air_fraction},
                  {"air_erosion_px", rings.air.erosion_px},
                  {"min_air_pixels", rings.air.min_pixels},
-                 {"max_mean_response_change", rings.air.max_mean_response_change}}},
+                 {"max_mean_response_change", rings.air.max_mean_response_change},
+                 {"smoothing_bins", rings.air.smoothing_bins}}},
                {"engine", engine_name(engine)}};
   return root.dump(1) + "\n";
 }

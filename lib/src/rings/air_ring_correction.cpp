@@ -62,6 +62,34 @@ double ring_projection(const std::vector<double>& profile, double step_mm, const
   return sum * h;
 }
 
+// Gaussian smoothing (sigma in bins) over the measured bins only, into profile (0 elsewhere): the
+// rings training leaves are broad, and the medians of single bins carry pixel noise that would
+// otherwise come back as fine rings.
+void smooth_measured(const std::vector<double>& raw, const std::vector<char>& measured,
+                     double sigma, std::vector<double>& profile) {
+  const std::size_t bins = raw.size();
+  const auto reach = static_cast<std::ptrdiff_t>(std::ceil(3.0 * sigma));
+  for (std::size_t b = 0; b < bins; ++b) {
+    profile[b] = 0.0;
+    if (!measured[b]) continue;
+    if (reach == 0) {
+      profile[b] = raw[b];
+      continue;
+    }
+    double sum = 0.0;
+    double weight = 0.0;
+    for (std::ptrdiff_t d = -reach; d <= reach; ++d) {
+      const std::ptrdiff_t j = static_cast<std::ptrdiff_t>(b) + d;
+      if (j < 0 || j >= static_cast<std::ptrdiff_t>(bins) || !measured[static_cast<std::size_t>(j)])
+        continue;
+      const double w = std::exp(-0.5 * static_cast<double>(d * d) / (sigma * sigma));
+      sum += w * raw[static_cast<std::size_t>(j)];
+      weight += w;
+    }
+    profile[b] = sum / weight;
+  }
+}
+
 }  // namespace
 
 AirRingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
@@ -77,10 +105,11 @@ AirRingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
                      " values for " + std::to_string(geometry.n_u) + " detector elements");
   }
   if (!(settings.air_fraction > 0.0 && settings.air_fraction < 1.0) || settings.erosion_px < 0 ||
-      settings.min_pixels < 1 || !(settings.max_mean_response_change > 0.0)) {
+      settings.min_pixels < 1 || !(settings.max_mean_response_change > 0.0) ||
+      !(settings.smoothing_bins >= 0.0 && settings.smoothing_bins <= 100.0)) {
     throw InputError(
         "air ring correction: air_fraction must be in (0, 1), erosion >= 0, min_pixels >= 1, "
-        "max_mean_response_change > 0");
+        "max_mean_response_change > 0, smoothing_bins in [0, 100]");
   }
   AirRingCorrection out;
   out.image = image;
@@ -133,10 +162,12 @@ AirRingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
       break;
     }
     const double level = median_of(air_values);
+    std::vector<double> raw(bins, 0.0);
     for (std::size_t b = 0; b < bins; ++b) {
       measured[b] = air_by_bin[b].size() >= static_cast<std::size_t>(settings.min_pixels);
-      profile[b] = measured[b] ? median_of(air_by_bin[b]) - level : 0.0;
+      raw[b] = measured[b] ? median_of(air_by_bin[b]) - level : 0.0;
     }
+    smooth_measured(raw, measured, settings.smoothing_bins, profile);
   }
 
   out.measured_radii = static_cast<std::size_t>(std::count(measured.begin(), measured.end(), 1));
