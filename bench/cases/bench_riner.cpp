@@ -154,6 +154,19 @@ RINER_BENCH_CASE(riner_parallel_shepp_logan, "Riner on a parallel-beam Shepp-Log
 
 namespace {
 
+// Two images of the same shape side by side.
+riner::Array beside(const riner::Array& left, const riner::Array& right) {
+  const std::size_t ny = left.shape[0], nx = left.shape[1];
+  riner::Array panel({ny, 2 * nx});
+  for (std::size_t i = 0; i < ny; ++i) {
+    for (std::size_t k = 0; k < nx; ++k) {
+      panel(i, k) = left(i, k);
+      panel(i, nx + k) = right(i, k);
+    }
+  }
+  return panel;
+}
+
 // A real scan (neutron360 by default): FBP and Riner side by side, ring index of each.
 std::vector<Result> riner_real_scan(const Options& o) {
   const std::string scan_path = o.get("scan", "../shared/data/neutron360/sino.npy");
@@ -175,25 +188,12 @@ std::vector<Result> riner_real_scan(const Options& o) {
   if (!png.empty()) {
     // FBP | Riner at the same window (FBP's percentiles), then the central quarter enlarged.
     const std::size_t ny = image.shape[0], nx = image.shape[1];
-    riner::Array panel({ny, 2 * nx});
-    for (std::size_t i = 0; i < ny; ++i) {
-      for (std::size_t k = 0; k < nx; ++k) {
-        panel(i, k) = fbp_image(i, k);
-        panel(i, nx + k) = image(i, k);
-      }
-    }
     const riner::Window w = riner::percentile_window(fbp_image, 1.0, 99.5);
-    riner::write_png(png + "_fbp_riner.png", panel, w);
+    riner::write_png(png + "_fbp_riner.png", beside(fbp_image, image), w);
     if (rings && rings->applied) {
       // The trained field | after the air-referenced ring correction, a narrow window on the air.
-      for (std::size_t i = 0; i < ny; ++i) {
-        for (std::size_t k = 0; k < nx; ++k) {
-          panel(i, k) = field(i, k);
-          panel(i, nx + k) = image(i, k);
-        }
-      }
-      const riner::Window narrow = riner::percentile_window(field, 1.0, 90.0);
-      riner::write_png(png + "_field_corrected.png", panel, narrow);
+      riner::write_png(png + "_field_corrected.png", beside(field, image),
+                       riner::percentile_window(field, 1.0, 90.0));
     }
     const std::size_t h = ny / 4, c0 = ny / 2 - h / 2, c1 = nx / 2 - h / 2;
     riner::Array zoom({2 * h, 4 * h});

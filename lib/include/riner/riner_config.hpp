@@ -3,6 +3,7 @@
 // against error (bench/RESULTS.md); the paper's values are reachable through the same fields.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -43,7 +44,7 @@ enum class Sampler {
 };
 
 struct TrainingConfig {
-  int steps = 12000;
+  int steps = 24000;
   Sampler sampler = Sampler::kUniform;
   int rays_per_step = 160;      // uniform sampler
   int views_per_step = 40;      // views x elements sampler
@@ -52,7 +53,9 @@ struct TrainingConfig {
   bool jitter = false;          // stratified random offsets while training (midpoints if off)
   bool circle_region = false;   // sample the inscribed circle instead of the whole grid
   double learning_rate = 1e-3;
-  int lr_decay_steps = 3000;  // the rate is multiplied by lr_decay every this many steps
+  // The rate is multiplied by lr_decay every lr_decay_steps steps; 0: every steps / 4, so the
+  // schedule stretches with the budget (--steps 12000 halves every 3000).
+  int lr_decay_steps = 0;
   double lr_decay = 0.5;
   double adam_beta1 = 0.9;
   double adam_beta2 = 0.99;
@@ -60,13 +63,14 @@ struct TrainingConfig {
   double lambda = 0.01;  // weight of the -beta^2 term
   // alpha0 and beta0 learn at learning_rate times these scales. alpha0 stays at its initial
   // value for alpha_warmup_steps. beta0 of an element with no invalid (non-finite) reading
-  // stays put for beta_warmup_steps: while the image is still far off, every element's
-  // residual is large and beta would switch live elements off, most where rays are longest;
-  // an element with invalid readings learns from the start (the readings are the evidence).
+  // stays put for beta_warmup_steps (-1: the first learning-rate phase): while the image is
+  // still far off, every element's residual is large and beta would switch live elements off,
+  // most where rays are longest; an element with invalid readings learns from the start (the
+  // readings are the evidence).
   double alpha_lr_scale = 1.0;
   double beta_lr_scale = 3.0;
   int alpha_warmup_steps = 0;
-  int beta_warmup_steps = 3000;
+  int beta_warmup_steps = -1;  // -1: the first learning-rate phase (decay_interval())
   // Coarse to fine: when > 0, level l >= 1 of the encoding fades in over steps
   // [(l - 1) k, l k] with k = level_warmup_steps (its features are scaled by 0 .. 1), so the
   // image can hold fine structure, rings included, only after alpha has had time to explain
@@ -86,6 +90,11 @@ struct TrainingConfig {
   // data_weight * relative_beta_threshold * median / 2, step by step).
   double relative_beta_threshold = 0.0;
   std::uint64_t seed = 0;
+
+  int decay_interval() const {
+    return lr_decay_steps > 0 ? lr_decay_steps : std::max(1, steps / 4);
+  }
+  int beta_warmup() const { return beta_warmup_steps >= 0 ? beta_warmup_steps : decay_interval(); }
 };
 
 // After training, 2D: the air-referenced ring correction (riner/ring_correction.hpp) moves the

@@ -97,7 +97,7 @@ void RinerConfig::validate() const {
           "training.sample_spacing must be in (0.01, 100] voxels");
   require(t.learning_rate > 0.0 && t.learning_rate < 10.0 && std::isfinite(t.learning_rate),
           "training.learning_rate must be in (0, 10)");
-  require(t.lr_decay_steps >= 1, "training.lr_decay_steps must be >= 1");
+  require(t.lr_decay_steps >= 0, "training.lr_decay_steps must be >= 0 (0: steps / 4)");
   require(t.lr_decay > 0.0 && t.lr_decay <= 1.0, "training.lr_decay must be in (0, 1]");
   require(t.adam_beta1 >= 0.0 && t.adam_beta1 < 1.0, "training.adam_beta1 must be in [0, 1)");
   require(t.adam_beta2 >= 0.0 && t.adam_beta2 < 1.0, "training.adam_beta2 must be in [0, 1)");
@@ -109,7 +109,8 @@ void RinerConfig::validate() const {
   require(t.beta_lr_scale >= 0.0 && t.beta_lr_scale < 1e3,
           "training.beta_lr_scale must be in [0, 1000)");
   require(t.alpha_warmup_steps >= 0, "training.alpha_warmup_steps must be >= 0");
-  require(t.beta_warmup_steps >= 0, "training.beta_warmup_steps must be >= 0");
+  require(t.beta_warmup_steps >= -1,
+          "training.beta_warmup_steps must be >= 0, or -1 (the first learning-rate phase)");
   require(t.level_warmup_steps >= 0, "training.level_warmup_steps must be >= 0");
   require(t.ring_lambda >= 0.0 && t.ring_lambda < 1e9 && std::isfinite(t.ring_lambda),
           "training.ring_lambda must be >= 0");

@@ -35,7 +35,7 @@ struct TrainingSetup {
   // Adam settings of a step: the schedule for the field, alpha0 and beta0.
   AdamRates adam_rates(int step) const;
   // Whether beta0 of the elements without invalid readings is held at this step (warm-up).
-  bool hold_valid_beta(int step) const { return step < config.training.beta_warmup_steps; }
+  bool hold_valid_beta(int step) const { return step < config.training.beta_warmup(); }
   // Scale of each encoding level's features at a step (coarse to fine); all 1 when done.
   std::vector<float> level_weights(int step) const;
 };

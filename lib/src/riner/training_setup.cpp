@@ -35,7 +35,7 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c) : scan(std::move(s)), config
 
 double TrainingSetup::learning_rate(int step) const {
   const TrainingConfig& t = config.training;
-  return t.learning_rate * std::pow(t.lr_decay, step / t.lr_decay_steps);
+  return t.learning_rate * std::pow(t.lr_decay, step / t.decay_interval());
 }
 
 std::vector<float> TrainingSetup::level_weights(int step) const {
