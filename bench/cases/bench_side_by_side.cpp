@@ -67,6 +67,16 @@ nlohmann::json to_json(const std::vector<Checkpoint>& curve) {
   return out;
 }
 
+// A checkpoint's image metrics and position, as the result rows report them.
+nlohmann::json checkpoint_metrics(const Checkpoint& c) {
+  return {{"psnr", c.psnr},
+          {"ssim", c.ssim},
+          {"field_psnr", c.field_psnr},
+          {"field_ssim", c.field_ssim},
+          {"seconds", c.seconds},
+          {"steps", c.step}};
+}
+
 // The mean curve over scenes, checkpoint by checkpoint, as far as every scene got.
 std::vector<Checkpoint> mean_curve(const std::vector<std::vector<Checkpoint>>& curves) {
   std::vector<Checkpoint> mean;
@@ -170,21 +180,16 @@ std::vector<Result> side_by_side(const Options& o) {
       const riner::TrainingStats st = r.stats();
       e.samples_per_second += st.samples / st.seconds;
       const Checkpoint& end = curve.back();
-      results.push_back({"side_by_side",
-                         {{"scene", scene.name},
-                          {"engine", e.name},
-                          {"device", st.device},
-                          {"gradient_mode", st.gradient_mode},
-                          {"psnr", end.psnr},
-                          {"ssim", end.ssim},
-                          {"field_psnr", end.field_psnr},
-                          {"field_ssim", end.field_ssim},
-                          {"seconds", end.seconds},
-                          {"steps", end.step},
-                          {"samples_per_second", st.samples / st.seconds},
-                          {"detector", end.detector},
-                          {"curve", to_json(curve)},
-                          {"config", nlohmann::json::parse(config.to_json())}},
+      nlohmann::json fields = {{"scene", scene.name},
+                               {"engine", e.name},
+                               {"device", st.device},
+                               {"gradient_mode", st.gradient_mode},
+                               {"samples_per_second", st.samples / st.seconds},
+                               {"detector", end.detector},
+                               {"curve", to_json(curve)},
+                               {"config", nlohmann::json::parse(config.to_json())}};
+      fields.update(checkpoint_metrics(end));
+      results.push_back({"side_by_side", fields,
                          riner::bench::format("%-22s %-10s %8d %6.2f dB  SSIM %.3f  (field %6.2f / "
                                               "%.3f)  %7.2f s  %.3g samples/s  "
                                               "alpha MAE %.4f  dead %d/%d  live off %d",
@@ -232,20 +237,15 @@ std::vector<Result> side_by_side(const Options& o) {
     }
     plot.series.push_back(series);
     const Checkpoint& end = mean.back();
-    results.push_back({"side_by_side",
-                       {{"scene", "mean"},
-                        {"engine", e.name},
-                        {"scenes", scenes},
-                        {"psnr", end.psnr},
-                        {"ssim", end.ssim},
-                        {"field_psnr", end.field_psnr},
-                        {"field_ssim", end.field_ssim},
-                        {"seconds", end.seconds},
-                        {"steps", end.step},
-                        {"alpha_mae_live", end.detector["alpha_mae_live"]},
-                        {"samples_per_second", e.samples_per_second / scenes},
-                        {"seconds_to_psnr", to_target},
-                        {"curve", to_json(mean)}},
+    nlohmann::json fields = {{"scene", "mean"},
+                             {"engine", e.name},
+                             {"scenes", scenes},
+                             {"alpha_mae_live", end.detector["alpha_mae_live"]},
+                             {"samples_per_second", e.samples_per_second / scenes},
+                             {"seconds_to_psnr", to_target},
+                             {"curve", to_json(mean)}};
+    fields.update(checkpoint_metrics(end));
+    results.push_back({"side_by_side", fields,
                        riner::bench::format("%-22s %-10s %8d %6.2f dB  SSIM %.3f  (field %6.2f / "
                                             "%.3f)  %7.2f s  %.3g samples/s |%s",
                                             "mean", e.name.c_str(), end.step, end.psnr, end.ssim,
