@@ -75,7 +75,10 @@ int run_reconstruct(int argc, char** argv, int first) {
       .option("out", "DIR", "output folder (created if missing)")
       .option("format", "EXT", "image format: nii, npy, tif or raw", "nii")
       .option("config", "FILE", "settings JSON ({\"training\": {\"steps\": 4000}, ...})", "")
-      .option("steps", "N", "training steps", "")
+      .option("steps", "N",
+              "training steps (default " + std::to_string(RinerConfig().training.steps) +
+                  "; the learning rate halves every quarter of them)",
+              "")
       .option("seed", "N", "random seed", "")
       .option("rays-per-step", "N", "rays per training step", "")
       .option("lr", "RATE", "initial learning rate", "")
