@@ -122,9 +122,10 @@ int run_reconstruct(int argc, char** argv, int first) {
   }
 
   const Geometry& g = reconstructor.scan().geometry;
-  const std::optional<AirRingCorrection> rings = reconstructor.ring_correction();
-  const Array image = rings ? rings->image : reconstructor.field_image();
-  const Array alpha = rings ? rings->alpha : reconstructor.trained_alpha();
+  const ReconstructionResult result = reconstructor.result();
+  const Array& image = result.image;
+  const Array& alpha = result.alpha;
+  const std::optional<AirRingCorrection>& rings = result.rings;
   const std::filesystem::path image_path = out / ("image." + format);
   write_array(image_path, image, {std::vector<double>(image.rank(), g.voxel_mm)});
   write_png(out / "image.png", image);

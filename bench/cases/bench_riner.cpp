@@ -61,10 +61,11 @@ std::vector<Result> riner_deeplesion(const Options& o) {
                                : std::nullopt);
     std::vector<nlohmann::json> curve;
     train_and_measure(r, truth, every, &curve);
-    const riner::Array image = r.image();
+    const riner::ReconstructionResult result = r.result();
+    const riner::Array& image = result.image;
+    const riner::Array& field = result.field_image;
     const riner::ImageMetrics m = riner::compare_images(image, truth);
     const riner::TrainingStats st = r.stats();
-    const riner::Array field = r.field_image();
     const riner::ImageMetrics fm = riner::compare_images(field, truth);
     if (!png_dir.empty()) {
       // truth | FBP | the trained field | Riner (after the air-referenced ring correction)
@@ -81,7 +82,7 @@ std::vector<Result> riner_deeplesion(const Options& o) {
       riner::write_png(png_dir + "/deeplesion_slice" + std::to_string(slice) + ".png", panel,
                        riner::Window{0.0f, 0.035f});
     }
-    nlohmann::json fields = riner::bench::detector_accuracy(r.alpha(), r.beta(), scene.sim);
+    nlohmann::json fields = riner::bench::detector_accuracy(result.alpha, r.beta(), scene.sim);
     fields.update({{"scene", scene.name},
                    {"slice", slice},
                    {"psnr", m.psnr},
@@ -130,8 +131,9 @@ std::vector<Result> riner_parallel_shepp_logan(const Options& o) {
   riner::Reconstructor r(scan, config, fbp_options.device);
   std::vector<nlohmann::json> curve;
   train_and_measure(r, truth, o.get_int("checkpoint", 2000), &curve);
-  const riner::ImageMetrics m = riner::compare_images(r.image(), truth);
-  const riner::ImageMetrics field = riner::compare_images(r.field_image(), truth);
+  const riner::ReconstructionResult result = r.result();
+  const riner::ImageMetrics m = riner::compare_images(result.image, truth);
+  const riner::ImageMetrics field = riner::compare_images(result.field_image, truth);
   std::fprintf(stderr, "parallel Shepp-Logan: PSNR %.2f SSIM %.4f (field %.2f / %.4f; FBP %.2f)\n",
                m.psnr, m.ssim, field.psnr, field.ssim, fbp.psnr);
   return {{"riner_parallel_shepp_logan",
@@ -179,9 +181,10 @@ std::vector<Result> riner_real_scan(const Options& o) {
   const riner::RinerConfig config = riner::bench::config_from(o);
   riner::Reconstructor r(scan, config, device);
   r.run();
-  const riner::Array field = r.field_image();
-  const std::optional<riner::AirRingCorrection> rings = r.ring_correction();
-  const riner::Array image = rings ? rings->image : field;
+  const riner::ReconstructionResult result = r.result();
+  const riner::Array& field = result.field_image;
+  const riner::Array& image = result.image;
+  const std::optional<riner::AirRingCorrection>& rings = result.rings;
   const riner::Array beta = r.beta();
   int off = 0;
   for (float b : beta.data) off += b < 0.5f;

@@ -41,14 +41,11 @@ std::vector<Checkpoint> train(riner::Reconstructor& r, const riner::bench::RingS
   const int total = r.config().training.steps;
   while (r.steps_done() < total && r.stats().seconds < budget_s) {
     r.step(std::min(every, total - r.steps_done()));
-    const riner::Array field = r.field_image();
-    const std::optional<riner::AirRingCorrection> rings = r.ring_correction();
-    const riner::ImageMetrics m =
-        riner::compare_images(rings ? rings->image : field, scene.sim.ground_truth);
-    const riner::ImageMetrics f = riner::compare_images(field, scene.sim.ground_truth);
+    const riner::ReconstructionResult result = r.result();
+    const riner::ImageMetrics m = riner::compare_images(result.image, scene.sim.ground_truth);
+    const riner::ImageMetrics f = riner::compare_images(result.field_image, scene.sim.ground_truth);
     curve.push_back({r.steps_done(), r.stats().seconds, m.psnr, m.ssim, f.psnr, f.ssim,
-                     riner::bench::detector_accuracy(rings ? rings->alpha : r.trained_alpha(),
-                                                     r.beta(), scene.sim)});
+                     riner::bench::detector_accuracy(result.alpha, r.beta(), scene.sim)});
   }
   return curve;
 }

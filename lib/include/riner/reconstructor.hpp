@@ -38,6 +38,16 @@ struct TrainingProgress {
 // Return false to stop training early.
 using ProgressCallback = std::function<bool(const TrainingProgress&)>;
 
+// Everything one evaluation of the field gives: the field itself, the image and alpha after the
+// air-referenced ring correction (the field and the trained alpha when it is off or 3D), and
+// the correction.
+struct ReconstructionResult {
+  Array field_image;
+  Array image;
+  Array alpha;
+  std::optional<AirRingCorrection> rings;
+};
+
 struct TrainingStats {
   int steps = 0;
   double seconds = 0.0;        // wall time inside step()/run()
@@ -73,8 +83,8 @@ class Reconstructor {
   // What training alone gives: the field at every voxel centre and max(alpha0, 1e-8).
   Array field_image() const;
   Array trained_alpha() const;
-  // The correction image() and alpha() apply (std::nullopt when off or 3D).
-  std::optional<AirRingCorrection> ring_correction() const;
+  // All of the above from one evaluation of the field.
+  ReconstructionResult result() const;
   std::vector<LossRecord> history() const;
   TrainingStats stats() const;
   const RinerConfig& config() const;

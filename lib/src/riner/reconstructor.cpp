@@ -79,21 +79,29 @@ Array Reconstructor::field_image() const {
   return out;
 }
 
-std::optional<AirRingCorrection> Reconstructor::ring_correction() const {
+ReconstructionResult Reconstructor::result() const {
   const RinerConfig& c = impl_->setup.config;
-  if (!c.rings.air_reference || impl_->setup.scan.geometry.is_3d()) return std::nullopt;
-  return correct_rings_from_air(field_image(), trained_alpha(), impl_->setup.scan.geometry,
-                                c.rings.air);
+  const Geometry& g = impl_->setup.scan.geometry;
+  ReconstructionResult r;
+  r.field_image = field_image();
+  if (c.rings.air_reference && !g.is_3d()) {
+    r.rings = correct_rings_from_air(r.field_image, trained_alpha(), g, c.rings.air);
+    r.image = r.rings->image;
+    r.alpha = r.rings->alpha;
+  } else {
+    r.image = r.field_image;
+    r.alpha = trained_alpha();
+  }
+  return r;
 }
 
-Array Reconstructor::image() const {
-  std::optional<AirRingCorrection> rings = ring_correction();
-  return rings ? std::move(rings->image) : field_image();
-}
+Array Reconstructor::image() const { return result().image; }
 
 Array Reconstructor::alpha() const {
-  std::optional<AirRingCorrection> rings = ring_correction();
-  return rings ? std::move(rings->alpha) : trained_alpha();
+  const RinerConfig& c = impl_->setup.config;
+  // Without the correction, alpha needs no evaluation of the field.
+  if (!c.rings.air_reference || impl_->setup.scan.geometry.is_3d()) return trained_alpha();
+  return result().alpha;
 }
 
 Array Reconstructor::trained_alpha() const {

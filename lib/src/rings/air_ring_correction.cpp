@@ -171,7 +171,6 @@ AirRingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
   }
 
   out.measured_radii = static_cast<std::size_t>(std::count(measured.begin(), measured.end(), 1));
-  profile.back() = 0.0;
   if (out.measured_radii > 0) {
     std::vector<double> change(geometry.n_u);
     for (std::size_t e = 0; e < geometry.n_u; ++e) {
