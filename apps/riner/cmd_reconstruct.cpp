@@ -17,7 +17,7 @@ namespace riner::app {
 
 namespace {
 
-nlohmann::json ring_summary(const std::optional<AirRingCorrection>& rings) {
+nlohmann::json ring_summary(const std::optional<RingCorrection>& rings) {
   if (!rings) return {{"applied", false}};
   double largest = 0.0;
   for (double v : rings->profile) largest = std::max(largest, std::fabs(v));
@@ -25,7 +25,6 @@ nlohmann::json ring_summary(const std::optional<AirRingCorrection>& rings) {
           {"measured_radii", rings->measured_radii},
           {"mean_response_change", rings->mean_response_change},
           {"radius_step_mm", rings->radius_step_mm},
-          {"air_pixels", rings->air_pixels},
           {"largest_ring_per_mm", largest}};
 }
 
@@ -45,7 +44,10 @@ RinerConfig config_from(const Args& args) {
   }
   if (auto v = args.maybe("lr"); v && !v->empty())
     config.training.learning_rate = args.number("lr");
-  if (args.is_set("no-ring-correction")) config.rings.air_reference = false;
+  if (args.is_set("no-ring-correction")) {
+    config.rings.air_reference = false;
+    config.rings.gradient_reference = false;
+  }
   config.engine = engine_from(args);
   config.validate();
   return config;
@@ -86,7 +88,7 @@ int run_reconstruct(int argc, char** argv, int first) {
       .option("report-every", "N", "steps between progress reports", "200")
       .flag("paper", "use the paper's settings (L=10, T=2^10, F=8, width 128, 4000 steps, ...)")
       .flag("no-ring-correction",
-            "write the trained field and alpha as they are (no air-referenced ring correction)");
+            "write the trained field and alpha as they are (no ring corrections)");
   add_engine_flags(args);
   args.output_flags();
   if (!args.parse(argc, argv, first)) return 0;
@@ -125,7 +127,6 @@ int run_reconstruct(int argc, char** argv, int first) {
   const ReconstructionResult result = reconstructor.result();
   const Array& image = result.image;
   const Array& alpha = result.alpha;
-  const std::optional<AirRingCorrection>& rings = result.rings;
   const std::filesystem::path image_path = out / ("image." + format);
   write_array(image_path, image, {std::vector<double>(image.rank(), g.voxel_mm)});
   write_png(out / "image.png", image);
@@ -147,7 +148,8 @@ int run_reconstruct(int argc, char** argv, int first) {
       {"engine", stats.engine},
       {"device", stats.device},
       {"gradient_mode", stats.gradient_mode},
-      {"air_ring_correction", ring_summary(rings)},
+      {"air_ring_correction", ring_summary(result.air_rings)},
+      {"gradient_ring_correction", ring_summary(result.gradient_rings)},
       {"final_loss",
        reconstructor.history().empty() ? 0.0 : reconstructor.history().back().data_loss}};
   write_text(out / "summary.json", summary.dump(1) + "\n");

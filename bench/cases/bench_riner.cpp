@@ -184,7 +184,7 @@ std::vector<Result> riner_real_scan(const Options& o) {
   const riner::ReconstructionResult result = r.result();
   const riner::Array& field = result.field_image;
   const riner::Array& image = result.image;
-  const std::optional<riner::AirRingCorrection>& rings = result.rings;
+  const std::optional<riner::RingCorrection>& rings = result.air_rings;
   const riner::Array beta = r.beta();
   int off = 0;
   for (float b : beta.data) off += b < 0.5f;

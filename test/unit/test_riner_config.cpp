@@ -26,7 +26,8 @@ TEST_SUITE("riner_config") {
     CHECK(p.training.learning_rate == 1e-3);
     CHECK(p.training.lr_decay_steps == 1000);
     CHECK(p.training.data_term == riner::DataTerm::kSum);
-    CHECK_FALSE(p.rings.air_reference);  // riner's addition
+    CHECK_FALSE(p.rings.air_reference);  // riner's additions
+    CHECK_FALSE(p.rings.gradient_reference);
     CHECK_NOTHROW(p.validate());
   }
 
@@ -68,6 +69,8 @@ TEST_SUITE("riner_config") {
     expect(R"({"engine": "gpu"})", "c.json: engine must be opencl or reference (got \"gpu\")");
     expect("[1, 2]", "c.json: config: config must be an object");
     expect(R"({"rings": {"air_fraction": 1.5}})", "config: rings.air_fraction must be in (0, 1)");
+    expect(R"({"rings": {"gradient_flat_fraction": 0}})",
+           "config: rings.gradient_flat_fraction must be in (0, 1]");
     expect(R"({"rings": {"air_reference": 1}})",
            "c.json: config: rings.air_reference must be true or false");
   }

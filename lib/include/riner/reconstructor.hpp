@@ -39,13 +39,14 @@ struct TrainingProgress {
 using ProgressCallback = std::function<bool(const TrainingProgress&)>;
 
 // Everything one evaluation of the field gives: the field itself, the image and alpha after the
-// air-referenced ring correction (the field and the trained alpha when it is off or 3D), and
-// the correction.
+// ring corrections (the field and the trained alpha when they are off or 3D), and each
+// correction as it was made (the gradient one runs on the air-corrected image).
 struct ReconstructionResult {
   Array field_image;
   Array image;
   Array alpha;
-  std::optional<AirRingCorrection> rings;
+  std::optional<RingCorrection> air_rings;
+  std::optional<RingCorrection> gradient_rings;
 };
 
 struct TrainingStats {
@@ -75,8 +76,8 @@ class Reconstructor {
 
   int steps_done() const;
   // The result: mu in 1/mm on the geometry's grid and the response per element ([n_u] in 2D,
-  // [n_v, n_u] in 3D). With config.rings.air_reference (2D), after the air-referenced ring
-  // correction, which changes the image and alpha together and keeps the data fit.
+  // [n_v, n_u] in 3D). In 2D, after the ring corrections config.rings turns on, which change
+  // the image and alpha together and keep the data fit.
   Array image() const;
   Array alpha() const;
   Array beta() const;  // sigmoid(beta0) per element; < 0.5 marks an element as dead

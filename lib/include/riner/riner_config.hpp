@@ -49,7 +49,7 @@ struct TrainingConfig {
   int rays_per_step = 160;      // uniform sampler
   int views_per_step = 40;      // views x elements sampler
   int elements_per_step = 2;    // views x elements sampler: adjacent elements
-  double sample_spacing = 2.0;  // along each ray, in voxels (the paper uses a fixed interval)
+  double sample_spacing = 1.5;  // along each ray, in voxels (the paper uses a fixed interval)
   bool jitter = false;          // stratified random offsets while training (midpoints if off)
   bool circle_region = false;   // sample the inscribed circle instead of the whole grid
   double learning_rate = 1e-3;
@@ -97,11 +97,14 @@ struct TrainingConfig {
   int beta_warmup() const { return beta_warmup_steps >= 0 ? beta_warmup_steps : decay_interval(); }
 };
 
-// After training, 2D: the air-referenced ring correction (riner/ring_correction.hpp) moves the
-// rings the data cannot tell from detector offsets out of the image wherever air shows them.
+// After training, 2D: the ring corrections (riner/ring_correction.hpp) move the rings the data
+// cannot tell from detector offsets out of the image: first wherever air shows them, then the
+// narrow ones inside the object, from the image's radial slopes.
 struct RingCorrectionConfig {
   bool air_reference = true;
   AirRingSettings air;
+  bool gradient_reference = true;
+  GradientRingSettings gradient;
 };
 
 struct RinerConfig {

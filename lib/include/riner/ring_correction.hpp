@@ -1,20 +1,27 @@
-// Air-referenced ring correction: a step after training that moves rings from the image into
-// the detector response, where the data cannot tell them apart.
+// Ring corrections: steps after training that move rings from the image into the detector
+// response, where the data cannot tell them apart.
 //
 // A ring centred on the rotation axis adds the same amount to every view of one detector
 // element, exactly like a change of that element's response (README, "Rings and the detector
 // response"), so the data fit is the same for (image, alpha) and (image - G, alpha exp(-P G))
 // for any rotationally symmetric image G with per-element projections P G. Training settles
-// somewhere on that line; this step picks the point where the image's air is flat: for every
-// radius whose circle crosses enough air (pixels well below the object's values, away from
-// its edges), the ring's value there is the median of the air minus the image's overall air
-// level. Radii whose circles lie inside the object keep what training gave them.
+// somewhere on that line; these steps pick a better point on it:
 //
-// What it cannot see: a faint object that is itself rotationally symmetric about the axis (a
-// sample holder or container, below the air threshold) looks exactly like a ring. Erosion keeps
-// thin walls out of the air; a thick one would need a large change of the detector response
-// to explain, far beyond the 1-2% that training leaves, so a correction whose mean change of
-// ln(alpha) exceeds max_mean_response_change is not applied.
+// - Air reference: for every radius whose circle crosses enough air (pixels well below the
+//   object's values, away from its edges), the ring's value there is the median of the air
+//   minus the image's overall air level. This sees rings of any width, only where there is air.
+// - Radial gradient: inside the object, a ring changes the image by the same amount along its
+//   whole circle, while anatomy's edges cross a circle at a few places. So the ring's slope at
+//   radius r is the median, over the circle's flattest points (least change along the circle),
+//   of the image's change from r to r + 1 pixel; summed outwards and high-passed at
+//   scale_px, it gives the narrow rings everywhere. Broader rings (and the image's mean radial
+//   trend) are left alone: the median cannot tell them apart.
+//
+// What neither can see: an object that is itself rotationally symmetric about the axis (a
+// sample holder, a container, a cylindrical sample's edge) looks exactly like a ring. Such an
+// object would need a large change of the detector response to explain, far beyond the 1-2%
+// that training leaves, so a correction whose mean change of ln(alpha) exceeds
+// max_mean_response_change is not applied.
 #pragma once
 
 #include <cstddef>
@@ -39,7 +46,7 @@ struct AirRingSettings {
   double max_mean_response_change = 0.03;
 };
 
-struct AirRingCorrection {
+struct RingCorrection {
   // Whether image and alpha were changed: false when no radius was measured or the change of
   // the response was too large to be a ring (then both are the input).
   bool applied = false;
@@ -49,16 +56,33 @@ struct AirRingCorrection {
   // Ring profile: value (1/mm) subtracted at radii bin * radius_step_mm; 0 where unmeasured.
   std::vector<double> profile;
   double radius_step_mm = 0.0;
-  std::size_t measured_radii = 0;  // bins with enough air
-  std::size_t air_pixels = 0;      // after erosion, in the final pass
+  std::size_t measured_radii = 0;  // bins with enough air, or enough samples on the circle
+  std::size_t air_pixels = 0;      // air reference: air pixels after erosion, in the final pass
 };
 
 // `image` on the 2D geometry's grid ([n_y, n_x]) and `alpha` with one value per detector
 // element. Returns the input unchanged (applied = false) when the image has too little air, no
 // positive values, non-finite values, or the rings found would change the response too much.
 // Throws InputError for a 3D geometry or mismatched shapes.
-AirRingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
-                                         const Geometry& geometry,
-                                         const AirRingSettings& settings = {});
+RingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
+                                      const Geometry& geometry,
+                                      const AirRingSettings& settings = {});
+
+struct GradientRingSettings {
+  // Rings narrower than this (sigma of the Gaussian high-pass, in pixels) are measured; broader
+  // ones stay, as the image's own radial trends do.
+  double scale_px = 12.0;
+  // The fraction of each circle's points whose slopes enter the median: those with the least
+  // change along the circle, where anatomy's edges are not.
+  double flat_fraction = 0.5;
+  // Largest mean |change of ln(alpha)| over the elements that is still taken for rings.
+  double max_mean_response_change = 0.03;
+};
+
+// Same inputs and guarantees as correct_rings_from_air; the profile has one node per pixel of
+// radius. Run it after the air reference: the air fixes broad rings where it can see them.
+RingCorrection correct_rings_from_gradient(const Array& image, const Array& alpha,
+                                           const Geometry& geometry,
+                                           const GradientRingSettings& settings = {});
 
 }  // namespace riner

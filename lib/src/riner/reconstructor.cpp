@@ -84,13 +84,18 @@ ReconstructionResult Reconstructor::result() const {
   const Geometry& g = impl_->setup.scan.geometry;
   ReconstructionResult r;
   r.field_image = field_image();
-  if (c.rings.air_reference && !g.is_3d()) {
-    r.rings = correct_rings_from_air(r.field_image, trained_alpha(), g, c.rings.air);
-    r.image = r.rings->image;
-    r.alpha = r.rings->alpha;
-  } else {
-    r.image = r.field_image;
-    r.alpha = trained_alpha();
+  r.image = r.field_image;
+  r.alpha = trained_alpha();
+  if (g.is_3d()) return r;
+  if (c.rings.air_reference) {
+    r.air_rings = correct_rings_from_air(r.image, r.alpha, g, c.rings.air);
+    r.image = r.air_rings->image;
+    r.alpha = r.air_rings->alpha;
+  }
+  if (c.rings.gradient_reference) {
+    r.gradient_rings = correct_rings_from_gradient(r.image, r.alpha, g, c.rings.gradient);
+    r.image = r.gradient_rings->image;
+    r.alpha = r.gradient_rings->alpha;
   }
   return r;
 }
@@ -99,8 +104,9 @@ Array Reconstructor::image() const { return result().image; }
 
 Array Reconstructor::alpha() const {
   const RinerConfig& c = impl_->setup.config;
-  // Without the correction, alpha needs no evaluation of the field.
-  if (!c.rings.air_reference || impl_->setup.scan.geometry.is_3d()) return trained_alpha();
+  // Without the corrections, alpha needs no evaluation of the field.
+  if ((!c.rings.air_reference && !c.rings.gradient_reference) || impl_->setup.scan.geometry.is_3d())
+    return trained_alpha();
   return result().alpha;
 }
 

@@ -130,6 +130,13 @@ void RinerConfig::validate() const {
           "rings.max_mean_response_change must be in (0, 10]");
   require(air.smoothing_bins >= 0.0 && air.smoothing_bins <= 100.0,
           "rings.smoothing_bins must be in [0, 100]");
+  const GradientRingSettings& gradient = rings.gradient;
+  require(gradient.scale_px > 0.0 && gradient.scale_px <= 1000.0,
+          "rings.gradient_scale_px must be in (0, 1000]");
+  require(gradient.flat_fraction > 0.0 && gradient.flat_fraction <= 1.0,
+          "rings.gradient_flat_fraction must be in (0, 1]");
+  require(gradient.max_mean_response_change > 0.0 && gradient.max_mean_response_change <= 10.0,
+          "rings.gradient_max_mean_response_change must be in (0, 10]");
 }
 
 void RinerConfig::update_from_json(std::string_view text, std::string_view source) {
@@ -235,15 +242,22 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
     }
     if (root.contains("rings")) {
       const json& r = root["rings"];
-      check_keys(r, "rings",
-                 {"air_reference", "air_fraction", "air_erosion_px", "min_air_pixels",
-                  "max_mean_response_change", "smoothing_bins"});
+      check_keys(
+          r, "rings",
+          {"air_reference", "air_fraction", "air_erosion_px", "min_air_pixels",
+           "max_mean_response_change", "smoothing_bins", "gradient_reference", "gradient_scale_px",
+           "gradient_flat_fraction", "gradient_max_mean_response_change"});
       read(r, "rings", "air_reference", rings.air_reference);
       read(r, "rings", "air_fraction", rings.air.air_fraction);
       read(r, "rings", "air_erosion_px", rings.air.erosion_px);
       read(r, "rings", "min_air_pixels", rings.air.min_pixels);
       read(r, "rings", "max_mean_response_change", rings.air.max_mean_response_change);
       read(r, "rings", "smoothing_bins", rings.air.smoothing_bins);
+      read(r, "rings", "gradient_reference", rings.gradient_reference);
+      read(r, "rings", "gradient_scale_px", rings.gradient.scale_px);
+      read(r, "rings", "gradient_flat_fraction", rings.gradient.flat_fraction);
+      read(r, "rings", "gradient_max_mean_response_change",
+           rings.gradient.max_mean_response_change);
     }
     if (root.contains("engine")) {
       require(root["engine"].is_string(), "engine must be a string");
@@ -297,7 +311,11 @@ std::string RinerConfig::to_json() const {
                  {"air_erosion_px", rings.air.erosion_px},
                  {"min_air_pixels", rings.air.min_pixels},
                  {"max_mean_response_change", rings.air.max_mean_response_change},
-                 {"smoothing_bins", rings.air.smoothing_bins}}},
+                 {"smoothing_bins", rings.air.smoothing_bins},
+                 {"gradient_reference", rings.gradient_reference},
+                 {"gradient_scale_px", rings.gradient.scale_px},
+                 {"gradient_flat_fraction", rings.gradient.flat_fraction},
+                 {"gradient_max_mean_response_change", rings.gradient.max_mean_response_change}}},
                {"engine", engine_name(engine)}};
   return root.dump(1) + "\n";
 }
@@ -320,7 +338,8 @@ RinerConfig RinerConfig::paper() {
   c.training.data_weight = 1.0;
   c.training.alpha_lr_scale = 1.0;
   c.training.beta_lr_scale = 1.0;
-  c.rings.air_reference = false;  // riner's addition, not the paper's
+  c.rings.air_reference = false;  // riner's additions, not the paper's
+  c.rings.gradient_reference = false;
   return c;
 }
 

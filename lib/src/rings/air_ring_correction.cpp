@@ -5,6 +5,7 @@
 #include "riner/error.hpp"
 #include "riner/rays.hpp"
 #include "riner/ring_correction.hpp"
+#include "rings/ring_profile.hpp"
 
 namespace riner {
 
@@ -39,29 +40,6 @@ std::vector<char> erode(std::vector<char> mask, std::size_t ny, std::size_t nx, 
   return mask;
 }
 
-// Line integral of the piecewise-linear profile (nodes at bin * step mm) along `ray` inside the
-// grid: what the ring adds to that detector element in every view.
-double ring_projection(const std::vector<double>& profile, double step_mm, const Geometry& g,
-                       const Ray& ray) {
-  const Segment seg = clip_to_box(g, ray);
-  if (seg.empty()) return 0.0;
-  const double ds = 0.1 * g.voxel_mm;
-  const auto n = static_cast<std::size_t>(std::ceil(seg.length() / ds));
-  const double h = seg.length() / static_cast<double>(n);
-  double sum = 0.0;
-  for (std::size_t j = 0; j < n; ++j) {
-    const double t = seg.enter + (static_cast<double>(j) + 0.5) * h;
-    const double x = ray.origin.x + t * ray.direction.x;
-    const double y = ray.origin.y + t * ray.direction.y;
-    const double r = std::hypot(x, y) / step_mm;
-    const auto k = static_cast<std::size_t>(r);
-    if (k + 1 >= profile.size()) continue;
-    const double w = r - static_cast<double>(k);
-    sum += (1.0 - w) * profile[k] + w * profile[k + 1];
-  }
-  return sum * h;
-}
-
 // Gaussian smoothing (sigma in bins) over the measured bins only, into profile (0 elsewhere): the
 // rings training leaves are broad, and the medians of single bins carry pixel noise that would
 // otherwise come back as fine rings.
@@ -92,18 +70,9 @@ void smooth_measured(const std::vector<double>& raw, const std::vector<char>& me
 
 }  // namespace
 
-AirRingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
-                                         const Geometry& geometry,
-                                         const AirRingSettings& settings) {
-  if (geometry.is_3d()) throw InputError("air ring correction: only 2D geometries");
-  if (image.shape != geometry.volume_shape) {
-    throw InputError("air ring correction: image shape " + shape_string(image.shape) +
-                     " is not the geometry's grid " + shape_string(geometry.volume_shape));
-  }
-  if (alpha.size() != geometry.n_u) {
-    throw InputError("air ring correction: alpha has " + std::to_string(alpha.size()) +
-                     " values for " + std::to_string(geometry.n_u) + " detector elements");
-  }
+RingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
+                                      const Geometry& geometry, const AirRingSettings& settings) {
+  rings::check_inputs("air ring correction", image, alpha, geometry);
   if (!(settings.air_fraction > 0.0 && settings.air_fraction < 1.0) || settings.erosion_px < 0 ||
       settings.min_pixels < 1 || !(settings.max_mean_response_change > 0.0) ||
       !(settings.smoothing_bins >= 0.0 && settings.smoothing_bins <= 100.0)) {
@@ -111,7 +80,7 @@ AirRingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
         "air ring correction: air_fraction must be in (0, 1), erosion >= 0, min_pixels >= 1, "
         "max_mean_response_change > 0, smoothing_bins in [0, 100]");
   }
-  AirRingCorrection out;
+  RingCorrection out;
   out.image = image;
   out.alpha = alpha;
   out.radius_step_mm = 0.5 * geometry.voxel_mm;
@@ -172,19 +141,10 @@ AirRingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
 
   out.measured_radii = static_cast<std::size_t>(std::count(measured.begin(), measured.end(), 1));
   if (out.measured_radii > 0) {
-    std::vector<double> change(geometry.n_u);
-    for (std::size_t e = 0; e < geometry.n_u; ++e) {
-      change[e] = ring_projection(profile, out.radius_step_mm, geometry,
-                                  detector_ray(geometry, 0, static_cast<double>(e)));
-      out.mean_response_change += std::fabs(change[e]) / static_cast<double>(geometry.n_u);
-    }
-    out.applied = out.mean_response_change <= settings.max_mean_response_change;
-    if (out.applied) {
+    out.profile = profile;
+    if (rings::fold_into_alpha(out, geometry, settings.max_mean_response_change)) {
       for (std::size_t p = 0; p < n; ++p) {
         out.image.data[p] = image.data[p] - static_cast<float>(profile[bin[p]]);
-      }
-      for (std::size_t e = 0; e < geometry.n_u; ++e) {
-        out.alpha.data[e] = static_cast<float>(alpha.data[e] * std::exp(-change[e]));
       }
     }
   }

@@ -1,0 +1,110 @@
+// Compares the ring corrections on the same trained fields: each DeepLesion slice (paper
+// protocol) is trained once at the current settings, then the field goes through the air
+// reference alone and through the air reference plus the radial-gradient correction at several
+// high-pass scales (and the gradient correction alone), so the differences are the corrections'
+// only.
+//
+//   riner_bench --case=ring_corrections [--first=0] [--last=9] [--config=JSON] [--json=FILE]
+#include <cstdio>
+
+#include "harness.hpp"
+#include "riner/metrics.hpp"
+#include "riner/reconstructor.hpp"
+#include "riner/ring_correction.hpp"
+#include "scenes.hpp"
+
+namespace {
+
+using riner::bench::Options;
+using riner::bench::Result;
+
+struct Variant {
+  std::string name;
+  bool air = true;
+  double gradient_scale_px = 0.0;  // 0: no gradient correction
+};
+
+struct Totals {
+  double psnr = 0.0, ssim = 0.0, alpha_error = 0.0;
+};
+
+std::vector<Result> ring_corrections(const Options& o) {
+  const int first = o.get_int("first", 0);
+  const int last = o.get_int("last", o.size == "tiny" ? first : 9);
+  riner::RinerConfig config = riner::bench::config_from(o);
+  if (o.size == "tiny") config.training.steps = std::min(config.training.steps, 200);
+  riner::Device device = riner::Device::open(o.device);
+  const riner::Projector projector(riner::preset_geometry("fan2d-paper"), riner::Engine::kOpenCL,
+                                   device);
+  const std::vector<Variant> variants = {{"field", false, 0.0},
+                                         {"air", true, 0.0},
+                                         {"air + gradient 8 px", true, 8.0},
+                                         {"air + gradient 12 px", true, 12.0},
+                                         {"air + gradient 16 px", true, 16.0},
+                                         {"gradient 12 px alone", false, 12.0}};
+  std::vector<Totals> totals(variants.size());
+  std::vector<Result> results;
+  int scenes = 0;
+  for (int index = first; index <= last; ++index, ++scenes) {
+    const riner::bench::RingScene scene = riner::bench::paper_scene(o, index, projector);
+    const riner::Geometry& g = scene.sim.scan.geometry;
+    riner::Reconstructor r(scene.sim.scan, config, device);
+    r.run();
+    const riner::Array field = r.field_image();
+    const riner::Array alpha = r.trained_alpha();
+    const riner::Array beta = r.beta();
+    const riner::RingCorrection air =
+        riner::correct_rings_from_air(field, alpha, g, config.rings.air);
+    nlohmann::json row{{"scene", scene.name},
+                       {"seconds", r.stats().seconds},
+                       {"samples_per_second", r.stats().samples / r.stats().seconds},
+                       {"detector", riner::bench::detector_accuracy(alpha, beta, scene.sim)}};
+    std::string line = riner::bench::format("%-20s %6.1f s", scene.name.c_str(), r.stats().seconds);
+    for (std::size_t v = 0; v < variants.size(); ++v) {
+      riner::Array image = variants[v].air ? air.image : field;
+      riner::Array response = variants[v].air ? air.alpha : alpha;
+      double change = 0.0;
+      if (variants[v].gradient_scale_px > 0.0) {
+        riner::GradientRingSettings settings = config.rings.gradient;
+        settings.scale_px = variants[v].gradient_scale_px;
+        const riner::RingCorrection c =
+            riner::correct_rings_from_gradient(image, response, g, settings);
+        image = c.image;
+        response = c.alpha;
+        change = c.applied ? c.mean_response_change : -1.0;
+      }
+      const riner::ImageMetrics m = riner::compare_images(image, scene.sim.ground_truth);
+      const double alpha_error =
+          riner::bench::detector_accuracy(response, beta, scene.sim)["alpha_mae_live"]
+              .get<double>();
+      totals[v].psnr += m.psnr;
+      totals[v].ssim += m.ssim;
+      totals[v].alpha_error += alpha_error;
+      row[variants[v].name] = {{"psnr", m.psnr},
+                               {"ssim", m.ssim},
+                               {"alpha_mae_live", alpha_error},
+                               {"gradient_response_change", change}};
+      line += riner::bench::format(" | %s %.2f/%.3f", variants[v].name.c_str(), m.psnr, m.ssim);
+    }
+    std::fprintf(stderr, "%s\n", line.c_str());
+    results.push_back({"ring_corrections", row, line});
+  }
+  nlohmann::json mean{{"scene", "mean"}, {"scenes", scenes}};
+  std::string line = "mean:";
+  for (std::size_t v = 0; v < variants.size(); ++v) {
+    const Totals t{totals[v].psnr / scenes, totals[v].ssim / scenes,
+                   totals[v].alpha_error / scenes};
+    mean[variants[v].name] = {
+        {"psnr", t.psnr}, {"ssim", t.ssim}, {"alpha_mae_live", t.alpha_error}};
+    line += riner::bench::format("\n  %-22s %6.2f dB  SSIM %.3f  alpha error %.4f",
+                                 variants[v].name.c_str(), t.psnr, t.ssim, t.alpha_error);
+  }
+  results.push_back({"ring_corrections", mean, line});
+  return results;
+}
+
+}  // namespace
+
+RINER_BENCH_CASE(ring_corrections,
+                 "ring corrections compared on the same trained fields (DeepLesion slices)",
+                 ring_corrections);

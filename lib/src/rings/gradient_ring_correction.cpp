@@ -1,0 +1,164 @@
+#include <algorithm>
+#include <cmath>
+
+#include "riner/error.hpp"
+#include "riner/ring_correction.hpp"
+#include "rings/ring_profile.hpp"
+
+namespace riner {
+
+namespace {
+
+// A circle with fewer usable points than this (near the grid's corners) is not measured.
+constexpr std::size_t kMinPoints = 32;
+
+// The image sampled on circles about the rotation axis (the grid's centre): one row of
+// `angles` bilinear samples per radius of whole pixels; NaN where a sample leaves the grid.
+struct PolarSamples {
+  std::size_t radii = 0;
+  std::size_t angles = 0;
+  std::vector<float> values;  // [radius][angle]
+  float at(std::size_t r, std::size_t a) const { return values[r * angles + a]; }
+};
+
+PolarSamples sample_circles(const Array& image) {
+  const std::size_t ny = image.shape[0];
+  const std::size_t nx = image.shape[1];
+  const double cx = 0.5 * static_cast<double>(nx - 1);
+  const double cy = 0.5 * static_cast<double>(ny - 1);
+  PolarSamples s;
+  s.radii = static_cast<std::size_t>(std::ceil(std::hypot(cx, cy))) + 1;
+  // About four samples per pixel of the largest circle's circumference.
+  s.angles = std::max<std::size_t>(256, 8 * std::max(nx, ny));
+  s.values.assign(s.radii * s.angles, std::nanf(""));
+  for (std::size_t r = 0; r < s.radii; ++r) {
+    for (std::size_t a = 0; a < s.angles; ++a) {
+      const double phi = 2.0 * M_PI * static_cast<double>(a) / static_cast<double>(s.angles);
+      const double col = cx + static_cast<double>(r) * std::cos(phi);
+      const double row = cy - static_cast<double>(r) * std::sin(phi);
+      if (col < 0.0 || row < 0.0 || col > static_cast<double>(nx - 1) ||
+          row > static_cast<double>(ny - 1))
+        continue;
+      const auto k = std::min(static_cast<std::size_t>(col), nx - 2);
+      const auto i = std::min(static_cast<std::size_t>(row), ny - 2);
+      const double u = col - static_cast<double>(k);
+      const double v = row - static_cast<double>(i);
+      s.values[r * s.angles + a] =
+          static_cast<float>((1 - v) * ((1 - u) * image(i, k) + u * image(i, k + 1)) +
+                             v * ((1 - u) * image(i + 1, k) + u * image(i + 1, k + 1)));
+    }
+  }
+  return s;
+}
+
+// The ring's slope from radius r to r + 1: the median change over the circle's flattest
+// points. False when too few points lie inside the grid.
+bool ring_slope(const PolarSamples& s, std::size_t r, double flat_fraction, double& slope) {
+  std::vector<float> change;
+  std::vector<float> along;  // how much the image changes along the circle at that point
+  for (std::size_t a = 0; a < s.angles; ++a) {
+    const std::size_t prev = (a + s.angles - 1) % s.angles;
+    const std::size_t next = (a + 1) % s.angles;
+    const float d = s.at(r + 1, a) - s.at(r, a);
+    const float t = std::max(std::fabs(s.at(r, next) - s.at(r, prev)),
+                             std::fabs(s.at(r + 1, next) - s.at(r + 1, prev)));
+    if (!std::isfinite(d) || !std::isfinite(t)) continue;
+    change.push_back(d);
+    along.push_back(t);
+  }
+  if (change.size() < kMinPoints) return false;
+  std::vector<float> sorted = along;
+  const auto cut =
+      static_cast<std::ptrdiff_t>(flat_fraction * static_cast<double>(sorted.size() - 1));
+  std::nth_element(sorted.begin(), sorted.begin() + cut, sorted.end());
+  const float limit = sorted[static_cast<std::size_t>(cut)];
+  std::vector<float> flat;
+  for (std::size_t j = 0; j < change.size(); ++j) {
+    if (along[j] <= limit) flat.push_back(change[j]);
+  }
+  const auto mid = flat.begin() + static_cast<std::ptrdiff_t>(flat.size() / 2);
+  std::nth_element(flat.begin(), mid, flat.end());
+  slope = *mid;
+  return true;
+}
+
+// Index j mirrored into 0..n-1 about the first and last nodes (g(-r) = g(r): a radial profile
+// is even about the axis).
+std::ptrdiff_t mirrored(std::ptrdiff_t j, std::ptrdiff_t n) {
+  if (n == 1) return 0;
+  const std::ptrdiff_t period = 2 * (n - 1);
+  j %= period;
+  if (j < 0) j += period;
+  return j < n ? j : period - j;
+}
+
+// values minus their Gaussian smoothing (sigma in nodes), mirrored at both ends.
+std::vector<double> high_pass(const std::vector<double>& values, double sigma) {
+  const auto n = static_cast<std::ptrdiff_t>(values.size());
+  const auto reach = static_cast<std::ptrdiff_t>(std::ceil(4.0 * sigma));
+  std::vector<double> out(values.size());
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
+    double sum = 0.0;
+    double weight = 0.0;
+    for (std::ptrdiff_t d = -reach; d <= reach; ++d) {
+      const double w = std::exp(-0.5 * static_cast<double>(d * d) / (sigma * sigma));
+      sum += w * values[static_cast<std::size_t>(mirrored(i + d, n))];
+      weight += w;
+    }
+    out[static_cast<std::size_t>(i)] = values[static_cast<std::size_t>(i)] - sum / weight;
+  }
+  return out;
+}
+
+}  // namespace
+
+RingCorrection correct_rings_from_gradient(const Array& image, const Array& alpha,
+                                           const Geometry& geometry,
+                                           const GradientRingSettings& settings) {
+  rings::check_inputs("gradient ring correction", image, alpha, geometry);
+  if (!(settings.scale_px > 0.0 && settings.scale_px <= 1000.0) ||
+      !(settings.flat_fraction > 0.0 && settings.flat_fraction <= 1.0) ||
+      !(settings.max_mean_response_change > 0.0)) {
+    throw InputError(
+        "gradient ring correction: scale_px must be in (0, 1000], flat_fraction in (0, 1], "
+        "max_mean_response_change > 0");
+  }
+  RingCorrection out;
+  out.image = image;
+  out.alpha = alpha;
+  out.radius_step_mm = geometry.voxel_mm;
+  for (float v : image.data) {
+    if (!std::isfinite(v)) return out;
+  }
+  const std::size_t ny = image.shape[0];
+  const std::size_t nx = image.shape[1];
+  if (ny < 2 || nx < 2) return out;
+
+  const PolarSamples circles = sample_circles(image);
+  std::vector<double> ring(circles.radii, 0.0);
+  for (std::size_t r = 0; r + 1 < circles.radii; ++r) {
+    double slope = 0.0;
+    if (ring_slope(circles, r, settings.flat_fraction, slope)) ++out.measured_radii;
+    ring[r + 1] = ring[r] + slope;
+  }
+  if (out.measured_radii == 0) return out;
+  out.profile = high_pass(ring, settings.scale_px);
+  out.profile.push_back(out.profile.back());  // a spare node for the interpolation
+  if (rings::fold_into_alpha(out, geometry, settings.max_mean_response_change)) {
+    const double cx = 0.5 * static_cast<double>(nx - 1);
+    const double cy = 0.5 * static_cast<double>(ny - 1);
+    for (std::size_t i = 0; i < ny; ++i) {
+      for (std::size_t k = 0; k < nx; ++k) {
+        const double r = std::hypot(static_cast<double>(k) - cx, static_cast<double>(i) - cy);
+        const auto b = std::min(static_cast<std::size_t>(r), out.profile.size() - 2);
+        const double w = std::min(r - static_cast<double>(b), 1.0);
+        out.image(i, k) =
+            image(i, k) - static_cast<float>((1 - w) * out.profile[b] + w * out.profile[b + 1]);
+      }
+    }
+  }
+  out.profile.pop_back();
+  return out;
+}
+
+}  // namespace riner

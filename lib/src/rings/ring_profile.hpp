@@ -1,0 +1,28 @@
+// What every ring correction shares: a rotationally symmetric profile g(r) about the rotation
+// axis is moved from the image into the detector response, alpha * exp(-P g), which keeps the
+// data fit, unless the response would have to change more than a ring can explain.
+#pragma once
+
+#include <vector>
+
+#include "riner/geometry.hpp"
+#include "riner/ring_correction.hpp"
+
+namespace riner::rings {
+
+// InputError (prefixed with `what`) for a 3D geometry, an image off the geometry's grid or an
+// alpha with the wrong number of elements.
+void check_inputs(const char* what, const Array& image, const Array& alpha, const Geometry& g);
+
+// Line integral of the piecewise-linear profile (nodes at index * step_mm) along detector
+// element `element`'s ray (view 0: a ring is the same in every view).
+double ring_projection(const std::vector<double>& profile, double step_mm, const Geometry& g,
+                       std::size_t element);
+
+// With out.profile and out.radius_step_mm set (and out.image / out.alpha holding the input):
+// computes the response change, and when its mean |change of ln alpha| is at most
+// `max_mean_response_change`, folds it into out.alpha and returns true. The caller subtracts
+// the profile from the image only then.
+bool fold_into_alpha(RingCorrection& out, const Geometry& g, double max_mean_response_change);
+
+}  // namespace riner::rings
