@@ -185,6 +185,8 @@ std::vector<Result> riner_real_scan(const Options& o) {
   const riner::Array& field = result.field_image;
   const riner::Array& image = result.image;
   const std::optional<riner::RingCorrection>& rings = result.air_rings;
+  const std::optional<riner::RingCorrection>& gradient = result.gradient_rings;
+  const bool corrected = (rings && rings->applied) || (gradient && gradient->applied);
   const riner::Array beta = r.beta();
   int off = 0;
   for (float b : beta.data) off += b < 0.5f;
@@ -193,8 +195,8 @@ std::vector<Result> riner_real_scan(const Options& o) {
     const std::size_t ny = image.shape[0], nx = image.shape[1];
     const riner::Window w = riner::percentile_window(fbp_image, 1.0, 99.5);
     riner::write_png(png + "_fbp_riner.png", beside(fbp_image, image), w);
-    if (rings && rings->applied) {
-      // The trained field | after the air-referenced ring correction, a narrow window on the air.
+    if (corrected) {
+      // The trained field | after the ring corrections, a narrow window on the air.
       riner::write_png(png + "_field_corrected.png", beside(field, image),
                        riner::percentile_window(field, 1.0, 90.0));
     }
@@ -215,6 +217,9 @@ std::vector<Result> riner_real_scan(const Options& o) {
             {"field_ring_index", riner::ring_index(field)},
             {"ring_correction_applied", rings && rings->applied},
             {"ring_correction_response_change", rings ? rings->mean_response_change : 0.0},
+            {"gradient_correction_applied", gradient && gradient->applied},
+            {"gradient_correction_response_change",
+             gradient ? gradient->mean_response_change : 0.0},
             {"elements_switched_off", off},
             {"seconds", r.stats().seconds},
             {"steps", r.stats().steps}}}};
