@@ -80,7 +80,8 @@ class Reconstructor {
   // the image and alpha together and keep the data fit.
   Array image() const;
   Array alpha() const;
-  Array beta() const;  // sigmoid(beta0) per element; < 0.5 marks an element as dead
+  // sigmoid(beta0) per element, 0 for an element with no finite reading; < 0.5: dead.
+  Array beta() const;
   // What training alone gives: the field at every voxel centre and max(alpha0, 1e-8).
   Array field_image() const;
   Array trained_alpha() const;
