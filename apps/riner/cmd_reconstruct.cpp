@@ -130,7 +130,8 @@ int run_reconstruct(int argc, char** argv, int first) {
   const std::filesystem::path image_path = out / ("image." + format);
   write_array(image_path, image, {std::vector<double>(image.rank(), g.voxel_mm)});
   write_png(out / "image.png", image);
-  const std::vector<std::size_t> dead = write_detector_outputs(out, alpha, reconstructor.beta());
+  write_detector_outputs(out, alpha, reconstructor.beta());
+  const std::vector<std::size_t> dead = reconstructor.dead_elements();
   write_history(out / "loss.csv", reconstructor.history());
   write_text(out / "config.json", config.to_json());
 

@@ -7,14 +7,10 @@
 
 namespace riner::app {
 
-std::vector<std::size_t> write_detector_outputs(const std::filesystem::path& dir,
-                                                const Array& alpha, const Array& beta) {
+void write_detector_outputs(const std::filesystem::path& dir, const Array& alpha,
+                            const Array& beta) {
   write_array(dir / "alpha.npy", alpha);
   write_array(dir / "beta.npy", beta);
-  std::vector<std::size_t> dead;
-  for (std::size_t e = 0; e < beta.size(); ++e) {
-    if (beta.data[e] < 0.5f) dead.push_back(e);
-  }
   if (alpha.rank() == 1) {
     LinePlot plot;
     plot.title = "estimated detector response alpha (blue) and mask beta (orange)";
@@ -45,7 +41,6 @@ std::vector<std::size_t> write_detector_outputs(const std::filesystem::path& dir
     }
     write_png(dir / "detector.png", both, Window{0.0f, 1.0f});
   }
-  return dead;
 }
 
 }  // namespace riner::app

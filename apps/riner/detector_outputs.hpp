@@ -1,5 +1,5 @@
-// Writing what a reconstruction learnt about the detector: alpha and beta arrays, a plot (2D)
-// or maps (3D), and the list of elements flagged dead.
+// Writing what a reconstruction learnt about the detector: alpha and beta arrays and a plot
+// (2D) or maps (3D).
 #pragma once
 
 #include <filesystem>
@@ -10,8 +10,8 @@
 namespace riner::app {
 
 // alpha.npy, beta.npy and detector.png (both against element index; in 3D, alpha and beta maps
-// side by side) in dir. Returns the elements with beta < 0.5.
-std::vector<std::size_t> write_detector_outputs(const std::filesystem::path& dir,
-                                                const Array& alpha, const Array& beta);
+// side by side) in dir.
+void write_detector_outputs(const std::filesystem::path& dir, const Array& alpha,
+                            const Array& beta);
 
 }  // namespace riner::app

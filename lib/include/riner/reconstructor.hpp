@@ -80,8 +80,10 @@ class Reconstructor {
   // the image and alpha together and keep the data fit.
   Array image() const;
   Array alpha() const;
-  // sigmoid(beta0) per element, 0 for an element with no finite reading; < 0.5: dead.
-  Array beta() const;
+  Array beta() const;  // sigmoid(beta0) per element; < 0.5 marks an element as dead
+  // Flat indices of the dead elements: beta < 0.5, or no finite reading at all (where the rays
+  // miss the object, training has no reason to switch such an element off).
+  std::vector<std::size_t> dead_elements() const;
   // What training alone gives: the field at every voxel centre and max(alpha0, 1e-8).
   Array field_image() const;
   Array trained_alpha() const;

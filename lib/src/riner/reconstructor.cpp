@@ -124,15 +124,21 @@ Array Reconstructor::beta() const {
   const std::vector<float> p = impl_->trainer->parameters();
   const Geometry& g = impl_->setup.scan.geometry;
   Array out(g.is_3d() ? std::vector<std::size_t>{g.n_v, g.n_u} : std::vector<std::size_t>{g.n_u});
-  const std::vector<std::uint32_t>& invalid = impl_->setup.invalid_readings;
   for (std::size_t e = 0; e < l.elements; ++e) {
-    // An element with no finite reading is dead by its readings, even where training had no
-    // reason to switch it off (rays that miss the object: an invalid reading counts as 0,
-    // which alpha fits).
-    out.data[e] =
-        invalid[e] == g.n_views() ? 0.0f : 1.0f / (1.0f + std::exp(-p[l.beta_offset + e]));
+    out.data[e] = 1.0f / (1.0f + std::exp(-p[l.beta_offset + e]));
   }
   return out;
+}
+
+std::vector<std::size_t> Reconstructor::dead_elements() const {
+  const Array b = beta();
+  const std::vector<std::uint32_t>& invalid = impl_->setup.invalid_readings;
+  const std::size_t views = impl_->setup.scan.geometry.n_views();
+  std::vector<std::size_t> dead;
+  for (std::size_t e = 0; e < b.size(); ++e) {
+    if (b.data[e] < 0.5f || invalid[e] == views) dead.push_back(e);
+  }
+  return dead;
 }
 
 std::vector<LossRecord> Reconstructor::history() const {
