@@ -4,6 +4,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <initializer_list>
 
 #include "reference/project_ref.hpp"
 #include "riner/error.hpp"
@@ -69,6 +70,25 @@ std::vector<double> predicted(const riner::Geometry& g, const riner::Array& imag
       riner::ref::project(g, std::vector<double>(image.data.begin(), image.data.end()));
   for (std::size_t j = 0; j < out.size(); ++j) out[j] -= std::log(alpha.data[j % g.n_u]);
   return out;
+}
+
+struct Disc {
+  double x, y, radius;  // mm
+  float value;
+};
+
+// Discs on an empty grid, each painted over the ones before it.
+riner::Array discs(const riner::Geometry& g, std::initializer_list<Disc> list) {
+  riner::Array image(g.volume_shape);
+  for (std::size_t i = 0; i < 128; ++i) {
+    for (std::size_t k = 0; k < 128; ++k) {
+      const riner::Vec3 c = riner::voxel_centre(g, static_cast<double>(k), static_cast<double>(i));
+      for (const Disc& d : list) {
+        if (std::hypot(c.x - d.x, c.y - d.y) < d.radius) image(i, k) = d.value;
+      }
+    }
+  }
+  return image;
 }
 
 // A narrow ring inside the ellipse (raised cosine of -0.0006/mm at 12 mm, half-width 3 mm),
@@ -187,17 +207,8 @@ TEST_SUITE("ring_correction") {
     // radius, with two dense spheres: removing it would change the response by ~4% on average
     // (training leaves ~1-2%).
     const riner::Geometry g = ring_geometry();
-    riner::Array image(g.volume_shape);
-    for (std::size_t i = 0; i < 128; ++i) {
-      for (std::size_t k = 0; k < 128; ++k) {
-        const riner::Vec3 c =
-            riner::voxel_centre(g, static_cast<double>(k), static_cast<double>(i));
-        float v = std::hypot(c.x, c.y) < 55.0 ? 0.001f : 0.0f;
-        if (std::hypot(c.x - 20.0, c.y) < 8.0 || std::hypot(c.x + 15.0, c.y - 15.0) < 8.0)
-          v = 0.04f;
-        image(i, k) = v;
-      }
-    }
+    const riner::Array image =
+        discs(g, {{0, 0, 55, 0.001f}, {20, 0, 8, 0.04f}, {-15, 15, 8, 0.04f}});
     riner::Array alpha({g.n_u}, 1.0f);
     const riner::RingCorrection c = riner::correct_rings_from_air(image, alpha, g);
     CHECK(c.measured_radii > 20);
@@ -258,16 +269,7 @@ TEST_SUITE("ring_correction") {
     // A cylinder of 0.02/mm, 30 mm in radius, with an insert: its edge is a step on every
     // circle, which only a response change of several percent could explain.
     const riner::Geometry g = ring_geometry();
-    riner::Array image(g.volume_shape);
-    for (std::size_t i = 0; i < 128; ++i) {
-      for (std::size_t k = 0; k < 128; ++k) {
-        const riner::Vec3 c =
-            riner::voxel_centre(g, static_cast<double>(k), static_cast<double>(i));
-        float v = std::hypot(c.x, c.y) < 30.0 ? 0.02f : 0.0f;
-        if (std::hypot(c.x - 10.0, c.y - 5.0) < 6.0) v = 0.03f;
-        image(i, k) = v;
-      }
-    }
+    const riner::Array image = discs(g, {{0, 0, 30, 0.02f}, {10, 5, 6, 0.03f}});
     riner::Array alpha({g.n_u}, 1.0f);
     const riner::RingCorrection c = riner::correct_rings_from_gradient(image, alpha, g);
     MESSAGE("mean response change " << c.mean_response_change);
