@@ -140,16 +140,14 @@ RingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
   }
 
   out.measured_radii = static_cast<std::size_t>(std::count(measured.begin(), measured.end(), 1));
-  if (out.measured_radii > 0) {
-    out.profile = profile;
-    if (rings::fold_into_alpha(out, geometry, settings.max_mean_response_change)) {
-      for (std::size_t p = 0; p < n; ++p) {
-        out.image.data[p] = image.data[p] - static_cast<float>(profile[bin[p]]);
-      }
+  out.profile = std::move(profile);
+  if (out.measured_radii > 0 &&
+      rings::fold_into_alpha(out, geometry, settings.max_mean_response_change)) {
+    for (std::size_t p = 0; p < n; ++p) {
+      out.image.data[p] = image.data[p] - static_cast<float>(out.profile[bin[p]]);
     }
   }
-  profile.pop_back();
-  out.profile = std::move(profile);
+  out.profile.pop_back();
   return out;
 }
 
