@@ -48,7 +48,10 @@ RingScene paper_scene(const Options& o, int index, const Projector& projector) {
     scene.name = "shepp-logan/seed_" + std::to_string(index);
   }
   RingModel model;
-  model.seed = static_cast<std::uint64_t>(index);
+  model.seed = static_cast<std::uint64_t>(index + o.get_int("seed-offset", 0));
+  if (model.seed != static_cast<std::uint64_t>(index)) {
+    scene.name += " (seed " + std::to_string(model.seed) + ")";
+  }
   scene.sim = simulate(truth, projector, model);
   return scene;
 }

@@ -21,7 +21,9 @@ struct RingScene {
 // --data=DIR (default ../shared/data/deeplesion; "builtin" for the phantoms). Falls back to the
 // phantoms, with a note on stderr, only when the default folder is missing.
 bool uses_deeplesion(const Options& o);
-// Scene `index` (a slice index, also the ring seed) in the fan2d-paper geometry.
+// Scene `index` (a slice index, also the ring seed) in the fan2d-paper geometry. --seed-offset=N
+// adds N to the seed: the same slices with other responses, dead elements and noise (a check
+// of settings chosen on the default seeds).
 RingScene paper_scene(const Options& o, int index, const Projector& projector);
 
 // The defaults, then --config=FILE|JSON, then --steps, then --engine.

@@ -47,6 +47,7 @@ RinerConfig config_from(const Args& args) {
   if (args.is_set("no-ring-correction")) {
     config.rings.air_reference = false;
     config.rings.gradient_reference = false;
+    config.rings.response_reference = false;
   }
   config.engine = engine_from(args);
   config.validate();
@@ -151,6 +152,7 @@ int run_reconstruct(int argc, char** argv, int first) {
       {"gradient_mode", stats.gradient_mode},
       {"air_ring_correction", ring_summary(result.air_rings)},
       {"gradient_ring_correction", ring_summary(result.gradient_rings)},
+      {"response_ring_correction", ring_summary(result.response_rings)},
       {"final_loss",
        reconstructor.history().empty() ? 0.0 : reconstructor.history().back().data_loss}};
   write_text(out / "summary.json", summary.dump(1) + "\n");

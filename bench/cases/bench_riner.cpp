@@ -186,7 +186,9 @@ std::vector<Result> riner_real_scan(const Options& o) {
   const riner::Array& image = result.image;
   const std::optional<riner::RingCorrection>& rings = result.air_rings;
   const std::optional<riner::RingCorrection>& gradient = result.gradient_rings;
-  const bool corrected = (rings && rings->applied) || (gradient && gradient->applied);
+  const std::optional<riner::RingCorrection>& response = result.response_rings;
+  const bool corrected = (rings && rings->applied) || (gradient && gradient->applied) ||
+                         (response && response->applied);
   const riner::Array beta = r.beta();
   int off = 0;
   for (float b : beta.data) off += b < 0.5f;
@@ -220,6 +222,9 @@ std::vector<Result> riner_real_scan(const Options& o) {
             {"gradient_correction_applied", gradient && gradient->applied},
             {"gradient_correction_response_change",
              gradient ? gradient->mean_response_change : 0.0},
+            {"response_correction_applied", response && response->applied},
+            {"response_correction_response_change",
+             response ? response->mean_response_change : 0.0},
             {"elements_switched_off", off},
             {"seconds", r.stats().seconds},
             {"steps", r.stats().steps}}}};

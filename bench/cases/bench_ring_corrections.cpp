@@ -1,10 +1,11 @@
 // Compares the ring corrections on the same trained fields: each DeepLesion slice (paper
 // protocol) is trained once at the current settings, then the field goes through the air
-// reference alone and through the air reference plus the radial-gradient correction at several
-// high-pass scales (and the gradient correction alone), so the differences are the corrections'
-// only.
+// reference alone, the air reference plus the radial-gradient correction, and those plus the
+// detector-response correction at several scales (and without the gradient step), so the
+// differences are the corrections' only.
 //
-//   riner_bench --case=ring_corrections [--first=0] [--last=9] [--config=JSON] [--json=FILE]
+//   riner_bench --case=ring_corrections [--first=0] [--last=9] [--seed-offset=0] [--config=JSON]
+//               [--json=FILE]
 #include <cstdio>
 
 #include "harness.hpp"
@@ -22,6 +23,7 @@ struct Variant {
   std::string name;
   bool air = true;
   double gradient_scale_px = 0.0;  // 0: no gradient correction
+  double response_scale_px = 0.0;  // 0: no detector-response correction
 };
 
 struct Totals {
@@ -36,12 +38,13 @@ std::vector<Result> ring_corrections(const Options& o) {
   riner::Device device = riner::Device::open(o.device);
   const riner::Projector projector(riner::preset_geometry("fan2d-paper"), riner::Engine::kOpenCL,
                                    device);
-  const std::vector<Variant> variants = {{"field", false, 0.0},
-                                         {"air", true, 0.0},
-                                         {"air + gradient 8 px", true, 8.0},
-                                         {"air + gradient 12 px", true, 12.0},
-                                         {"air + gradient 16 px", true, 16.0},
-                                         {"gradient 12 px alone", false, 12.0}};
+  const std::vector<Variant> variants = {{"field", false, 0.0, 0.0},
+                                         {"air", true, 0.0, 0.0},
+                                         {"air + gradient", true, 12.0, 0.0},
+                                         {"air + gradient + response 16 px", true, 12.0, 16.0},
+                                         {"air + gradient + response 24 px", true, 12.0, 24.0},
+                                         {"air + gradient + response 32 px", true, 12.0, 32.0},
+                                         {"air + response 24 px", true, 0.0, 24.0}};
   std::vector<Totals> totals(variants.size());
   std::vector<Result> results;
   int scenes = 0;
@@ -53,6 +56,7 @@ std::vector<Result> ring_corrections(const Options& o) {
     const riner::Array field = r.field_image();
     const riner::Array alpha = r.trained_alpha();
     const riner::Array beta = r.beta();
+    const std::vector<std::size_t> dead = r.dead_elements();
     const riner::RingCorrection air =
         riner::correct_rings_from_air(field, alpha, g, config.rings.air);
     nlohmann::json row{{"scene", scene.name},
@@ -64,6 +68,7 @@ std::vector<Result> ring_corrections(const Options& o) {
       riner::Array image = variants[v].air ? air.image : field;
       riner::Array response = variants[v].air ? air.alpha : alpha;
       double change = 0.0;
+      double response_change = 0.0;
       if (variants[v].gradient_scale_px > 0.0) {
         riner::GradientRingSettings settings = config.rings.gradient;
         settings.scale_px = variants[v].gradient_scale_px;
@@ -72,6 +77,15 @@ std::vector<Result> ring_corrections(const Options& o) {
         image = c.image;
         response = c.alpha;
         change = c.applied ? c.mean_response_change : -1.0;
+      }
+      if (variants[v].response_scale_px > 0.0) {
+        riner::ResponseRingSettings settings = config.rings.response;
+        settings.scale_px = variants[v].response_scale_px;
+        const riner::RingCorrection c =
+            riner::correct_rings_from_response(image, response, g, dead, settings);
+        image = c.image;
+        response = c.alpha;
+        response_change = c.applied ? c.mean_response_change : -1.0;
       }
       const riner::ImageMetrics m = riner::compare_images(image, scene.sim.ground_truth);
       const double alpha_error =
@@ -83,7 +97,8 @@ std::vector<Result> ring_corrections(const Options& o) {
       row[variants[v].name] = {{"psnr", m.psnr},
                                {"ssim", m.ssim},
                                {"alpha_mae_live", alpha_error},
-                               {"gradient_response_change", change}};
+                               {"gradient_response_change", change},
+                               {"response_response_change", response_change}};
       line += riner::bench::format(" | %s %.2f/%.3f", variants[v].name.c_str(), m.psnr, m.ssim);
     }
     std::fprintf(stderr, "%s\n", line.c_str());
@@ -96,7 +111,7 @@ std::vector<Result> ring_corrections(const Options& o) {
                    totals[v].alpha_error / scenes};
     mean[variants[v].name] = {
         {"psnr", t.psnr}, {"ssim", t.ssim}, {"alpha_mae_live", t.alpha_error}};
-    line += riner::bench::format("\n  %-22s %6.2f dB  SSIM %.3f  alpha error %.4f",
+    line += riner::bench::format("\n  %-32s %6.2f dB  SSIM %.3f  alpha error %.4f",
                                  variants[v].name.c_str(), t.psnr, t.ssim, t.alpha_error);
   }
   results.push_back({"ring_corrections", mean, line});

@@ -150,13 +150,17 @@ TEST_SUITE("cli") {
     CHECK(gradient["measured_radii"].get<int>() > 100);
     CHECK(nlohmann::json::parse(without.out)["air_ring_correction"]["applied"] == false);
     CHECK(nlohmann::json::parse(without.out)["gradient_ring_correction"]["applied"] == false);
+    const auto response = nlohmann::json::parse(with.out)["response_ring_correction"];
+    CHECK(response["measured_radii"].get<int>() > 100);
+    CHECK(nlohmann::json::parse(without.out)["response_ring_correction"]["applied"] == false);
     // Training is deterministic, so the images differ by the subtracted rings alone: no pixel
     // by more than their largest values, and pixels at the same radius by the same amount.
     const riner::Array a = riner::read_array(dir / "a" / "image.npy").array;
     const riner::Array b = riner::read_array(dir / "b" / "image.npy").array;
     const double largest =
         rings["largest_ring_per_mm"].get<double>() +
-        (gradient["applied"] == true ? gradient["largest_ring_per_mm"].get<double>() : 0.0);
+        (gradient["applied"] == true ? gradient["largest_ring_per_mm"].get<double>() : 0.0) +
+        (response["applied"] == true ? response["largest_ring_per_mm"].get<double>() : 0.0);
     CHECK(largest > 0.0);
     double biggest_change = 0.0;
     for (std::size_t p = 0; p < a.size(); ++p) {

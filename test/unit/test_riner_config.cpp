@@ -28,6 +28,7 @@ TEST_SUITE("riner_config") {
     CHECK(p.training.data_term == riner::DataTerm::kSum);
     CHECK_FALSE(p.rings.air_reference);  // riner's additions
     CHECK_FALSE(p.rings.gradient_reference);
+    CHECK_FALSE(p.rings.response_reference);
     CHECK_NOTHROW(p.validate());
   }
 
@@ -71,6 +72,8 @@ TEST_SUITE("riner_config") {
     expect(R"({"rings": {"air_fraction": 1.5}})", "config: rings.air_fraction must be in (0, 1)");
     expect(R"({"rings": {"gradient_flat_fraction": 0}})",
            "config: rings.gradient_flat_fraction must be in (0, 1]");
+    expect(R"({"rings": {"response_scale_px": 0}})",
+           "config: rings.response_scale_px must be in (0, 1000]");
     expect(R"({"rings": {"air_reference": 1}})",
            "c.json: config: rings.air_reference must be true or false");
   }

@@ -40,13 +40,14 @@ using ProgressCallback = std::function<bool(const TrainingProgress&)>;
 
 // Everything one evaluation of the field gives: the field itself, the image and alpha after the
 // ring corrections (the field and the trained alpha when they are off or 3D), and each
-// correction as it was made (the gradient one runs on the air-corrected image).
+// correction as it was made (each runs on the image the one before it left).
 struct ReconstructionResult {
   Array field_image;
   Array image;
   Array alpha;
   std::optional<RingCorrection> air_rings;
   std::optional<RingCorrection> gradient_rings;
+  std::optional<RingCorrection> response_rings;
 };
 
 struct TrainingStats {

@@ -99,12 +99,15 @@ struct TrainingConfig {
 
 // After training, 2D: the ring corrections (riner/ring_correction.hpp) move the rings the data
 // cannot tell from detector offsets out of the image: first wherever air shows them, then the
-// narrow ones inside the object, from the image's radial slopes.
+// narrow ones inside the object, from the image's radial slopes; then the broad ones back from
+// alpha, whose broad structure across the detector is not a detector's.
 struct RingCorrectionConfig {
   bool air_reference = true;
   AirRingSettings air;
   bool gradient_reference = true;
   GradientRingSettings gradient;
+  bool response_reference = true;
+  ResponseRingSettings response;
 };
 
 struct RinerConfig {

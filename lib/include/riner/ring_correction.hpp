@@ -16,6 +16,12 @@
 //   of the image's change from r to r + 1 pixel; summed outwards and high-passed at
 //   scale_px, it gives the narrow rings everywhere. Broader rings (and the image's mean radial
 //   trend) are left alone: the median cannot tell them apart.
+// - Detector response: a detector's responses differ element by element; they do not drift
+//   together over dozens of neighbouring elements. So -ln(alpha)'s structure across the detector
+//   broader than scale_px, beyond its mean, is taken for broad rings the training put into
+//   alpha instead of the image: the rotationally symmetric profile whose projections best match
+//   it (least squares, kept out of air) goes back into the image. This is the broad band the
+//   radial gradient leaves.
 //
 // What neither can see: an object that is itself rotationally symmetric about the axis (a
 // sample holder, a container, a cylindrical sample's edge) looks exactly like a ring. Such an
@@ -56,8 +62,9 @@ struct RingCorrection {
   // Ring profile: value (1/mm) subtracted at radii bin * radius_step_mm; 0 where unmeasured.
   std::vector<double> profile;
   double radius_step_mm = 0.0;
-  std::size_t measured_radii = 0;  // bins with enough air, or enough samples on the circle
-  std::size_t air_pixels = 0;      // air reference: air pixels after erosion, in the final pass
+  // Bins with enough air, enough samples on the circle, or a live element's ray through them.
+  std::size_t measured_radii = 0;
+  std::size_t air_pixels = 0;  // air reference: air pixels after erosion, in the final pass
 };
 
 // `image` on the 2D geometry's grid ([n_y, n_x]) and `alpha` with one value per detector
@@ -84,5 +91,25 @@ struct GradientRingSettings {
 RingCorrection correct_rings_from_gradient(const Array& image, const Array& alpha,
                                            const Geometry& geometry,
                                            const GradientRingSettings& settings = {});
+
+struct ResponseRingSettings {
+  // Structure of -ln(alpha) across the detector broader than this (sigma of a Gaussian over the
+  // elements' distances from the axis, in pixels) is taken for rings.
+  double scale_px = 24.0;
+  // Air pixels (the air reference's rule: below air_fraction of the 99.5th percentile) hold the
+  // profile at 0 with this weight per unit of a circle's air fraction, relative to the fit.
+  double air_fraction = 0.03;
+  double air_weight = 30.0;
+  // Largest mean |change of ln(alpha)| over the elements that is still taken for rings.
+  double max_mean_response_change = 0.03;
+};
+
+// Same inputs and guarantees as correct_rings_from_air; `dead_elements` (flat indices) do not
+// count: their alpha is not a response. The profile has one node per pixel of radius and is
+// negative where the image gains. Run it after the other two: it is the broad band they leave.
+RingCorrection correct_rings_from_response(const Array& image, const Array& alpha,
+                                           const Geometry& geometry,
+                                           const std::vector<std::size_t>& dead_elements,
+                                           const ResponseRingSettings& settings = {});
 
 }  // namespace riner

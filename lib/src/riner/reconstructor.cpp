@@ -97,6 +97,12 @@ ReconstructionResult Reconstructor::result() const {
     r.image = r.gradient_rings->image;
     r.alpha = r.gradient_rings->alpha;
   }
+  if (c.rings.response_reference) {
+    r.response_rings =
+        correct_rings_from_response(r.image, r.alpha, g, dead_elements(), c.rings.response);
+    r.image = r.response_rings->image;
+    r.alpha = r.response_rings->alpha;
+  }
   return r;
 }
 
@@ -105,7 +111,8 @@ Array Reconstructor::image() const { return result().image; }
 Array Reconstructor::alpha() const {
   const RinerConfig& c = impl_->setup.config;
   // Without the corrections, alpha needs no evaluation of the field.
-  if ((!c.rings.air_reference && !c.rings.gradient_reference) || impl_->setup.scan.geometry.is_3d())
+  if ((!c.rings.air_reference && !c.rings.gradient_reference && !c.rings.response_reference) ||
+      impl_->setup.scan.geometry.is_3d())
     return trained_alpha();
   return result().alpha;
 }

@@ -137,6 +137,13 @@ void RinerConfig::validate() const {
           "rings.gradient_flat_fraction must be in (0, 1]");
   require(gradient.max_mean_response_change > 0.0 && gradient.max_mean_response_change <= 10.0,
           "rings.gradient_max_mean_response_change must be in (0, 10]");
+  const ResponseRingSettings& response = rings.response;
+  require(response.scale_px > 0.0 && response.scale_px <= 1000.0,
+          "rings.response_scale_px must be in (0, 1000]");
+  require(response.air_weight >= 0.0 && response.air_weight <= 1e6,
+          "rings.response_air_weight must be in [0, 1e6]");
+  require(response.max_mean_response_change > 0.0 && response.max_mean_response_change <= 10.0,
+          "rings.response_max_mean_response_change must be in (0, 10]");
 }
 
 void RinerConfig::update_from_json(std::string_view text, std::string_view source) {
@@ -246,7 +253,8 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
           r, "rings",
           {"air_reference", "air_fraction", "air_erosion_px", "min_air_pixels",
            "max_mean_response_change", "smoothing_bins", "gradient_reference", "gradient_scale_px",
-           "gradient_flat_fraction", "gradient_max_mean_response_change"});
+           "gradient_flat_fraction", "gradient_max_mean_response_change", "response_reference",
+           "response_scale_px", "response_air_weight", "response_max_mean_response_change"});
       read(r, "rings", "air_reference", rings.air_reference);
       read(r, "rings", "air_fraction", rings.air.air_fraction);
       read(r, "rings", "air_erosion_px", rings.air.erosion_px);
@@ -258,6 +266,11 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
       read(r, "rings", "gradient_flat_fraction", rings.gradient.flat_fraction);
       read(r, "rings", "gradient_max_mean_response_change",
            rings.gradient.max_mean_response_change);
+      read(r, "rings", "response_reference", rings.response_reference);
+      read(r, "rings", "response_scale_px", rings.response.scale_px);
+      read(r, "rings", "response_air_weight", rings.response.air_weight);
+      read(r, "rings", "response_max_mean_response_change",
+           rings.response.max_mean_response_change);
     }
     if (root.contains("engine")) {
       require(root["engine"].is_string(), "engine must be a string");
@@ -315,7 +328,11 @@ std::string RinerConfig::to_json() const {
                  {"gradient_reference", rings.gradient_reference},
                  {"gradient_scale_px", rings.gradient.scale_px},
                  {"gradient_flat_fraction", rings.gradient.flat_fraction},
-                 {"gradient_max_mean_response_change", rings.gradient.max_mean_response_change}}},
+                 {"gradient_max_mean_response_change", rings.gradient.max_mean_response_change},
+                 {"response_reference", rings.response_reference},
+                 {"response_scale_px", rings.response.scale_px},
+                 {"response_air_weight", rings.response.air_weight},
+                 {"response_max_mean_response_change", rings.response.max_mean_response_change}}},
                {"engine", engine_name(engine)}};
   return root.dump(1) + "\n";
 }
@@ -340,6 +357,7 @@ RinerConfig RinerConfig::paper() {
   c.training.beta_lr_scale = 1.0;
   c.rings.air_reference = false;  // riner's additions, not the paper's
   c.rings.gradient_reference = false;
+  c.rings.response_reference = false;
   return c;
 }
 

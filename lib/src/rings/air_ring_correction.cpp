@@ -80,21 +80,13 @@ RingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
         "air ring correction: air_fraction must be in (0, 1), erosion >= 0, min_pixels >= 1, "
         "max_mean_response_change > 0, smoothing_bins in [0, 100]");
   }
-  RingCorrection out;
-  out.image = image;
-  out.alpha = alpha;
-  out.radius_step_mm = 0.5 * geometry.voxel_mm;
+  RingCorrection out = rings::unchanged(image, alpha, 0.5 * geometry.voxel_mm);
   const std::size_t ny = image.shape[0];
   const std::size_t nx = image.shape[1];
   const std::size_t n = image.size();
-  for (float v : image.data) {
-    if (!std::isfinite(v)) return out;
-  }
+  if (!rings::all_finite(image)) return out;
 
-  std::vector<float> sorted = image.data;
-  const auto rank = static_cast<std::ptrdiff_t>(0.995 * static_cast<double>(n - 1));
-  std::nth_element(sorted.begin(), sorted.begin() + rank, sorted.end());
-  const double threshold = settings.air_fraction * sorted[static_cast<std::size_t>(rank)];
+  const double threshold = rings::air_threshold(image, settings.air_fraction);
   if (!(threshold > 0.0)) return out;
 
   // Radius bin of every pixel centre (the rotation axis is the grid's centre).

@@ -123,13 +123,8 @@ RingCorrection correct_rings_from_gradient(const Array& image, const Array& alph
         "gradient ring correction: scale_px must be in (0, 1000], flat_fraction in (0, 1], "
         "max_mean_response_change > 0");
   }
-  RingCorrection out;
-  out.image = image;
-  out.alpha = alpha;
-  out.radius_step_mm = geometry.voxel_mm;
-  for (float v : image.data) {
-    if (!std::isfinite(v)) return out;
-  }
+  RingCorrection out = rings::unchanged(image, alpha, geometry.voxel_mm);
+  if (!rings::all_finite(image)) return out;
   const std::size_t ny = image.shape[0];
   const std::size_t nx = image.shape[1];
   if (ny < 2 || nx < 2) return out;
@@ -145,17 +140,7 @@ RingCorrection correct_rings_from_gradient(const Array& image, const Array& alph
   out.profile = high_pass(ring, settings.scale_px);
   out.profile.push_back(out.profile.back());  // a spare node for the interpolation
   if (rings::fold_into_alpha(out, geometry, settings.max_mean_response_change)) {
-    const double cx = 0.5 * static_cast<double>(nx - 1);
-    const double cy = 0.5 * static_cast<double>(ny - 1);
-    for (std::size_t i = 0; i < ny; ++i) {
-      for (std::size_t k = 0; k < nx; ++k) {
-        const double r = std::hypot(static_cast<double>(k) - cx, static_cast<double>(i) - cy);
-        const auto b = std::min(static_cast<std::size_t>(r), out.profile.size() - 2);
-        const double w = std::min(r - static_cast<double>(b), 1.0);
-        out.image(i, k) =
-            image(i, k) - static_cast<float>((1 - w) * out.profile[b] + w * out.profile[b + 1]);
-      }
-    }
+    rings::subtract_profile(out, image, geometry);
   }
   out.profile.pop_back();
   return out;

@@ -1,6 +1,8 @@
 #include "rings/ring_profile.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include <string>
 
@@ -22,26 +24,72 @@ void check_inputs(const char* what, const Array& image, const Array& alpha, cons
   }
 }
 
-double ring_projection(const std::vector<double>& profile, double step_mm, const Geometry& g,
-                       std::size_t element) {
+RingCorrection unchanged(const Array& image, const Array& alpha, double radius_step_mm) {
+  RingCorrection out;
+  out.image = image;
+  out.alpha = alpha;
+  out.radius_step_mm = radius_step_mm;
+  return out;
+}
+
+bool all_finite(const Array& image) {
+  return std::all_of(image.data.begin(), image.data.end(),
+                     [](float v) { return std::isfinite(v); });
+}
+
+std::vector<double> ring_projection_weights(std::size_t nodes, double step_mm, const Geometry& g,
+                                            std::size_t element) {
+  std::vector<double> weights(nodes, 0.0);
   const Ray ray = detector_ray(g, 0, static_cast<double>(element));
   const Segment seg = clip_to_box(g, ray);
-  if (seg.empty()) return 0.0;
+  if (seg.empty()) return weights;
   const double ds = 0.1 * g.voxel_mm;
   const auto n = static_cast<std::size_t>(std::ceil(seg.length() / ds));
   const double h = seg.length() / static_cast<double>(n);
-  double sum = 0.0;
   for (std::size_t j = 0; j < n; ++j) {
     const double t = seg.enter + (static_cast<double>(j) + 0.5) * h;
     const double x = ray.origin.x + t * ray.direction.x;
     const double y = ray.origin.y + t * ray.direction.y;
     const double r = std::hypot(x, y) / step_mm;
     const auto k = static_cast<std::size_t>(r);
-    if (k + 1 >= profile.size()) continue;
+    if (k + 1 >= nodes) continue;
     const double w = r - static_cast<double>(k);
-    sum += (1.0 - w) * profile[k] + w * profile[k + 1];
+    weights[k] += (1.0 - w) * h;
+    weights[k + 1] += w * h;
   }
-  return sum * h;
+  return weights;
+}
+
+double ring_projection(const std::vector<double>& profile, double step_mm, const Geometry& g,
+                       std::size_t element) {
+  const std::vector<double> w = ring_projection_weights(profile.size(), step_mm, g, element);
+  return std::inner_product(w.begin(), w.end(), profile.begin(), 0.0);
+}
+
+double air_threshold(const Array& image, double fraction) {
+  if (image.data.empty()) return 0.0;
+  std::vector<float> sorted = image.data;
+  const auto rank = static_cast<std::ptrdiff_t>(0.995 * static_cast<double>(sorted.size() - 1));
+  std::nth_element(sorted.begin(), sorted.begin() + rank, sorted.end());
+  return fraction * sorted[static_cast<std::size_t>(rank)];
+}
+
+void subtract_profile(RingCorrection& out, const Array& image, const Geometry& g) {
+  const std::size_t ny = image.shape[0];
+  const std::size_t nx = image.shape[1];
+  const double cx = 0.5 * static_cast<double>(nx - 1);
+  const double cy = 0.5 * static_cast<double>(ny - 1);
+  const double step_px = out.radius_step_mm / g.voxel_mm;
+  for (std::size_t i = 0; i < ny; ++i) {
+    for (std::size_t k = 0; k < nx; ++k) {
+      const double r =
+          std::hypot(static_cast<double>(k) - cx, static_cast<double>(i) - cy) / step_px;
+      const auto b = std::min(static_cast<std::size_t>(r), out.profile.size() - 2);
+      const double w = std::min(r - static_cast<double>(b), 1.0);
+      out.image(i, k) =
+          image(i, k) - static_cast<float>((1 - w) * out.profile[b] + w * out.profile[b + 1]);
+    }
+  }
 }
 
 bool fold_into_alpha(RingCorrection& out, const Geometry& g, double max_mean_response_change) {

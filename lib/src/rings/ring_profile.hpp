@@ -14,10 +14,27 @@ namespace riner::rings {
 // alpha with the wrong number of elements.
 void check_inputs(const char* what, const Array& image, const Array& alpha, const Geometry& g);
 
+// The input as it is (applied = false), with the profile's node spacing set.
+RingCorrection unchanged(const Array& image, const Array& alpha, double radius_step_mm);
+
+bool all_finite(const Array& image);
+
 // Line integral of the piecewise-linear profile (nodes at index * step_mm) along detector
 // element `element`'s ray (view 0: a ring is the same in every view).
 double ring_projection(const std::vector<double>& profile, double step_mm, const Geometry& g,
                        std::size_t element);
+// The same integral as weights, one per node: ring_projection is their dot product with the
+// profile.
+std::vector<double> ring_projection_weights(std::size_t nodes, double step_mm, const Geometry& g,
+                                            std::size_t element);
+
+// The air rule of the corrections: pixels below fraction times the image's 99.5th percentile.
+// Returns that threshold (not positive when the image has no positive values).
+double air_threshold(const Array& image, double fraction);
+
+// out.image = image minus the profile, linearly interpolated at each pixel's distance from the
+// axis (out.profile needs a spare last node).
+void subtract_profile(RingCorrection& out, const Array& image, const Geometry& g);
 
 // With out.profile and out.radius_step_mm set (and out.image / out.alpha holding the input):
 // computes the response change, and when its mean |change of ln alpha| is at most
