@@ -21,11 +21,17 @@ nlohmann::json ring_summary(const std::optional<RingCorrection>& rings) {
   if (!rings) return {{"applied", false}};
   double largest = 0.0;
   for (double v : rings->profile) largest = std::max(largest, std::fabs(v));
-  return {{"applied", rings->applied},
-          {"measured_radii", rings->measured_radii},
-          {"mean_response_change", rings->mean_response_change},
-          {"radius_step_mm", rings->radius_step_mm},
-          {"largest_ring_per_mm", largest}};
+  nlohmann::json out{{"applied", rings->applied},
+                     {"measured_radii", rings->measured_radii},
+                     {"mean_response_change", rings->mean_response_change},
+                     {"radius_step_mm", rings->radius_step_mm},
+                     {"largest_ring_per_mm", largest}};
+  // The detector-response correction's evidence (null: no odd structure at all).
+  if (rings->even_to_odd != 0.0) {
+    out["even_to_odd"] = std::isfinite(rings->even_to_odd) ? nlohmann::json(rings->even_to_odd)
+                                                           : nlohmann::json(nullptr);
+  }
+  return out;
 }
 
 RinerConfig config_from(const Args& args) {

@@ -225,6 +225,8 @@ std::vector<Result> riner_real_scan(const Options& o) {
             {"response_correction_applied", response && response->applied},
             {"response_correction_response_change",
              response ? response->mean_response_change : 0.0},
+            {"response_correction_even_to_odd",
+             response && std::isfinite(response->even_to_odd) ? response->even_to_odd : 1e9},
             {"elements_switched_off", off},
             {"seconds", r.stats().seconds},
             {"steps", r.stats().steps}}}};

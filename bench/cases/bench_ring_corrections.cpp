@@ -6,6 +6,7 @@
 //
 //   riner_bench --case=ring_corrections [--first=0] [--last=9] [--seed-offset=0] [--config=JSON]
 //               [--json=FILE]
+#include <cmath>
 #include <cstdio>
 
 #include "harness.hpp"
@@ -24,6 +25,7 @@ struct Variant {
   bool air = true;
   double gradient_scale_px = 0.0;  // 0: no gradient correction
   double response_scale_px = 0.0;  // 0: no detector-response correction
+  double min_even_to_odd = riner::ResponseRingSettings{}.min_even_to_odd;
 };
 
 struct Totals {
@@ -38,13 +40,14 @@ std::vector<Result> ring_corrections(const Options& o) {
   riner::Device device = riner::Device::open(o.device);
   const riner::Projector projector(riner::preset_geometry("fan2d-paper"), riner::Engine::kOpenCL,
                                    device);
-  const std::vector<Variant> variants = {{"field", false, 0.0, 0.0},
-                                         {"air", true, 0.0, 0.0},
-                                         {"air + gradient", true, 12.0, 0.0},
-                                         {"air + gradient + response 16 px", true, 12.0, 16.0},
-                                         {"air + gradient + response 24 px", true, 12.0, 24.0},
-                                         {"air + gradient + response 32 px", true, 12.0, 32.0},
-                                         {"air + response 24 px", true, 0.0, 24.0}};
+  const std::vector<Variant> variants = {
+      {"field", false, 0.0, 0.0},
+      {"air", true, 0.0, 0.0},
+      {"air + gradient", true, 12.0, 0.0},
+      {"air + gradient + response 24 px", true, 12.0, 24.0},
+      {"air + gradient + response 24 px, ungated", true, 12.0, 24.0, 0.0},
+      {"air + gradient + response 16 px", true, 12.0, 16.0},
+      {"air + gradient + response 32 px", true, 12.0, 32.0}};
   std::vector<Totals> totals(variants.size());
   std::vector<Result> results;
   int scenes = 0;
@@ -69,6 +72,7 @@ std::vector<Result> ring_corrections(const Options& o) {
       riner::Array response = variants[v].air ? air.alpha : alpha;
       double change = 0.0;
       double response_change = 0.0;
+      double even_to_odd = 0.0;
       if (variants[v].gradient_scale_px > 0.0) {
         riner::GradientRingSettings settings = config.rings.gradient;
         settings.scale_px = variants[v].gradient_scale_px;
@@ -81,11 +85,13 @@ std::vector<Result> ring_corrections(const Options& o) {
       if (variants[v].response_scale_px > 0.0) {
         riner::ResponseRingSettings settings = config.rings.response;
         settings.scale_px = variants[v].response_scale_px;
+        settings.min_even_to_odd = variants[v].min_even_to_odd;
         const riner::RingCorrection c =
             riner::correct_rings_from_response(image, response, g, dead, settings);
         image = c.image;
         response = c.alpha;
         response_change = c.applied ? c.mean_response_change : -1.0;
+        even_to_odd = std::isfinite(c.even_to_odd) ? c.even_to_odd : 1e9;
       }
       const riner::ImageMetrics m = riner::compare_images(image, scene.sim.ground_truth);
       const double alpha_error =
@@ -98,7 +104,8 @@ std::vector<Result> ring_corrections(const Options& o) {
                                {"ssim", m.ssim},
                                {"alpha_mae_live", alpha_error},
                                {"gradient_response_change", change},
-                               {"response_response_change", response_change}};
+                               {"response_response_change", response_change},
+                               {"even_to_odd", even_to_odd}};
       line += riner::bench::format(" | %s %.2f/%.3f", variants[v].name.c_str(), m.psnr, m.ssim);
     }
     std::fprintf(stderr, "%s\n", line.c_str());
@@ -111,7 +118,7 @@ std::vector<Result> ring_corrections(const Options& o) {
                    totals[v].alpha_error / scenes};
     mean[variants[v].name] = {
         {"psnr", t.psnr}, {"ssim", t.ssim}, {"alpha_mae_live", t.alpha_error}};
-    line += riner::bench::format("\n  %-32s %6.2f dB  SSIM %.3f  alpha error %.4f",
+    line += riner::bench::format("\n  %-42s %6.2f dB  SSIM %.3f  alpha error %.4f",
                                  variants[v].name.c_str(), t.psnr, t.ssim, t.alpha_error);
   }
   results.push_back({"ring_corrections", mean, line});

@@ -331,6 +331,8 @@ TEST_SUITE("ring_correction") {
 
     const riner::RingCorrection c =
         riner::correct_rings_from_response(trained, alpha, g, {}, settings);
+    MESSAGE("even / odd " << c.even_to_odd);
+    CHECK(c.even_to_odd > settings.min_even_to_odd);
     CHECK(c.applied);
     CHECK(c.measured_radii > 60);
     const double before = rms_difference(trained, truth);
@@ -343,27 +345,56 @@ TEST_SUITE("ring_correction") {
     }
     MESSAGE("dip rms " << before << " -> " << after << "; mean abs(alpha error) " << alpha_before
                        << " -> " << alpha_after);
-    // Measured: 2.1e-4 -> 8.8e-5/mm and 0.0078 -> 0.0041. What stays is mostly the white
-    // responses' own broad part (next test), which no correction can tell from a ring.
+    // Measured: 2.1e-4 -> 8.1e-5/mm and 0.0078 -> 0.0041 (even / odd 2.3). What stays is
+    // mostly the white responses' own broad part (next test), which no correction can tell from
+    // a ring.
     CHECK(after < 0.5 * before);
     CHECK(alpha_after < 0.6 * alpha_before);
     const double largest_ring = largest_response_change(c.alpha, alpha);
     const double mismatch = prediction_mismatch(g, trained, alpha, c.image, c.alpha).mean;
-    // Measured 4.3%: as for the gradient correction, pixels against a continuous profile.
+    // Measured 1.1%: as for the gradient correction, pixels against a continuous profile.
     MESSAGE("largest ring projection " << largest_ring << ", mismatch " << mismatch);
     CHECK(mismatch < 0.05 * largest_ring);
   }
 
-  TEST_CASE("response: responses without broad structure leave the image nearly as it is") {
+  TEST_CASE("response: responses without broad structure leave the image as it is") {
     const riner::Geometry g = ring_geometry();
     const riner::Array truth = phantom(g, false);
     const riner::Array alpha = white_responses(g.n_u);
+    // The chance broad structure of random responses is as odd as it is even: no evidence.
     const riner::RingCorrection c = riner::correct_rings_from_response(truth, alpha, g, {});
-    const double change = rms_difference(c.image, truth);
-    MESSAGE("rms change " << change << ", mean response change " << c.mean_response_change);
-    // Measured 3.9e-5 (0.2% of the ellipse's 0.02/mm): the broad part that 181 random
-    // responses in [0.95, 1.05] have by chance moves into the image.
+    MESSAGE("even / odd " << c.even_to_odd);
+    CHECK(c.even_to_odd < riner::ResponseRingSettings{}.min_even_to_odd);
+    CHECK_FALSE(c.applied);
+    CHECK(c.image.data == truth.data);
+    // Measured even / odd 1.2. Forced through anyway, that chance structure moves into the
+    // image: measured 3.6e-5/mm rms (0.2% of the ellipse's 0.02/mm).
+    riner::ResponseRingSettings ungated;
+    ungated.min_even_to_odd = 0.0;
+    const riner::RingCorrection forced =
+        riner::correct_rings_from_response(truth, alpha, g, {}, ungated);
+    CHECK(forced.applied);
+    const double change = rms_difference(forced.image, truth);
+    MESSAGE("forced: rms change " << change);
     CHECK(change < 5e-5);
+  }
+
+  TEST_CASE("response: a smooth gain across the detector is the detector's, not rings") {
+    // A beam profile centred 30 elements off the axis (a neutron or synchrotron beam normalised
+    // by one flat value): broad, but as odd about the axis as it is even.
+    const riner::Geometry g = ring_geometry();
+    const riner::Array truth = phantom(g, false);
+    riner::Array alpha = white_responses(g.n_u);
+    for (std::size_t e = 0; e < g.n_u; ++e) {
+      const double t = (static_cast<double>(e) - 120.0) / 60.0;
+      alpha.data[e] *= static_cast<float>(std::exp(-0.1 * t * t));
+    }
+    const riner::RingCorrection c = riner::correct_rings_from_response(truth, alpha, g, {});
+    MESSAGE("even / odd " << c.even_to_odd);
+    CHECK(c.even_to_odd < riner::ResponseRingSettings{}.min_even_to_odd);
+    CHECK_FALSE(c.applied);
+    CHECK(c.image.data == truth.data);
+    CHECK(c.alpha.data == alpha.data);
   }
 
   TEST_CASE("response: dead elements do not count, whatever their alpha") {

@@ -21,7 +21,8 @@
 //   broader than scale_px, beyond its mean, is taken for broad rings the training put into
 //   alpha instead of the image: the rotationally symmetric profile whose projections best match
 //   it (least squares, kept out of air) goes back into the image. This is the broad band the
-//   radial gradient leaves.
+//   radial gradient leaves. Rings can only make structure that is even about the axis, so the
+//   correction needs the even part to stand out over the odd one (the responses' own level).
 //
 // What neither can see: an object that is itself rotationally symmetric about the axis (a
 // sample holder, a container, a cylindrical sample's edge) looks exactly like a ring. Such an
@@ -65,6 +66,8 @@ struct RingCorrection {
   // Bins with enough air, enough samples on the circle, or a live element's ray through them.
   std::size_t measured_radii = 0;
   std::size_t air_pixels = 0;  // air reference: air pixels after erosion, in the final pass
+  // Detector response: rms of -ln(alpha)'s broad structure even about the axis over the odd one.
+  double even_to_odd = 0.0;
 };
 
 // `image` on the 2D geometry's grid ([n_y, n_x]) and `alpha` with one value per detector
@@ -100,6 +103,10 @@ struct ResponseRingSettings {
   // profile at 0 with this weight per unit of a circle's air fraction, relative to the fit.
   double air_fraction = 0.03;
   double air_weight = 30.0;
+  // Rings make only broad structure even about the axis (a ring projects the same at distance
+  // d and -d); the responses' own broad structure is as odd as it is even. Applied only when
+  // the even part's rms is at least this many times the odd part's.
+  double min_even_to_odd = 1.5;
   // Largest mean |change of ln(alpha)| over the elements that is still taken for rings.
   double max_mean_response_change = 0.03;
 };

@@ -142,6 +142,8 @@ void RinerConfig::validate() const {
           "rings.response_scale_px must be in (0, 1000]");
   require(response.air_weight >= 0.0 && response.air_weight <= 1e6,
           "rings.response_air_weight must be in [0, 1e6]");
+  require(response.min_even_to_odd >= 0.0 && response.min_even_to_odd <= 1e6,
+          "rings.response_min_even_to_odd must be in [0, 1e6]");
   require(response.max_mean_response_change > 0.0 && response.max_mean_response_change <= 10.0,
           "rings.response_max_mean_response_change must be in (0, 10]");
 }
@@ -254,7 +256,8 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
           {"air_reference", "air_fraction", "air_erosion_px", "min_air_pixels",
            "max_mean_response_change", "smoothing_bins", "gradient_reference", "gradient_scale_px",
            "gradient_flat_fraction", "gradient_max_mean_response_change", "response_reference",
-           "response_scale_px", "response_air_weight", "response_max_mean_response_change"});
+           "response_scale_px", "response_air_weight", "response_min_even_to_odd",
+           "response_max_mean_response_change"});
       read(r, "rings", "air_reference", rings.air_reference);
       read(r, "rings", "air_fraction", rings.air.air_fraction);
       read(r, "rings", "air_erosion_px", rings.air.erosion_px);
@@ -269,6 +272,7 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
       read(r, "rings", "response_reference", rings.response_reference);
       read(r, "rings", "response_scale_px", rings.response.scale_px);
       read(r, "rings", "response_air_weight", rings.response.air_weight);
+      read(r, "rings", "response_min_even_to_odd", rings.response.min_even_to_odd);
       read(r, "rings", "response_max_mean_response_change",
            rings.response.max_mean_response_change);
     }
@@ -332,6 +336,7 @@ std::string RinerConfig::to_json() const {
                  {"response_reference", rings.response_reference},
                  {"response_scale_px", rings.response.scale_px},
                  {"response_air_weight", rings.response.air_weight},
+                 {"response_min_even_to_odd", rings.response.min_even_to_odd},
                  {"response_max_mean_response_change", rings.response.max_mean_response_change}}},
                {"engine", engine_name(engine)}};
   return root.dump(1) + "\n";
