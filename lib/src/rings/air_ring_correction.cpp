@@ -134,7 +134,9 @@ RingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
   out.measured_radii = static_cast<std::size_t>(std::count(measured.begin(), measured.end(), 1));
   out.profile = std::move(profile);
   if (out.measured_radii > 0 &&
-      rings::fold_into_alpha(out, geometry, settings.max_mean_response_change)) {
+      rings::fold_into_alpha(out,
+                             rings::ring_projections(out.profile, out.radius_step_mm, geometry),
+                             settings.max_mean_response_change)) {
     for (std::size_t p = 0; p < n; ++p) {
       out.image.data[p] = image.data[p] - static_cast<float>(out.profile[bin[p]]);
     }

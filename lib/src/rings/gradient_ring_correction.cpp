@@ -139,7 +139,9 @@ RingCorrection correct_rings_from_gradient(const Array& image, const Array& alph
   if (out.measured_radii == 0) return out;
   out.profile = high_pass(ring, settings.scale_px);
   out.profile.push_back(out.profile.back());  // a spare node for the interpolation
-  if (rings::fold_into_alpha(out, geometry, settings.max_mean_response_change)) {
+  if (rings::fold_into_alpha(out,
+                             rings::ring_projections(out.profile, out.radius_step_mm, geometry),
+                             settings.max_mean_response_change)) {
     rings::subtract_profile(out, image, geometry);
   }
   out.profile.pop_back();

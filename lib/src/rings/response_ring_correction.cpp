@@ -162,17 +162,21 @@ RingCorrection correct_rings_from_response(const Array& image, const Array& alph
       2;
   const auto m = static_cast<Eigen::Index>(0.5 * static_cast<double>(std::min(nx, ny) - 1));
   if (m < 3) return out;
-  // Columns: the nodes' projection weights, then 1 for the level.
-  Eigen::MatrixXd projection = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(n), m + 1);
+  // Every element's projection weights on the solved nodes (all elements: the profile is
+  // folded into each one's alpha); the fit's columns are those of the usable elements, then 1
+  // for the level.
+  Eigen::MatrixXd weights(static_cast<Eigen::Index>(n), m);
+  Eigen::VectorXd mask = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(n));
   for (std::size_t e = 0; e < n; ++e) {
-    if (!usable[e]) continue;
     const std::vector<double> w =
         rings::ring_projection_weights(nodes, out.radius_step_mm, geometry, e);
     for (Eigen::Index k = 0; k < m; ++k) {
-      projection(static_cast<Eigen::Index>(e), k) = w[static_cast<std::size_t>(k)];
+      weights(static_cast<Eigen::Index>(e), k) = w[static_cast<std::size_t>(k)];
     }
-    projection(static_cast<Eigen::Index>(e), m) = 1.0;
+    if (usable[e]) mask[static_cast<Eigen::Index>(e)] = 1.0;
   }
+  Eigen::MatrixXd projection(static_cast<Eigen::Index>(n), m + 1);
+  projection << mask.asDiagonal() * weights, mask;
   for (Eigen::Index k = 0; k < m; ++k) {
     if (projection.col(k).squaredNorm() > 0.0) ++out.measured_radii;
   }
@@ -194,10 +198,12 @@ RingCorrection correct_rings_from_response(const Array& image, const Array& alph
   }
   const Eigen::VectorXd gain = normal.ldlt().solve(projection.transpose() * broad);
 
-  // The image gains g, so the profile it loses is -g.
+  // The image gains g, so the profile it loses is -g (0 beyond the solved nodes).
   out.profile.assign(nodes, 0.0);
   for (Eigen::Index k = 0; k < m; ++k) out.profile[static_cast<std::size_t>(k)] = -gain[k];
-  if (rings::fold_into_alpha(out, geometry, settings.max_mean_response_change)) {
+  const Eigen::VectorXd change = weights * -gain.head(m);
+  if (rings::fold_into_alpha(out, std::vector<double>(change.begin(), change.end()),
+                             settings.max_mean_response_change)) {
     rings::subtract_profile(out, image, geometry);
   }
   return out;

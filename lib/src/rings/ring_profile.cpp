@@ -60,10 +60,14 @@ std::vector<double> ring_projection_weights(std::size_t nodes, double step_mm, c
   return weights;
 }
 
-double ring_projection(const std::vector<double>& profile, double step_mm, const Geometry& g,
-                       std::size_t element) {
-  const std::vector<double> w = ring_projection_weights(profile.size(), step_mm, g, element);
-  return std::inner_product(w.begin(), w.end(), profile.begin(), 0.0);
+std::vector<double> ring_projections(const std::vector<double>& profile, double step_mm,
+                                     const Geometry& g) {
+  std::vector<double> out(g.n_u);
+  for (std::size_t e = 0; e < g.n_u; ++e) {
+    const std::vector<double> w = ring_projection_weights(profile.size(), step_mm, g, e);
+    out[e] = std::inner_product(w.begin(), w.end(), profile.begin(), 0.0);
+  }
+  return out;
 }
 
 double air_threshold(const Array& image, double fraction) {
@@ -92,16 +96,14 @@ void subtract_profile(RingCorrection& out, const Array& image, const Geometry& g
   }
 }
 
-bool fold_into_alpha(RingCorrection& out, const Geometry& g, double max_mean_response_change) {
-  std::vector<double> change(g.n_u);
+bool fold_into_alpha(RingCorrection& out, const std::vector<double>& change,
+                     double max_mean_response_change) {
+  const std::size_t n = change.size();
   out.mean_response_change = 0.0;
-  for (std::size_t e = 0; e < g.n_u; ++e) {
-    change[e] = ring_projection(out.profile, out.radius_step_mm, g, e);
-    out.mean_response_change += std::fabs(change[e]) / static_cast<double>(g.n_u);
-  }
+  for (double c : change) out.mean_response_change += std::fabs(c) / static_cast<double>(n);
   out.applied = out.mean_response_change <= max_mean_response_change;
   if (!out.applied) return false;
-  for (std::size_t e = 0; e < g.n_u; ++e) {
+  for (std::size_t e = 0; e < n; ++e) {
     out.alpha.data[e] = static_cast<float>(out.alpha.data[e] * std::exp(-change[e]));
   }
   return true;

@@ -19,14 +19,14 @@ RingCorrection unchanged(const Array& image, const Array& alpha, double radius_s
 
 bool all_finite(const Array& image);
 
-// Line integral of the piecewise-linear profile (nodes at index * step_mm) along detector
-// element `element`'s ray (view 0: a ring is the same in every view).
-double ring_projection(const std::vector<double>& profile, double step_mm, const Geometry& g,
-                       std::size_t element);
-// The same integral as weights, one per node: ring_projection is their dot product with the
-// profile.
+// The line integral of a piecewise-linear profile with `nodes` nodes (at index * step_mm)
+// along detector element `element`'s ray (view 0: a ring is the same in every view), as one
+// weight per node: the integral is their dot product with the profile.
 std::vector<double> ring_projection_weights(std::size_t nodes, double step_mm, const Geometry& g,
                                             std::size_t element);
+// That integral of `profile` for every element: what the ring adds to each element's readings.
+std::vector<double> ring_projections(const std::vector<double>& profile, double step_mm,
+                                     const Geometry& g);
 
 // The air rule of the corrections: pixels below fraction times the image's 99.5th percentile.
 // Returns that threshold (not positive when the image has no positive values).
@@ -36,10 +36,11 @@ double air_threshold(const Array& image, double fraction);
 // axis (out.profile needs a spare last node).
 void subtract_profile(RingCorrection& out, const Array& image, const Geometry& g);
 
-// With out.profile and out.radius_step_mm set (and out.image / out.alpha holding the input):
-// computes the response change, and when its mean |change of ln alpha| is at most
-// `max_mean_response_change`, folds it into out.alpha and returns true. The caller subtracts
-// the profile from the image only then.
-bool fold_into_alpha(RingCorrection& out, const Geometry& g, double max_mean_response_change);
+// With out.alpha holding the input and `change` the profile's projection per element
+// (ring_projections): sets out.mean_response_change, and when it is at most
+// `max_mean_response_change`, folds the change into out.alpha and returns true. The caller
+// subtracts the profile from the image only then.
+bool fold_into_alpha(RingCorrection& out, const std::vector<double>& change,
+                     double max_mean_response_change);
 
 }  // namespace riner::rings
