@@ -8,6 +8,7 @@
 
 #include "harness.hpp"
 #include "riner/device.hpp"
+#include "riner/error.hpp"
 
 int main(int argc, char** argv) {
   riner::bench::Options options;
@@ -65,6 +66,10 @@ int main(int argc, char** argv) {
           std::ofstream(options.json_path, std::ios::app) << line.dump() << "\n";
         }
       }
+    } catch (const riner::BuildError& e) {
+      std::fprintf(stderr, "riner_bench: case %s failed: %s\n%s\n", c.name.c_str(), e.what(),
+                   e.log().c_str());
+      return 1;
     } catch (const std::exception& e) {
       std::fprintf(stderr, "riner_bench: case %s failed: %s\n", c.name.c_str(), e.what());
       return 1;

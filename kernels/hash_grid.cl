@@ -36,21 +36,33 @@ typedef struct {
   uint hashed;
 } GridLevel;
 
-// The cell a position falls in at one level, and its position inside the cell.
-inline void hash_grid_cell(__constant const GridLevel* level, const float* pos, uint* cell, float* frac) {
+// The cell a position falls in at one level, and its position inside the cell. The scaled
+// position is at least 0.5, so truncation is floor.
+RINER_INLINE void hash_grid_cell(__constant const GridLevel* level, const float* pos, uint* cell,
+                                 float* frac) {
+  RINER_UNROLL
   for (int d = 0; d < DIMS; ++d) {
     const float x = clamp(pos[d], 0.0f, 1.0f) * level->scale + 0.5f;
-    const float f = floor(x);
-    cell[d] = (uint)f;
-    frac[d] = x - f;
+    cell[d] = (uint)x;
+    frac[d] = x - (float)cell[d];
   }
 }
 
-// Parameter index (feature 0) and interpolation weight of one corner of the cell.
-inline uint hash_grid_corner(__constant const GridLevel* level, const uint* cell, const float* frac,
-                             int corner, float* weight) {
+// Entries of one level: dense levels hold every vertex, hashed ones TABLE_SIZE.
+RINER_INLINE uint hash_grid_entries(__constant const GridLevel* level) {
+  if (level->hashed) return TABLE_SIZE;
+  uint n = level->resolution;
+  RINER_UNROLL
+  for (int d = 1; d < DIMS; ++d) n *= level->resolution;
+  return n;
+}
+
+// Entry (within its level) and interpolation weight of one corner of the cell.
+RINER_INLINE uint hash_grid_corner_entry(__constant const GridLevel* level, const uint* cell,
+                                         const float* frac, int corner, float* weight) {
   uint coords[DIMS];
   float w = 1.0f;
+  RINER_UNROLL
   for (int d = 0; d < DIMS; ++d) {
     const uint upper = (corner >> d) & 1;
     coords[d] = cell[d] + upper;
@@ -70,35 +82,77 @@ inline uint hash_grid_corner(__constant const GridLevel* level, const uint* cell
     index += coords[2] * level->resolution * level->resolution;
 #endif
   }
-  return level->offset + index * N_FEATURES;
+  return index;
 }
 
-inline void hash_grid_encode(__constant const GridLevel* levels, __global const float* table,
-                             const float* pos, float* out) {
+// Parameter index (feature 0) and interpolation weight of one corner of the cell.
+RINER_INLINE uint hash_grid_corner(__constant const GridLevel* level, const uint* cell,
+                                   const float* frac, int corner, float* weight) {
+  return level->offset + hash_grid_corner_entry(level, cell, frac, corner, weight) * N_FEATURES;
+}
+
+RINER_INLINE void hash_grid_encode(__constant const GridLevel* levels, __global const float* table,
+                                   const float* pos, float* out) {
+  RINER_UNROLL
   for (int l = 0; l < N_LEVELS; ++l) {
+    __constant const GridLevel* level = &levels[l];
     uint cell[DIMS];
     float frac[DIMS];
-    hash_grid_cell(&levels[l], pos, cell, frac);
+    hash_grid_cell(level, pos, cell, frac);
+#if N_FEATURES == 2
+    if (!level->hashed) {
+      // Dense: the two vertices of a cell's edge along x are neighbours in memory, so each
+      // pair of corners is one float4 (half the loads of corner by corner).
+      uint base = cell[0] + cell[1] * level->resolution;
+#if DIMS == 3
+      base += cell[2] * level->resolution * level->resolution;
+#endif
+      float2 acc = (float2)(0.0f);
+      RINER_UNROLL
+      for (int pair = 0; pair < N_CORNERS / 2; ++pair) {
+        uint index = base;
+        float w = 1.0f;
+        if (pair & 1) index += level->resolution;
+        w *= (pair & 1) ? frac[1] : 1.0f - frac[1];
+#if DIMS == 3
+        if (pair & 2) index += level->resolution * level->resolution;
+        w *= (pair & 2) ? frac[2] : 1.0f - frac[2];
+#endif
+        const float4 v = vload4(0, table + level->offset + index * 2);
+        acc += w * ((1.0f - frac[0]) * v.xy + frac[0] * v.zw);
+      }
+      out[l * 2] = acc.x;
+      out[l * 2 + 1] = acc.y;
+      continue;
+    }
+#endif
     float acc[N_FEATURES];
+    RINER_UNROLL
     for (int f = 0; f < N_FEATURES; ++f) acc[f] = 0.0f;
+    RINER_UNROLL
     for (int c = 0; c < N_CORNERS; ++c) {
       float w;
-      const uint index = hash_grid_corner(&levels[l], cell, frac, c, &w);
+      const uint index = hash_grid_corner(level, cell, frac, c, &w);
+      RINER_UNROLL
       for (int f = 0; f < N_FEATURES; ++f) acc[f] += w * table[index + f];
     }
+    RINER_UNROLL
     for (int f = 0; f < N_FEATURES; ++f) out[l * N_FEATURES + f] = acc[f];
   }
 }
 
-inline void hash_grid_scatter(__constant const GridLevel* levels, __global float* grad, const float* pos,
-                              const float* d_out) {
+RINER_INLINE void hash_grid_scatter(__constant const GridLevel* levels, __global float* grad,
+                                    const float* pos, const float* d_out) {
+  RINER_UNROLL
   for (int l = 0; l < N_LEVELS; ++l) {
     uint cell[DIMS];
     float frac[DIMS];
     hash_grid_cell(&levels[l], pos, cell, frac);
+    RINER_UNROLL
     for (int c = 0; c < N_CORNERS; ++c) {
       float w;
       const uint index = hash_grid_corner(&levels[l], cell, frac, c, &w);
+      RINER_UNROLL
       for (int f = 0; f < N_FEATURES; ++f) GRAD_ADD(&grad[index + f], w * d_out[l * N_FEATURES + f]);
     }
   }

@@ -13,7 +13,7 @@
 #define ALPHA_EPSILON 1e-8f
 
 // Returns the ray's loss; writes the gradients with respect to the ray sum, alpha0, beta0.
-inline float ray_loss(float ray_sum, float alpha0, float beta0, float rho, float weight, float* d_sum,
+RINER_INLINE float ray_loss(float ray_sum, float alpha0, float beta0, float rho, float weight, float* d_sum,
                       float* d_alpha0, float* d_beta0) {
   if (!isfinite(rho)) rho = 0.0f;
   const int clamped = !(alpha0 > ALPHA_EPSILON);
@@ -29,12 +29,12 @@ inline float ray_loss(float ray_sum, float alpha0, float beta0, float rho, float
 }
 
 // |(-ln alpha + ray_sum) - rho|: how far a ray is from its measurement, before beta.
-inline float ray_mismatch(float ray_sum, float alpha0, float rho) {
+RINER_INLINE float ray_mismatch(float ray_sum, float alpha0, float rho) {
   if (!isfinite(rho)) rho = 0.0f;
   return fabs(-log(fmax(alpha0, ALPHA_EPSILON)) + ray_sum - rho);
 }
 
-inline float beta_penalty(float beta0, float lambda, float* d_beta0) {
+RINER_INLINE float beta_penalty(float beta0, float lambda, float* d_beta0) {
   const float beta = 1.0f / (1.0f + exp(-beta0));
   *d_beta0 = -2.0f * lambda * beta * beta * (1.0f - beta);
   return -lambda * beta * beta;

@@ -1,102 +1,79 @@
-// riner_step.cl: one training step of Riner in three kernels, and the trained field's evaluation.
-//   riner_step_forward(n_samples, sample_rays, offsets, rays, segments, levels, level_weights,
-//                      params, mlp_offset, seed, step, jitter, mu_dx, cache, cache_stride)
-//     one work-item per sample of the batch (batch ray b = sample_rays[i] owns samples
-//     offsets[b] .. offsets[b + 1]): mu_dx[i] = mu * dx at the sample, and its encoded features
-//     and hidden activations (SAMPLE_CACHE values, value v at cache[v * cache_stride + i]),
-//     which the backward pass reads back instead of recomputing them. Per sample rather than per ray so that the work-items of a work-group
-//     run in lock step (the SIMD lanes of a CPU, the warps of a GPU).
-//   riner_step_loss(n_batch, offsets, mu_dx, rays, sums, rho, weights, elements_per_view, params, alpha_offset,
-//                   beta_offset, n_elements, elements, lambda, relative_threshold, data_weight,
-//                   block_first, block_views, block_elements, ring_lambda, hold_valid_beta,
-//                   invalid_readings, grad, d_sums, loss, scratch)
-//     one work-item, over the batch in order (deterministic): each ray's sum of mu dx into
-//     sums[b] (in sample order), each ray's loss (ray_sum.cl) and
-//     its gradient d_sums[b] with respect to sums[b]; alpha0/beta0 gradients into grad; the
-//     -lambda beta^2 term of the batch's elements; and, when ring_lambda > 0, the ring prior on
-//     the views x elements block (below). loss[0] = data term, loss[1] = penalties.
-//     When relative_threshold > 0, lambda is replaced by
+// riner_step.cl: one training step of Riner (METHOD.md section 2), sample-parallel, and the
+// trained field's evaluation. The step runs as
+//   riner_step_forward    one work-item per sample of the batch
+//   riner_step_loss       one work-group: ray sums, losses, alpha0/beta0 gradients, penalties
+//   riner_step_backward   one work-item per sample
+// then the weight gradients are reduced by mlp_gradient.cl, the grid's by atomics here
+// (-D ATOMIC_GRADIENTS) or by ownership in hash_grid_gradient.cl, and adam.cl applies them.
+//
+//   riner_step_forward(p, batch, segments, levels, params, mu_dx, cache)
+//     sample i of batch ray b (batch_ray_of): mu_dx[i] = mu * dx at the sample; its features
+//     and activations into the cache (sample_cache.cl).
+//   riner_step_loss(p, batch, mu_dx, rho, params, invalid_readings, grad, sums, d_sums,
+//                   ray_grads, history, scratch)
+//     one work-group of any size (the plan's): work-items take rays b = lid, lid + size, ...:
+//     sums[b] = sum of mu dx over the ray's samples (in sample order), the ray's loss
+//     (ray_sum.cl), d_sums[b] and its alpha0/beta0 gradients; then elements i = lid, ...
+//     of the batch's distinct elements: their rays' gradients in ascending ray order plus the
+//     -lambda beta^2 term into grad (each element's entries are written by one work-item:
+//     deterministic, no atomics). history[2 * slot] = data term, [2 * slot + 1] = penalties,
+//     summed by a fixed tree. When relative_threshold > 0, lambda is replaced by
 //     data_weight relative_threshold max(m, 1e-3) / 2, m the batch's median ray mismatch
-//     (scratch float[n_batch] holds the mismatches): the beta penalty then switches an element
-//     off when its rays miss by more than relative_threshold times the batch's typical ray,
-//     whatever the object and however far training has come.
-//     When hold_valid_beta != 0, beta0 of every element without invalid readings
-//     (invalid_readings[e] == 0) gets no gradient: held during the beta warm-up.
-//   riner_step_backward(n_lanes, n_batch, offsets, rays, segments, levels, level_weights,
-//                       params, grad, lane_stride, mlp_offset, seed, step, jitter, d_sums, cache,
-//                       cache_stride)
-//     one work-item per lane; lane l takes the batch's rays l, l + n_lanes, ... (interleaved, so
-//     lanes get similar work) and back-propagates d_sums[b] * dx through each sample's cached
-//     features and activations into grad + lane * lane_stride (lane_stride = 0 with
-//     -D ATOMIC_GRADIENTS: one shared gradient).
+//     (scratch float[n_batch]). When hold_valid_beta != 0, beta0 of every element without
+//     invalid readings gets no gradient (the beta warm-up).
+//   riner_step_backward(p, batch, segments, levels, params, d_sums, cache, grad)
+//     sample i: d_mu = d_sums[b] dx through the MLP (mlp_deltas); deltas and d_mu into the
+//     cache for mlp_gradient.cl; the features' gradient into the grid: with
+//     -D ATOMIC_GRADIENTS by float atomics into grad (common.cl picks the device's fastest),
+//     otherwise into the cache (CACHE_DIN, CACHE_POS) for hash_grid_gradient.cl.
 //   field_evaluate(n, first, nx, ny, nz, voxel, extent, levels, level_weights, params,
 //                  mlp_offset, out)
 //     one work-item per voxel index first + i of the grid [nz][ny][nx]: mu at its centre.
 //
 // Ring prior (riner's addition; off when ring_lambda = 0): a detector offset constant over
-// views can always be explained by a ring in the image instead, so the data alone cannot decide
-// (README, "Rings and the detector response"). The block of the batch holds block_views views
-// of the same block_elements adjacent elements, view-major from block_first. For each inner
-// element e of the block, r_e = mean over the block's views of the second difference
-// sums(v, e - 1) - 2 sums(v, e) + sums(v, e + 1): the view-averaged projection's curvature,
-// which a ring in the image makes large and a real object (not rotationally symmetric) does not.
-// The prior adds ring_lambda * sum_e r_e^2, so per-element offsets go to alpha.
+// views can always be explained by a ring in the image instead (README, "Rings and the
+// detector response"). The block of the batch holds block_views views of the same
+// block_elements adjacent elements, view-major from block_first. For each inner element e,
+// r_e = mean over the block's views of sums(v, e - 1) - 2 sums(v, e) + sums(v, e + 1), and the
+// prior adds ring_lambda * sum_e r_e^2, so per-element offsets go to alpha.
 //
-// Buffers: rays uint[n_batch] (ray ids); segments float8[rays] = (start xyz, step xyz, dx,
-// count as uint bits) in normalised coordinates (lib/src/model/ray_segments.hpp); rho
-// float[rays]; weights float[n_batch] (data-term weight per ray); params/grad float[n_params] as
-// lib/src/model/parameter_layout.hpp lays them out; level_weights float[N_LEVELS] (coarse to
-// fine, all 1 when every level is on).
-// Needs common.cl, hash_grid.cl, mlp.cl, ray_sum.cl (and their -D constants).
+// Buffers: batch uint[] packed as sample_cache.cl describes, StepParams p says where;
+// segments float8[rays] = (start xyz, step xyz, dx, count as uint bits) in normalised
+// coordinates (lib/src/model/ray_segments.hpp); rho float[rays]; params/grad float[n_params]
+// as lib/src/model/parameter_layout.hpp lays them out; sums, d_sums float[n_batch], ray_grads
+// float2[n_batch].
+// Needs common.cl, hash_grid.cl, mlp.cl, ray_sum.cl, sample_cache.cl (and their -D constants).
 
-// Coarse to fine: level l's features scaled by weights[l] (and so its gradient).
-inline void scale_levels(__global const float* weights, float* values) {
-  for (int l = 0; l < N_LEVELS; ++l) {
-    for (int f = 0; f < N_FEATURES; ++f) values[l * N_FEATURES + f] *= weights[l];
-  }
-}
-
-inline void segment_sample(float8 s, uint k, float u, float* pos) {
-  const float t = (float)k + u;
-  pos[0] = s.s0 + t * s.s3;
-  pos[1] = s.s1 + t * s.s4;
-#if DIMS == 3
-  pos[2] = s.s2 + t * s.s5;
-#endif
-}
-
-// Floats cached per sample between the forward and the backward pass.
-#define SAMPLE_CACHE (N_ENCODED + MLP_HIDDEN * MLP_WIDTH)
-
-__kernel void riner_step_forward(const uint n_samples, __global const uint* sample_rays,
-                                 __global const uint* offsets, __global const uint* rays, __global const float8* segments,
-                                 __constant const GridLevel* levels, __global const float* level_weights,
-                                 __global const float* params, const uint mlp_offset, const uint seed,
-                                 const uint step, const int jitter, __global float* mu_dx,
-                                 __global float* cache, const uint cache_stride) {
+__kernel void riner_step_forward(const StepParams p, __global const uint* batch,
+                                 __global const float8* segments, __constant const GridLevel* levels,
+                                 __global const float* params, __global float* mu_dx,
+                                 __global float* cache) {
   const uint i = get_global_id(0);
-  if (i >= n_samples) return;
-  const uint b = sample_rays[i];
-  const uint ray = rays[b];
+  if (i >= p.n_samples) return;
+  __global const uint* offsets = batch + p.offsets_at;
+  const uint b = batch_ray_of(offsets, p.n_batch, i);
+  const uint ray = batch[p.rays_at + b];
   const float8 s = segments[ray];
   const uint k = i - offsets[b];
   float pos[DIMS];
   float features[N_ENCODED];
   float act[MLP_HIDDEN][MLP_WIDTH];
-  segment_sample(s, k, jitter ? sample_jitter(seed, step, ray, k) : 0.5f, pos);
+  segment_sample(s, k, p.jitter ? sample_jitter(p.seed, p.step, ray, k) : 0.5f, pos);
   hash_grid_encode(levels, params, pos, features);
-  scale_levels(level_weights, features);
-  mu_dx[i] = mlp_forward(params + mlp_offset, features, act) * s.s6;
-  // Value v of sample i at cache[v * cache_stride + i]: neighbouring work-items store to
-  // neighbouring addresses.
-  for (int f = 0; f < N_ENCODED; ++f) cache[f * cache_stride + i] = features[f];
+  scale_levels((__global const float*)(batch + p.level_weights_at), features);
+  mu_dx[i] = mlp_forward(params + p.mlp_offset, features, act) * s.s6;
+  const uint stride = p.cache_stride;
+  RINER_UNROLL
+  for (int f = 0; f < N_ENCODED; ++f) cache[(CACHE_FEATURES + f) * stride + i] = features[f];
+  RINER_UNROLL
   for (int h = 0; h < MLP_HIDDEN; ++h) {
-    for (int j = 0; j < MLP_WIDTH; ++j) cache[(N_ENCODED + h * MLP_WIDTH + j) * cache_stride + i] = act[h][j];
+    RINER_UNROLL
+    for (int j = 0; j < MLP_WIDTH; ++j) cache[(CACHE_ACT(h) + j) * stride + i] = act[h][j];
   }
 }
 
 // The k-th smallest of values[0 .. n) (Hoare's selection; reorders values).
-inline float select_kth(__global float* values, uint n, uint k) {
+RINER_INLINE float select_kth(__global float* values, uint n, uint k) {
   uint lo = 0;
   uint hi = n - 1;
   while (lo < hi) {
@@ -126,108 +103,145 @@ inline float select_kth(__global float* values, uint n, uint k) {
   return values[k];
 }
 
-__kernel void riner_step_loss(const uint n_batch, __global const uint* offsets, __global const float* mu_dx,
-                              __global const uint* rays, __global float* sums,
-                              __global const float* rho, __global const float* weights,
-                              const uint elements_per_view, __global const float* params,
-                              const uint alpha_offset, const uint beta_offset, const uint n_elements,
-                              __global const uint* elements, const float lambda, const float relative_threshold,
-                              const float data_weight, const uint block_first, const uint block_views,
-                              const uint block_elements, const float ring_lambda,
-                              const uint hold_valid_beta, __global const uint* invalid_readings,
-                              __global float* grad,
-                              __global float* d_sums, __global float* loss, __global float* scratch) {
-  if (get_global_id(0) != 0) return;
-  for (uint b = 0; b < n_batch; ++b) {
+// The work-group's sum of value (every work-item calls it); the same tree every time.
+RINER_INLINE float group_sum(float value, __local float* scratch) {
+  const uint lid = get_local_id(0);
+  const uint n = get_local_size(0);
+  scratch[lid] = value;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (uint span = 1; span < n; span *= 2) {
+    if (lid % (2 * span) == 0 && lid + span < n) scratch[lid] += scratch[lid + span];
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
+  const float total = scratch[0];
+  barrier(CLK_LOCAL_MEM_FENCE);
+  return total;
+}
+
+// The ring prior on the batch's views x elements block: its value; its gradient into d_sums.
+RINER_INLINE float ring_prior(const StepParams* p, __global const float* sums, __global float* d_sums) {
+  if (p->ring_lambda <= 0.0f || p->block_views == 0 || p->block_elements < 3) return 0.0f;
+  const uint E = p->block_elements;
+  float penalty = 0.0f;
+  for (uint e = 1; e + 1 < E; ++e) {
+    float r = 0.0f;
+    for (uint v = 0; v < p->block_views; ++v) {
+      const uint base = p->block_first + v * E;
+      r += sums[base + e - 1] - 2.0f * sums[base + e] + sums[base + e + 1];
+    }
+    r /= (float)p->block_views;
+    penalty += p->ring_lambda * r * r;
+    const float g = 2.0f * p->ring_lambda * r / (float)p->block_views;
+    for (uint v = 0; v < p->block_views; ++v) {
+      const uint base = p->block_first + v * E;
+      d_sums[base + e - 1] += g;
+      d_sums[base + e] -= 2.0f * g;
+      d_sums[base + e + 1] += g;
+    }
+  }
+  return penalty;
+}
+
+__kernel void riner_step_loss(const StepParams p, __global const uint* batch, __global const float* mu_dx,
+                              __global const float* rho, __global const float* params,
+                              __global const uint* invalid_readings, __global float* grad,
+                              __global float* sums, __global float* d_sums, __global float2* ray_grads,
+                              __global float* history, __global float* scratch, __local float* reduce) {
+  const uint lid = get_local_id(0);
+  const uint size = get_local_size(0);
+  __global const uint* offsets = batch + p.offsets_at;
+  for (uint b = lid; b < p.n_batch; b += size) {
     float sum = 0.0f;
     for (uint i = offsets[b]; i < offsets[b + 1]; ++i) sum += mu_dx[i];
     sums[b] = sum;
   }
-  float penalty_weight = lambda;
-  if (relative_threshold > 0.0f && n_batch > 0) {
-    for (uint b = 0; b < n_batch; ++b) {
-      const uint ray = rays[b];
-      scratch[b] = ray_mismatch(sums[b], params[alpha_offset + ray % elements_per_view], rho[ray]);
+  barrier(CLK_GLOBAL_MEM_FENCE | CLK_LOCAL_MEM_FENCE);
+  float penalty_weight = p.lambda;
+  if (p.relative_threshold > 0.0f && p.n_batch > 0) {
+    if (lid == 0) {
+      for (uint b = 0; b < p.n_batch; ++b) {
+        const uint ray = batch[p.rays_at + b];
+        scratch[b] = ray_mismatch(sums[b], params[p.alpha_offset + ray % p.elements_per_view], rho[ray]);
+      }
+      reduce[0] = select_kth(scratch, p.n_batch, (p.n_batch - 1) / 2);
     }
-    const float median = select_kth(scratch, n_batch, (n_batch - 1) / 2);
-    penalty_weight = 0.5f * data_weight * relative_threshold * fmax(median, 1e-3f);
+    barrier(CLK_LOCAL_MEM_FENCE);
+    penalty_weight = 0.5f * p.data_weight * p.relative_threshold * fmax(reduce[0], 1e-3f);
+    barrier(CLK_LOCAL_MEM_FENCE);
   }
   float data = 0.0f;
-  for (uint b = 0; b < n_batch; ++b) {
-    const uint ray = rays[b];
-    const uint e = ray % elements_per_view;
+  for (uint b = lid; b < p.n_batch; b += size) {
+    const uint ray = batch[p.rays_at + b];
+    const uint e = ray % p.elements_per_view;
     float d_sum;
     float d_alpha0;
     float d_beta0;
-    data += ray_loss(sums[b], params[alpha_offset + e], params[beta_offset + e], rho[ray], weights[b], &d_sum,
-                     &d_alpha0, &d_beta0);
+    data += ray_loss(sums[b], params[p.alpha_offset + e], params[p.beta_offset + e], rho[ray],
+                     as_float(batch[p.weights_at + b]), &d_sum, &d_alpha0, &d_beta0);
     d_sums[b] = d_sum;
-    GRAD_ADD(&grad[alpha_offset + e], d_alpha0);
-    if (!hold_valid_beta || invalid_readings[e] != 0) GRAD_ADD(&grad[beta_offset + e], d_beta0);
+    ray_grads[b] = (float2)(d_alpha0, d_beta0);
   }
+  barrier(CLK_GLOBAL_MEM_FENCE | CLK_LOCAL_MEM_FENCE);
   float penalty = 0.0f;
-  for (uint i = 0; i < n_elements; ++i) {
+  if (lid == 0) penalty = ring_prior(&p, sums, d_sums);
+  __global const uint* starts = batch + p.element_rays_at;
+  __global const uint* element_rays = starts + p.n_elements + 1;
+  for (uint i = lid; i < p.n_elements; i += size) {
+    const uint e = batch[p.elements_at + i];
+    float2 g = (float2)(0.0f);
+    for (uint j = starts[i]; j < starts[i + 1]; ++j) g += ray_grads[element_rays[j]];
     float d_beta0;
-    penalty += beta_penalty(params[beta_offset + elements[i]], penalty_weight, &d_beta0);
-    if (!hold_valid_beta || invalid_readings[elements[i]] != 0)
-      GRAD_ADD(&grad[beta_offset + elements[i]], d_beta0);
+    penalty += beta_penalty(params[p.beta_offset + e], penalty_weight, &d_beta0);
+    grad[p.alpha_offset + e] += g.x;
+    if (!p.hold_valid_beta || invalid_readings[e] != 0) grad[p.beta_offset + e] += g.y + d_beta0;
   }
-  if (ring_lambda > 0.0f && block_views > 0 && block_elements >= 3) {
-    // r_e for the inner elements e = 1 .. E - 2, then its gradient on every block sum.
-    const uint E = block_elements;
-    for (uint e = 1; e + 1 < E; ++e) {
-      float r = 0.0f;
-      for (uint v = 0; v < block_views; ++v) {
-        const uint base = block_first + v * E;
-        r += sums[base + e - 1] - 2.0f * sums[base + e] + sums[base + e + 1];
-      }
-      r /= (float)block_views;
-      penalty += ring_lambda * r * r;
-      const float g = 2.0f * ring_lambda * r / (float)block_views;
-      for (uint v = 0; v < block_views; ++v) {
-        const uint base = block_first + v * E;
-        d_sums[base + e - 1] += g;
-        d_sums[base + e] -= 2.0f * g;
-        d_sums[base + e + 1] += g;
-      }
-    }
+  data = group_sum(data, reduce);
+  penalty = group_sum(penalty, reduce);
+  if (lid == 0) {
+    history[2 * p.history_slot] = data;
+    history[2 * p.history_slot + 1] = penalty;
   }
-  loss[0] = data;
-  loss[1] = penalty;
 }
 
-__kernel void riner_step_backward(const uint n_lanes, const uint n_batch, __global const uint* offsets,
-                                  __global const uint* rays, __global const float8* segments,
-                                  __constant const GridLevel* levels, __global const float* level_weights,
-                                  __global const float* params, __global float* grad_all, const uint lane_stride,
-                                  const uint mlp_offset, const uint seed, const uint step, const int jitter,
-                                  __global const float* d_sums, __global const float* cache,
-                                  const uint cache_stride) {
-  const uint lane = get_global_id(0);
-  if (lane >= n_lanes) return;
-  __global float* grad = grad_all + lane * lane_stride;
-  __global const float* mlp = params + mlp_offset;
-  float features[N_ENCODED];
+__kernel void riner_step_backward(const StepParams p, __global const uint* batch,
+                                  __global const float8* segments, __constant const GridLevel* levels,
+                                  __global const float* params, __global const float* d_sums,
+                                  __global float* cache, __global float* grad) {
+  const uint i = get_global_id(0);
+  if (i >= p.n_samples) return;
+  __global const uint* offsets = batch + p.offsets_at;
+  const uint b = batch_ray_of(offsets, p.n_batch, i);
+  const uint ray = batch[p.rays_at + b];
+  const float8 s = segments[ray];
+  const float d_mu = d_sums[b] * s.s6;
+  const uint stride = p.cache_stride;
   float act[MLP_HIDDEN][MLP_WIDTH];
-  float d_features[N_ENCODED];
-  float pos[DIMS];
-  for (uint b = lane; b < n_batch; b += n_lanes) {
-    const uint ray = rays[b];
-    const float8 s = segments[ray];
-    const float d_mu = d_sums[b] * s.s6;
-    if (d_mu == 0.0f) continue;
-    for (uint i = offsets[b]; i < offsets[b + 1]; ++i) {
-      const uint k = i - offsets[b];
-      for (int f = 0; f < N_ENCODED; ++f) features[f] = cache[f * cache_stride + i];
-      for (int h = 0; h < MLP_HIDDEN; ++h) {
-        for (int j = 0; j < MLP_WIDTH; ++j) act[h][j] = cache[(N_ENCODED + h * MLP_WIDTH + j) * cache_stride + i];
-      }
-      mlp_backward(mlp, grad + mlp_offset, features, act, d_mu, d_features);
-      scale_levels(level_weights, d_features);
-      segment_sample(s, k, jitter ? sample_jitter(seed, step, ray, k) : 0.5f, pos);
-      hash_grid_scatter(levels, grad, pos, d_features);
-    }
+  RINER_UNROLL
+  for (int h = 0; h < MLP_HIDDEN; ++h) {
+    RINER_UNROLL
+    for (int j = 0; j < MLP_WIDTH; ++j) act[h][j] = cache[(CACHE_ACT(h) + j) * stride + i];
   }
+  float delta[MLP_HIDDEN][MLP_WIDTH];
+  float d_features[N_ENCODED];
+  mlp_deltas(params + p.mlp_offset, act, d_mu, delta, d_features);
+  RINER_UNROLL
+  for (int h = 0; h < MLP_HIDDEN; ++h) {
+    RINER_UNROLL
+    for (int j = 0; j < MLP_WIDTH; ++j) cache[(CACHE_DELTA(h) + j) * stride + i] = delta[h][j];
+  }
+  cache[CACHE_DMU * stride + i] = d_mu;
+  scale_levels((__global const float*)(batch + p.level_weights_at), d_features);
+  float pos[DIMS];
+  const uint k = i - offsets[b];
+  segment_sample(s, k, p.jitter ? sample_jitter(p.seed, p.step, ray, k) : 0.5f, pos);
+#ifdef ATOMIC_GRADIENTS
+  if (d_mu != 0.0f) hash_grid_scatter(levels, grad, pos, d_features);
+#else
+  RINER_UNROLL
+  for (int f = 0; f < N_ENCODED; ++f) cache[(CACHE_DIN + f) * stride + i] = d_features[f];
+  RINER_UNROLL
+  for (int d = 0; d < DIMS; ++d) cache[(CACHE_POS + d) * stride + i] = pos[d];
+#endif
 }
 
 __kernel void field_evaluate(const uint n, const uint first, const uint nx, const uint ny, const uint nz,

@@ -2,6 +2,8 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "riner/execution_plan.hpp"
+
 #include "cli_args.hpp"
 #include "commands.hpp"
 #include "riner/device.hpp"
@@ -43,7 +45,9 @@ nlohmann::json to_json(const DeviceInfo& d) {
           {"preferred_vector_width_float", d.preferred_vector_width_float},
           {"native_vector_width_float", d.native_vector_width_float},
           {"preferred_vector_width_int", d.preferred_vector_width_int},
-          {"native_vector_width_int", d.native_vector_width_int}};
+          {"native_vector_width_int", d.native_vector_width_int},
+          {"fp32_global_atomic_add", d.fp32_global_atomic_add},
+          {"training_plan", nlohmann::json::parse(choose_execution_plan(d).to_json())}};
 }
 
 void print_table(const std::vector<DeviceInfo>& devices) {
@@ -68,6 +72,8 @@ void print_table(const std::vector<DeviceInfo>& devices) {
                                   ", native " + std::to_string(d.native_vector_width_float));
     row("int vector width", "preferred " + std::to_string(d.preferred_vector_width_int) +
                                 ", native " + std::to_string(d.native_vector_width_int));
+    row("float atomic add", d.fp32_global_atomic_add ? "cl_ext_float_atomics" : "not reported");
+    row("training plan", choose_execution_plan(d).describe());
   }
 }
 

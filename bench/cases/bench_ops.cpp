@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <random>
 
+#include "cases/training_step.hpp"
 #include "cl/buffer.hpp"
 #include "cl/context.hpp"
 #include "harness.hpp"
@@ -180,49 +181,18 @@ void model_ops(const riner::Device& device, const Options& o, const Peaks& peaks
                      peaks));
 }
 
-// The fused training step as the Reconstructor runs it, per kernel, on the paper geometry.
-// gradients: "" for the device's default, or "atomic" / "partitioned" (RINER_GRADIENTS).
-void training_step(const riner::Device& device, const Options& o, const Peaks& peaks,
-                   const std::string& gradients, std::vector<Result>* out) {
+// The trained field evaluated on the paper's 512^2 grid.
+void field_image(const riner::Device& device, const Options& o, const Peaks& peaks,
+                 std::vector<Result>* out) {
   const riner::Projector projector(riner::preset_geometry("fan2d-paper"), riner::Engine::kOpenCL,
                                    device);
   const riner::bench::RingScene scene = riner::bench::paper_scene(o, 0, projector);
-  const riner::RinerConfig config = riner::bench::config_from(o);
-  if (!gradients.empty()) setenv("RINER_GRADIENTS", gradients.c_str(), 1);
+  riner::RinerConfig config = riner::bench::config_from(o);
+  config.training.skip_air = false;  // the whole grid
   riner::Reconstructor r(scene.sim.scan, config, device);
-  if (!gradients.empty()) unsetenv("RINER_GRADIENTS");
-  const int steps = o.size == "tiny" ? 20 : 300;
-  r.step(50);  // past the first lazy allocations and the program build
-  const riner::TrainingStats before = r.stats();
-  const OpTiming t = riner::bench::time_op(device, 0, steps, [&] { r.step(1); });
-  const riner::TrainingStats after = r.stats();
-  const double samples = (after.samples - before.samples) / steps;  // forward + backward
+  r.step(1);
   const riner::model::ParameterLayout l =
       riner::model::make_layout(2, config.encoding, config.network, scene.sim.scan.geometry.n_u);
-  // Forward, then the backward pass recomputing the forward before its own work.
-  const double flops = samples * (2.0 * (grid_forward_flops(l) + mlp_forward_flops(l)) +
-                                  2.0 * mlp_forward_flops(l) + grid_backward_flops(l));
-  out->push_back(row("training_step (" + after.gradient_mode + ")",
-                     std::to_string(config.training.rays_per_step) + " rays, " +
-                         std::to_string(static_cast<long>(samples)) + " samples",
-                     t, {samples, "samples/s", flops, 0.0}, peaks));
-  if (!gradients.empty()) return;  // the split and the field: for the default mode only
-  const double params = static_cast<double>(after.parameters);
-  for (const auto& [kernel, stats] : t.kernel_ms) {
-    OpTiming k;
-    k.wall_ms = k.device_ms = stats;
-    Throughput w{samples, "samples/s", 0.0, 0.0};
-    if (kernel == "riner_step_loss")
-      w = {double(config.training.rays_per_step), "rays/s", 0.0, 0.0};
-    if (kernel == "adam_step") {
-      // Reads params, m, v and one partial gradient per compute unit; writes params, m, v and
-      // the zeroed partials.
-      const double lanes = device.info().type == "CPU" ? device.info().compute_units : 1.0;
-      w = {params, "params/s", 0.0, sizeof(float) * params * (6.0 + 2.0 * lanes)};
-    }
-    out->push_back(row("  " + kernel, "per step", k, w, peaks));
-  }
-  // The field on the 512^2 grid (chunked field_evaluate).
   const OpTiming e =
       riner::bench::time_op(device, 1, o.size == "tiny" ? 1 : 5, [&] { r.field_image(); });
   const double pixels = 512.0 * 512.0;
@@ -283,8 +253,12 @@ std::vector<Result> ops(const Options& o) {
   out.front().line += riner::bench::format("\n%-24s %-22s %9s    [%7s..%7s] %9s", "op", "shape",
                                            "wall", "q25", "q75", "device");
   model_ops(device, o, peaks, &out);
-  training_step(device, o, peaks, "", &out);
-  if (device.info().type == "CPU") training_step(device, o, peaks, "atomic", &out);
+  // The training step under the device's own plan, then the other one (both run everywhere).
+  for (Result& r : riner::bench::time_training_steps(
+           device, o, {"", device.info().type == "CPU" ? "gpu" : "cpu"}, {0}, &peaks))
+    out.push_back(std::move(r));
+  // The field on the 512^2 grid (chunked field_evaluate).
+  field_image(device, o, peaks, &out);
   geometry_ops(device, o, peaks, &out);
   return out;
 }

@@ -180,7 +180,7 @@ std::vector<Result> side_by_side(const Options& o) {
       nlohmann::json fields = {{"scene", scene.name},
                                {"engine", e.name},
                                {"device", st.device},
-                               {"gradient_mode", st.gradient_mode},
+                               {"plan", st.plan ? st.plan->describe() : "reference"},
                                {"samples_per_second", st.samples / st.seconds},
                                {"detector", end.detector},
                                {"curve", to_json(curve)},

@@ -165,9 +165,9 @@ TEST_SUITE("model_kernels") {
     for (float v : d_loss.read()) CHECK(std::isfinite(v));
   }
 
-  TEST_CASE("Adam over partial gradients with per-group learning rates, several steps") {
+  TEST_CASE("Adam over a gradient plus split-K slices, per-group learning rates, several steps") {
     const std::size_t n = 1000;
-    const std::size_t partials = 3;
+    const std::size_t slice_offset = 200, slice_count = 300, slices = 3;
     std::vector<float> params = uniform(n, -1.0f, 1.0f, 40);
     riner::ref::AdamSettings rs;
     rs.learning_rate = 1e-2;
@@ -187,16 +187,19 @@ TEST_SUITE("model_kernels") {
                                 rs.epsilon};
     std::vector<double> p(params.begin(), params.end()), m(n, 0.0), v(n, 0.0);
     riner::cl::Buffer<float> d_params(ctx(), std::span<const float>(params));
-    riner::cl::Buffer<float> d_grad(ctx(), n * partials);
-    riner::ops::AdamOp op(ctx(), n, partials);
+    riner::cl::Buffer<float> d_grad(ctx(), n);
+    riner::cl::Buffer<float> d_slices(ctx(), slice_count * slices);
+    riner::ops::AdamOp op(ctx(), n);
     for (int step = 1; step <= 5; ++step) {
-      const std::vector<float> g = uniform(n * partials, -1.0f, 1.0f, 40 + step);
+      const std::vector<float> g = uniform(n, -1.0f, 1.0f, 40 + step);
+      const std::vector<float> s = uniform(slice_count * slices, -1.0f, 1.0f, 60 + step);
       d_grad.write(g);
-      op.step(ds, step, d_params, d_grad);
-      std::vector<double> total(n, 0.0);
-      for (std::size_t k = 0; k < n * partials; ++k) total[k % n] += g[k];
+      d_slices.write(s);
+      op.step(ds, step, d_params, d_grad, {&d_slices, slice_offset, slice_count, slices});
+      std::vector<double> total(g.begin(), g.end());
+      for (std::size_t k = 0; k < s.size(); ++k) total[slice_offset + k % slice_count] += s[k];
       riner::ref::adam_step(rs, step, total, p, m, v);
-      for (float x : d_grad.read()) REQUIRE(x == 0.0f);  // partials cleared for the next step
+      for (float x : d_grad.read()) REQUIRE(x == 0.0f);  // cleared for the next step
     }
     // Five fp32 updates of parameters of order 1: rounding leaves ~1e-7.
     const auto stats = riner::test::compare(d_params.read(), p);

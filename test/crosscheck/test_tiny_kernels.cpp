@@ -42,7 +42,8 @@ TEST_SUITE("tiny_kernels") {
   }
 
   TEST_CASE(
-      "Riner's training kernels on a tiny problem (mixed batches, ring prior, coarse to fine)") {
+      "Riner's training kernels under both execution plans on a tiny problem (mixed batches, "
+      "ring prior, coarse to fine)") {
     riner::test::TinyProblem t = riner::test::tiny_problem(3);
     riner::RinerConfig c = riner::test::tiny_config();
     c.encoding = {3, 2, 8, 4, 16};
@@ -53,15 +54,23 @@ TEST_SUITE("tiny_kernels") {
     c.training.ring_lambda = 1.0;
     c.training.level_warmup_steps = 1;
     c.training.jitter = true;
-    riner::Reconstructor device(t.scan, c, riner::test::device());
-    c.engine = riner::Engine::kReference;
-    riner::Reconstructor reference(t.scan, c);
-    device.step(3);
+    riner::RinerConfig r = c;
+    r.engine = riner::Engine::kReference;
+    riner::Reconstructor reference(t.scan, r);
     reference.step(3);
-    const auto a = device.history();
     const auto b = reference.history();
-    for (std::size_t i = 0; i < 3; ++i)
-      CHECK(a[i].data_loss == doctest::Approx(b[i].data_loss).epsilon(1e-3));
-    CHECK(riner::test::compare(device.image().data, reference.image().data).rms_rel < 1e-3);
+    const riner::Array image = reference.image();
+    for (const char* kind : {"cpu", "gpu"}) {
+      CAPTURE(kind);
+      c.plan.kind = kind;
+      c.plan.sample_group = 4;  // several work-groups even on this tiny batch
+      c.plan.gradient_slices = 3;
+      riner::Reconstructor device(t.scan, c, riner::test::device());
+      device.step(3);
+      const auto a = device.history();
+      for (std::size_t i = 0; i < 3; ++i)
+        CHECK(a[i].data_loss == doctest::Approx(b[i].data_loss).epsilon(1e-3));
+      CHECK(riner::test::compare(device.image().data, image.data).rms_rel < 1e-3);
+    }
   }
 }

@@ -1,10 +1,13 @@
 // The parameter layout, initialisation, ray segments and batch sampler shared by both engines.
 #include <doctest/doctest.h>
 
+#include <cstring>
+
 #include <cmath>
 #include <map>
 
 #include "model/batch_sampler.hpp"
+#include "model/packed_batch.hpp"
 #include "model/parameter_layout.hpp"
 #include "model/ray_segments.hpp"
 #include "riner/rays.hpp"
@@ -103,5 +106,56 @@ TEST_SUITE("model_layout") {
     for (std::size_t i = 0; i < b.rays.size(); ++i) per_element[b.rays[i] % g.n_u] += b.weights[i];
     for (const auto& [e, w] : per_element) CHECK(w == doctest::Approx(0.2));
     CHECK(per_element.size() == b.elements.size());
+  }
+
+  TEST_CASE("packed batches: offsets, rays grouped by element, weights and level scales") {
+    const riner::Geometry g = riner::test::small_fan2d();
+    riner::TrainingConfig t;
+    t.sampler = riner::Sampler::kMixed;
+    t.rays_per_step = 300;  // enough that elements repeat
+    t.views_per_step = 4;
+    t.elements_per_step = 3;
+    const riner::model::BatchSampler sampler(g, t);
+    const riner::model::Batch b = sampler.batch(7);
+    const std::vector<riner::model::RaySegment> segments =
+        riner::model::ray_segments(g, 1.0, false);
+    riner::model::PackedBatch p;
+    riner::model::pack_batch(b, segments, g.n_u, {1.0f, 0.5f, 0.25f}, p);
+    const std::vector<std::uint32_t>& w = p.words;
+    REQUIRE(p.n_batch == b.rays.size());
+    REQUIRE(p.n_elements == b.elements.size());
+    std::uint32_t samples = 0;
+    for (std::uint32_t i = 0; i < p.n_batch; ++i) {
+      CHECK(w[p.rays_at + i] == b.rays[i]);
+      CHECK(w[p.offsets_at + i] == samples);
+      samples += segments[b.rays[i]].count;
+      float weight;
+      std::memcpy(&weight, &w[p.weights_at + i], 4);
+      CHECK(weight == b.weights[i]);
+    }
+    CHECK(w[p.offsets_at + p.n_batch] == samples);
+    CHECK(p.n_samples == samples);
+    // Every ray once, under its own element, ascending within the element.
+    std::vector<int> seen(p.n_batch, 0);
+    const std::uint32_t* starts = &w[p.element_rays_at];
+    const std::uint32_t* grouped = starts + p.n_elements + 1;
+    CHECK(starts[0] == 0);
+    CHECK(starts[p.n_elements] == p.n_batch);
+    bool repeated = false;
+    for (std::uint32_t e = 0; e < p.n_elements; ++e) {
+      CHECK(w[p.elements_at + e] == b.elements[e]);
+      repeated = repeated || starts[e + 1] - starts[e] > 1;
+      for (std::uint32_t j = starts[e]; j < starts[e + 1]; ++j) {
+        ++seen[grouped[j]];
+        CHECK(b.rays[grouped[j]] % g.n_u == b.elements[e]);
+        if (j > starts[e]) CHECK(grouped[j] > grouped[j - 1]);
+      }
+    }
+    CHECK(repeated);
+    for (int count : seen) CHECK(count == 1);
+    float scale;
+    std::memcpy(&scale, &w[p.level_weights_at + 2], 4);
+    CHECK(scale == 0.25f);
+    CHECK(w.size() == p.level_weights_at + 3);
   }
 }

@@ -76,5 +76,43 @@ TEST_SUITE("riner_config") {
            "config: rings.response_scale_px must be in (0, 1000]");
     expect(R"({"rings": {"air_reference": 1}})",
            "c.json: config: rings.air_reference must be true or false");
+    expect(R"({"plan": {"kind": "fpga"}})", "config: plan.kind must be auto, cpu or gpu");
+    expect(R"({"plan": {"float_atomics": "fast"}})",
+           "config: plan.float_atomics must be auto, nvidia-ptx, cl_ext_float_atomics, "
+           "amd-builtin or compare-exchange");
+    expect(R"({"plan": {"kind": 1}})", "c.json: config: plan.kind must be a string");
+    expect(R"({"plan": {"sample_group": -1}})",
+           "config: plan.sample_group must be in 0..4096 (0: the device's choice)");
+    expect(R"({"plan": {"lanes": 4}})", "c.json: config: unknown setting plan.lanes");
+    expect(R"({"training": {"air_margin_px": 100}})",
+           "config: training.air_margin_px must be in 0..64");
+    expect(R"({"training": {"air_noise_sigmas": 0}})",
+           "config: training.air_noise_sigmas must be in [0.5, 100]");
+    expect(R"({"training": {"rays_per_step": -3}})",
+           "config: training.rays_per_step must be in 1..2^20, or 0 (the device's execution "
+           "plan chooses)");
+  }
+
+  TEST_CASE("the execution plan and air skipping are settings like the others") {
+    riner::RinerConfig c;
+    CHECK(c.plan.kind == "auto");
+    CHECK(c.training.rays_per_step == 0);  // the plan's choice
+    CHECK(c.training.skip_air);
+    CHECK_FALSE(riner::RinerConfig::paper().training.skip_air);
+    c.update_from_json(
+        R"({"plan": {"kind": "gpu", "float_atomics": "compare-exchange", "sample_group": 32,
+                     "gradient_slices": 7, "grid_bands": 2},
+            "training": {"skip_air": false, "air_margin_px": 2, "air_noise_sigmas": 6}})");
+    CHECK(c.plan.kind == "gpu");
+    CHECK(c.plan.float_atomics == "compare-exchange");
+    CHECK(c.plan.sample_group == 32);
+    CHECK(c.plan.gradient_slices == 7);
+    CHECK(c.plan.grid_bands == 2);
+    CHECK_FALSE(c.training.skip_air);
+    CHECK(c.training.air_margin_px == 2);
+    CHECK(c.training.air_noise_sigmas == 6.0);
+    riner::RinerConfig d;
+    d.update_from_json(c.to_json());
+    CHECK(d.to_json() == c.to_json());
   }
 }

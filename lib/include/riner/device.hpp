@@ -38,6 +38,10 @@ struct DeviceInfo {
   std::uint32_t native_vector_width_float = 0;
   std::uint32_t preferred_vector_width_int = 0;
   std::uint32_t native_vector_width_int = 0;
+  std::string extensions;               // CL_DEVICE_EXTENSIONS, space-separated
+  bool fp32_global_atomic_add = false;  // cl_ext_float_atomics reports global float add
+
+  bool has_extension(std::string_view name) const;
 
   // "Portable Computing Language / pthread-skylake-avx512-..."
   std::string full_name() const;

@@ -29,6 +29,17 @@ Ray detector_ray(const Geometry& g, std::size_t view, double u, double v = 0.0);
 // Where detector element (u, v) sits in the world at `view` (its centre for integer indices).
 Vec3 detector_position(const Geometry& g, std::size_t view, double u, double v = 0.0);
 
+// Where the ray through world point p lands at `view`: fractional element indices (u, v) (the
+// inverse of detector_position along the ray; v = 0 in 2D), and the magnification there
+// (detector mm per mm at p across the ray; 1 for parallel beams). Undefined for a point at or
+// behind a fan/cone source.
+struct DetectorPoint {
+  double u = 0.0;
+  double v = 0.0;
+  double magnification = 1.0;
+};
+DetectorPoint project_to_detector(const Geometry& g, std::size_t view, const Vec3& p);
+
 // Parameter interval [enter, exit] of a ray inside a region; empty when it misses.
 struct Segment {
   double enter = 0.0;

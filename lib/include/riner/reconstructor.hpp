@@ -15,6 +15,7 @@
 
 #include "riner/array.hpp"
 #include "riner/device.hpp"
+#include "riner/execution_plan.hpp"
 #include "riner/riner_config.hpp"
 #include "riner/ring_correction.hpp"
 #include "riner/scan.hpp"
@@ -57,8 +58,15 @@ struct TrainingStats {
   std::size_t non_finite = 0;  // measurements that were NaN/inf (treated as 0)
   std::size_t parameters = 0;
   std::string engine;
-  std::string device;         // device name, or "CPU reference"
-  std::string gradient_mode;  // "partitioned" (per-lane partial gradients) or "atomic"
+  std::string device;                 // device name, or "CPU reference"
+  std::optional<ExecutionPlan> plan;  // how the OpenCL engine shaped the work (none: reference)
+  // Skipping the air (training.skip_air): whether the measurements certified any, the share of
+  // the grid still sampled and of the samples kept, and why not when they did not.
+  bool air_skipped = false;
+  double inside_fraction = 1.0;
+  double samples_kept_fraction = 1.0;
+  double noise = 0.0;  // the readings' noise sigma the carving used
+  std::string air_note;
 };
 
 class Reconstructor {
@@ -85,7 +93,8 @@ class Reconstructor {
   // Flat indices of the dead elements: beta < 0.5, or no finite reading at all (where the rays
   // miss the object, training has no reason to switch such an element off).
   std::vector<std::size_t> dead_elements() const;
-  // What training alone gives: the field at every voxel centre and max(alpha0, 1e-8).
+  // What training alone gives: the field at every voxel centre (0 where the measurements show
+  // air, training.skip_air) and max(alpha0, 1e-8).
   Array field_image() const;
   Array trained_alpha() const;
   // All of the above from one evaluation of the field.

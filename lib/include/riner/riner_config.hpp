@@ -9,6 +9,7 @@
 #include <string_view>
 
 #include "riner/engine.hpp"
+#include "riner/execution_plan.hpp"
 #include "riner/ring_correction.hpp"
 
 namespace riner {
@@ -46,12 +47,18 @@ enum class Sampler {
 struct TrainingConfig {
   int steps = 24000;
   Sampler sampler = Sampler::kUniform;
-  int rays_per_step = 160;      // uniform sampler
-  int views_per_step = 40;      // views x elements sampler
-  int elements_per_step = 2;    // views x elements sampler: adjacent elements
+  int rays_per_step = 0;      // uniform sampler; 0: the execution plan's (riner/execution_plan.hpp)
+  int views_per_step = 40;    // views x elements sampler
+  int elements_per_step = 2;  // views x elements sampler: adjacent elements
   double sample_spacing = 1.5;  // along each ray, in voxels (the paper uses a fixed interval)
   bool jitter = false;          // stratified random offsets while training (midpoints if off)
   bool circle_region = false;   // sample the inscribed circle instead of the whole grid
+  // Skip the air around the object (model/occupancy.hpp): voxels that some ray certifies as
+  // air (its reading within air_noise_sigmas noise sigmas of its element's offset) are not
+  // sampled and read 0 in the image; air_margin_px voxels around the rest stay.
+  bool skip_air = true;
+  double air_noise_sigmas = 4.0;
+  int air_margin_px = 4;
   double learning_rate = 1e-3;
   // The rate is multiplied by lr_decay every lr_decay_steps steps; 0: every steps / 4, so the
   // schedule stretches with the budget (--steps 12000 halves every 3000).
@@ -115,6 +122,7 @@ struct RinerConfig {
   NetworkConfig network;
   TrainingConfig training;
   RingCorrectionConfig rings;
+  PlanConfig plan;  // how the OpenCL engine shapes its work (riner/execution_plan.hpp)
   Engine engine = Engine::kOpenCL;
 
   // InputError naming the first impossible setting.

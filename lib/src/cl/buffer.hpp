@@ -62,6 +62,13 @@ class Buffer {
     RINER_CL_CALL(clEnqueueWriteBuffer, context_->queue(), mem_.get(), CL_TRUE, offset * sizeof(T),
                   host.size_bytes(), host.data(), 0, nullptr, nullptr);
   }
+  // Non-blocking: `host` must stay unchanged until *done completes (cl/upload_ring.hpp).
+  void write_async(std::span<const T> host, cl_event* done) {
+    check_range(host.size(), 0, "write");
+    if (host.empty()) return;
+    RINER_CL_CALL(clEnqueueWriteBuffer, context_->queue(), mem_.get(), CL_FALSE, 0,
+                  host.size_bytes(), host.data(), 0, nullptr, done);
+  }
   void read(std::span<T> host, std::size_t offset = 0) const {
     check_range(host.size(), offset, "read");
     if (host.empty()) return;

@@ -83,6 +83,18 @@ DeviceInfo query_device_info(cl_device_id device) {
   info.preferred_vector_width_int =
       device_value<cl_uint>(device, CL_DEVICE_PREFERRED_VECTOR_WIDTH_INT);
   info.native_vector_width_int = device_value<cl_uint>(device, CL_DEVICE_NATIVE_VECTOR_WIDTH_INT);
+  info.extensions = device_string(device, CL_DEVICE_EXTENSIONS);
+  if (info.has_extension("cl_ext_float_atomics")) {
+    // CL_DEVICE_SINGLE_FP_ATOMIC_CAPABILITIES_EXT and CL_DEVICE_GLOBAL_FP_ATOMIC_ADD_EXT
+    // (cl_ext.h of newer headers; Debian 12's do not have them).
+    constexpr cl_device_info kSingleFpAtomicCapabilities = 0x4231;
+    constexpr cl_bitfield kGlobalFpAtomicAdd = 1 << 1;
+    cl_bitfield caps = 0;
+    if (clGetDeviceInfo(device, kSingleFpAtomicCapabilities, sizeof(caps), &caps, nullptr) ==
+        CL_SUCCESS) {
+      info.fp32_global_atomic_add = (caps & kGlobalFpAtomicAdd) != 0;
+    }
+  }
   return info;
 }
 

@@ -1,11 +1,23 @@
 #include "riner/device.hpp"
 
+#include <algorithm>
+
 #include "cl/context.hpp"
 #include "cl/device_list.hpp"
 
 namespace riner {
 
 std::string DeviceInfo::full_name() const { return platform + " / " + name; }
+
+bool DeviceInfo::has_extension(std::string_view wanted) const {
+  std::size_t at = 0;
+  while (at < extensions.size()) {
+    const std::size_t end = std::min(extensions.find(' ', at), extensions.size());
+    if (std::string_view(extensions).substr(at, end - at) == wanted) return true;
+    at = end + 1;
+  }
+  return false;
+}
 
 std::vector<DeviceInfo> list_devices() {
   std::vector<DeviceInfo> infos;

@@ -54,6 +54,22 @@ Ray detector_ray(const Geometry& g, std::size_t view, double u, double v) {
   return {target, {-s, c, 0.0}};
 }
 
+DetectorPoint project_to_detector(const Geometry& g, std::size_t view, const Vec3& p) {
+  const double c = std::cos(g.angles[view]);
+  const double s = std::sin(g.angles[view]);
+  // p in the view's frame: a across the detector, b towards it (R(-theta) p).
+  const double a = p.x * c + p.y * s;
+  const double b = -p.x * s + p.y * c;
+  DetectorPoint d;
+  if (g.is_divergent())
+    d.magnification = (g.source_origin_mm + g.origin_detector_mm) / (g.source_origin_mm + b);
+  d.u = a * d.magnification / g.pitch_u + 0.5 * (static_cast<double>(g.n_u) - 1.0) - g.offset_u;
+  if (g.is_3d()) {
+    d.v = p.z * d.magnification / g.pitch_v + 0.5 * (static_cast<double>(g.n_v) - 1.0) - g.offset_v;
+  }
+  return d;
+}
+
 Segment clip_to_box(const Geometry& g, const Ray& ray) {
   const std::size_t rank = g.volume_shape.size();
   const double nx = static_cast<double>(g.volume_shape[rank - 1]);

@@ -20,6 +20,10 @@ std::uint32_t draw(std::uint32_t seed, std::uint32_t step, std::uint32_t i, std:
 
 BatchSampler::BatchSampler(const Geometry& g, const TrainingConfig& config)
     : views_(g.n_views()), rows_(g.is_3d() ? g.n_v : 1), n_u_(g.n_u), config_(config) {
+  if (config.sampler != Sampler::kViewsTimesElements && config.rays_per_step < 1) {
+    throw Error("BatchSampler: rays_per_step " + std::to_string(config.rays_per_step) +
+                " (0 is for the execution plan to resolve first)");
+  }
   if (config.sampler != Sampler::kUniform &&
       static_cast<std::size_t>(config.elements_per_step) > n_u_) {
     throw InputError("elements_per_step (" + std::to_string(config.elements_per_step) +

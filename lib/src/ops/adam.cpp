@@ -8,12 +8,12 @@
 
 namespace riner::ops {
 
-AdamOp::AdamOp(cl::Context& context, std::size_t n_params, std::size_t n_partials)
+AdamOp::AdamOp(cl::Context& context, std::size_t n_params)
     : context_(context),
       n_params_(n_params),
-      n_partials_(n_partials),
       m_(context, n_params),
       v_(context, n_params),
+      no_slices_(context, 1),
       program_(context.program({"common", "adam"})),
       kernel_(*program_, "adam_step") {
   reset();
@@ -26,20 +26,26 @@ void AdamOp::reset() {
 }
 
 void AdamOp::step(const AdamSettings& s, int step, cl::Buffer<float>& params,
-                  cl::Buffer<float>& partials) {
-  if (params.size() != n_params_ || partials.size() != n_params_ * n_partials_) {
+                  cl::Buffer<float>& grad, const GradientSlices& slices) {
+  const bool sliced = slices.buffer != nullptr && slices.slices > 0;
+  if (params.size() != n_params_ || grad.size() != n_params_ ||
+      (sliced && (slices.offset + slices.count > n_params_ ||
+                  slices.buffer->size() < slices.count * slices.slices))) {
     throw Error("adam_step: buffer sizes do not match");
   }
   const double bias1 = 1.0 - std::pow(s.beta1, step);
   const double bias2 = 1.0 - std::pow(s.beta2, step);
-  kernel_.set_args(static_cast<cl_uint>(n_params_), static_cast<cl_uint>(n_partials_),
-                   static_cast<float>(s.learning_rate / bias1),
+  kernel_.set_args(static_cast<cl_uint>(n_params_), static_cast<float>(s.learning_rate / bias1),
                    static_cast<cl_uint>(std::min(s.alpha_offset, n_params_)),
                    static_cast<float>(s.alpha_learning_rate / bias1),
                    static_cast<cl_uint>(std::min(s.beta_offset, n_params_)),
                    static_cast<float>(s.beta_learning_rate / bias1), static_cast<float>(s.beta1),
                    static_cast<float>(s.beta2), static_cast<float>(1.0 / std::sqrt(bias2)),
-                   static_cast<float>(s.epsilon), params, m_, v_, partials);
+                   static_cast<float>(s.epsilon), params, m_, v_, grad,
+                   static_cast<cl_uint>(sliced ? slices.offset : 0),
+                   static_cast<cl_uint>(sliced ? slices.count : 0),
+                   static_cast<cl_uint>(sliced ? slices.slices : 0),
+                   sliced ? *slices.buffer : no_slices_);
   context_.launch(kernel_, n_params_);
 }
 

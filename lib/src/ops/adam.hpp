@@ -1,5 +1,5 @@
-// Host side of kernels/adam.cl: Adam over the flat parameter buffer, reducing and clearing the
-// lanes' partial gradients as it goes.
+// Host side of kernels/adam.cl: Adam over the flat parameter buffer, taking the gradient from
+// one full-size buffer (cleared as it goes) plus split-K partial sums over a range of it.
 #pragma once
 
 #include <memory>
@@ -12,13 +12,22 @@ namespace riner::ops {
 
 using AdamSettings = model::AdamSettings;
 
+// `slices` partial sums of `count` values each (slice p at [p count, (p + 1) count)), added to
+// the gradient of parameters [offset, offset + count).
+struct GradientSlices {
+  const cl::Buffer<float>* buffer = nullptr;
+  std::size_t offset = 0;
+  std::size_t count = 0;
+  std::size_t slices = 0;
+};
+
 class AdamOp {
  public:
-  AdamOp(cl::Context& context, std::size_t n_params, std::size_t n_partials);
+  AdamOp(cl::Context& context, std::size_t n_params);
 
-  // step counts from 1; partials holds n_partials gradients of n_params each (zeroed after).
+  // step counts from 1; grad holds n_params gradients (zeroed after).
   void step(const AdamSettings& settings, int step, cl::Buffer<float>& params,
-            cl::Buffer<float>& partials);
+            cl::Buffer<float>& grad, const GradientSlices& slices = {});
 
   // Back to fresh moments.
   void reset();
@@ -26,9 +35,9 @@ class AdamOp {
  private:
   cl::Context& context_;
   std::size_t n_params_;
-  std::size_t n_partials_;
   cl::Buffer<float> m_;
   cl::Buffer<float> v_;
+  cl::Buffer<float> no_slices_;  // a valid argument when there are none
   std::shared_ptr<const cl::Program> program_;
   cl::Kernel kernel_;
 };

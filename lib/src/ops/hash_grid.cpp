@@ -9,7 +9,8 @@ HashGridOp::HashGridOp(cl::Context& context, const model::ParameterLayout& layou
     : context_(context),
       layout_(layout),
       levels_(upload_levels(context, layout)),
-      program_(context.program({"common", "hash_grid"}, model_build_options(layout, true))),
+      program_(context.program({"common", "hash_grid"},
+                               model_build_options(layout, true, device_float_atomics(context)))),
       forward_(*program_, "hash_grid_forward"),
       backward_(*program_, "hash_grid_backward") {}
 

@@ -8,7 +8,8 @@ namespace riner::ops {
 MlpOp::MlpOp(cl::Context& context, const model::ParameterLayout& layout)
     : context_(context),
       layout_(layout),
-      program_(context.program({"common", "mlp"}, model_build_options(layout, true))),
+      program_(context.program({"common", "mlp"},
+                               model_build_options(layout, true, device_float_atomics(context)))),
       forward_(*program_, "mlp_forward_batch"),
       backward_(*program_, "mlp_backward_batch") {}
 

@@ -8,64 +8,101 @@
 namespace riner::ops {
 
 namespace {
-constexpr std::size_t kForwardGroup = 64;
+
+// Fewer samples than this per slice of the MLP gradient cost more in partial sums than they
+// save in parallelism.
+constexpr std::size_t kMinSliceSamples = 64;
+
+std::vector<std::string> step_sources() {
+  return {"common",       "hash_grid",  "mlp",          "ray_sum",
+          "sample_cache", "riner_step", "mlp_gradient", "hash_grid_gradient"};
+}
+
 }  // namespace
 
-RinerStepOp::RinerStepOp(cl::Context& context, const model::ParameterLayout& layout, bool atomic,
-                         std::size_t max_batch)
+void set_batch_shape(const model::PackedBatch& b, StepParams& p) {
+  p.n_batch = b.n_batch;
+  p.n_samples = b.n_samples;
+  p.n_elements = b.n_elements;
+  p.rays_at = b.rays_at;
+  p.offsets_at = b.offsets_at;
+  p.weights_at = b.weights_at;
+  p.element_rays_at = b.element_rays_at;
+  p.elements_at = b.elements_at;
+  p.level_weights_at = b.level_weights_at;
+}
+
+RinerStepOp::RinerStepOp(cl::Context& context, const model::ParameterLayout& layout,
+                         const ExecutionPlan& plan, std::size_t max_batch)
     : context_(context),
       layout_(layout),
-      atomic_(atomic),
+      plan_(plan),
+      // sample_cache.cl: features, activations, deltas, d_mu, feature gradients, position.
+      cache_rows_(2 * static_cast<std::size_t>(layout.inputs) +
+                  2 * static_cast<std::size_t>(layout.hidden_layers) * layout.width + 1 +
+                  static_cast<std::size_t>(layout.dims)),
       levels_(upload_levels(context, layout)),
-      sums_(context, max_batch),
-      d_sums_(context, max_batch),
-      scratch_(context, max_batch),
-      program_(context.program({"common", "hash_grid", "mlp", "ray_sum", "riner_step"},
-                               model_build_options(layout, atomic))),
+      sums_(context, std::max<std::size_t>(1, max_batch)),
+      d_sums_(context, std::max<std::size_t>(1, max_batch)),
+      ray_grads_(context, std::max<std::size_t>(1, max_batch)),
+      scratch_(context, std::max<std::size_t>(1, max_batch)),
+      partials_(context, plan.gradient_slices * layout.mlp_params),
+      program_(context.program(
+          step_sources(),
+          model_build_options(layout, plan.kind == PlanKind::kGpu, plan.float_atomics) +
+              " -cl-mad-enable")),
       forward_(*program_, "riner_step_forward"),
       loss_(*program_, "riner_step_loss"),
       backward_(*program_, "riner_step_backward"),
+      mlp_gradient_(*program_,
+                    plan.kind == PlanKind::kCpu ? "mlp_gradient_blocked" : "mlp_gradient_partial"),
+      grid_gradient_(*program_, "hash_grid_gradient_accumulate"),
       evaluate_(*program_, "field_evaluate") {}
 
-void RinerStepOp::step(const StepArgs& a, cl_uint n_lanes, const cl::Buffer<float>& params,
-                       cl::Buffer<float>& grad, cl::Buffer<float>& loss) {
-  const std::size_t gradients = atomic_ ? 1 : n_lanes;
-  if (params.size() != layout_.total || grad.size() != gradients * layout_.total ||
-      loss.size() < 2 || a.rays->size() < a.n_batch || sums_.size() < a.n_batch) {
+void RinerStepOp::reserve_samples(std::size_t n) {
+  if (n <= cache_stride_ && cache_stride_ > 0) return;
+  // Room to grow, and a multiple of 4 so each cache row starts 16-byte aligned.
+  const std::size_t capacity = (std::max<std::size_t>(n + n / 4, 64) + 3) / 4 * 4;
+  mu_dx_ = cl::Buffer<float>(context_, capacity);
+  cache_ = cl::Buffer<float>(context_, capacity * cache_rows_);
+  cache_stride_ = capacity;
+}
+
+void RinerStepOp::step(StepParams p, const cl::Buffer<cl_uint>& batch, const StepScan& scan,
+                       const cl::Buffer<float>& params, cl::Buffer<float>& grad,
+                       cl::Buffer<float>& history) {
+  if (params.size() != layout_.total || grad.size() != layout_.total || sums_.size() < p.n_batch ||
+      history.size() < 2 * (static_cast<std::size_t>(p.history_slot) + 1)) {
     throw Error("riner_step: buffer sizes do not match the layout");
   }
-  const auto mlp = static_cast<cl_uint>(layout_.mlp_offset);
-  const auto jitter = static_cast<cl_int>(a.jitter);
-  const std::size_t cache_floats = static_cast<std::size_t>(layout_.inputs) +
-                                   static_cast<std::size_t>(layout_.hidden_layers) * layout_.width;
-  if (mu_dx_.size() < a.n_samples || mu_dx_.size() == 0) {
-    const std::size_t capacity = std::max<std::size_t>(1, a.n_samples + a.n_samples / 4);
-    mu_dx_ = cl::Buffer<float>(context_, capacity);
-    cache_ = cl::Buffer<float>(context_, capacity * cache_floats);
-    cache_stride_ = capacity;
+  reserve_samples(p.n_samples);
+  p.cache_stride = static_cast<cl_uint>(cache_stride_);
+  p.alpha_offset = static_cast<cl_uint>(layout_.alpha_offset);
+  p.beta_offset = static_cast<cl_uint>(layout_.beta_offset);
+  p.mlp_offset = static_cast<cl_uint>(layout_.mlp_offset);
+  const std::size_t samples = p.n_samples;
+  if (samples > 0) {
+    forward_.set_args(p, batch, *scan.segments, levels_, params, mu_dx_, cache_);
+    context_.launch(forward_, samples, plan_.sample_group);
   }
-  const auto stride_samples = static_cast<cl_uint>(cache_stride_);
-  if (a.n_samples > 0) {
-    forward_.set_args(a.n_samples, *a.sample_rays, *a.offsets, *a.rays, *a.segments, levels_,
-                      *a.level_weights, params, mlp, a.seed, a.step, jitter, mu_dx_, cache_,
-                      stride_samples);
-    // A fixed work-group size: the sample count changes every step, and PoCL compiles a kernel
-    // variant for every distinct work-group size it is asked for.
-    context_.launch(forward_, a.n_samples, kForwardGroup);
+  loss_.set_args(p, batch, mu_dx_, *scan.rho, params, *scan.invalid_readings, grad, sums_, d_sums_,
+                 ray_grads_, history, scratch_, cl::LocalMemory{plan_.loss_group * sizeof(float)});
+  context_.launch(loss_, plan_.loss_group, plan_.loss_group);
+  slices_ = 0;
+  if (samples == 0) return;
+  backward_.set_args(p, batch, *scan.segments, levels_, params, d_sums_, cache_, grad);
+  context_.launch(backward_, samples, plan_.sample_group);
+  if (plan_.kind == PlanKind::kCpu) {
+    const auto bands = static_cast<cl_uint>(plan_.grid_bands);
+    grid_gradient_.set_args(p.n_samples, bands, p.cache_stride, levels_, cache_, grad);
+    context_.launch(grid_gradient_, static_cast<std::size_t>(layout_.levels) * bands, 1);
   }
-  loss_.set_args(a.n_batch, *a.offsets, mu_dx_, *a.rays, sums_, *a.rho, *a.weights,
-                 a.elements_per_view, params, static_cast<cl_uint>(layout_.alpha_offset),
-                 static_cast<cl_uint>(layout_.beta_offset), a.n_elements, *a.elements, a.lambda,
-                 a.relative_threshold, a.data_weight, a.block_first, a.block_views,
-                 a.block_elements, a.ring_lambda, static_cast<cl_uint>(a.hold_valid_beta),
-                 *a.invalid_readings, grad, d_sums_, loss, scratch_);
-  context_.launch(loss_, 1, 1);
-  // Lanes are independent work-groups of one work-item: on a CPU each runs as plain code.
-  const auto stride = static_cast<cl_uint>(atomic_ ? 0 : layout_.total);
-  backward_.set_args(n_lanes, a.n_batch, *a.offsets, *a.rays, *a.segments, levels_,
-                     *a.level_weights, params, grad, stride, mlp, a.seed, a.step, jitter, d_sums_,
-                     cache_, stride_samples);
-  context_.launch(backward_, n_lanes, 1);
+  slices_ = std::clamp<std::size_t>(samples / kMinSliceSamples, 1, plan_.gradient_slices);
+  const std::size_t chunk = ((samples + slices_ - 1) / slices_ + 3) / 4 * 4;
+  slices_ = (samples + chunk - 1) / chunk;
+  mlp_gradient_.set_args(p.n_samples, static_cast<cl_uint>(chunk), p.cache_stride, cache_,
+                         partials_);
+  context_.launch(mlp_gradient_, slices_ * plan_.gradient_group, plan_.gradient_group);
 }
 
 void RinerStepOp::evaluate(cl_uint first, cl_uint n, const std::vector<std::size_t>& shape,

@@ -1,56 +1,77 @@
-// Host side of kernels/riner_step.cl: the training step (forward ray sums over lanes of rays,
-// the batch's loss, the backward pass over lanes) and the evaluation of the field.
+// Host side of kernels/riner_step.cl (with the gradient reductions of mlp_gradient.cl and
+// hash_grid_gradient.cl): one training step, shaped by an execution plan, and the evaluation of
+// the field.
 #pragma once
 
 #include <memory>
 
 #include "cl/buffer.hpp"
 #include "cl/program.hpp"
+#include "model/packed_batch.hpp"
 #include "model/parameter_layout.hpp"
+#include "riner/execution_plan.hpp"
 
 namespace riner::ops {
 
-struct StepArgs {
-  const cl::Buffer<cl_uint>* rays;         // the batch's ray ids
-  const cl::Buffer<cl_uint>* offsets;      // n_batch + 1: batch ray b owns samples
-                                           // offsets[b] .. offsets[b + 1] (its segment count)
-  const cl::Buffer<cl_uint>* sample_rays;  // n_samples: the batch ray of each sample
-  const cl::Buffer<cl_float8>* segments;   // every ray of the scan
-  const cl::Buffer<float>* rho;            // every ray of the scan
-  const cl::Buffer<float>* weights;        // data-term weight per batch ray
-  const cl::Buffer<float>* level_weights;  // per encoding level
-  const cl::Buffer<cl_uint>* elements;     // the batch's distinct elements
-  cl_uint n_batch;
-  cl_uint n_samples;  // offsets[n_batch]
-  cl_uint n_elements;
-  cl_uint elements_per_view;
-  cl_uint seed;
-  cl_uint step;
-  bool jitter;
-  float lambda;
-  float relative_threshold;  // 0: the absolute balance
-  float data_weight;
-  cl_uint block_first;
-  cl_uint block_views;
-  cl_uint block_elements;
-  float ring_lambda;
-  bool hold_valid_beta;                         // beta warm-up: see invalid_readings
-  const cl::Buffer<cl_uint>* invalid_readings;  // per element: its non-finite readings; while
-                                                // hold_valid_beta, beta0 of elements with none
-                                                // gets no gradient
+// Host mirror of StepParams in kernels/sample_cache.cl (27 four-byte members).
+struct StepParams {
+  cl_uint n_batch = 0;
+  cl_uint n_samples = 0;
+  cl_uint n_elements = 0;
+  cl_uint rays_at = 0;
+  cl_uint offsets_at = 0;
+  cl_uint weights_at = 0;
+  cl_uint element_rays_at = 0;
+  cl_uint elements_at = 0;
+  cl_uint level_weights_at = 0;
+  cl_uint elements_per_view = 0;
+  cl_uint alpha_offset = 0;
+  cl_uint beta_offset = 0;
+  cl_uint mlp_offset = 0;
+  cl_uint seed = 0;
+  cl_uint step = 0;
+  cl_uint jitter = 0;
+  cl_uint hold_valid_beta = 0;
+  cl_uint history_slot = 0;
+  float lambda = 0.0f;
+  float relative_threshold = 0.0f;  // 0: the absolute balance
+  float data_weight = 1.0f;
+  float ring_lambda = 0.0f;
+  cl_uint block_first = 0;
+  cl_uint block_views = 0;
+  cl_uint block_elements = 0;
+  cl_uint cache_stride = 0;  // set by RinerStepOp
+  cl_uint reserved = 0;
+};
+static_assert(sizeof(StepParams) == 108);
+
+// The batch's sizes and section starts (the rest of StepParams is the step's settings).
+void set_batch_shape(const model::PackedBatch& batch, StepParams& p);
+
+// The scan-wide inputs of every step.
+struct StepScan {
+  const cl::Buffer<cl_float8>* segments;        // every ray of the scan
+  const cl::Buffer<float>* rho;                 // every ray of the scan
+  const cl::Buffer<cl_uint>* invalid_readings;  // per element: its non-finite readings
 };
 
 class RinerStepOp {
  public:
-  // atomic: one shared gradient (lanes = rays); otherwise lanes own partial gradients.
-  // The per-sample buffers grow to the largest batch seen.
-  RinerStepOp(cl::Context& context, const model::ParameterLayout& layout, bool atomic,
+  // max_batch: the most rays of a step. Per-sample buffers grow to the largest step seen.
+  RinerStepOp(cl::Context& context, const model::ParameterLayout& layout, const ExecutionPlan& plan,
               std::size_t max_batch);
 
-  // Adds the step's gradient into grad (n_lanes partial gradients of layout.total each, or
-  // one when atomic); loss[0] = data term, loss[1] = penalties.
-  void step(const StepArgs& args, cl_uint n_lanes, const cl::Buffer<float>& params,
-            cl::Buffer<float>& grad, cl::Buffer<float>& loss);
+  // Enqueues the step's kernels: grad (zero on entry; Adam zeroes it after use) receives the
+  // grid, alpha0 and beta0 gradients, mlp_partials() the MLP's (mlp_slices() slices of
+  // layout.mlp_params), history[2 p.history_slot ..] the data term and the penalties.
+  void step(StepParams p, const cl::Buffer<cl_uint>& batch, const StepScan& scan,
+            const cl::Buffer<float>& params, cl::Buffer<float>& grad, cl::Buffer<float>& history);
+
+  const cl::Buffer<float>& mlp_partials() const { return partials_; }
+  // The last step's ray sums and their loss gradients (for cross-checks).
+  const cl::Buffer<float>& ray_sums() const { return sums_; }
+  const cl::Buffer<float>& ray_sum_gradients() const { return d_sums_; }
+  std::size_t mlp_slices() const { return slices_; }
 
   // out[first .. first + n) = mu at the centres of voxels of the grid [nz][ny][nx].
   void evaluate(cl_uint first, cl_uint n, const std::vector<std::size_t>& volume_shape,
@@ -58,20 +79,28 @@ class RinerStepOp {
                 const cl::Buffer<float>& params, cl::Buffer<float>& out);
 
  private:
+  void reserve_samples(std::size_t n_samples);
+
   cl::Context& context_;
   model::ParameterLayout layout_;
-  bool atomic_;
+  ExecutionPlan plan_;
+  std::size_t cache_rows_;
   cl::Buffer<model::GridLevel> levels_;
   cl::Buffer<float> sums_;
   cl::Buffer<float> d_sums_;
+  cl::Buffer<cl_float2> ray_grads_;
   cl::Buffer<float> scratch_;
   cl::Buffer<float> mu_dx_;  // per sample
-  cl::Buffer<float> cache_;  // per sample: features and activations (SAMPLE_CACHE floats)
+  cl::Buffer<float> cache_;  // per sample: cache_rows_ floats (kernels/sample_cache.cl)
   std::size_t cache_stride_ = 0;
+  cl::Buffer<float> partials_;
+  std::size_t slices_ = 0;
   std::shared_ptr<const cl::Program> program_;
   cl::Kernel forward_;
   cl::Kernel loss_;
   cl::Kernel backward_;
+  cl::Kernel mlp_gradient_;
+  cl::Kernel grid_gradient_;
   cl::Kernel evaluate_;
 };
 

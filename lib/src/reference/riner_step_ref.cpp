@@ -91,6 +91,8 @@ StepResult riner_step(const StepInputs& in, const model::Batch& batch,
     if (with_gradient && beta_learns(e)) result.grad[l.beta_offset + e] += d_beta0;
   }
   result.penalty += ring_prior(batch, sums, in.ring_lambda, &d_sums);
+  result.sums = sums;
+  result.d_sums = d_sums;
   if (!with_gradient) return result;
 
   // Backward: threads own contiguous rays and their own gradients, summed in order.

@@ -34,7 +34,9 @@ struct StepInputs {
 struct StepResult {
   double data_loss = 0.0;
   double penalty = 0.0;
-  std::vector<double> grad;  // over the whole parameter buffer
+  std::vector<double> grad;    // over the whole parameter buffer
+  std::vector<double> sums;    // per batch ray: sum of mu dx
+  std::vector<double> d_sums;  // per batch ray: dloss/dsum (ring prior included)
 };
 
 StepResult riner_step(const StepInputs& in, const model::Batch& batch,

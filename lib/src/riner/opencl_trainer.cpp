@@ -1,10 +1,12 @@
-// The OpenCL engine: the fused step kernel over lanes of rays, Adam on the device, losses
-// copied into a history buffer on the device and read back in blocks (no per-step sync).
+// The OpenCL engine: the step's kernels shaped by the device's execution plan, the batch in one
+// non-blocking upload per step, Adam on the device, losses written into a history buffer on
+// the device and read back in blocks (no per-step sync).
 #include <algorithm>
-#include <cstdlib>
 #include <cstring>
 
 #include "cl/context.hpp"
+#include "cl/upload_ring.hpp"
+#include "model/packed_batch.hpp"
 #include "ops/adam.hpp"
 #include "ops/riner_step.hpp"
 #include "riner/error.hpp"
@@ -14,28 +16,8 @@ namespace riner::detail {
 
 namespace {
 
-constexpr int kHistoryBlock = 256;  // steps between reads of the loss history
-
-// CPUs: one lane per compute unit, each adding into its own partial gradient (no atomics,
-// deterministic). Other devices: one work-item per ray and float atomics into one gradient.
-// RINER_GRADIENTS=atomic|partitioned and RINER_LANES=N override (for benchmarks).
-bool use_atomics(const DeviceInfo& info) {
-  if (const char* env = std::getenv("RINER_GRADIENTS"); env != nullptr && *env != '\0') {
-    if (std::strcmp(env, "atomic") == 0) return true;
-    if (std::strcmp(env, "partitioned") == 0) return false;
-    throw InputError("RINER_GRADIENTS must be atomic or partitioned");
-  }
-  return info.type != "CPU";
-}
-
-cl_uint partitioned_lanes(const DeviceInfo& info) {
-  if (const char* env = std::getenv("RINER_LANES"); env != nullptr && *env != '\0') {
-    const long n = std::strtol(env, nullptr, 10);
-    if (n < 1 || n > 1024) throw InputError("RINER_LANES must be in 1..1024");
-    return static_cast<cl_uint>(n);
-  }
-  return std::max<cl_uint>(1, info.compute_units);
-}
+constexpr int kHistoryBlock = 256;   // steps between reads of the loss history
+constexpr int kUploadsInFlight = 3;  // steps the host may prepare ahead of the device
 
 std::vector<cl_float8> segment_table(const std::vector<model::RaySegment>& segments) {
   std::vector<cl_float8> table(segments.size());
@@ -46,84 +28,52 @@ std::vector<cl_float8> segment_table(const std::vector<model::RaySegment>& segme
 
 class OpenclTrainer final : public Trainer {
  public:
-  OpenclTrainer(const TrainingSetup& setup, Device device)
+  OpenclTrainer(const TrainingSetup& setup, Device device, const ExecutionPlan& plan)
       : setup_(setup),
         device_(std::move(device)),
         ctx_(device_.context()),
-        atomic_(use_atomics(device_.info())),
-        max_batch_(model::BatchSampler(setup.scan.geometry, setup.config.training).rays_per_step()),
-        lanes_(atomic_ ? static_cast<cl_uint>(max_batch_) : partitioned_lanes(device_.info())),
-        gradients_(atomic_ ? 1 : lanes_),
+        plan_(plan),
         params_(ctx_, std::span<const float>(
                           model::initial_parameters(setup.layout, setup.config.training.seed))),
-        grad_(ctx_, gradients_ * setup.layout.total),
-        loss_(ctx_, 2),
+        grad_(ctx_, std::vector<float>(setup.layout.total, 0.0f)),
         history_(ctx_, static_cast<std::size_t>(kHistoryBlock) * 2),
         segments_(ctx_, std::span<const cl_float8>(segment_table(setup.segments)),
                   CL_MEM_READ_ONLY),
         rho_(ctx_, std::span<const float>(setup.scan.measurement.data), CL_MEM_READ_ONLY),
         invalid_readings_(ctx_, std::span<const cl_uint>(setup.invalid_readings), CL_MEM_READ_ONLY),
-        rays_(ctx_, max_batch_),
-        offsets_(ctx_, max_batch_ + 1),
-        elements_(ctx_, max_batch_),
-        weights_(ctx_, max_batch_),
         level_weights_(ctx_, static_cast<std::size_t>(setup.layout.levels)),
-        step_op_(ctx_, setup.layout, atomic_, max_batch_),
-        adam_(ctx_, setup.layout.total, gradients_) {
-    grad_.write(std::vector<float>(grad_.size(), 0.0f));
-    set_level_weights(setup_.level_weights(0));
-  }
+        uploads_(ctx_, kUploadsInFlight),
+        step_op_(ctx_, setup.layout, plan_,
+                 model::BatchSampler(setup.scan.geometry, setup.config.training).rays_per_step()),
+        adam_(ctx_, setup.layout.total) {}
 
   void step(int index, const model::Batch& batch) override {
     const TrainingConfig& t = setup_.config.training;
-    rays_.write(batch.rays);
-    offsets_host_.resize(batch.rays.size() + 1);
-    offsets_host_[0] = 0;
-    for (std::size_t b = 0; b < batch.rays.size(); ++b)
-      offsets_host_[b + 1] = offsets_host_[b] + setup_.segments[batch.rays[b]].count;
-    offsets_.write(offsets_host_);
-    sample_rays_host_.resize(offsets_host_.back());
-    for (std::size_t b = 0; b < batch.rays.size(); ++b) {
-      std::fill(sample_rays_host_.begin() + offsets_host_[b],
-                sample_rays_host_.begin() + offsets_host_[b + 1], static_cast<cl_uint>(b));
-    }
-    if (sample_rays_.size() < sample_rays_host_.size())
-      sample_rays_ = cl::Buffer<cl_uint>(ctx_, sample_rays_host_.size() * 5 / 4 + 1);
-    sample_rays_.write(sample_rays_host_);
-    elements_.write(batch.elements);
-    weights_.write(batch.weights);
-    set_level_weights(setup_.level_weights(index));
-    ops::StepArgs args{};
-    args.rays = &rays_;
-    args.offsets = &offsets_;
-    args.sample_rays = &sample_rays_;
-    args.segments = &segments_;
-    args.rho = &rho_;
-    args.weights = &weights_;
-    args.level_weights = &level_weights_;
-    args.elements = &elements_;
-    args.n_batch = static_cast<cl_uint>(batch.rays.size());
-    args.n_samples = offsets_host_.back();
-    args.n_elements = static_cast<cl_uint>(batch.elements.size());
-    args.elements_per_view = static_cast<cl_uint>(setup_.elements_per_view);
-    args.seed = setup_.seed;
-    args.step = static_cast<cl_uint>(index);
-    args.jitter = t.jitter;
-    args.lambda = static_cast<float>(t.lambda);
-    args.relative_threshold = static_cast<float>(t.relative_beta_threshold);
-    args.data_weight = static_cast<float>(t.data_weight);
-    args.block_first = batch.block_first;
-    args.block_views = batch.block_views;
-    args.block_elements = batch.block_elements;
-    args.ring_lambda = static_cast<float>(t.ring_lambda);
-    args.hold_valid_beta = setup_.hold_valid_beta(index);
-    args.invalid_readings = &invalid_readings_;
-    step_op_.step(args, lanes_, params_, grad_, loss_);
+    model::pack_batch(batch, setup_.segments, setup_.elements_per_view, setup_.level_weights(index),
+                      packed_);
+    ops::StepParams p;
+    ops::set_batch_shape(packed_, p);
+    p.elements_per_view = static_cast<cl_uint>(setup_.elements_per_view);
+    p.seed = setup_.seed;
+    p.step = static_cast<cl_uint>(index);
+    p.jitter = t.jitter ? 1 : 0;
+    p.hold_valid_beta = setup_.hold_valid_beta(index) ? 1 : 0;
+    p.history_slot = static_cast<cl_uint>(pending_.size());
+    p.lambda = static_cast<float>(t.lambda);
+    p.relative_threshold = static_cast<float>(t.relative_beta_threshold);
+    p.data_weight = static_cast<float>(t.data_weight);
+    p.ring_lambda = static_cast<float>(t.ring_lambda);
+    p.block_first = batch.block_first;
+    p.block_views = batch.block_views;
+    p.block_elements = batch.block_elements;
+    const cl::Buffer<cl_uint>& words = uploads_.upload(packed_.words);
+    step_op_.step(p, words, {&segments_, &rho_, &invalid_readings_}, params_, grad_, history_);
     const AdamRates rates = setup_.adam_rates(index);
     adam_.step({rates.field, setup_.layout.alpha_offset, rates.alpha, setup_.layout.beta_offset,
                 rates.beta, t.adam_beta1, t.adam_beta2, t.adam_epsilon},
-               index + 1, params_, grad_);
-    loss_.copy_to(history_, pending_.size() * 2);
+               index + 1, params_, grad_,
+               {&step_op_.mlp_partials(), setup_.layout.mlp_offset, setup_.layout.mlp_params,
+                step_op_.mlp_slices()});
     pending_.push_back({index, 0.0, 0.0, rates.field});
     steps_ = index + 1;
     if (pending_.size() == kHistoryBlock) read_history();
@@ -142,7 +92,7 @@ class OpenclTrainer final : public Trainer {
     const Geometry& g = setup_.scan.geometry;
     const std::size_t n = shape_size(g.volume_shape);
     cl::Buffer<float> out(ctx_, n);
-    set_level_weights(setup_.level_weights(steps_));
+    level_weights_.write(setup_.level_weights(steps_));
     const model::SamplingDomain domain = model::sampling_domain(g);
     constexpr std::size_t kChunk = std::size_t{1} << 20;
     for (std::size_t first = 0; first < n; first += kChunk) {
@@ -155,16 +105,9 @@ class OpenclTrainer final : public Trainer {
   }
 
   std::string device_name() const override { return device_.info().full_name(); }
-  std::string gradient_mode() const override { return atomic_ ? "atomic" : "partitioned"; }
+  std::optional<ExecutionPlan> plan() const override { return plan_; }
 
  private:
-  // Uploads the coarse-to-fine level scales when they change.
-  void set_level_weights(const std::vector<float>& weights) {
-    if (weights == current_level_weights_) return;
-    level_weights_.write(weights);
-    current_level_weights_ = weights;
-  }
-
   void read_history() {
     if (pending_.empty()) return;
     const std::vector<float> values = history_.read();
@@ -180,26 +123,16 @@ class OpenclTrainer final : public Trainer {
   const TrainingSetup& setup_;
   Device device_;
   cl::Context& ctx_;
-  bool atomic_;
-  std::size_t max_batch_;
-  cl_uint lanes_;
-  std::size_t gradients_;
+  ExecutionPlan plan_;
   cl::Buffer<float> params_;
   cl::Buffer<float> grad_;
-  cl::Buffer<float> loss_;
   cl::Buffer<float> history_;
   cl::Buffer<cl_float8> segments_;
   cl::Buffer<float> rho_;
   cl::Buffer<cl_uint> invalid_readings_;
-  cl::Buffer<cl_uint> rays_;
-  cl::Buffer<cl_uint> offsets_;
-  std::vector<cl_uint> offsets_host_;
-  cl::Buffer<cl_uint> sample_rays_;
-  std::vector<cl_uint> sample_rays_host_;
-  cl::Buffer<cl_uint> elements_;
-  cl::Buffer<float> weights_;
   cl::Buffer<float> level_weights_;
-  std::vector<float> current_level_weights_;
+  cl::UploadRing<cl_uint> uploads_;
+  model::PackedBatch packed_;
   ops::RinerStepOp step_op_;
   ops::AdamOp adam_;
   std::vector<LossRecord> pending_;
@@ -209,8 +142,9 @@ class OpenclTrainer final : public Trainer {
 
 }  // namespace
 
-std::unique_ptr<Trainer> make_opencl_trainer(const TrainingSetup& setup, Device device) {
-  return std::make_unique<OpenclTrainer>(setup, std::move(device));
+std::unique_ptr<Trainer> make_opencl_trainer(const TrainingSetup& setup, Device device,
+                                             const ExecutionPlan& plan) {
+  return std::make_unique<OpenclTrainer>(setup, std::move(device), plan);
 }
 
 }  // namespace riner::detail

@@ -32,13 +32,29 @@ struct Reconstructor::Impl {
   }
 };
 
-Reconstructor::Reconstructor(Scan scan, RinerConfig config, std::optional<Device> device)
-    : impl_(std::make_unique<Impl>(std::move(scan), std::move(config))) {
-  if (impl_->setup.config.engine == Engine::kReference) {
-    impl_->trainer = detail::make_reference_trainer(impl_->setup);
-  } else {
-    impl_->trainer = detail::make_opencl_trainer(impl_->setup, device ? *device : Device::open());
+namespace {
+
+// The settings left to the device (rays_per_step = 0) filled in from its execution plan.
+RinerConfig resolved(RinerConfig config, const std::optional<ExecutionPlan>& plan) {
+  if (config.training.rays_per_step == 0) {
+    config.training.rays_per_step = plan ? plan->rays_per_step : ExecutionPlan::kCpuRaysPerStep;
   }
+  return config;
+}
+
+}  // namespace
+
+Reconstructor::Reconstructor(Scan scan, RinerConfig config, std::optional<Device> device) {
+  config.validate();
+  if (config.engine == Engine::kReference) {
+    impl_ = std::make_unique<Impl>(std::move(scan), resolved(std::move(config), std::nullopt));
+    impl_->trainer = detail::make_reference_trainer(impl_->setup);
+    return;
+  }
+  Device d = device ? *device : Device::open();
+  const ExecutionPlan plan = choose_execution_plan(d.info(), config.plan);
+  impl_ = std::make_unique<Impl>(std::move(scan), resolved(std::move(config), plan));
+  impl_->trainer = detail::make_opencl_trainer(impl_->setup, std::move(d), plan);
 }
 
 Reconstructor::~Reconstructor() = default;
@@ -76,6 +92,12 @@ Array Reconstructor::field_image() const {
   const Geometry& g = impl_->setup.scan.geometry;
   Array out(g.volume_shape);
   out.data = impl_->trainer->evaluate_grid();
+  const model::Occupancy& o = impl_->setup.occupancy;
+  if (o.carved) {
+    for (std::size_t i = 0; i < out.data.size(); ++i) {
+      if (!o.inside[i]) out.data[i] = 0.0f;
+    }
+  }
   return out;
 }
 
@@ -162,7 +184,14 @@ TrainingStats Reconstructor::stats() const {
   s.parameters = impl_->setup.layout.total;
   s.engine = engine_name(impl_->setup.config.engine);
   s.device = impl_->trainer->device_name();
-  s.gradient_mode = impl_->trainer->gradient_mode();
+  s.plan = impl_->trainer->plan();
+  const detail::TrainingSetup& setup = impl_->setup;
+  s.air_skipped = setup.occupancy.carved;
+  s.inside_fraction = setup.occupancy.inside_fraction;
+  s.samples_kept_fraction =
+      setup.samples_in_grid > 0.0 ? setup.samples_kept / setup.samples_in_grid : 1.0;
+  s.noise = setup.occupancy.noise;
+  s.air_note = setup.occupancy.note;
   return s;
 }
 

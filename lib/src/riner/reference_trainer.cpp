@@ -56,7 +56,7 @@ class ReferenceTrainer final : public Trainer {
   }
 
   std::string device_name() const override { return "CPU reference"; }
-  std::string gradient_mode() const override { return "partitioned"; }
+  std::optional<ExecutionPlan> plan() const override { return std::nullopt; }
 
  private:
   const TrainingSetup& setup_;

@@ -87,14 +87,17 @@ void RinerConfig::validate() const {
           "network.hidden_layers must be in 1..4");
   const TrainingConfig& t = training;
   require(t.steps >= 0 && t.steps <= 10000000, "training.steps must be in 0..10^7");
-  require(t.rays_per_step >= 1 && t.rays_per_step <= 1 << 20,
-          "training.rays_per_step must be in 1..2^20");
+  require(t.rays_per_step >= 0 && t.rays_per_step <= 1 << 20,
+          "training.rays_per_step must be in 1..2^20, or 0 (the device's execution plan chooses)");
   require(t.views_per_step >= 1 && t.views_per_step <= 1 << 16,
           "training.views_per_step must be in 1..65536");
   require(t.elements_per_step >= 1 && t.elements_per_step <= 1 << 16,
           "training.elements_per_step must be in 1..65536");
   require(t.sample_spacing > 0.01 && t.sample_spacing <= 100.0,
           "training.sample_spacing must be in (0.01, 100] voxels");
+  require(t.air_noise_sigmas >= 0.5 && t.air_noise_sigmas <= 100.0,
+          "training.air_noise_sigmas must be in [0.5, 100]");
+  require(t.air_margin_px >= 0 && t.air_margin_px <= 64, "training.air_margin_px must be in 0..64");
   require(t.learning_rate > 0.0 && t.learning_rate < 10.0 && std::isfinite(t.learning_rate),
           "training.learning_rate must be in (0, 10)");
   require(t.lr_decay_steps >= 0, "training.lr_decay_steps must be >= 0 (0: steps / 4)");
@@ -121,6 +124,19 @@ void RinerConfig::validate() const {
           "training.relative_beta_threshold must be >= 0");
   require(t.data_weight > 0.0 && t.data_weight < 1e6 && std::isfinite(t.data_weight),
           "training.data_weight must be > 0");
+  require(plan.kind == "auto" || plan.kind == "cpu" || plan.kind == "gpu",
+          "plan.kind must be auto, cpu or gpu");
+  require(plan.float_atomics == "auto" || plan.float_atomics == "nvidia-ptx" ||
+              plan.float_atomics == "cl_ext_float_atomics" || plan.float_atomics == "amd-builtin" ||
+              plan.float_atomics == "compare-exchange",
+          "plan.float_atomics must be auto, nvidia-ptx, cl_ext_float_atomics, amd-builtin or "
+          "compare-exchange");
+  require(plan.sample_group >= 0 && plan.sample_group <= 4096,
+          "plan.sample_group must be in 0..4096 (0: the device's choice)");
+  require(plan.gradient_slices >= 0 && plan.gradient_slices <= 65536,
+          "plan.gradient_slices must be in 0..65536 (0: the device's choice)");
+  require(plan.grid_bands >= 0 && plan.grid_bands <= 4096,
+          "plan.grid_bands must be in 0..4096 (0: the device's choice)");
   const AirRingSettings& air = rings.air;
   require(air.air_fraction > 0.0 && air.air_fraction < 1.0, "rings.air_fraction must be in (0, 1)");
   require(air.erosion_px >= 0 && air.erosion_px <= 64, "rings.air_erosion_px must be in 0..64");
@@ -156,7 +172,7 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
     throw InputError(std::string(source) + ": invalid JSON: " + e.what());
   }
   try {
-    check_keys(root, "config", {"encoding", "network", "training", "rings", "engine"});
+    check_keys(root, "config", {"encoding", "network", "training", "rings", "engine", "plan"});
     if (root.contains("encoding")) {
       const json& e = root["encoding"];
       check_keys(e, "encoding",
@@ -184,6 +200,9 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
                   "sample_spacing",
                   "jitter",
                   "circle_region",
+                  "skip_air",
+                  "air_noise_sigmas",
+                  "air_margin_px",
                   "learning_rate",
                   "lr_decay_steps",
                   "lr_decay",
@@ -220,6 +239,9 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
       read(t, "training", "sample_spacing", training.sample_spacing);
       read(t, "training", "jitter", training.jitter);
       read(t, "training", "circle_region", training.circle_region);
+      read(t, "training", "skip_air", training.skip_air);
+      read(t, "training", "air_noise_sigmas", training.air_noise_sigmas);
+      read(t, "training", "air_margin_px", training.air_margin_px);
       read(t, "training", "learning_rate", training.learning_rate);
       read(t, "training", "lr_decay_steps", training.lr_decay_steps);
       read(t, "training", "lr_decay", training.lr_decay);
@@ -276,6 +298,19 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
       read(r, "rings", "response_max_mean_response_change",
            rings.response.max_mean_response_change);
     }
+    if (root.contains("plan")) {
+      const json& p = root["plan"];
+      check_keys(p, "plan",
+                 {"kind", "float_atomics", "sample_group", "gradient_slices", "grid_bands"});
+      for (const char* key : {"kind", "float_atomics"}) {
+        if (!p.contains(key)) continue;
+        require(p[key].is_string(), std::string("plan.") + key + " must be a string");
+        (std::string(key) == "kind" ? plan.kind : plan.float_atomics) = p[key].get<std::string>();
+      }
+      read(p, "plan", "sample_group", plan.sample_group);
+      read(p, "plan", "gradient_slices", plan.gradient_slices);
+      read(p, "plan", "grid_bands", plan.grid_bands);
+    }
     if (root.contains("engine")) {
       require(root["engine"].is_string(), "engine must be a string");
       engine = parse_engine(root["engine"].get<std::string>());
@@ -305,6 +340,9 @@ std::string RinerConfig::to_json() const {
                  {"sample_spacing", training.sample_spacing},
                  {"jitter", training.jitter},
                  {"circle_region", training.circle_region},
+                 {"skip_air", training.skip_air},
+                 {"air_noise_sigmas", training.air_noise_sigmas},
+                 {"air_margin_px", training.air_margin_px},
                  {"learning_rate", training.learning_rate},
                  {"lr_decay_steps", training.lr_decay_steps},
                  {"lr_decay", training.lr_decay},
@@ -338,6 +376,12 @@ std::string RinerConfig::to_json() const {
                  {"response_air_weight", rings.response.air_weight},
                  {"response_min_even_to_odd", rings.response.min_even_to_odd},
                  {"response_max_mean_response_change", rings.response.max_mean_response_change}}},
+               {"plan",
+                {{"kind", plan.kind},
+                 {"float_atomics", plan.float_atomics},
+                 {"sample_group", plan.sample_group},
+                 {"gradient_slices", plan.gradient_slices},
+                 {"grid_bands", plan.grid_bands}}},
                {"engine", engine_name(engine)}};
   return root.dump(1) + "\n";
 }
@@ -360,7 +404,8 @@ RinerConfig RinerConfig::paper() {
   c.training.data_weight = 1.0;
   c.training.alpha_lr_scale = 1.0;
   c.training.beta_lr_scale = 1.0;
-  c.rings.air_reference = false;  // riner's additions, not the paper's
+  c.training.skip_air = false;  // riner's additions, not the paper's
+  c.rings.air_reference = false;
   c.rings.gradient_reference = false;
   c.rings.response_reference = false;
   return c;

@@ -7,9 +7,11 @@
 #include <vector>
 
 #include "model/batch_sampler.hpp"
+#include "model/occupancy.hpp"
 #include "model/parameter_layout.hpp"
 #include "model/ray_segments.hpp"
 #include "riner/device.hpp"
+#include "riner/execution_plan.hpp"
 #include "riner/reconstructor.hpp"
 
 namespace riner::detail {
@@ -29,6 +31,9 @@ struct TrainingSetup {
   std::size_t elements_per_view = 0;
   std::uint32_t seed = 0;
   std::vector<std::uint32_t> invalid_readings;  // per element: its non-finite measurements
+  model::Occupancy occupancy;                   // where the object can be (all, without skip_air)
+  double samples_in_grid = 0.0;                 // samples of every ray inside the grid
+  double samples_kept = 0.0;                    // of those, inside the occupied region
 
   TrainingSetup(Scan scan, RinerConfig config);
   double learning_rate(int step) const;
@@ -50,10 +55,12 @@ class Trainer {
   virtual std::vector<float> parameters() = 0;
   virtual std::vector<float> evaluate_grid() = 0;
   virtual std::string device_name() const = 0;
-  virtual std::string gradient_mode() const = 0;
+  // The execution plan the engine runs (none for the reference engine).
+  virtual std::optional<ExecutionPlan> plan() const = 0;
 };
 
 std::unique_ptr<Trainer> make_reference_trainer(const TrainingSetup& setup);
-std::unique_ptr<Trainer> make_opencl_trainer(const TrainingSetup& setup, Device device);
+std::unique_ptr<Trainer> make_opencl_trainer(const TrainingSetup& setup, Device device,
+                                             const ExecutionPlan& plan);
 
 }  // namespace riner::detail

@@ -25,6 +25,14 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c) : scan(std::move(s)), config
   for (const model::RaySegment& segment : segments) hit += segment.count > 0;
   if (hit == 0)
     throw InputError("no detector ray crosses the reconstruction grid: check the geometry");
+  for (const model::RaySegment& segment : segments) samples_in_grid += segment.count;
+  samples_kept = samples_in_grid;
+  occupancy.inside.assign(shape_size(g.volume_shape), 1);
+  if (config.training.skip_air) {
+    occupancy = model::carve_occupancy(
+        scan, {config.training.air_noise_sigmas, config.training.air_margin_px});
+    samples_kept = model::clip_segments(segments, g, occupancy, config.training.sample_spacing);
+  }
   seed = static_cast<std::uint32_t>(config.training.seed ^ (config.training.seed >> 32));
   invalid_readings.assign(elements_per_view, 0);
   const std::vector<float>& rho = scan.measurement.data;

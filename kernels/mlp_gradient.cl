@@ -1,0 +1,161 @@
+// mlp_gradient.cl: the MLP's weight gradient of a training step as a split-K reduction (the way
+// tiny-cuda-nn's fully fused MLP and CUTLASS's split-K GEMM do it): each weight's gradient is a
+// sum over the step's samples of its layer's input times its unit's delta, both in the sample
+// cache (sample_cache.cl); a bias's is the sum of its unit's delta. Work-group g sums samples
+// [g chunk, min((g + 1) chunk, n_samples)) and stores its partial sums
+// partials[g MLP_PARAMS + o] once, for every parameter o (mlp.cl's order); adam.cl adds the
+// groups' partials in group order. Deterministic, no atomics. Two shapes of the same sums:
+//   mlp_gradient_partial(n_samples, chunk, stride, cache, partials)
+//     one work-item per parameter (o = lid, lid + size, ...): many narrow work-items (GPUs).
+//   mlp_gradient_blocked(n_samples, chunk, stride, cache, partials)
+//     one work-item per block of 8 parameters that share a row (an input of 8 units, or the
+//     output unit's 8 inputs), 8 samples at a time in float8: few wide work-items that keep
+//     their rows in registers (CPUs, where PoCL runs a work-group on one thread).
+// Needs mlp.cl, sample_cache.cl (and their -D constants).
+
+#define ROW_ONE 0xffffffffu
+
+// The cache rows whose product, summed over samples, is parameter o's gradient (a = ROW_ONE:
+// a bias, the sum of row b alone).
+RINER_INLINE void mlp_gradient_rows(uint o, uint* a, uint* b) {
+  if (o < MLP_B_IN) {
+    *a = CACHE_FEATURES + o / MLP_WIDTH;
+    *b = CACHE_DELTA(0) + o % MLP_WIDTH;
+    return;
+  }
+  if (o < MLP_B_IN + MLP_WIDTH) {
+    *a = ROW_ONE;
+    *b = CACHE_DELTA(0) + (o - MLP_B_IN);
+    return;
+  }
+  for (int h = 1; h < MLP_HIDDEN; ++h) {
+    if (o < MLP_B_HIDDEN(h)) {
+      const uint r = o - MLP_W_HIDDEN(h);
+      *a = CACHE_ACT(h - 1) + r / MLP_WIDTH;
+      *b = CACHE_DELTA(h) + r % MLP_WIDTH;
+      return;
+    }
+    if (o < MLP_B_HIDDEN(h) + MLP_WIDTH) {
+      *a = ROW_ONE;
+      *b = CACHE_DELTA(h) + (o - MLP_B_HIDDEN(h));
+      return;
+    }
+  }
+  *a = o < MLP_B_OUT ? CACHE_ACT(MLP_HIDDEN - 1) + (o - MLP_W_OUT) : ROW_ONE;
+  *b = CACHE_DMU;
+}
+
+__kernel void mlp_gradient_partial(const uint n_samples, const uint chunk, const uint stride,
+                                   __global const float* cache, __global float* partials) {
+  const uint g = get_group_id(0);
+  const uint first = min(g * chunk, n_samples);
+  const uint last = min(first + chunk, n_samples);
+  for (uint o = get_local_id(0); o < MLP_PARAMS; o += get_local_size(0)) {
+    uint a;
+    uint b;
+    mlp_gradient_rows(o, &a, &b);
+    __global const float* rb = cache + (size_t)b * stride;
+    float4 acc = (float4)(0.0f);
+    float tail = 0.0f;
+    uint s = first;
+    if (a == ROW_ONE) {
+      for (; s + 4 <= last; s += 4) acc += vload4(0, rb + s);
+      for (; s < last; ++s) tail += rb[s];
+    } else {
+      __global const float* ra = cache + (size_t)a * stride;
+      for (; s + 4 <= last; s += 4) acc = mad(vload4(0, ra + s), vload4(0, rb + s), acc);
+      for (; s < last; ++s) tail = mad(ra[s], rb[s], tail);
+    }
+    partials[g * MLP_PARAMS + o] = (acc.x + acc.y) + (acc.z + acc.w) + tail;
+  }
+}
+
+// Blocks of 8 parameters: per layer (inputs + bias) x (units / 8) blocks whose shared row is
+// one input (or ROW_ONE for the biases) and whose 8 rows are 8 units' deltas; then the output
+// unit's weights as units / 8 blocks sharing the d_mu row; then b_out alone.
+#define BLOCKS_IN ((MLP_INPUTS + 1) * MLP_V * 2)
+#define BLOCKS_HIDDEN ((MLP_WIDTH + 1) * MLP_V * 2)
+#define BLOCKS_OUT (MLP_V * 2)
+#define MLP_BLOCKS (BLOCKS_IN + (MLP_HIDDEN - 1) * BLOCKS_HIDDEN + BLOCKS_OUT + 1)
+
+// Block k: its shared row, its first of 8 consecutive rows, and the parameter of row 0.
+RINER_INLINE void mlp_gradient_block(uint k, uint* shared, uint* rows, uint* param) {
+  const uint groups = MLP_WIDTH / 8;
+  if (k < BLOCKS_IN) {
+    const uint input = k / groups;
+    const uint unit = k % groups * 8;
+    *shared = input < MLP_INPUTS ? CACHE_FEATURES + input : ROW_ONE;
+    *rows = CACHE_DELTA(0) + unit;
+    *param = input < MLP_INPUTS ? MLP_W_IN + input * MLP_WIDTH + unit : MLP_B_IN + unit;
+    return;
+  }
+  k -= BLOCKS_IN;
+  for (int h = 1; h < MLP_HIDDEN; ++h) {
+    if (k < BLOCKS_HIDDEN) {
+      const uint input = k / groups;
+      const uint unit = k % groups * 8;
+      *shared = input < MLP_WIDTH ? CACHE_ACT(h - 1) + input : ROW_ONE;
+      *rows = CACHE_DELTA(h) + unit;
+      *param = input < MLP_WIDTH ? MLP_W_HIDDEN(h) + input * MLP_WIDTH + unit : MLP_B_HIDDEN(h) + unit;
+      return;
+    }
+    k -= BLOCKS_HIDDEN;
+  }
+  *shared = CACHE_DMU;
+  *rows = CACHE_ACT(MLP_HIDDEN - 1) + k * 8;
+  *param = MLP_W_OUT + k * 8;
+}
+
+__kernel void mlp_gradient_blocked(const uint n_samples, const uint chunk, const uint stride,
+                                   __global const float* cache, __global float* partials) {
+  const uint g = get_group_id(0);
+  const uint first = min(g * chunk, n_samples);
+  const uint last = min(first + chunk, n_samples);
+  __global float* out = partials + g * MLP_PARAMS;
+  for (uint k = get_local_id(0); k < MLP_BLOCKS; k += get_local_size(0)) {
+    if (k == MLP_BLOCKS - 1) {  // b_out: the sum of d_mu
+      float sum = 0.0f;
+      for (uint s = first; s < last; ++s) sum += cache[CACHE_DMU * stride + s];
+      out[MLP_B_OUT] = sum;
+      continue;
+    }
+    uint shared;
+    uint rows;
+    uint param;
+    mlp_gradient_block(k, &shared, &rows, &param);
+    __global const float* r = cache + (size_t)rows * stride;
+    float8 acc[8];
+    RINER_UNROLL
+    for (int j = 0; j < 8; ++j) acc[j] = (float8)(0.0f);
+    float tail[8];
+    RINER_UNROLL
+    for (int j = 0; j < 8; ++j) tail[j] = 0.0f;
+    uint s = first;
+    if (shared == ROW_ONE) {
+      for (; s + 8 <= last; s += 8) {
+        RINER_UNROLL
+        for (int j = 0; j < 8; ++j) acc[j] += vload8(0, r + j * stride + s);
+      }
+      for (; s < last; ++s) {
+        RINER_UNROLL
+        for (int j = 0; j < 8; ++j) tail[j] += r[j * stride + s];
+      }
+    } else {
+      __global const float* x = cache + (size_t)shared * stride;
+      for (; s + 8 <= last; s += 8) {
+        const float8 xs = vload8(0, x + s);
+        RINER_UNROLL
+        for (int j = 0; j < 8; ++j) acc[j] = mad(xs, vload8(0, r + j * stride + s), acc[j]);
+      }
+      for (; s < last; ++s) {
+        RINER_UNROLL
+        for (int j = 0; j < 8; ++j) tail[j] = mad(x[s], r[j * stride + s], tail[j]);
+      }
+    }
+    RINER_UNROLL
+    for (int j = 0; j < 8; ++j) {
+      const float4 h = acc[j].lo + acc[j].hi;
+      out[param + j] = (h.x + h.y) + (h.z + h.w) + tail[j];
+    }
+  }
+}

@@ -1,0 +1,292 @@
+#include "model/occupancy.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "riner/array.hpp"
+#include "riner/rays.hpp"
+#include "util/parallel.hpp"
+
+namespace riner::model {
+
+namespace {
+
+// Spread of an element's readings: the interquartile range of a normal is 1.349 sigma.
+constexpr double kIqrPerSigma = 1.349;
+// An element reads air in every view when its spread is close to the quietest elements' and
+// nothing sticks out (the range of 360 normal samples is about 6 sigma).
+constexpr double kAirSpreadFactor = 2.0;
+constexpr double kAirRangeSigmas = 12.0;
+// An air reading is -ln alpha: a detector whose responses are within [0.6, 1.65] of the flat
+// field. Steadier, larger readings are an object centred on the axis that every view shows
+// alike (wider than the detector, say), not air.
+constexpr double kMaxAirOffset = 0.5;
+// Normalised by a flat field, air reads about 0 on average (-ln of responses around 1; the
+// shared scans: -0.001 to 0.04). Steady readings that average more are an object centred on
+// the axis, or a scan normalised by the wrong I0: no carving.
+constexpr double kMaxAirLevel = 0.1;
+// Fewer air elements than this: no trustworthy noise or offset range, so no carving.
+constexpr std::size_t kMinAirElements = 4;
+// Noise floor (rho units) for noise-free simulations.
+constexpr double kNoiseFloor = 1e-5;
+constexpr std::uint16_t kFar = std::numeric_limits<std::uint16_t>::max();
+
+struct ElementStats {
+  std::size_t finite = 0;
+  double min = 0.0;
+  double median = 0.0;
+  double sigma = 0.0;
+  double range = 0.0;
+};
+
+std::vector<ElementStats> element_stats(const Scan& scan, std::size_t per_view) {
+  const std::size_t views = scan.geometry.n_views();
+  std::vector<ElementStats> stats(per_view);
+  util::parallel_for(per_view, [&](std::size_t begin, std::size_t end) {
+    std::vector<double> r;
+    for (std::size_t e = begin; e < end; ++e) {
+      r.clear();
+      for (std::size_t v = 0; v < views; ++v) {
+        const float x = scan.measurement.data[v * per_view + e];
+        if (std::isfinite(x)) r.push_back(x);
+      }
+      ElementStats& s = stats[e];
+      s.finite = r.size();
+      if (r.empty()) continue;
+      std::sort(r.begin(), r.end());
+      auto q = [&](double f) { return r[static_cast<std::size_t>(f * (r.size() - 1))]; };
+      s.min = r.front();
+      s.median = q(0.5);
+      s.sigma = (q(0.75) - q(0.25)) / kIqrPerSigma;
+      s.range = r.back() - r.front();
+    }
+  });
+  return stats;
+}
+
+// Chessboard distance (in voxels) of every voxel to the nearest one with inside != 0, capped.
+std::vector<std::uint16_t> distance_to_inside(const std::vector<std::uint8_t>& inside,
+                                              const std::vector<std::size_t>& shape) {
+  const std::size_t rank = shape.size();
+  const long nx = static_cast<long>(shape[rank - 1]);
+  const long ny = static_cast<long>(shape[rank - 2]);
+  const long nz = rank == 3 ? static_cast<long>(shape[0]) : 1;
+  std::vector<std::uint16_t> d(inside.size());
+  for (std::size_t i = 0; i < inside.size(); ++i) d[i] = inside[i] ? 0 : kFar;
+  // Two chamfer passes over all 3^rank - 1 neighbours: first those before each voxel in memory
+  // order, then those after.
+  for (int pass = 0; pass < 2; ++pass) {
+    const long step = pass == 0 ? 1 : -1;
+    const long z0 = pass == 0 ? 0 : nz - 1, y0 = pass == 0 ? 0 : ny - 1,
+               x0 = pass == 0 ? 0 : nx - 1;
+    for (long z = z0; z >= 0 && z < nz; z += step) {
+      for (long y = y0; y >= 0 && y < ny; y += step) {
+        for (long x = x0; x >= 0 && x < nx; x += step) {
+          const std::size_t i = static_cast<std::size_t>((z * ny + y) * nx + x);
+          std::uint32_t best = d[i];
+          for (long dz = (rank == 3 ? -1 : 0); dz <= (rank == 3 ? 1 : 0); ++dz) {
+            for (long dy = -1; dy <= 1; ++dy) {
+              for (long dx = -1; dx <= 1; ++dx) {
+                const long offset = (dz * ny + dy) * nx + dx;
+                if (offset * step >= 0) continue;  // not yet visited in this pass
+                const long zz = z + dz, yy = y + dy, xx = x + dx;
+                if (zz < 0 || zz >= nz || yy < 0 || yy >= ny || xx < 0 || xx >= nx) continue;
+                const std::size_t j = static_cast<std::size_t>((zz * ny + yy) * nx + xx);
+                if (d[j] != kFar) best = std::min<std::uint32_t>(best, d[j] + 1u);
+              }
+            }
+          }
+          d[i] = static_cast<std::uint16_t>(std::min<std::uint32_t>(best, kFar));
+        }
+      }
+    }
+  }
+  return d;
+}
+
+}  // namespace
+
+Occupancy carve_occupancy(const Scan& scan, const OccupancySettings& settings) {
+  const Geometry& g = scan.geometry;
+  const std::size_t rows = g.is_3d() ? g.n_v : 1;
+  const std::size_t per_view = rows * g.n_u;
+  const std::size_t views = g.n_views();
+  const std::size_t voxels = shape_size(g.volume_shape);
+  Occupancy o;
+  o.inside.assign(voxels, 1);
+
+  const std::vector<ElementStats> stats = element_stats(scan, per_view);
+  std::vector<double> spreads;
+  for (const ElementStats& s : stats) {
+    if (s.finite == views) spreads.push_back(s.sigma);
+  }
+  if (spreads.empty()) {
+    o.note = "no detector element has a finite reading in every view";
+    return o;
+  }
+  std::sort(spreads.begin(), spreads.end());
+  const double quiet = std::max(spreads[spreads.size() / 10], kNoiseFloor);
+  std::vector<double> air_sigmas;
+  std::vector<double> air_offsets;
+  double offset_lo = std::numeric_limits<double>::infinity();
+  double offset_hi = -offset_lo;
+  for (const ElementStats& s : stats) {
+    if (s.finite != views || s.sigma > kAirSpreadFactor * quiet ||
+        s.range > kAirRangeSigmas * std::max(s.sigma, kNoiseFloor) ||
+        std::fabs(s.median) > kMaxAirOffset)
+      continue;
+    air_sigmas.push_back(s.sigma);
+    air_offsets.push_back(s.median);
+    offset_lo = std::min(offset_lo, s.median);
+    offset_hi = std::max(offset_hi, s.median);
+  }
+  o.air_elements = air_sigmas.size();
+  if (air_sigmas.size() < std::max(kMinAirElements, per_view / 100)) {
+    o.note = "too few detector elements read air in every view (" +
+             std::to_string(air_sigmas.size()) + ")";
+    return o;
+  }
+  std::nth_element(air_offsets.begin(), air_offsets.begin() + air_offsets.size() / 2,
+                   air_offsets.end());
+  o.air_offset_median = air_offsets[air_offsets.size() / 2];
+  if (std::fabs(o.air_offset_median) > kMaxAirLevel) {
+    o.note = "the steadiest readings average " + std::to_string(o.air_offset_median) +
+             ", not the 0 of air in a flat-field-normalised scan";
+    return o;
+  }
+  std::nth_element(air_sigmas.begin(), air_sigmas.begin() + air_sigmas.size() / 2,
+                   air_sigmas.end());
+  o.noise = std::max(air_sigmas[air_sigmas.size() / 2], kNoiseFloor);
+  const double tolerance = settings.noise_sigmas * o.noise;
+  // The air elements sample the responses' spread; widen it for the elements they miss.
+  const double widen = 0.25 * (offset_hi - offset_lo) + tolerance;
+  offset_lo -= widen;
+  offset_hi += widen;
+
+  // certified[v * per_view + e]: this reading says the ray crossed only air.
+  std::vector<std::uint8_t> certified(views * per_view, 0);
+  for (std::size_t e = 0; e < per_view; ++e) {
+    const ElementStats& s = stats[e];
+    if (s.finite == 0) continue;
+    const double offset = s.min + o.noise;
+    if (offset < offset_lo || offset > offset_hi) continue;
+    for (std::size_t v = 0; v < views; ++v) {
+      const float x = scan.measurement.data[v * per_view + e];
+      certified[v * per_view + e] = std::isfinite(x) && x - offset < tolerance;
+    }
+  }
+
+  // A voxel is air when some view certifies every element of its shadow.
+  const std::size_t rank = g.volume_shape.size();
+  const std::size_t nx = g.volume_shape[rank - 1];
+  const std::size_t ny = g.volume_shape[rank - 2];
+  const double radius = 0.5 * g.voxel_mm * std::sqrt(static_cast<double>(rank));
+  std::vector<std::uint8_t> carved_inside(voxels, 1);
+  util::parallel_for(voxels, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      const Vec3 p =
+          voxel_centre(g, static_cast<double>(i % nx), static_cast<double>((i / nx) % ny),
+                       static_cast<double>(i / (nx * ny)));
+      for (std::size_t v = 0; v < views; ++v) {
+        const DetectorPoint d = project_to_detector(g, v, p);
+        const double hu = radius * d.magnification / g.pitch_u;
+        const double u0 = std::floor(d.u - hu), u1 = std::ceil(d.u + hu);
+        if (!(u0 >= 0.0 && u1 <= static_cast<double>(g.n_u) - 1.0)) continue;
+        double r0 = 0.0, r1 = 0.0;
+        if (g.is_3d()) {
+          const double hv = radius * d.magnification / g.pitch_v;
+          r0 = std::floor(d.v - hv);
+          r1 = std::ceil(d.v + hv);
+          if (!(r0 >= 0.0 && r1 <= static_cast<double>(rows) - 1.0)) continue;
+        }
+        bool air = true;
+        for (auto r = static_cast<std::size_t>(r0); air && r <= static_cast<std::size_t>(r1); ++r) {
+          const std::uint8_t* line = certified.data() + (v * rows + r) * g.n_u;
+          for (auto u = static_cast<std::size_t>(u0); air && u <= static_cast<std::size_t>(u1); ++u)
+            air = line[u] != 0;
+        }
+        if (air) {
+          carved_inside[i] = 0;
+          break;
+        }
+      }
+    }
+  });
+  const std::vector<std::uint16_t> distance = distance_to_inside(carved_inside, g.volume_shape);
+  std::size_t kept = 0;
+  for (std::size_t i = 0; i < voxels; ++i) {
+    o.inside[i] = distance[i] <= static_cast<std::uint16_t>(std::max(0, settings.margin_px));
+    kept += o.inside[i];
+  }
+  o.carved = true;
+  o.inside_fraction = static_cast<double>(kept) / static_cast<double>(voxels);
+  return o;
+}
+
+double clip_segments(std::vector<RaySegment>& segments, const Geometry& g,
+                     const Occupancy& occupancy, double spacing_voxels) {
+  double samples = 0.0;
+  if (!occupancy.carved) {
+    for (const RaySegment& s : segments) samples += s.count;
+    return samples;
+  }
+  const std::vector<std::uint16_t> distance = distance_to_inside(occupancy.inside, g.volume_shape);
+  const std::size_t rank = g.volume_shape.size();
+  const long nx = static_cast<long>(g.volume_shape[rank - 1]);
+  const long ny = static_cast<long>(g.volume_shape[rank - 2]);
+  const long nz = rank == 3 ? static_cast<long>(g.volume_shape[0]) : 1;
+  const double extent = sampling_domain(g).extent_mm;
+  const double per_voxel = extent / g.voxel_mm;
+  // Chessboard distance of sample k's voxel to the region (0: inside).
+  auto distance_at = [&](const RaySegment& s, std::uint32_t k) {
+    float pos[3];
+    sample_position(s, k, 0.5f, pos);
+    const double x = (pos[0] - 0.5) * per_voxel, y = (pos[1] - 0.5) * per_voxel,
+                 z = (pos[2] - 0.5) * per_voxel;
+    const long column = std::clamp(std::lround(x + 0.5 * (nx - 1)), 0L, nx - 1);
+    const long row = std::clamp(std::lround(0.5 * (ny - 1) - y), 0L, ny - 1);
+    const long slice = rank == 3 ? std::clamp(std::lround(z + 0.5 * (nz - 1)), 0L, nz - 1) : 0L;
+    return static_cast<double>(
+        distance[static_cast<std::size_t>((slice * ny + row) * nx + column)]);
+  };
+  // Samples that can be stepped over from one at distance d: every voxel closer than d is
+  // outside, and m samples move at most floor(m spacing) + 1 voxels.
+  auto skip = [&](double d) {
+    return std::max<std::int64_t>(
+        1, static_cast<std::int64_t>(std::ceil((d - 1.0) / spacing_voxels)) - 1);
+  };
+  const std::vector<double> kept =
+      util::parallel_map_chunks(segments.size(), [&](std::size_t begin, std::size_t end) {
+        double sum = 0.0;
+        for (std::size_t r = begin; r < end; ++r) {
+          RaySegment& s = segments[r];
+          if (s.count == 0) continue;
+          std::int64_t first = 0;
+          while (first < s.count) {
+            const double d = distance_at(s, static_cast<std::uint32_t>(first));
+            if (d == 0.0) break;
+            first += skip(d);
+          }
+          if (first >= s.count) {
+            s.count = 0;
+            continue;
+          }
+          std::int64_t last = s.count - 1;
+          while (last > first) {
+            const double d = distance_at(s, static_cast<std::uint32_t>(last));
+            if (d == 0.0) break;
+            last -= skip(d);
+          }
+          last = std::max(last, first);
+          for (int a = 0; a < 3; ++a) s.start[a] += static_cast<float>(first) * s.step[a];
+          s.count = static_cast<std::uint32_t>(last - first + 1);
+          sum += s.count;
+        }
+        return sum;
+      });
+  for (double k : kept) samples += k;
+  return samples;
+}
+
+}  // namespace riner::model

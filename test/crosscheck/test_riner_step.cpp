@@ -1,0 +1,246 @@
+// The training step of each execution plan (kernels/riner_step.cl with mlp_gradient.cl and
+// hash_grid_gradient.cl, ops::RinerStepOp) against its CPU twin ref::riner_step, in double, on
+// random parameters, measurements and batches: ray sums, their loss gradients, every
+// parameter's gradient, the losses.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <random>
+
+#include "cl/buffer.hpp"
+#include "model/batch_sampler.hpp"
+#include "model/packed_batch.hpp"
+#include "model/parameter_layout.hpp"
+#include "model/ray_segments.hpp"
+#include "ops/riner_step.hpp"
+#include "reference/riner_step_ref.hpp"
+#include "support/compare.hpp"
+#include "support/fixture.hpp"
+#include "support/geometries.hpp"
+
+namespace {
+
+riner::cl::Context& ctx() { return riner::test::device().context(); }
+
+struct Scenario {
+  const char* name;
+  riner::Geometry geometry;
+  riner::Sampler sampler = riner::Sampler::kUniform;
+  bool jitter = false;
+  double ring_lambda = 0.0;
+  double relative_threshold = 0.0;
+  bool hold_valid_beta = false;
+  bool coarse_to_fine = false;
+  int hidden_layers = 1;
+};
+
+std::vector<Scenario> scenarios() {
+  std::vector<Scenario> s;
+  s.push_back({"fan 2D, uniform rays, midpoints", riner::test::small_fan2d()});
+  Scenario mixed{"parallel 2D, mixed batch, ring prior, jitter, coarse to fine, relative beta",
+                 riner::test::small_parallel2d()};
+  mixed.sampler = riner::Sampler::kMixed;
+  mixed.jitter = true;
+  mixed.ring_lambda = 3.0;
+  mixed.relative_threshold = 4.0;
+  mixed.hold_valid_beta = true;
+  mixed.coarse_to_fine = true;
+  mixed.hidden_layers = 2;
+  s.push_back(mixed);
+  Scenario cone{"cone 3D, uniform rays, jitter, hashed levels", riner::test::small_cone3d()};
+  cone.jitter = true;
+  s.push_back(cone);
+  return s;
+}
+
+// The device's gradient: grad plus the MLP's split-K slices added where they belong.
+std::vector<double> full_gradient(const riner::ops::RinerStepOp& op,
+                                  const riner::model::ParameterLayout& l,
+                                  const std::vector<float>& grad) {
+  std::vector<double> g(grad.begin(), grad.end());
+  const std::vector<float> partials = op.mlp_partials().read();
+  for (std::size_t s = 0; s < op.mlp_slices(); ++s) {
+    for (std::size_t k = 0; k < l.mlp_params; ++k)
+      g[l.mlp_offset + k] += partials[s * l.mlp_params + k];
+  }
+  return g;
+}
+
+std::vector<double> section(const std::vector<double>& v, std::size_t first, std::size_t last) {
+  return {v.begin() + static_cast<long>(first), v.begin() + static_cast<long>(last)};
+}
+
+}  // namespace
+
+TEST_SUITE("riner_step") {
+  TEST_CASE("each plan's step matches ref::riner_step on random parameters and batches") {
+    std::mt19937_64 rng(riner::test::seed() + 71);
+    for (const Scenario& sc : scenarios()) {
+      const riner::Geometry& g = sc.geometry;
+      riner::RinerConfig c;
+      c.encoding = {5, 2, g.is_3d() ? 10 : 14, 4, 48};  // 3D: hashed fine levels
+      c.network = {16, sc.hidden_layers};
+      riner::TrainingConfig& t = c.training;
+      t.sampler = sc.sampler;
+      t.rays_per_step = 40;
+      t.views_per_step = 6;
+      t.elements_per_step = 5;
+      t.jitter = sc.jitter;
+      const std::size_t per_view = g.n_u * (g.is_3d() ? g.n_v : 1);
+      const riner::model::ParameterLayout l =
+          riner::model::make_layout(g.is_3d() ? 3 : 2, c.encoding, c.network, per_view);
+      const std::vector<riner::model::RaySegment> segments =
+          riner::model::ray_segments(g, 1.3 * g.voxel_mm, false);
+      // Parameters away from the initial ones, so every layer matters.
+      std::vector<float> params = riner::model::initial_parameters(l, riner::test::seed());
+      std::uniform_real_distribution<float> grid(-0.2f, 0.2f), response(0.8f, 1.2f),
+          logit(-1.0f, 2.0f), measured(0.0f, 2.0f);
+      for (std::size_t i = 0; i < l.grid_params; ++i) params[i] = grid(rng);
+      for (std::size_t e = 0; e < per_view; ++e) {
+        params[l.alpha_offset + e] = response(rng);
+        params[l.beta_offset + e] = logit(rng);
+      }
+      std::vector<float> rho(g.n_views() * per_view);
+      for (float& v : rho) v = measured(rng);
+      std::vector<std::uint32_t> invalid(per_view, 0);
+      for (std::size_t e = 3; e < per_view; e += 17) {  // a few elements with +inf readings
+        invalid[e] = static_cast<std::uint32_t>(g.n_views());
+        for (std::size_t v = 0; v < g.n_views(); ++v) rho[v * per_view + e] = INFINITY;
+      }
+      std::vector<float> level_weights(static_cast<std::size_t>(l.levels), 1.0f);
+      if (sc.coarse_to_fine) level_weights.back() = 0.3f;
+
+      const riner::cl::Buffer<cl_float8> d_segments(
+          ctx(), std::span<const cl_float8>(reinterpret_cast<const cl_float8*>(segments.data()),
+                                            segments.size()));
+      const riner::cl::Buffer<float> d_rho(ctx(), std::span<const float>(rho));
+      const riner::cl::Buffer<cl_uint> d_invalid(ctx(), std::span<const cl_uint>(invalid));
+      const riner::cl::Buffer<float> d_params(ctx(), std::span<const float>(params));
+      riner::cl::Buffer<float> history(ctx(), 2);
+      const std::vector<double> params_d(params.begin(), params.end());
+      const riner::model::BatchSampler sampler(g, t);
+
+      for (const char* kind : {"cpu", "gpu"}) {
+        riner::PlanConfig pc;
+        pc.kind = kind;
+        const riner::ExecutionPlan plan = riner::choose_execution_plan(ctx().info(), pc);
+        riner::ops::RinerStepOp op(ctx(), l, plan, sampler.rays_per_step());
+        for (std::uint32_t step : {3u, 11u}) {
+          CAPTURE(sc.name);
+          CAPTURE(kind);
+          CAPTURE(step);
+          const riner::model::Batch batch = sampler.batch(step);
+          riner::model::PackedBatch packed;
+          riner::model::pack_batch(batch, segments, per_view, level_weights, packed);
+          const riner::cl::Buffer<cl_uint> words(ctx(), std::span<const cl_uint>(packed.words));
+          riner::ops::StepParams p;
+          riner::ops::set_batch_shape(packed, p);
+          p.elements_per_view = static_cast<cl_uint>(per_view);
+          p.seed = 12345;
+          p.step = step;
+          p.jitter = sc.jitter;
+          p.hold_valid_beta = sc.hold_valid_beta;
+          p.lambda = 0.05f;
+          p.relative_threshold = static_cast<float>(sc.relative_threshold);
+          p.data_weight = 0.7f;
+          p.ring_lambda = static_cast<float>(sc.ring_lambda);
+          p.block_first = batch.block_first;
+          p.block_views = batch.block_views;
+          p.block_elements = batch.block_elements;
+          riner::cl::Buffer<float> grad(ctx(), std::vector<float>(l.total, 0.0f));
+          op.step(p, words, {&d_segments, &d_rho, &d_invalid}, d_params, grad, history);
+
+          riner::ref::StepInputs in;
+          in.layout = &l;
+          in.segments = &segments;
+          in.measurement = &rho;
+          in.elements_per_view = per_view;
+          in.jitter = sc.jitter;
+          in.seed = 12345;
+          in.step = step;
+          in.lambda = 0.05;
+          in.ring_lambda = sc.ring_lambda;
+          in.relative_beta_threshold = sc.relative_threshold;
+          in.data_weight = 0.7;
+          in.level_weights = level_weights;
+          in.hold_valid_beta = sc.hold_valid_beta;
+          in.invalid_readings = &invalid;
+          const riner::ref::StepResult want = riner::ref::riner_step(in, batch, params_d);
+
+          // float32 sums of ~100 samples against double: a few ulps of the sum.
+          const std::size_t n = batch.rays.size();
+          std::vector<float> sums = op.ray_sums().read();
+          sums.resize(n);
+          const auto sum_err = riner::test::compare(sums, want.sums);
+          CHECK_MESSAGE(sum_err.rms_rel < 1e-5, sum_err.describe());
+          std::vector<float> d_sums = op.ray_sum_gradients().read();
+          d_sums.resize(n);
+          const auto d_err = riner::test::compare(d_sums, want.d_sums);
+          CHECK_MESSAGE(d_err.rms_rel < 1e-5, d_err.describe());
+          const std::vector<float> losses = history.read();
+          CHECK(losses[0] == doctest::Approx(want.data_loss).epsilon(1e-5));
+          CHECK(losses[1] == doctest::Approx(want.penalty).epsilon(1e-5));
+          // Gradients: sums over thousands of float32 products (the MLP's) and atomics in any
+          // order (the gpu plan's grid) against double: 1e-4 of each section's norm.
+          const std::vector<double> got = full_gradient(op, l, grad.read());
+          const std::pair<const char*, std::pair<std::size_t, std::size_t>> sections[] = {
+              {"grid", {0, l.grid_params}},
+              {"mlp", {l.mlp_offset, l.mlp_offset + l.mlp_params}},
+              {"alpha0", {l.alpha_offset, l.beta_offset}},
+              {"beta0", {l.beta_offset, l.total}}};
+          for (const auto& [name, range] : sections) {
+            CAPTURE(name);
+            const auto err = riner::test::compare(section(got, range.first, range.second),
+                                                  section(want.grad, range.first, range.second));
+            CHECK_MESSAGE(err.rms_rel < 1e-4, err.describe());
+          }
+        }
+      }
+    }
+  }
+
+  TEST_CASE("the cpu plan's step is bit-identical run to run") {
+    const riner::Geometry g = riner::test::small_fan2d();
+    riner::RinerConfig c;
+    const riner::model::ParameterLayout l =
+        riner::model::make_layout(2, {6, 2, 14, 4, 64}, {16, 1}, g.n_u);
+    const std::vector<riner::model::RaySegment> segments =
+        riner::model::ray_segments(g, 1.5, false);
+    std::vector<float> params = riner::model::initial_parameters(l, 3);
+    std::mt19937_64 rng(riner::test::seed() + 5);
+    std::uniform_real_distribution<float> u(-0.2f, 0.2f);
+    for (std::size_t i = 0; i < l.grid_params; ++i) params[i] = u(rng);
+    std::vector<float> rho(g.n_views() * g.n_u, 0.5f);
+    std::vector<std::uint32_t> invalid(g.n_u, 0);
+    const riner::cl::Buffer<cl_float8> d_segments(
+        ctx(), std::span<const cl_float8>(reinterpret_cast<const cl_float8*>(segments.data()),
+                                          segments.size()));
+    const riner::cl::Buffer<float> d_rho(ctx(), std::span<const float>(rho));
+    const riner::cl::Buffer<cl_uint> d_invalid(ctx(), std::span<const cl_uint>(invalid));
+    const riner::cl::Buffer<float> d_params(ctx(), std::span<const float>(params));
+    riner::cl::Buffer<float> history(ctx(), 2);
+    c.training.rays_per_step = 200;
+    const riner::model::BatchSampler sampler(g, c.training);
+    riner::PlanConfig pc;
+    pc.kind = "cpu";
+    riner::ops::RinerStepOp op(ctx(), l, riner::choose_execution_plan(ctx().info(), pc), 200);
+    riner::model::PackedBatch packed;
+    riner::model::pack_batch(sampler.batch(1), segments, g.n_u, std::vector<float>(6, 1.0f),
+                             packed);
+    const riner::cl::Buffer<cl_uint> words(ctx(), std::span<const cl_uint>(packed.words));
+    riner::ops::StepParams p;
+    riner::ops::set_batch_shape(packed, p);
+    p.elements_per_view = static_cast<cl_uint>(g.n_u);
+    p.lambda = 0.01f;
+    std::vector<double> first;
+    for (int run = 0; run < 2; ++run) {
+      riner::cl::Buffer<float> grad(ctx(), std::vector<float>(l.total, 0.0f));
+      op.step(p, words, {&d_segments, &d_rho, &d_invalid}, d_params, grad, history);
+      const std::vector<double> g_run = full_gradient(op, l, grad.read());
+      if (run == 0)
+        first = g_run;
+      else
+        CHECK(g_run == first);
+    }
+  }
+}
