@@ -150,6 +150,8 @@ int run_reconstruct(int argc, char** argv, int first) {
       {"image", image_path.string()},
       {"shape", image.shape},
       {"steps", stats.steps},
+      {"steps_planned", stats.steps_planned},
+      {"stopped_on_plateau", stats.stopped_on_plateau},
       {"seconds", stats.seconds},
       {"samples", stats.samples},
       {"samples_per_second", stats.seconds > 0 ? stats.samples / stats.seconds : 0.0},

@@ -65,8 +65,12 @@ std::vector<Result> ring_corrections(const Options& o) {
     nlohmann::json row{{"scene", scene.name},
                        {"seconds", r.stats().seconds},
                        {"samples_per_second", r.stats().samples / r.stats().seconds},
+                       {"steps", r.stats().steps},
+                       {"stopped_on_plateau", r.stats().stopped_on_plateau},
+                       {"samples_kept_fraction", r.stats().samples_kept_fraction},
                        {"detector", riner::bench::detector_accuracy(alpha, beta, scene.sim)}};
-    std::string line = riner::bench::format("%-20s %6.1f s", scene.name.c_str(), r.stats().seconds);
+    std::string line = riner::bench::format("%-20s %6.1f s %5d steps", scene.name.c_str(),
+                                            r.stats().seconds, r.stats().steps);
     for (std::size_t v = 0; v < variants.size(); ++v) {
       riner::Array image = variants[v].air ? air.image : field;
       riner::Array response = variants[v].air ? air.alpha : alpha;

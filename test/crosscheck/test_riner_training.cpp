@@ -118,6 +118,29 @@ TEST_SUITE("riner_training") {
     CHECK(a.alpha().data == b.alpha().data);
   }
 
+  TEST_CASE("stop_on_plateau ends training in the last learning-rate phase, not before") {
+    const riner::test::TinyProblem t = riner::test::tiny_problem(5);
+    riner::RinerConfig c = riner::test::tiny_config();
+    c.training.steps = 400;
+    c.training.lr_decay_steps = 100;  // the last phase starts at 300
+    c.training.stop_on_plateau = true;
+    c.training.plateau_window = 20;
+    c.training.plateau_tolerance = 0.9;  // any window short of a 90% drop is a plateau
+    riner::Reconstructor r(t.scan, c, riner::test::device());
+    r.run();
+    const riner::TrainingStats s = r.stats();
+    CHECK(s.stopped_on_plateau);
+    CHECK(s.steps_planned == 400);
+    CHECK(s.steps >= 300 + 2 * 20);
+    CHECK(s.steps < 400);
+    CHECK(r.history().size() == static_cast<std::size_t>(s.steps));
+    c.training.stop_on_plateau = false;
+    riner::Reconstructor full(t.scan, c, riner::test::device());
+    full.run();
+    CHECK_FALSE(full.stats().stopped_on_plateau);
+    CHECK(full.stats().steps == 400);
+  }
+
   TEST_CASE("bad inputs are InputErrors") {
     const riner::test::TinyProblem t = riner::test::tiny_problem(6);
     riner::RinerConfig c = riner::test::tiny_config();

@@ -53,9 +53,11 @@ struct ReconstructionResult {
 
 struct TrainingStats {
   int steps = 0;
-  double seconds = 0.0;        // wall time inside step()/run()
-  double samples = 0.0;        // field evaluations trained on (forward + backward)
-  std::size_t non_finite = 0;  // measurements that were NaN/inf (treated as 0)
+  int steps_planned = 0;            // training.steps
+  bool stopped_on_plateau = false;  // training.stop_on_plateau ended the run early
+  double seconds = 0.0;             // wall time inside step()/run()
+  double samples = 0.0;             // field evaluations trained on (forward + backward)
+  std::size_t non_finite = 0;       // measurements that were NaN/inf (treated as 0)
   std::size_t parameters = 0;
   std::string engine;
   std::string device;                 // device name, or "CPU reference"
@@ -80,7 +82,8 @@ class Reconstructor {
 
   // n more training steps.
   void step(int n = 1);
-  // Trains until config.training.steps, calling back every `report_every` steps and at the end.
+  // Trains until config.training.steps (or a loss plateau, training.stop_on_plateau), calling
+  // back every `report_every` steps and at the end.
   void run(const ProgressCallback& callback = {}, int report_every = 50);
 
   int steps_done() const;

@@ -83,6 +83,12 @@ struct TrainingConfig {
   // image can hold fine structure, rings included, only after alpha has had time to explain
   // the per-element offsets.
   int level_warmup_steps = 0;
+  // Stop on a plateau instead of at `steps`: in the last learning-rate phase, every
+  // plateau_window steps (0: a quarter of the phase), training ends when the mean data loss of
+  // the latest window is less than plateau_tolerance (relative) below the window's before.
+  bool stop_on_plateau = false;
+  int plateau_window = 0;
+  double plateau_tolerance = 0.003;
   // Ring prior: weight of the squared view-averaged curvature of the model's projections across
   // adjacent elements of the views x elements block (kernels/riner_step.cl). Needs the
   // views-x-elements or mixed sampler with elements_per_step >= 3; 0 turns it off.

@@ -16,6 +16,7 @@ struct Reconstructor::Impl {
   double seconds = 0.0;
   double samples = 0.0;
   std::vector<LossRecord> history;
+  bool plateaued = false;
 
   Impl(Scan scan, RinerConfig config)
       : setup(std::move(scan), std::move(config)),
@@ -73,12 +74,40 @@ void Reconstructor::step(int n) {
   impl_->seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+namespace {
+
+// training.stop_on_plateau: in the last learning-rate phase, the mean data loss of the latest
+// window no longer `tolerance` below the window's before.
+bool on_plateau(const TrainingConfig& t, const std::vector<LossRecord>& history) {
+  if (!t.stop_on_plateau || t.steps <= 0) return false;
+  const int interval = t.decay_interval();
+  const int last_phase = (t.steps - 1) / interval * interval;
+  const int window = t.plateau_window > 0 ? t.plateau_window : std::max(1, interval / 4);
+  const int done = static_cast<int>(history.size());
+  if (done - 2 * window < last_phase) return false;
+  double latest = 0.0, before = 0.0;
+  for (int i = done - window; i < done; ++i)
+    latest += history[static_cast<std::size_t>(i)].data_loss;
+  for (int i = done - 2 * window; i < done - window; ++i)
+    before += history[static_cast<std::size_t>(i)].data_loss;
+  return before - latest < t.plateau_tolerance * before;
+}
+
+}  // namespace
+
 void Reconstructor::run(const ProgressCallback& callback, int report_every) {
-  const int total = impl_->setup.config.training.steps;
+  const TrainingConfig& t = impl_->setup.config.training;
+  const int total = t.steps;
   report_every = std::max(1, report_every);
-  while (impl_->steps < total) {
+  if (t.stop_on_plateau) {  // check at least once per window
+    const int window = t.plateau_window > 0 ? t.plateau_window : t.decay_interval() / 4;
+    report_every = std::min(report_every, std::max(1, window / 4));
+  }
+  while (impl_->steps < total && !impl_->plateaued) {
     step(std::min(report_every, total - impl_->steps));
     impl_->drain();  // also the divergence check, once per block
+    impl_->plateaued =
+        static_cast<int>(impl_->history.size()) == impl_->steps && on_plateau(t, impl_->history);
     if (callback) {
       const double loss = impl_->history.empty() ? 0.0 : impl_->history.back().data_loss;
       if (!callback({impl_->steps, total, loss, impl_->seconds})) break;
@@ -184,6 +213,8 @@ TrainingStats Reconstructor::stats() const {
   s.parameters = impl_->setup.layout.total;
   s.engine = engine_name(impl_->setup.config.engine);
   s.device = impl_->trainer->device_name();
+  s.steps_planned = impl_->setup.config.training.steps;
+  s.stopped_on_plateau = impl_->plateaued;
   s.plan = impl_->trainer->plan();
   const detail::TrainingSetup& setup = impl_->setup;
   s.air_skipped = setup.occupancy.carved;

@@ -115,6 +115,11 @@ void RinerConfig::validate() const {
   require(t.beta_warmup_steps >= -1,
           "training.beta_warmup_steps must be >= 0, or -1 (the first learning-rate phase)");
   require(t.level_warmup_steps >= 0, "training.level_warmup_steps must be >= 0");
+  require(t.plateau_window >= 0,
+          "training.plateau_window must be >= 0 (0: a quarter of the "
+          "last learning-rate phase)");
+  require(t.plateau_tolerance >= 0.0 && t.plateau_tolerance < 1.0,
+          "training.plateau_tolerance must be in [0, 1)");
   require(t.ring_lambda >= 0.0 && t.ring_lambda < 1e9 && std::isfinite(t.ring_lambda),
           "training.ring_lambda must be >= 0");
   require(t.ring_lambda == 0.0 || (t.sampler != Sampler::kUniform && t.elements_per_step >= 3),
@@ -215,6 +220,9 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
                   "alpha_warmup_steps",
                   "beta_warmup_steps",
                   "level_warmup_steps",
+                  "stop_on_plateau",
+                  "plateau_window",
+                  "plateau_tolerance",
                   "ring_lambda",
                   "data_term",
                   "data_weight",
@@ -268,6 +276,9 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
       read(t, "training", "alpha_warmup_steps", training.alpha_warmup_steps);
       read(t, "training", "beta_warmup_steps", training.beta_warmup_steps);
       read(t, "training", "level_warmup_steps", training.level_warmup_steps);
+      read(t, "training", "stop_on_plateau", training.stop_on_plateau);
+      read(t, "training", "plateau_window", training.plateau_window);
+      read(t, "training", "plateau_tolerance", training.plateau_tolerance);
       read(t, "training", "ring_lambda", training.ring_lambda);
       read(t, "training", "seed", training.seed);
     }
@@ -358,6 +369,9 @@ std::string RinerConfig::to_json() const {
                  {"alpha_warmup_steps", training.alpha_warmup_steps},
                  {"beta_warmup_steps", training.beta_warmup_steps},
                  {"level_warmup_steps", training.level_warmup_steps},
+                 {"stop_on_plateau", training.stop_on_plateau},
+                 {"plateau_window", training.plateau_window},
+                 {"plateau_tolerance", training.plateau_tolerance},
                  {"ring_lambda", training.ring_lambda},
                  {"seed", training.seed}}},
                {"rings",
