@@ -120,6 +120,19 @@ int run_reconstruct(int argc, char** argv, int first) {
 
   Reconstructor reconstructor(std::move(scan), config, device_from(args, config.engine));
   {
+    const TrainingStats setup = reconstructor.stats();
+    if (setup.plan) console.line(setup.plan->describe());
+    if (setup.air_skipped) {
+      char line[160];
+      std::snprintf(line, sizeof(line),
+                    "skipping the air: %.0f%% of the grid sampled, %.0f%% of the samples kept",
+                    100.0 * setup.inside_fraction, 100.0 * setup.samples_kept_fraction);
+      console.line(line);
+    } else if (config.training.skip_air && !setup.air_note.empty()) {
+      console.line("not skipping the air: " + setup.air_note);
+    }
+  }
+  {
     Progress progress("reconstruct", static_cast<std::size_t>(config.training.steps),
                       console.quiet());
     reconstructor.run(

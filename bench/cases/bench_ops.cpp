@@ -153,6 +153,25 @@ void model_ops(const riner::Device& device, const Options& o, const Peaks& peaks
                        peaks));
   }
 
+  // The first layer's weight gradient (inputs x width, summed over a step's samples) as one
+  // CLBlast SGEMM, to weigh against mlp_gradient.cl's split-K kernels (their time is in the
+  // training_step rows: the whole MLP's gradient, mlp_gradient_*). Samples per step of the
+  // default plans: 11k (160 rays), 45k (640), 180k (2560).
+  for (const std::size_t samples : o.size == "tiny"
+                                       ? std::vector<std::size_t>{4096}
+                                       : std::vector<std::size_t>{11264, 45056, 180224}) {
+    const riner::model::ParameterLayout l =
+        riner::model::make_layout(2, config.encoding, {32, 1}, 768);
+    const double ms = riner::bench::clblast_gemm_ms(device, static_cast<std::size_t>(l.inputs), 32,
+                                                    samples, warmup, runs);
+    OpTiming gemm;
+    gemm.wall_ms.median = gemm.wall_ms.q25 = gemm.wall_ms.q75 = ms;
+    out->push_back(row(
+        "clblast_weight_gradient", std::to_string(l.inputs) + " x 32, K=" + std::to_string(samples),
+        gemm, {static_cast<double>(samples), "samples/s", 2.0 * samples * l.inputs * 32, 0.0},
+        peaks));
+  }
+
   // Forward model and loss on explicit samples: 4096 rays of 128 samples (the unfused path).
   const std::size_t rays = o.size == "tiny" ? 256 : 4096, per_ray = 128;
   std::vector<cl_uint> offsets(rays + 1);
