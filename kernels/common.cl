@@ -30,13 +30,14 @@ inline void atomic_add_f32(volatile __global float* address, float value) {
 // Float atomic add where the sum is all that matters (no old value returned), in the fastest
 // form the device has; the host's execution plan picks one with -D:
 //   FLOAT_ATOMICS_NV   NVIDIA: inline PTX red.global.add.f32 (fire-and-forget, done in L2)
-//   FLOAT_ATOMICS_EXT  cl_ext_float_atomics (built with -cl-std=CL3.0)
+//   FLOAT_ATOMICS_EXT  cl_ext_float_atomics (built with -cl-std=CL3.0), where the compiler
+//                      declares it (PoCL 5 reports the extension but does not: CAS there)
 //   FLOAT_ATOMICS_AMD  AMD's builtin, where the compiler has it
 //   otherwise          the compare-and-swap loop above (serialises under contention)
 inline void atomic_add_global(volatile __global float* address, float value) {
 #if defined(FLOAT_ATOMICS_NV)
   asm volatile("red.global.add.f32 [%0], %1;" ::"l"(address), "f"(value) : "memory");
-#elif defined(FLOAT_ATOMICS_EXT)
+#elif defined(FLOAT_ATOMICS_EXT) && defined(__opencl_c_ext_fp32_global_atomic_add)
   atomic_fetch_add_explicit((volatile __global atomic_float*)address, value, memory_order_relaxed);
 #elif defined(FLOAT_ATOMICS_AMD) && defined(__has_builtin)
 #if __has_builtin(__builtin_amdgcn_global_atomic_fadd_f32)

@@ -54,6 +54,12 @@ TEST_SUITE("execution_plan") {
           riner::FloatAtomics::kCompareExchange);
     intel.fp32_global_atomic_add = true;
     CHECK(riner::choose_execution_plan(intel).float_atomics == riner::FloatAtomics::kExtension);
+    riner::DeviceInfo pocl5 = cpu_device(16);  // reports the extension, lacks the builtins
+    pocl5.fp32_global_atomic_add = true;
+    riner::PlanConfig gpu;
+    gpu.kind = "gpu";
+    CHECK(riner::choose_execution_plan(pocl5, gpu).float_atomics ==
+          riner::FloatAtomics::kCompareExchange);
     const riner::DeviceInfo amd =
         gpu_device("AMD Accelerated Parallel Processing", "Advanced Micro Devices, Inc.");
     CHECK(riner::choose_execution_plan(amd).float_atomics == riner::FloatAtomics::kAmdBuiltin);

@@ -38,10 +38,11 @@ FloatAtomics parse_atomics(const std::string& name) {
       name + ")");
 }
 
-// The device's fastest float add for accumulation.
+// The device's fastest float add for accumulation. A CPU reporting cl_ext_float_atomics (PoCL
+// 5) does not declare the builtins in its compiler: compare-and-swap there.
 FloatAtomics best_atomics(const DeviceInfo& d) {
   if (is_nvidia(d)) return FloatAtomics::kNvidiaPtx;
-  if (d.fp32_global_atomic_add) return FloatAtomics::kExtension;
+  if (d.fp32_global_atomic_add && d.type != "CPU") return FloatAtomics::kExtension;
   if (is_amd(d)) return FloatAtomics::kAmdBuiltin;
   return FloatAtomics::kCompareExchange;
 }
