@@ -2,7 +2,7 @@
 // instead of atomics: the execution plan for CPUs (deterministic, one gradient table, no
 // per-thread copies to add up afterwards).
 //   hash_grid_gradient_accumulate(n_samples, bands, stride, levels, cache, grad)
-//     work-group g owns band g % bands of level g / bands: entries [band E / bands,
+//     work-group g owns band g % bands of level N_LEVELS - 1 - g / bands: entries [band E / bands,
 //     (band + 1) E / bands) of the level's E entries. Its work-item 0 walks every sample in
 //     order (positions and feature gradients from the sample cache, sample_cache.cl) and adds
 //     the corners that fall in its band into grad. Each entry has one writer: no atomics, the
@@ -27,8 +27,10 @@ __kernel void hash_grid_gradient_accumulate(const uint n_samples, const uint ban
                                             __global const float* cache, __global float* grad) {
   if (get_local_id(0) != 0) return;
   const uint g = get_group_id(0);
-  const uint l = g / bands;
-  if (l >= N_LEVELS) return;
+  if (g / bands >= N_LEVELS) return;
+  // Finest level first: its table misses the cache most, and threads that take work-groups in
+  // order then finish together (longest first).
+  const uint l = N_LEVELS - 1 - g / bands;
   const uint band = g % bands;
   __constant const GridLevel* level = &levels[l];
   const uint entries = hash_grid_entries(level);
