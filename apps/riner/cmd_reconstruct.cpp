@@ -9,7 +9,9 @@
 #include "detector_outputs.hpp"
 #include "progress.hpp"
 #include "riner/error.hpp"
+#include "riner/fbp.hpp"
 #include "riner/io.hpp"
+#include "riner/quality.hpp"
 #include "riner/reconstructor.hpp"
 #include "riner/scan.hpp"
 
@@ -32,6 +34,31 @@ nlohmann::json ring_summary(const std::optional<RingCorrection>& rings) {
                                                            : nlohmann::json(nullptr);
   }
   return out;
+}
+
+// What a user without a ground truth can check (riner/quality.hpp): rings, specks and the
+// centre against the FBP of the same scan; 2D only (null in 3D).
+nlohmann::json quality_summary(const Reconstructor& r, const ReconstructionResult& result,
+                               const std::optional<Device>& device) {
+  if (r.scan().geometry.is_3d()) return nullptr;
+  FbpOptions options;
+  options.engine = r.config().engine;
+  options.device = device;
+  const Array fbp_image = fbp(r.scan(), options);
+  const QualityReport q = quality_against_fbp(result.image, fbp_image);
+  const CentreDeviation field = centre_deviation(result.field_image, fbp_image);
+  return {{"fbp_noise_per_mm", q.noise},
+          {"ring_index", q.ring_index},
+          {"fbp_ring_index", q.fbp_ring_index},
+          {"specks_per_10k_pixels", q.specks_per_10k},
+          {"fbp_specks_per_10k_pixels", q.fbp_specks_per_10k},
+          {"centre",
+           {{"radius_px", q.centre.radius_px},
+            {"largest_broad_deviation_from_fbp_per_mm", q.centre.deviation},
+            {"at_px", q.centre.at_px},
+            {"fbp_profile_noise_per_mm", q.centre.fbp_noise},
+            {"fbp_noise_sigmas", q.centre.sigmas},
+            {"field_fbp_noise_sigmas", field.sigmas}}}};
 }
 
 RinerConfig config_from(const Args& args) {
@@ -118,7 +145,8 @@ int run_reconstruct(int argc, char** argv, int first) {
                  "and their elements' beta learns to switch them off");
   }
 
-  Reconstructor reconstructor(std::move(scan), config, device_from(args, config.engine));
+  const std::optional<Device> device = device_from(args, config.engine);
+  Reconstructor reconstructor(std::move(scan), config, device);
   {
     const TrainingStats setup = reconstructor.stats();
     if (setup.plan) console.line(setup.plan->describe());
@@ -180,6 +208,7 @@ int run_reconstruct(int argc, char** argv, int first) {
         {"samples_kept_fraction", stats.samples_kept_fraction},
         {"noise_sigma", stats.noise},
         {"note", config.training.skip_air ? stats.air_note : "off (training.skip_air)"}}},
+      {"quality", quality_summary(reconstructor, result, device)},
       {"air_ring_correction", ring_summary(result.air_rings)},
       {"gradient_ring_correction", ring_summary(result.gradient_rings)},
       {"response_ring_correction", ring_summary(result.response_rings)},
@@ -189,6 +218,25 @@ int run_reconstruct(int argc, char** argv, int first) {
   console.line("reconstructed " + shape_string(image.shape) + " in " +
                format_duration(stats.seconds) + " (" + std::to_string(stats.steps) + " steps, " +
                std::to_string(dead.size()) + " elements flagged dead) -> " + out.string());
+  // Where the tool has doubts, say so (the measures: riner/quality.hpp).
+  if (const nlohmann::json& q = summary["quality"]; q.is_object()) {
+    char line[200];
+    const double sigmas = q["centre"]["fbp_noise_sigmas"].get<double>();
+    if (sigmas > 1.0) {
+      std::snprintf(line, sizeof(line),
+                    "note: near the rotation axis the image departs from FBP's broad profile by "
+                    "%.1f times FBP's own noise there (a disc or dip rings can hide)",
+                    sigmas);
+      console.line(line);
+    }
+    if (q["specks_per_10k_pixels"].get<double>() > q["fbp_specks_per_10k_pixels"].get<double>()) {
+      std::snprintf(line, sizeof(line),
+                    "note: %.1f isolated specks per 10^4 pixels against FBP's %.1f",
+                    q["specks_per_10k_pixels"].get<double>(),
+                    q["fbp_specks_per_10k_pixels"].get<double>());
+      console.line(line);
+    }
+  }
   console.summary(summary);
   return 0;
 }

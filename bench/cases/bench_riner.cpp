@@ -11,6 +11,7 @@
 #include "riner/fbp.hpp"
 #include "riner/io.hpp"
 #include "riner/metrics.hpp"
+#include "riner/quality.hpp"
 #include "riner/phantom.hpp"
 #include "riner/reconstructor.hpp"
 #include "riner/scan.hpp"
@@ -169,7 +170,9 @@ riner::Array beside(const riner::Array& left, const riner::Array& right) {
   return panel;
 }
 
-// A real scan (neutron360 by default): FBP and Riner side by side, ring index of each.
+// A real scan (neutron360 by default): FBP and Riner side by side, ring index, specks and the
+// centre's deviation from FBP (riner/quality.hpp) of each; --png=PREFIX for the PNG pairs,
+// --npy=PREFIX for the images and responses as .npy.
 std::vector<Result> riner_real_scan(const Options& o) {
   const std::string scan_path = o.get("scan", "../shared/data/neutron360/sino.npy");
   const std::string png = o.get("png", "");
@@ -212,10 +215,29 @@ std::vector<Result> riner_real_scan(const Options& o) {
     }
     riner::write_png(png + "_fbp_riner_centre.png", zoom, w);
   }
+  const riner::QualityReport quality = riner::quality_against_fbp(image, fbp_image);
+  if (const std::string npy = o.get("npy", ""); !npy.empty()) {  // the images, for analysis
+    riner::write_array(npy + "_fbp.npy", fbp_image);
+    riner::write_array(npy + "_field.npy", field);
+    riner::write_array(npy + "_image.npy", image);
+    riner::write_array(npy + "_alpha.npy", result.alpha);
+    riner::write_array(npy + "_trained_alpha.npy", r.trained_alpha());
+  }
   return {{"riner_real_scan",
            {{"scan", scan_path},
             {"fbp_ring_index", riner::ring_index(fbp_image)},
             {"riner_ring_index", riner::ring_index(image)},
+            {"noise", quality.noise},
+            {"fbp_specks_per_10k", quality.fbp_specks_per_10k},
+            {"riner_specks_per_10k", quality.specks_per_10k},
+            {"field_specks_per_10k", riner::specks_per_10k(field, quality.noise)},
+            {"centre_deviation", quality.centre.deviation},
+            {"centre_deviation_at_px", quality.centre.at_px},
+            {"centre_deviation_sigmas", quality.centre.sigmas},
+            {"centre_fbp_profile_noise", quality.centre.fbp_noise},
+            {"field_centre_deviation_sigmas",
+             riner::centre_deviation(field, fbp_image).sigmas},
+            {"samples_kept_fraction", r.stats().samples_kept_fraction},
             {"field_ring_index", riner::ring_index(field)},
             {"ring_correction_applied", rings && rings->applied},
             {"ring_correction_response_change", rings ? rings->mean_response_change : 0.0},

@@ -2,6 +2,7 @@
 // DeepLesion slice, or the built-in phantom): steady-state wall time per step over a block of
 // steps (the host enqueues ahead, as a real run does), device time per kernel, samples/s.
 //   --plan=both|auto|cpu|gpu   --rays=160,640,...   --timed=N steps (default 300; tiny 10)
+//   --scan=SINO (a scan with geometry.json beside it instead of the paper scene)
 #include "cases/training_step.hpp"
 
 #include <chrono>
@@ -12,6 +13,7 @@
 #include "model/parameter_layout.hpp"
 #include "riner/projector.hpp"
 #include "riner/reconstructor.hpp"
+#include "riner/scan.hpp"
 #include "riner/simulate.hpp"
 #include "scenes.hpp"
 
@@ -44,8 +46,15 @@ std::vector<int> parse_list(const std::string& text) {
 std::vector<Result> time_training_steps(const Device& device, const Options& o,
                                         const std::vector<std::string>& plans,
                                         const std::vector<int>& rays, const Peaks* peaks) {
-  const Projector projector(preset_geometry("fan2d-paper"), Engine::kOpenCL, device);
-  const RingScene scene = paper_scene(o, o.get_int("slice", 0), projector);
+  // --scan=SINO (geometry.json beside it) instead of the paper scene.
+  RingScene scene;
+  if (const std::string path = o.get("scan", ""); !path.empty()) {
+    scene.sim.scan = load_scan(path);
+    scene.name = path;
+  } else {
+    const Projector projector(preset_geometry("fan2d-paper"), Engine::kOpenCL, device);
+    scene = paper_scene(o, o.get_int("slice", 0), projector);
+  }
   const int timed = o.get_int("timed", o.size == "tiny" ? 10 : 300);
   std::vector<Result> out;
   for (const std::string& plan : plans) {
@@ -71,8 +80,8 @@ std::vector<Result> time_training_steps(const Device& device, const Options& o,
       const TrainingStats after = r.stats();
       const double samples = (after.samples - before.samples) / timed;
       const Geometry& g = scene.sim.scan.geometry;
-      const model::ParameterLayout l =
-          model::make_layout(2, config.encoding, config.network, g.n_u);
+      const model::ParameterLayout l = model::make_layout(
+          2, r.config().encoding, config.network, g.n_u);
       const double gflops = samples * step_flops_per_sample(l) / (wall_ms * 1e6);
       const std::string plan_name = after.plan ? plan_kind_name(after.plan->kind) : "?";
       nlohmann::json f{{"scene", scene.name},

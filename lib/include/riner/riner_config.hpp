@@ -69,7 +69,8 @@ struct TrainingConfig {
   double adam_epsilon = 1e-15;
   double lambda = 0.01;  // weight of the -beta^2 term
   // alpha0 and beta0 learn at learning_rate times these scales. alpha0 stays at its initial
-  // value for alpha_warmup_steps. beta0 of an element with no invalid (non-finite) reading
+  // value for alpha_warmup_steps (whichever of alpha and the field learns a ring first keeps
+  // it: bench/RESULTS.md, issue 13). beta0 of an element with no invalid (non-finite) reading
   // stays put for beta_warmup_steps (-1: the first learning-rate phase): while the image is
   // still far off, every element's residual is large and beta would switch live elements off,
   // most where rays are longest; an element with invalid readings learns from the start (the

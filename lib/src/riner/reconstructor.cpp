@@ -154,6 +154,15 @@ ReconstructionResult Reconstructor::result() const {
     r.image = r.response_rings->image;
     r.alpha = r.response_rings->alpha;
   }
+  // Each correction subtracts its profile along whole circles; where a circle leaves the
+  // region training sampled, that would paint the ring into air the measurements certified
+  // (the image is 0 there by construction): it stays 0.
+  const model::Occupancy& occupancy = impl_->setup.occupancy;
+  if (occupancy.carved) {
+    for (std::size_t p = 0; p < r.image.size(); ++p) {
+      if (!occupancy.inside[p]) r.image.data[p] = 0.0f;
+    }
+  }
   return r;
 }
 

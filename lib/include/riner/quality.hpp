@@ -1,0 +1,48 @@
+// No-reference quality of a 2D reconstruction, against the FBP of the same scan: what a user
+// without a ground truth can check (issue 13). Every measure is about the rotation axis at the
+// grid centre, inside the inscribed disc.
+//   ring index   riner::ring_index (metrics.hpp)
+//   specks       pixels whose difference from their 3 x 3 median exceeds 6 noise sigmas, per
+//                10^4 pixels of the disc; sigma is the FBP's pixel noise (1.4826 x the median
+//                absolute difference of the FBP from its own 3 x 3 median)
+//   centre       the largest difference, within `radius_px` of the axis, between the broad
+//                radial profiles (angular means smoothed over radius) of the image and of the
+//                FBP, against the FBP profile's own noise there (the rms of its angular means
+//                about their smoothed version): a disc or dip at the centre that FBP does not
+//                show stands out as more than one such sigma
+#pragma once
+
+#include "riner/array.hpp"
+
+namespace riner {
+
+// The FBP's pixel noise as the speck measure uses it (1/mm).
+double residual_noise(const Array& image);
+
+// Specks per 10^4 pixels of the inscribed disc, at 6 sigma of `noise`.
+double specks_per_10k(const Array& image, double noise);
+
+struct CentreDeviation {
+  int radius_px = 20;
+  double deviation = 0.0;  // largest |broad(image) - broad(fbp)| within radius_px (1/mm)
+  double at_px = 0.0;      // where
+  double fbp_noise = 0.0;  // rms of the FBP's angular means about their broad profile (1/mm)
+  double sigmas = 0.0;     // deviation / fbp_noise
+};
+
+CentreDeviation centre_deviation(const Array& image, const Array& fbp, int radius_px = 20,
+                                 double smoothing_px = 3.0);
+
+struct QualityReport {
+  double noise = 0.0;  // the FBP's pixel noise
+  double ring_index = 0.0;
+  double fbp_ring_index = 0.0;
+  double specks_per_10k = 0.0;
+  double fbp_specks_per_10k = 0.0;
+  CentreDeviation centre;
+};
+
+// InputError unless both are 2D, of the same shape, at least 16 x 16.
+QualityReport quality_against_fbp(const Array& image, const Array& fbp);
+
+}  // namespace riner

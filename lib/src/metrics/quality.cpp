@@ -1,0 +1,146 @@
+#include "riner/quality.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "riner/error.hpp"
+#include "riner/metrics.hpp"
+
+namespace riner {
+
+namespace {
+
+constexpr double kMadToSigma = 1.4826;
+constexpr double kSpeckSigmas = 6.0;
+
+void require_2d(const Array& a, const char* what) {
+  if (a.rank() != 2 || a.shape[0] < 16 || a.shape[1] < 16)
+    throw InputError(std::string(what) + " must be a 2D image of at least 16 x 16");
+}
+
+double disc_radius(const Array& a) { return 0.5 * static_cast<double>(std::min(a.shape[0], a.shape[1])) - 1.0; }
+
+double radius_of(const Array& a, std::size_t i, std::size_t k) {
+  return std::hypot(static_cast<double>(i) - 0.5 * (a.shape[0] - 1.0),
+                    static_cast<double>(k) - 0.5 * (a.shape[1] - 1.0));
+}
+
+// |pixel - median of its 3 x 3 neighbourhood| at every interior pixel of the disc, or -1.
+std::vector<double> median_residuals(const Array& a) {
+  const std::size_t ny = a.shape[0], nx = a.shape[1];
+  const double r_max = disc_radius(a);
+  std::vector<double> out(a.size(), -1.0);
+  std::array<float, 9> w{};
+  for (std::size_t i = 1; i + 1 < ny; ++i) {
+    for (std::size_t k = 1; k + 1 < nx; ++k) {
+      if (radius_of(a, i, k) > r_max) continue;
+      int n = 0;
+      for (int di = -1; di <= 1; ++di)
+        for (int dk = -1; dk <= 1; ++dk) w[n++] = a(i + di, k + dk);
+      std::nth_element(w.begin(), w.begin() + 4, w.end());
+      const double v = a(i, k);
+      if (std::isfinite(v) && std::isfinite(w[4])) out[i * nx + k] = std::fabs(v - w[4]);
+    }
+  }
+  return out;
+}
+
+// Angular-mean profile in 1-pixel bins about the grid centre, and the pixels per bin.
+void radial_profile(const Array& a, std::size_t bins, std::vector<double>& mean,
+                    std::vector<double>& count) {
+  mean.assign(bins, 0.0);
+  count.assign(bins, 0.0);
+  for (std::size_t i = 0; i < a.shape[0]; ++i) {
+    for (std::size_t k = 0; k < a.shape[1]; ++k) {
+      const auto r = static_cast<std::size_t>(std::lround(radius_of(a, i, k)));
+      if (r >= bins || !std::isfinite(a(i, k))) continue;
+      mean[r] += a(i, k);
+      count[r] += 1.0;
+    }
+  }
+  for (std::size_t r = 0; r < bins; ++r) mean[r] = count[r] > 0 ? mean[r] / count[r] : 0.0;
+}
+
+}  // namespace
+
+double residual_noise(const Array& image) {
+  require_2d(image, "the image");
+  std::vector<double> r;
+  for (double v : median_residuals(image)) {
+    if (v >= 0.0) r.push_back(v);
+  }
+  if (r.empty()) return 0.0;
+  std::nth_element(r.begin(), r.begin() + static_cast<long>(r.size() / 2), r.end());
+  return kMadToSigma * r[r.size() / 2];
+}
+
+double specks_per_10k(const Array& image, double noise) {
+  require_2d(image, "the image");
+  std::size_t specks = 0, pixels = 0;
+  for (double v : median_residuals(image)) {
+    if (v < 0.0) continue;
+    ++pixels;
+    specks += v > kSpeckSigmas * noise;
+  }
+  return pixels > 0 ? 1e4 * static_cast<double>(specks) / static_cast<double>(pixels) : 0.0;
+}
+
+CentreDeviation centre_deviation(const Array& image, const Array& fbp, int radius_px,
+                                 double smoothing_px) {
+  require_2d(image, "the image");
+  require_2d(fbp, "the FBP");
+  if (image.shape != fbp.shape) throw InputError("the image and the FBP differ in shape");
+  const long reach = static_cast<long>(std::ceil(3.0 * smoothing_px));
+  const std::size_t bins = static_cast<std::size_t>(radius_px + reach) + 1;
+  std::vector<double> pi, pf, count, unused;
+  radial_profile(image, bins, pi, unused);
+  radial_profile(fbp, bins, pf, count);
+  // Gaussian over radius, over the bins that hold pixels.
+  auto broad = [&](const std::vector<double>& p, long r) {
+    double wsum = 0.0, sum = 0.0;
+    for (long q = std::max(0L, r - reach); q <= r + reach; ++q) {
+      const auto b = static_cast<std::size_t>(q);
+      if (b >= bins || count[b] == 0) continue;
+      const double w = std::exp(-0.5 * (q - r) * (q - r) / (smoothing_px * smoothing_px));
+      wsum += w;
+      sum += w * p[b];
+    }
+    return wsum > 0.0 ? sum / wsum : 0.0;
+  };
+  CentreDeviation c;
+  c.radius_px = radius_px;
+  double noise2 = 0.0;
+  int used = 0;
+  for (long r = 0; r <= radius_px; ++r) {
+    if (count[static_cast<std::size_t>(r)] == 0) continue;
+    const double fbp_broad = broad(pf, r);
+    const double d = std::fabs(broad(pi, r) - fbp_broad);
+    noise2 += (pf[static_cast<std::size_t>(r)] - fbp_broad) * (pf[static_cast<std::size_t>(r)] - fbp_broad);
+    ++used;
+    if (d > c.deviation) {
+      c.deviation = d;
+      c.at_px = static_cast<double>(r);
+    }
+  }
+  c.fbp_noise = used > 0 ? std::sqrt(noise2 / used) : 0.0;
+  c.sigmas = c.fbp_noise > 0.0 ? c.deviation / c.fbp_noise : 0.0;
+  return c;
+}
+
+QualityReport quality_against_fbp(const Array& image, const Array& fbp) {
+  require_2d(image, "the image");
+  require_2d(fbp, "the FBP");
+  if (image.shape != fbp.shape) throw InputError("the image and the FBP differ in shape");
+  QualityReport q;
+  q.noise = residual_noise(fbp);
+  q.ring_index = ring_index(image);
+  q.fbp_ring_index = ring_index(fbp);
+  q.specks_per_10k = specks_per_10k(image, q.noise);
+  q.fbp_specks_per_10k = specks_per_10k(fbp, q.noise);
+  q.centre = centre_deviation(image, fbp);
+  return q;
+}
+
+}  // namespace riner

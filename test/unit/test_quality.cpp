@@ -1,0 +1,67 @@
+// The no-reference quality measures (riner/quality.hpp): noise, specks and the centre's broad
+// deviation from the FBP, on images with known noise, spikes and discs.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <random>
+
+#include "riner/error.hpp"
+#include "riner/quality.hpp"
+
+namespace {
+
+// A smooth ramp plus white noise of the given sigma.
+riner::Array noisy(std::size_t n, double sigma, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g(0.0, sigma);
+  riner::Array a({n, n});
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t k = 0; k < n; ++k)
+      a(i, k) = static_cast<float>(0.02 + 1e-5 * static_cast<double>(i + k) + g(rng));
+  return a;
+}
+
+}  // namespace
+
+TEST_SUITE("quality") {
+  TEST_CASE("the noise estimate scales with the noise, specks count isolated outliers") {
+    const riner::Array a = noisy(128, 1e-3, 1);
+    const riner::Array b = noisy(128, 2e-3, 2);
+    const double na = riner::residual_noise(a), nb = riner::residual_noise(b);
+    CHECK(na > 0.5e-3);
+    CHECK(na < 2e-3);
+    CHECK(nb / na == doctest::Approx(2.0).epsilon(0.1));
+    // White noise has (almost) no 6-sigma outliers; ten planted spikes of 20 sigma are ten.
+    CHECK(riner::specks_per_10k(a, na) < 1.0);
+    riner::Array spiky = a;
+    for (std::size_t s = 0; s < 10; ++s) spiky(30 + 6 * s, 40 + 5 * s) += 20.0f * static_cast<float>(na);
+    const double pixels = M_PI * 63.0 * 63.0;  // the inscribed disc, roughly
+    CHECK(riner::specks_per_10k(spiky, na) == doctest::Approx(1e4 * 10 / pixels).epsilon(0.1));
+  }
+
+  TEST_CASE("a disc at the centre that the FBP lacks stands out; the FBP's own noise does not") {
+    const std::size_t n = 160;
+    const riner::Array fbp = noisy(n, 2e-3, 3);
+    const double noise = riner::residual_noise(fbp);
+    riner::Array clean = noisy(n, 0.0, 4);  // the same ramp, no noise
+    const riner::CentreDeviation same = riner::centre_deviation(clean, fbp);
+    CHECK(same.fbp_noise > 0.0);
+    CHECK(same.sigmas < 2.0);
+    riner::Array disc = clean;
+    const double c = 0.5 * (n - 1.0);
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t k = 0; k < n; ++k)
+        if (std::hypot(i - c, k - c) < 12.0) disc(i, k) += 3e-3f;
+    const riner::CentreDeviation d = riner::centre_deviation(disc, fbp);
+    CHECK(d.deviation == doctest::Approx(3e-3).epsilon(0.3));
+    CHECK(d.at_px < 12.0);  // inside the disc
+    CHECK(d.sigmas > 3.0);
+    CHECK_THROWS_AS(riner::quality_against_fbp(riner::Array({8, 8}), riner::Array({8, 8})),
+                    riner::InputError);
+    CHECK_THROWS_AS(riner::centre_deviation(disc, riner::Array({n, n + 1})),
+                    riner::InputError);
+    const riner::QualityReport q = riner::quality_against_fbp(disc, fbp);
+    CHECK(q.noise == noise);
+    CHECK(q.specks_per_10k < q.fbp_specks_per_10k + 1.0);
+  }
+}
