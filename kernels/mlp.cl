@@ -89,53 +89,6 @@ RINER_INLINE float mlp_forward(__global const float* w, const float* in, float a
   return out;
 }
 
-// Accumulates d_out * d(output)/d(weights) into g and, when d_in is not 0, writes
-// d_out * d(output)/d(input) there.
-RINER_INLINE void mlp_backward(__global const float* w, __global float* g, const float* in,
-                         const float act[MLP_HIDDEN][MLP_WIDTH], float d_out, float* d_in) {
-  float16 delta[MLP_V];
-  RINER_UNROLL
-  for (int v = 0; v < MLP_V; ++v) {
-    const float16 a = vload16(v, act[MLP_HIDDEN - 1]);
-    grad_add16(g, MLP_W_OUT + 16 * v, d_out * a);
-    // Through the ReLU: only units that were on pass the gradient.
-    delta[v] = select((float16)(0.0f), d_out * vload16(v, w + MLP_W_OUT), a > 0.0f);
-  }
-  GRAD_ADD(&g[MLP_B_OUT], d_out);
-  RINER_UNROLL
-  for (int layer = MLP_HIDDEN - 1; layer >= 1; --layer) {
-    float next[MLP_WIDTH];
-    RINER_UNROLL
-    for (int i = 0; i < MLP_WIDTH; ++i) {
-      const float below = act[layer - 1][i];
-      float16 acc = (float16)(0.0f);
-      RINER_UNROLL
-      for (int v = 0; v < MLP_V; ++v) {
-        grad_add16(g, MLP_W_HIDDEN(layer) + i * MLP_WIDTH + 16 * v, below * delta[v]);
-        acc = mad(vload16(v, w + MLP_W_HIDDEN(layer) + i * MLP_WIDTH), delta[v], acc);
-      }
-      next[i] = sum16(acc);
-    }
-    RINER_UNROLL
-    for (int v = 0; v < MLP_V; ++v) {
-      grad_add16(g, MLP_B_HIDDEN(layer) + 16 * v, delta[v]);
-      delta[v] = select((float16)(0.0f), vload16(v, next), vload16(v, act[layer - 1]) > 0.0f);
-    }
-  }
-  RINER_UNROLL
-  for (int i = 0; i < MLP_INPUTS; ++i) {
-    float16 acc = (float16)(0.0f);
-    RINER_UNROLL
-    for (int v = 0; v < MLP_V; ++v) {
-      grad_add16(g, MLP_W_IN + i * MLP_WIDTH + 16 * v, in[i] * delta[v]);
-      acc = mad(vload16(v, w + MLP_W_IN + i * MLP_WIDTH), delta[v], acc);
-    }
-    if (d_in != 0) d_in[i] = sum16(acc);
-  }
-  RINER_UNROLL
-  for (int v = 0; v < MLP_V; ++v) grad_add16(g, MLP_B_IN + 16 * v, delta[v]);
-}
-
 // Back-propagates d_out without touching any weight gradient: delta[h][j] = dloss/d(pre-
 // activation j of hidden layer h) and d_in = dloss/d(input). A layer's weight gradient is the
 // sum over samples of its input times its delta (mlp_gradient.cl reduces it).
@@ -170,6 +123,36 @@ RINER_INLINE void mlp_deltas(__global const float* w, const float act[MLP_HIDDEN
     for (int v = 0; v < MLP_V; ++v) acc = mad(vload16(v, w + MLP_W_IN + i * MLP_WIDTH), d[v], acc);
     d_in[i] = sum16(acc);
   }
+}
+
+// Accumulates d_out * d(output)/d(weights) into g and writes d_out * d(output)/d(input) to
+// d_in: mlp_deltas, then each layer's input times its delta.
+RINER_INLINE void mlp_backward(__global const float* w, __global float* g, const float* in,
+                         const float act[MLP_HIDDEN][MLP_WIDTH], float d_out, float* d_in) {
+  float delta[MLP_HIDDEN][MLP_WIDTH];
+  mlp_deltas(w, act, d_out, delta, d_in);
+  RINER_UNROLL
+  for (int v = 0; v < MLP_V; ++v) grad_add16(g, MLP_W_OUT + 16 * v, d_out * vload16(v, act[MLP_HIDDEN - 1]));
+  GRAD_ADD(&g[MLP_B_OUT], d_out);
+  RINER_UNROLL
+  for (int layer = MLP_HIDDEN - 1; layer >= 1; --layer) {
+    RINER_UNROLL
+    for (int i = 0; i < MLP_WIDTH; ++i) {
+      const float below = act[layer - 1][i];
+      RINER_UNROLL
+      for (int v = 0; v < MLP_V; ++v)
+        grad_add16(g, MLP_W_HIDDEN(layer) + i * MLP_WIDTH + 16 * v, below * vload16(v, delta[layer]));
+    }
+    RINER_UNROLL
+    for (int v = 0; v < MLP_V; ++v) grad_add16(g, MLP_B_HIDDEN(layer) + 16 * v, vload16(v, delta[layer]));
+  }
+  RINER_UNROLL
+  for (int i = 0; i < MLP_INPUTS; ++i) {
+    RINER_UNROLL
+    for (int v = 0; v < MLP_V; ++v) grad_add16(g, MLP_W_IN + i * MLP_WIDTH + 16 * v, in[i] * vload16(v, delta[0]));
+  }
+  RINER_UNROLL
+  for (int v = 0; v < MLP_V; ++v) grad_add16(g, MLP_B_IN + 16 * v, vload16(v, delta[0]));
 }
 
 __kernel void mlp_forward_batch(const uint n, __global const float* params, const uint offset,

@@ -37,16 +37,28 @@ nlohmann::json ring_summary(const std::optional<RingCorrection>& rings) {
 }
 
 // What a user without a ground truth can check (riner/quality.hpp): rings, specks and the
-// centre against the FBP of the same scan; 2D only (null in 3D).
-nlohmann::json quality_summary(const Reconstructor& r, const ReconstructionResult& result,
-                               const std::optional<Device>& device) {
-  if (r.scan().geometry.is_3d()) return nullptr;
+// centre against the FBP of the same scan, for the image and (the centre) the trained field.
+struct QualityCheck {
+  QualityReport image;
+  CentreDeviation field;
+};
+
+// 2D only (nullopt in 3D).
+std::optional<QualityCheck> check_quality(const Reconstructor& r,
+                                          const ReconstructionResult& result,
+                                          const std::optional<Device>& device) {
+  if (r.scan().geometry.is_3d()) return std::nullopt;
   FbpOptions options;
   options.engine = r.config().engine;
   options.device = device;
   const Array fbp_image = fbp(r.scan(), options);
-  const QualityReport q = quality_against_fbp(result.image, fbp_image);
-  const CentreDeviation field = centre_deviation(result.field_image, fbp_image);
+  return QualityCheck{quality_against_fbp(result.image, fbp_image),
+                      centre_deviation(result.field_image, fbp_image)};
+}
+
+nlohmann::json quality_summary(const std::optional<QualityCheck>& check) {
+  if (!check) return nullptr;
+  const QualityReport& q = check->image;
   return {{"fbp_noise_per_mm", q.noise},
           {"ring_index", q.ring_index},
           {"fbp_ring_index", q.fbp_ring_index},
@@ -58,7 +70,25 @@ nlohmann::json quality_summary(const Reconstructor& r, const ReconstructionResul
             {"at_px", q.centre.at_px},
             {"fbp_profile_noise_per_mm", q.centre.fbp_noise},
             {"fbp_noise_sigmas", q.centre.sigmas},
-            {"field_fbp_noise_sigmas", field.sigmas}}}};
+            {"field_fbp_noise_sigmas", check->field.sigmas}}}};
+}
+
+// Where the tool has doubts, say so.
+void print_doubts(Console& console, const QualityReport& q) {
+  char line[200];
+  if (q.centre.sigmas > 1.0) {
+    std::snprintf(line, sizeof(line),
+                  "note: near the rotation axis the image departs from FBP's broad profile by "
+                  "%.1f times FBP's own noise there (a disc or dip rings can hide)",
+                  q.centre.sigmas);
+    console.line(line);
+  }
+  if (q.specks_per_10k > q.fbp_specks_per_10k) {
+    std::snprintf(line, sizeof(line),
+                  "note: %.1f isolated specks per 10^4 pixels against FBP's %.1f",
+                  q.specks_per_10k, q.fbp_specks_per_10k);
+    console.line(line);
+  }
 }
 
 RinerConfig config_from(const Args& args) {
@@ -187,6 +217,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   write_text(out / "config.json", reconstructor.config().to_json());  // as resolved for the device
 
   const TrainingStats stats = reconstructor.stats();
+  const std::optional<QualityCheck> quality = check_quality(reconstructor, result, device);
   nlohmann::json summary = {
       {"image", image_path.string()},
       {"shape", image.shape},
@@ -208,7 +239,7 @@ int run_reconstruct(int argc, char** argv, int first) {
         {"samples_kept_fraction", stats.samples_kept_fraction},
         {"noise_sigma", stats.noise},
         {"note", config.training.skip_air ? stats.air_note : "off (training.skip_air)"}}},
-      {"quality", quality_summary(reconstructor, result, device)},
+      {"quality", quality_summary(quality)},
       {"air_ring_correction", ring_summary(result.air_rings)},
       {"gradient_ring_correction", ring_summary(result.gradient_rings)},
       {"response_ring_correction", ring_summary(result.response_rings)},
@@ -218,25 +249,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   console.line("reconstructed " + shape_string(image.shape) + " in " +
                format_duration(stats.seconds) + " (" + std::to_string(stats.steps) + " steps, " +
                std::to_string(dead.size()) + " elements flagged dead) -> " + out.string());
-  // Where the tool has doubts, say so (the measures: riner/quality.hpp).
-  if (const nlohmann::json& q = summary["quality"]; q.is_object()) {
-    char line[200];
-    const double sigmas = q["centre"]["fbp_noise_sigmas"].get<double>();
-    if (sigmas > 1.0) {
-      std::snprintf(line, sizeof(line),
-                    "note: near the rotation axis the image departs from FBP's broad profile by "
-                    "%.1f times FBP's own noise there (a disc or dip rings can hide)",
-                    sigmas);
-      console.line(line);
-    }
-    if (q["specks_per_10k_pixels"].get<double>() > q["fbp_specks_per_10k_pixels"].get<double>()) {
-      std::snprintf(line, sizeof(line),
-                    "note: %.1f isolated specks per 10^4 pixels against FBP's %.1f",
-                    q["specks_per_10k_pixels"].get<double>(),
-                    q["fbp_specks_per_10k_pixels"].get<double>());
-      console.line(line);
-    }
-  }
+  if (quality) print_doubts(console, quality->image);
   console.summary(summary);
   return 0;
 }

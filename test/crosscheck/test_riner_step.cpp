@@ -53,6 +53,29 @@ std::vector<Scenario> scenarios() {
   return s;
 }
 
+// A step's fixed inputs on the device, and its loss history.
+struct DeviceInputs {
+  riner::cl::Buffer<cl_float8> segments;
+  riner::cl::Buffer<float> rho;
+  riner::cl::Buffer<cl_uint> invalid;
+  riner::cl::Buffer<float> params;
+  riner::cl::Buffer<float> history;
+
+  DeviceInputs(const std::vector<riner::model::RaySegment>& s, const std::vector<float>& r,
+               const std::vector<std::uint32_t>& inv, const std::vector<float>& p)
+      : segments(ctx(), std::span<const cl_float8>(reinterpret_cast<const cl_float8*>(s.data()),
+                                                   s.size())),
+        rho(ctx(), std::span<const float>(r)),
+        invalid(ctx(), std::span<const cl_uint>(inv)),
+        params(ctx(), std::span<const float>(p)),
+        history(ctx(), 2) {}
+
+  void step(riner::ops::RinerStepOp& op, const riner::ops::StepParams& p,
+            const riner::cl::Buffer<cl_uint>& words, riner::cl::Buffer<float>& grad) {
+    op.step(p, words, {&segments, &rho, &invalid}, params, grad, history);
+  }
+};
+
 // The device's gradient: grad plus the MLP's split-K slices added where they belong.
 std::vector<double> full_gradient(const riner::ops::RinerStepOp& op,
                                   const riner::model::ParameterLayout& l,
@@ -110,13 +133,7 @@ TEST_SUITE("riner_step") {
       std::vector<float> level_weights(static_cast<std::size_t>(l.levels), 1.0f);
       if (sc.coarse_to_fine) level_weights.back() = 0.3f;
 
-      const riner::cl::Buffer<cl_float8> d_segments(
-          ctx(), std::span<const cl_float8>(reinterpret_cast<const cl_float8*>(segments.data()),
-                                            segments.size()));
-      const riner::cl::Buffer<float> d_rho(ctx(), std::span<const float>(rho));
-      const riner::cl::Buffer<cl_uint> d_invalid(ctx(), std::span<const cl_uint>(invalid));
-      const riner::cl::Buffer<float> d_params(ctx(), std::span<const float>(params));
-      riner::cl::Buffer<float> history(ctx(), 2);
+      DeviceInputs device(segments, rho, invalid, params);
       const std::vector<double> params_d(params.begin(), params.end());
       const riner::model::BatchSampler sampler(g, t);
 
@@ -148,7 +165,7 @@ TEST_SUITE("riner_step") {
           p.block_views = batch.block_views;
           p.block_elements = batch.block_elements;
           riner::cl::Buffer<float> grad(ctx(), std::vector<float>(l.total, 0.0f));
-          op.step(p, words, {&d_segments, &d_rho, &d_invalid}, d_params, grad, history);
+          device.step(op, p, words, grad);
 
           riner::ref::StepInputs in;
           in.layout = &l;
@@ -177,7 +194,7 @@ TEST_SUITE("riner_step") {
           d_sums.resize(n);
           const auto d_err = riner::test::compare(d_sums, want.d_sums);
           CHECK_MESSAGE(d_err.rms_rel < 1e-5, d_err.describe());
-          const std::vector<float> losses = history.read();
+          const std::vector<float> losses = device.history.read();
           CHECK(losses[0] == doctest::Approx(want.data_loss).epsilon(1e-5));
           CHECK(losses[1] == doctest::Approx(want.penalty).epsilon(1e-5));
           // Gradients: sums over thousands of float32 products (the MLP's) and atomics in any
@@ -212,13 +229,7 @@ TEST_SUITE("riner_step") {
     for (std::size_t i = 0; i < l.grid_params; ++i) params[i] = u(rng);
     std::vector<float> rho(g.n_views() * g.n_u, 0.5f);
     std::vector<std::uint32_t> invalid(g.n_u, 0);
-    const riner::cl::Buffer<cl_float8> d_segments(
-        ctx(), std::span<const cl_float8>(reinterpret_cast<const cl_float8*>(segments.data()),
-                                          segments.size()));
-    const riner::cl::Buffer<float> d_rho(ctx(), std::span<const float>(rho));
-    const riner::cl::Buffer<cl_uint> d_invalid(ctx(), std::span<const cl_uint>(invalid));
-    const riner::cl::Buffer<float> d_params(ctx(), std::span<const float>(params));
-    riner::cl::Buffer<float> history(ctx(), 2);
+    DeviceInputs device(segments, rho, invalid, params);
     c.training.rays_per_step = 200;
     const riner::model::BatchSampler sampler(g, c.training);
     riner::PlanConfig pc;
@@ -235,7 +246,7 @@ TEST_SUITE("riner_step") {
     std::vector<double> first;
     for (int run = 0; run < 2; ++run) {
       riner::cl::Buffer<float> grad(ctx(), std::vector<float>(l.total, 0.0f));
-      op.step(p, words, {&d_segments, &d_rho, &d_invalid}, d_params, grad, history);
+      device.step(op, p, words, grad);
       const std::vector<double> g_run = full_gradient(op, l, grad.read());
       if (run == 0)
         first = g_run;

@@ -109,6 +109,9 @@ struct TrainingConfig {
     return lr_decay_steps > 0 ? lr_decay_steps : std::max(1, steps / 4);
   }
   int beta_warmup() const { return beta_warmup_steps >= 0 ? beta_warmup_steps : decay_interval(); }
+  int plateau_window_steps() const {
+    return plateau_window > 0 ? plateau_window : std::max(1, decay_interval() / 4);
+  }
 };
 
 // After training, 2D: the ring corrections (riner/ring_correction.hpp) move the rings the data

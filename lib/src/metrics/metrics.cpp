@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "metrics/radial_profile.hpp"
 #include "riner/error.hpp"
 #include "riner/io.hpp"
 
@@ -168,29 +169,41 @@ ImageMetrics compare_images(const Array& image, const Array& reference, const Ar
   return m;
 }
 
-double ring_index(const Array& image) {
-  if (image.rank() != 2) throw InputError("the ring index takes a 2D image");
+namespace metrics {
+
+void radial_means(const Array& image, std::size_t bins, std::vector<double>& mean,
+                  std::vector<double>& count) {
   const std::size_t ny = image.shape[0];
   const std::size_t nx = image.shape[1];
-  const double cy = 0.5 * (ny - 1.0);
-  const double cx = 0.5 * (nx - 1.0);
-  const auto bins = static_cast<std::size_t>(0.5 * static_cast<double>(std::min(nx, ny)));
-  if (bins < 8) throw InputError("the ring index needs an image of at least 16 x 16");
-  std::vector<double> sum(bins, 0.0);
-  std::vector<double> count(bins, 0.0);
+  const double cy = 0.5 * (static_cast<double>(ny) - 1.0);
+  const double cx = 0.5 * (static_cast<double>(nx) - 1.0);
+  mean.assign(bins, 0.0);
+  count.assign(bins, 0.0);
   for (std::size_t i = 0; i < ny; ++i) {
     for (std::size_t k = 0; k < nx; ++k) {
       const auto r = static_cast<std::size_t>(
           std::lround(std::hypot(static_cast<double>(i) - cy, static_cast<double>(k) - cx)));
       if (r >= bins || !std::isfinite(image(i, k))) continue;
-      sum[r] += image(i, k);
+      mean[r] += image(i, k);
       count[r] += 1.0;
     }
   }
+  for (std::size_t r = 0; r < bins; ++r) mean[r] = count[r] > 0 ? mean[r] / count[r] : 0.0;
+}
+
+}  // namespace metrics
+
+double ring_index(const Array& image) {
+  if (image.rank() != 2) throw InputError("the ring index takes a 2D image");
+  const auto bins =
+      static_cast<std::size_t>(0.5 * static_cast<double>(std::min(image.shape[0], image.shape[1])));
+  if (bins < 8) throw InputError("the ring index needs an image of at least 16 x 16");
+  std::vector<double> mean, count;
+  metrics::radial_means(image, bins, mean, count);
   // Radii no pixel centre rounds to (0 on an even grid) are left out, not taken as 0.
   std::vector<double> profile;
   for (std::size_t r = 0; r < bins; ++r) {
-    if (count[r] > 0) profile.push_back(sum[r] / count[r]);
+    if (count[r] > 0) profile.push_back(mean[r]);
   }
   double residual = 0.0;
   const std::size_t n = profile.size();

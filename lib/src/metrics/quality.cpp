@@ -5,6 +5,7 @@
 #include <cmath>
 #include <vector>
 
+#include "metrics/radial_profile.hpp"
 #include "riner/error.hpp"
 #include "riner/metrics.hpp"
 
@@ -47,22 +48,6 @@ std::vector<double> median_residuals(const Array& a) {
   return out;
 }
 
-// Angular-mean profile in 1-pixel bins about the grid centre, and the pixels per bin.
-void radial_profile(const Array& a, std::size_t bins, std::vector<double>& mean,
-                    std::vector<double>& count) {
-  mean.assign(bins, 0.0);
-  count.assign(bins, 0.0);
-  for (std::size_t i = 0; i < a.shape[0]; ++i) {
-    for (std::size_t k = 0; k < a.shape[1]; ++k) {
-      const auto r = static_cast<std::size_t>(std::lround(radius_of(a, i, k)));
-      if (r >= bins || !std::isfinite(a(i, k))) continue;
-      mean[r] += a(i, k);
-      count[r] += 1.0;
-    }
-  }
-  for (std::size_t r = 0; r < bins; ++r) mean[r] = count[r] > 0 ? mean[r] / count[r] : 0.0;
-}
-
 }  // namespace
 
 double residual_noise(const Array& image) {
@@ -95,8 +80,8 @@ CentreDeviation centre_deviation(const Array& image, const Array& fbp, int radiu
   const long reach = static_cast<long>(std::ceil(3.0 * smoothing_px));
   const std::size_t bins = static_cast<std::size_t>(radius_px + reach) + 1;
   std::vector<double> pi, pf, count, unused;
-  radial_profile(image, bins, pi, unused);
-  radial_profile(fbp, bins, pf, count);
+  metrics::radial_means(image, bins, pi, unused);
+  metrics::radial_means(fbp, bins, pf, count);
   // Gaussian over radius, over the bins that hold pixels.
   auto broad = [&](const std::vector<double>& p, long r) {
     double wsum = 0.0, sum = 0.0;

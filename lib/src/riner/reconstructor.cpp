@@ -22,6 +22,15 @@ struct Reconstructor::Impl {
       : setup(std::move(scan), std::move(config)),
         sampler(setup.scan.geometry, setup.config.training) {}
 
+  // The air training skipped reads 0 (the measurements certified it).
+  void zero_skipped_air(Array& image) const {
+    const model::Occupancy& o = setup.occupancy;
+    if (!o.carved) return;
+    for (std::size_t i = 0; i < image.data.size(); ++i) {
+      if (!o.inside[i]) image.data[i] = 0.0f;
+    }
+  }
+
   void drain() {
     for (LossRecord& r : trainer->drain_losses()) {
       if (!std::isfinite(r.data_loss)) {
@@ -82,7 +91,7 @@ bool on_plateau(const TrainingConfig& t, const std::vector<LossRecord>& history)
   if (!t.stop_on_plateau || t.steps <= 0) return false;
   const int interval = t.decay_interval();
   const int last_phase = (t.steps - 1) / interval * interval;
-  const int window = t.plateau_window > 0 ? t.plateau_window : std::max(1, interval / 4);
+  const int window = t.plateau_window_steps();
   const int done = static_cast<int>(history.size());
   if (done - 2 * window < last_phase) return false;
   double latest = 0.0, before = 0.0;
@@ -100,8 +109,7 @@ void Reconstructor::run(const ProgressCallback& callback, int report_every) {
   const int total = t.steps;
   report_every = std::max(1, report_every);
   if (t.stop_on_plateau) {  // check at least once per window
-    const int window = t.plateau_window > 0 ? t.plateau_window : t.decay_interval() / 4;
-    report_every = std::min(report_every, std::max(1, window / 4));
+    report_every = std::min(report_every, std::max(1, t.plateau_window_steps() / 4));
   }
   while (impl_->steps < total && !impl_->plateaued) {
     step(std::min(report_every, total - impl_->steps));
@@ -121,12 +129,7 @@ Array Reconstructor::field_image() const {
   const Geometry& g = impl_->setup.scan.geometry;
   Array out(g.volume_shape);
   out.data = impl_->trainer->evaluate_grid();
-  const model::Occupancy& o = impl_->setup.occupancy;
-  if (o.carved) {
-    for (std::size_t i = 0; i < out.data.size(); ++i) {
-      if (!o.inside[i]) out.data[i] = 0.0f;
-    }
-  }
+  impl_->zero_skipped_air(out);
   return out;
 }
 
@@ -155,14 +158,8 @@ ReconstructionResult Reconstructor::result() const {
     r.alpha = r.response_rings->alpha;
   }
   // Each correction subtracts its profile along whole circles; where a circle leaves the
-  // region training sampled, that would paint the ring into air the measurements certified
-  // (the image is 0 there by construction): it stays 0.
-  const model::Occupancy& occupancy = impl_->setup.occupancy;
-  if (occupancy.carved) {
-    for (std::size_t p = 0; p < r.image.size(); ++p) {
-      if (!occupancy.inside[p]) r.image.data[p] = 0.0f;
-    }
-  }
+  // sampled region, that would paint the ring into the skipped air.
+  impl_->zero_skipped_air(r.image);
   return r;
 }
 
