@@ -85,8 +85,8 @@ void print_doubts(Console& console, const QualityReport& q) {
   }
   if (q.specks_per_10k > q.fbp_specks_per_10k) {
     std::snprintf(line, sizeof(line),
-                  "note: %.1f isolated specks per 10^4 pixels against FBP's %.1f",
-                  q.specks_per_10k, q.fbp_specks_per_10k);
+                  "note: %.1f isolated specks per 10^4 pixels against FBP's %.1f", q.specks_per_10k,
+                  q.fbp_specks_per_10k);
     console.line(line);
   }
 }
@@ -107,6 +107,19 @@ RinerConfig config_from(const Args& args) {
   }
   if (auto v = args.maybe("lr"); v && !v->empty())
     config.training.learning_rate = args.number("lr");
+  if (const std::string list = args.get("set"); !list.empty()) {
+    std::size_t begin = 0;
+    while (begin <= list.size()) {
+      const std::size_t end = std::min(list.find(',', begin), list.size());
+      const std::string item = list.substr(begin, end - begin);
+      const std::size_t eq = item.find('=');
+      if (eq == std::string::npos || eq == 0) {
+        throw UsageError("--set takes NAME=VALUE pairs separated by commas (got '" + item + "')");
+      }
+      config.set(item.substr(0, eq), item.substr(eq + 1));
+      begin = end + 1;
+    }
+  }
   if (args.is_set("no-ring-correction")) {
     config.rings.air_reference = false;
     config.rings.gradient_reference = false;
@@ -141,6 +154,10 @@ int run_reconstruct(int argc, char** argv, int first) {
       .option("out", "DIR", "output folder (created if missing)")
       .option("format", "EXT", "image format: nii, npy, tif or raw", "nii")
       .option("config", "FILE", "settings JSON ({\"training\": {\"steps\": 4000}, ...})", "")
+      .option("set", "NAME=VALUE,...",
+              "change settings after --config (training.alpha_lr_scale=0.3; `riner settings` "
+              "lists them)",
+              "")
       .option("steps", "N",
               "training steps (default " + std::to_string(RinerConfig().training.steps) +
                   "; the learning rate halves every quarter of them)",

@@ -11,5 +11,6 @@ int run_fbp(int argc, char** argv, int first);
 int run_compare(int argc, char** argv, int first);
 int run_reconstruct(int argc, char** argv, int first);
 int run_demo(int argc, char** argv, int first);
+int run_settings(int argc, char** argv, int first);
 
 }  // namespace riner::app

@@ -26,6 +26,7 @@ constexpr Command kCommands[] = {
     {"simulate", riner::app::run_simulate, "simulate a ring-corrupted scan (paper protocol)"},
     {"fbp", riner::app::run_fbp, "filtered backprojection (FBP / FDK) of a scan"},
     {"compare", riner::app::run_compare, "PSNR / SSIM / MAE of an image against a reference"},
+    {"settings", riner::app::run_settings, "every reconstruct setting: default, range, meaning"},
 };
 
 void print_usage(std::FILE* out) {

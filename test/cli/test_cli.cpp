@@ -129,6 +129,47 @@ TEST_SUITE("cli") {
     CHECK(clean(0, 249) == doctest::Approx(256 * 0.02).epsilon(0.01));
   }
 
+  TEST_CASE("settings: one table for the list, the README, --set and config.json") {
+    riner::test::TempDir dir;
+    const Run list = riner_cli("settings --json", dir);
+    REQUIRE(list.code == 0);
+    const auto settings = nlohmann::json::parse(list.out)["settings"];
+    CHECK(settings.size() >= 60);
+    // The README's table is the one `riner settings --markdown` prints.
+    const Run markdown = riner_cli("settings --markdown", dir);
+    REQUIRE(markdown.code == 0);
+    const std::string readme =
+        riner::test::read_bytes(std::string(RINER_SOURCE_DIR) + "/README.md");
+    CHECK_MESSAGE(readme.find(markdown.out) != std::string::npos,
+                  "README.md's settings table is out of date: paste `riner settings --markdown`");
+
+    const std::string sim = (dir / "sim").string();
+    REQUIRE(riner_cli("simulate --quiet --seed 3 --out " + sim, dir).code == 0);
+    const Run run = riner_cli("reconstruct " + sim +
+                                  "/sino.npy --quiet --set "
+                                  "training.steps=20,training.sampler=mixed,"
+                                  "rings.response_air_fraction=0.05 --out " +
+                                  (dir / "r").string(),
+                              dir);
+    REQUIRE(run.code == 0);
+    const auto written = nlohmann::json::parse(riner::test::read_bytes(dir / "r" / "config.json"));
+    CHECK(written["training"]["steps"] == 20);
+    CHECK(written["training"]["sampler"] == "mixed");
+    CHECK(written["rings"]["response_air_fraction"] == 0.05);
+    expect_error(riner_cli("reconstruct " + sim + "/sino.npy --set training.steps=-4 --out " +
+                               (dir / "s").string(),
+                           dir),
+                 2, "config: training.steps must be in 0..10000000 (training steps)");
+    expect_error(riner_cli("reconstruct " + sim + "/sino.npy --set training.stepz=4 --out " +
+                               (dir / "s").string(),
+                           dir),
+                 2, "config: unknown setting training.stepz (riner settings lists them)");
+    expect_error(
+        riner_cli("reconstruct " + sim + "/sino.npy --set steps --out " + (dir / "s").string(),
+                  dir),
+        2, "--set takes NAME=VALUE pairs separated by commas (got 'steps')");
+  }
+
   TEST_CASE("reconstruct: the ring corrections change image and alpha by rings, or not at all") {
     riner::test::TempDir dir;
     const std::string sim = (dir / "sim").string();

@@ -1,7 +1,14 @@
 #include <doctest/doctest.h>
 
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
 #include "riner/error.hpp"
 #include "riner/riner_config.hpp"
+#include "rings/ring_settings.hpp"
+#include "settings/config_settings.hpp"
 
 TEST_SUITE("riner_config") {
   TEST_CASE("defaults are valid and round-trip through JSON") {
@@ -54,43 +61,39 @@ TEST_SUITE("riner_config") {
     };
     expect(R"({"training": {"stepz": 3}})", "c.json: config: unknown setting training.stepz");
     expect(R"({"network": {"width": 24}})",
-           "config: network.width must be a multiple of 16 in 16..256");
+           "c.json: config: network.width must be a multiple of 16");
     expect(R"({"training": {"steps": "many"}})",
            "c.json: config: training.steps must be an integer");
     expect(R"({"training": {"learning_rate": -1}})",
-           "config: training.learning_rate must be in (0, 10)");
+           "c.json: config: training.learning_rate must be in (0, 10) (Adam's learning rate)");
     expect(R"({"training": {"sampler": "random"}})",
-           "c.json: config: training.sampler must be uniform, views-x-elements or mixed");
+           "c.json: config: training.sampler must be one of uniform, views-x-elements, mixed");
     expect(R"({"training": {"ring_lambda": 1}})",
-           "config: training.ring_lambda needs the views-x-elements or mixed sampler with "
-           "elements_per_step >= 3");
+           "c.json: config: training.ring_lambda needs the views-x-elements or mixed sampler "
+           "with elements_per_step >= 3");
     expect(R"({"encoding": {"finest_resolution": 8}})",
-           "config: encoding.finest_resolution must be 0 (the grid's size) or >= base_resolution "
-           "and <= 2^20");
-    expect(R"({"engine": "gpu"})", "c.json: engine must be opencl or reference (got \"gpu\")");
-    expect("[1, 2]", "c.json: config: config must be an object");
-    expect(R"({"rings": {"air_fraction": 1.5}})", "config: rings.air_fraction must be in (0, 1)");
+           "c.json: config: encoding.finest_resolution must be 0 (the grid's size) or >= "
+           "base_resolution");
+    expect(R"({"engine": "gpu"})", "c.json: config: engine must be one of opencl, reference");
+    expect("[1, 2]", "c.json: config: the settings must be a JSON object");
     expect(R"({"rings": {"gradient_flat_fraction": 0}})",
-           "config: rings.gradient_flat_fraction must be in (0, 1]");
-    expect(R"({"rings": {"response_scale_px": 0}})",
-           "config: rings.response_scale_px must be in (0, 1000]");
+           "c.json: config: rings.gradient_flat_fraction must be in (0, 1] (gradient correction: "
+           "fraction of each circle's flattest points in the median)");
     expect(R"({"rings": {"air_reference": 1}})",
            "c.json: config: rings.air_reference must be true or false");
-    expect(R"({"plan": {"kind": "fpga"}})", "config: plan.kind must be auto, cpu or gpu");
-    expect(R"({"plan": {"float_atomics": "fast"}})",
-           "config: plan.float_atomics must be auto, nvidia-ptx, cl_ext_float_atomics, "
-           "amd-builtin or compare-exchange");
-    expect(R"({"plan": {"kind": 1}})", "c.json: config: plan.kind must be a string");
-    expect(R"({"plan": {"sample_group": -1}})",
-           "config: plan.sample_group must be in 0..4096 (0: the device's choice)");
+    expect(R"({"plan": {"kind": 1}})",
+           "c.json: config: plan.kind must be a string: one of auto, cpu, gpu");
     expect(R"({"plan": {"lanes": 4}})", "c.json: config: unknown setting plan.lanes");
-    expect(R"({"training": {"air_margin_px": 100}})",
-           "config: training.air_margin_px must be in 0..64");
-    expect(R"({"training": {"air_noise_sigmas": 0}})",
-           "config: training.air_noise_sigmas must be in [0.5, 100]");
+    expect(R"({"plan": 4})", "c.json: config: plan must be an object");
     expect(R"({"training": {"rays_per_step": -3}})",
-           "config: training.rays_per_step must be in 1..2^20, or 0 (the device's execution "
-           "plan chooses)");
+           "c.json: config: training.rays_per_step must be in 0..1048576 (uniform sampler's rays "
+           "per step; 0: the execution plan's)");
+    // A value beyond an int's range is refused, not wrapped.
+    expect(R"({"training": {"steps": 5000000000}})",
+           "c.json: config: training.steps must be in 0..10000000 (training steps)");
+    expect(R"({"training": {"seed": -1}})",
+           "c.json: config: training.seed must be in 0..1.84467e+19 (seed of the initial "
+           "weights and the sampler)");
   }
 
   TEST_CASE("the execution plan and air skipping are settings like the others") {
@@ -114,5 +117,128 @@ TEST_SUITE("riner_config") {
     riner::RinerConfig d;
     d.update_from_json(c.to_json());
     CHECK(d.to_json() == c.to_json());
+  }
+}
+
+// Every setting of the table: a value other than the default round-trips through config.json
+// and through set(); each finite bound is enforced (just outside it is refused naming the
+// setting, the bound itself accepted where the range is closed); a value of the wrong type is
+// refused.
+TEST_SUITE("settings table") {
+  using riner::RinerConfig;
+  using riner::settings::Type;
+
+  // A value just outside `bound` (below when `below`): the next integer, or a relative step.
+  double outside(Type type, double bound, bool open, bool below) {
+    const double sign = below ? -1.0 : 1.0;
+    if (open) return bound;
+    if (type == Type::kInteger) return bound + sign;
+    return bound + sign * std::max(1e-6, std::fabs(bound) * 1e-3);
+  }
+
+  std::string set_json(const riner::settings::Setting<RinerConfig>& s, const std::string& value) {
+    if (s.section.empty()) return "{\"" + s.key + "\": " + value + "}";
+    return "{\"" + s.section + "\": {\"" + s.key + "\": " + value + "}}";
+  }
+
+  std::string number_text(Type type, double v) {
+    char text[64];
+    std::snprintf(text, sizeof(text), type == Type::kInteger ? "%.0f" : "%.17g", v);
+    return text;
+  }
+
+  TEST_CASE("every setting round-trips and every bound is enforced") {
+    const auto& table = riner::config_settings();
+    CHECK(table.size() == RinerConfig::settings().size());
+    // ring_lambda > 0 needs this sampler; everything else is valid on the defaults.
+    const std::string base = R"({"training": {"sampler": "mixed", "elements_per_step": 4}})";
+    for (const auto& s : table) {
+      CAPTURE(s.name());
+      RinerConfig defaults;
+      defaults.update_from_json(base);
+      const nlohmann::json default_value = s.get(defaults);
+      std::vector<std::string> candidates;
+      if (s.type == Type::kBool) candidates = {default_value.get<bool>() ? "false" : "true"};
+      if (s.type == Type::kChoice) {
+        for (const auto& c : s.choices) candidates.push_back("\"" + c + "\"");
+      }
+      if (s.type == Type::kInteger || s.type == Type::kNumber) {
+        const riner::settings::Range& r = s.range;
+        REQUIRE(std::isfinite(r.lo));
+        REQUIRE(std::isfinite(r.hi));
+        const double mid =
+            s.type == Type::kInteger ? std::floor(0.5 * (r.lo + r.hi)) : 0.5 * (r.lo + r.hi);
+        if (!r.lo_open) candidates.push_back(number_text(s.type, r.lo));
+        if (!r.hi_open && r.hi < 1e15) candidates.push_back(number_text(s.type, r.hi));
+        candidates.push_back(number_text(s.type, mid));
+        // Out of range, below and above: refused, naming the setting.
+        for (bool below : {true, false}) {
+          const double bad =
+              outside(s.type, below ? r.lo : r.hi, below ? r.lo_open : r.hi_open, below);
+          if (std::fabs(bad) > 1e15) continue;
+          RinerConfig c = defaults;
+          try {
+            c.update_from_json(set_json(s, number_text(s.type, bad)), "t.json");
+            FAIL("accepted " << bad);
+          } catch (const riner::InputError& e) {
+            CHECK(std::string(e.what()).find(s.name() + " must be") != std::string::npos);
+          }
+        }
+        RinerConfig c = defaults;
+        CHECK_THROWS_AS(c.update_from_json(set_json(s, "\"text\"")), riner::InputError);
+      } else {
+        RinerConfig c = defaults;
+        CHECK_THROWS_AS(c.update_from_json(set_json(s, "17.5")), riner::InputError);
+      }
+      // The first candidate other than the default that the cross-setting rules allow.
+      bool round_tripped = false;
+      for (const std::string& text : candidates) {
+        if (nlohmann::json::parse(text) == default_value) continue;
+        RinerConfig c = defaults;
+        try {
+          c.update_from_json(set_json(s, text));
+        } catch (const riner::InputError&) {
+          continue;  // e.g. network.width 136, not a multiple of 16
+        }
+        CHECK(s.get(c) == nlohmann::json::parse(text));
+        RinerConfig d;
+        d.update_from_json(c.to_json());
+        CHECK(d.to_json() == c.to_json());
+        RinerConfig e = defaults;
+        e.set(s.name(), text);
+        CHECK(e.to_json() == c.to_json());
+        round_tripped = true;
+        break;
+      }
+      CHECK(round_tripped);
+    }
+  }
+
+  TEST_CASE("set() takes bare words for choices and names unknown settings") {
+    RinerConfig c;
+    c.set("training.sampler", "views-x-elements");
+    CHECK(c.training.sampler == riner::Sampler::kViewsTimesElements);
+    c.set("engine", "reference");
+    CHECK(c.engine == riner::Engine::kReference);
+    c.set("rings.response_air_fraction", "0.05");
+    CHECK(c.rings.response.air_fraction == 0.05);
+    CHECK_THROWS_WITH_AS(c.set("training.stepz", "3"),
+                         "config: unknown setting training.stepz (riner settings lists them)",
+                         riner::InputError);
+    CHECK_THROWS_WITH_AS(c.set("network.width", "24"),
+                         "config: network.width must be a multiple of 16", riner::InputError);
+    CHECK(c.network.width == 32);  // a refused change leaves the config as it was
+  }
+
+  TEST_CASE("the corrections refuse settings outside the config's bounds") {
+    riner::AirRingSettings air;
+    air.erosion_px = 65;
+    CHECK_THROWS_WITH_AS(riner::rings::validate("air ring correction", air),
+                         "air ring correction: rings.air_erosion_px must be in 0..64 (air pixels "
+                         "this far (|dx|+|dy|) from anything that is not air)",
+                         riner::InputError);
+    riner::ResponseRingSettings response;
+    response.max_mean_response_change = 11;
+    CHECK_THROWS_AS(riner::rings::validate("r", response), riner::InputError);
   }
 }

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "riner/engine.hpp"
 #include "riner/execution_plan.hpp"
@@ -142,6 +143,19 @@ struct RinerConfig {
   // missing keys keep their current values, unknown keys are an InputError.
   void update_from_json(std::string_view json_text, std::string_view source = "config");
   std::string to_json() const;
+  // One setting by its JSON name ("training.steps") from text: a JSON value (12000, true, 0.3)
+  // or a bare word for a named choice (uniform). InputError for an unknown name or bad value.
+  void set(std::string_view name, std::string_view value);
+
+  // Every setting a config file can hold, in the order config.json lists them.
+  struct SettingInfo {
+    std::string name;           // "training.steps"
+    std::string type;           // bool, integer, number or choice
+    std::string allowed;        // "in 0..10000000", "one of uniform, mixed", ...
+    std::string default_value;  // as JSON
+    std::string help;
+  };
+  static std::vector<SettingInfo> settings();
 
   // The paper's settings: L=10, T=2^10, F=8, N_min=2, b=2, width 128, 80 rays per step
   // (40 views x 2 elements), lr 1e-3 halved every 1000 steps, 4000 steps, summed data term;

@@ -6,6 +6,7 @@
 #include "riner/rays.hpp"
 #include "riner/ring_correction.hpp"
 #include "rings/ring_profile.hpp"
+#include "rings/ring_settings.hpp"
 
 namespace riner {
 
@@ -73,13 +74,7 @@ void smooth_measured(const std::vector<double>& raw, const std::vector<char>& me
 RingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
                                       const Geometry& geometry, const AirRingSettings& settings) {
   rings::check_inputs("air ring correction", image, alpha, geometry);
-  if (!(settings.air_fraction > 0.0 && settings.air_fraction < 1.0) || settings.erosion_px < 0 ||
-      settings.min_pixels < 1 || !(settings.max_mean_response_change > 0.0) ||
-      !(settings.smoothing_bins >= 0.0 && settings.smoothing_bins <= 100.0)) {
-    throw InputError(
-        "air ring correction: air_fraction must be in (0, 1), erosion >= 0, min_pixels >= 1, "
-        "max_mean_response_change > 0, smoothing_bins in [0, 100]");
-  }
+  rings::validate("air ring correction", settings);
   RingCorrection out = rings::unchanged(image, alpha, 0.5 * geometry.voxel_mm);
   const std::size_t ny = image.shape[0];
   const std::size_t nx = image.shape[1];

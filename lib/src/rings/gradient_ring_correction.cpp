@@ -4,6 +4,7 @@
 #include "riner/error.hpp"
 #include "riner/ring_correction.hpp"
 #include "rings/ring_profile.hpp"
+#include "rings/ring_settings.hpp"
 
 namespace riner {
 
@@ -116,13 +117,7 @@ RingCorrection correct_rings_from_gradient(const Array& image, const Array& alph
                                            const Geometry& geometry,
                                            const GradientRingSettings& settings) {
   rings::check_inputs("gradient ring correction", image, alpha, geometry);
-  if (!(settings.scale_px > 0.0 && settings.scale_px <= 1000.0) ||
-      !(settings.flat_fraction > 0.0 && settings.flat_fraction <= 1.0) ||
-      !(settings.max_mean_response_change > 0.0)) {
-    throw InputError(
-        "gradient ring correction: scale_px must be in (0, 1000], flat_fraction in (0, 1], "
-        "max_mean_response_change > 0");
-  }
+  rings::validate("gradient ring correction", settings);
   RingCorrection out = rings::unchanged(image, alpha, geometry.voxel_mm);
   if (!rings::all_finite(image)) return out;
   const std::size_t ny = image.shape[0];

@@ -8,6 +8,7 @@
 #include "riner/rays.hpp"
 #include "riner/ring_correction.hpp"
 #include "rings/ring_profile.hpp"
+#include "rings/ring_settings.hpp"
 
 namespace riner {
 
@@ -63,15 +64,7 @@ RingCorrection correct_rings_from_response(const Array& image, const Array& alph
                                            const std::vector<std::size_t>& dead_elements,
                                            const ResponseRingSettings& settings) {
   rings::check_inputs("response ring correction", image, alpha, geometry);
-  if (!(settings.scale_px > 0.0 && settings.scale_px <= 1000.0) ||
-      !(settings.air_fraction > 0.0 && settings.air_fraction < 1.0) ||
-      !(settings.air_weight >= 0.0 && settings.air_weight <= 1e6) ||
-      !(settings.min_even_to_odd >= 0.0 && settings.min_even_to_odd <= 1e6) ||
-      !(settings.max_mean_response_change > 0.0)) {
-    throw InputError(
-        "response ring correction: scale_px must be in (0, 1000], air_fraction in (0, 1), "
-        "air_weight in [0, 1e6], min_even_to_odd in [0, 1e6], max_mean_response_change > 0");
-  }
+  rings::validate("response ring correction", settings);
   std::vector<bool> usable(geometry.n_u, true);
   for (std::size_t e : dead_elements) {
     if (e >= geometry.n_u) {

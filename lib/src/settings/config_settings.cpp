@@ -1,0 +1,199 @@
+#include "settings/config_settings.hpp"
+
+#include <algorithm>
+
+#include "rings/ring_settings.hpp"
+
+namespace riner {
+
+namespace {
+
+using settings::closed;
+using settings::closed_open;
+using settings::enum_choice;
+using settings::field;
+using settings::open;
+using settings::open_closed;
+using settings::string_choice;
+using C = RinerConfig;
+using E = EncodingConfig;
+using N = NetworkConfig;
+using T = TrainingConfig;
+using P = PlanConfig;
+using R = RingCorrectionConfig;
+using Table = std::vector<settings::Setting<C>>;
+
+constexpr double kMaxSteps = 1e7;
+
+void add_encoding(Table& t) {
+  t.push_back(
+      field<C>("encoding", "levels", closed(1, 32), "hash-grid levels", &C::encoding, &E::levels));
+  t.push_back(field<C>("encoding", "features", closed(1, 8), "features per level", &C::encoding,
+                       &E::features));
+  t.push_back(field<C>("encoding", "log2_table_size", closed(4, 26),
+                       "log2 of each level's table entries (dense while the level fits)",
+                       &C::encoding, &E::log2_table_size));
+  t.push_back(field<C>("encoding", "base_resolution", closed(2, 65536), "coarsest level's scale",
+                       &C::encoding, &E::base_resolution));
+  t.push_back(field<C>("encoding", "finest_resolution", closed(0, 1 << 20),
+                       "finest level's scale, >= base_resolution; 0: the grid's largest side",
+                       &C::encoding, &E::finest_resolution));
+}
+
+void add_network(Table& t) {
+  t.push_back(field<C>("network", "width", closed(16, 256), "hidden width, a multiple of 16",
+                       &C::network, &N::width));
+  t.push_back(field<C>("network", "hidden_layers", closed(1, 4), "hidden layers", &C::network,
+                       &N::hidden_layers));
+}
+
+void add_training(Table& t) {
+  t.push_back(field<C>("training", "steps", closed(0, kMaxSteps), "training steps", &C::training,
+                       &T::steps));
+  t.push_back(enum_choice<C>(
+      "training", "sampler", {Sampler::kUniform, Sampler::kViewsTimesElements, Sampler::kMixed},
+      sampler_name, "how a step's rays are drawn", &C::training, &T::sampler));
+  t.push_back(field<C>("training", "rays_per_step", closed(0, 1 << 20),
+                       "uniform sampler's rays per step; 0: the execution plan's", &C::training,
+                       &T::rays_per_step));
+  t.push_back(field<C>("training", "views_per_step", closed(1, 65536),
+                       "views x elements sampler: views", &C::training, &T::views_per_step));
+  t.push_back(field<C>("training", "elements_per_step", closed(1, 65536),
+                       "views x elements sampler: adjacent elements", &C::training,
+                       &T::elements_per_step));
+  t.push_back(field<C>("training", "sample_spacing", open_closed(0.01, 100),
+                       "spacing of the samples along a ray, in voxels", &C::training,
+                       &T::sample_spacing));
+  t.push_back(field<C>("training", "jitter", {}, "stratified random sample offsets", &C::training,
+                       &T::jitter));
+  t.push_back(field<C>("training", "circle_region", {},
+                       "sample the inscribed circle instead of the whole grid", &C::training,
+                       &T::circle_region));
+  t.push_back(field<C>("training", "skip_air", {},
+                       "do not sample the air the readings certify (it reads 0)", &C::training,
+                       &T::skip_air));
+  t.push_back(field<C>("training", "air_noise_sigmas", closed(0.5, 100),
+                       "skip_air: a reading within this many noise sigmas of its offset is air",
+                       &C::training, &T::air_noise_sigmas));
+  t.push_back(field<C>("training", "air_margin_px", closed(0, 64),
+                       "skip_air: voxels kept around what is not air", &C::training,
+                       &T::air_margin_px));
+  t.push_back(field<C>("training", "learning_rate", open(0, 10), "Adam's learning rate",
+                       &C::training, &T::learning_rate));
+  t.push_back(field<C>("training", "lr_decay_steps", closed(0, kMaxSteps),
+                       "steps between learning-rate decays; 0: steps / 4", &C::training,
+                       &T::lr_decay_steps));
+  t.push_back(field<C>("training", "lr_decay", open_closed(0, 1),
+                       "factor of each learning-rate decay", &C::training, &T::lr_decay));
+  t.push_back(field<C>("training", "adam_beta1", closed_open(0, 1), "Adam's beta1", &C::training,
+                       &T::adam_beta1));
+  t.push_back(field<C>("training", "adam_beta2", closed_open(0, 1), "Adam's beta2", &C::training,
+                       &T::adam_beta2));
+  t.push_back(field<C>("training", "adam_epsilon", open(0, 1), "Adam's epsilon", &C::training,
+                       &T::adam_epsilon));
+  t.push_back(field<C>("training", "lambda", closed_open(0, 1e6),
+                       "weight of the -beta^2 term (dead-element mask)", &C::training, &T::lambda));
+  t.push_back(field<C>("training", "alpha_lr_scale", closed_open(0, 1000),
+                       "alpha's learning rate over the field's (0.3: fewer specks on real scans)",
+                       &C::training, &T::alpha_lr_scale));
+  t.push_back(field<C>("training", "beta_lr_scale", closed_open(0, 1000),
+                       "beta's learning rate over the field's", &C::training, &T::beta_lr_scale));
+  t.push_back(field<C>("training", "alpha_warmup_steps", closed(0, kMaxSteps),
+                       "alpha stays at its initial value for these steps", &C::training,
+                       &T::alpha_warmup_steps));
+  t.push_back(field<C>("training", "beta_warmup_steps", closed(-1, kMaxSteps),
+                       "beta of elements with valid readings stays put for these steps; -1: the "
+                       "first learning-rate phase",
+                       &C::training, &T::beta_warmup_steps));
+  t.push_back(field<C>("training", "level_warmup_steps", closed(0, kMaxSteps),
+                       "coarse to fine: each finer level fades in over these steps; 0: off",
+                       &C::training, &T::level_warmup_steps));
+  t.push_back(field<C>("training", "stop_on_plateau", {},
+                       "stop in the last learning-rate phase when the loss stops falling",
+                       &C::training, &T::stop_on_plateau));
+  t.push_back(field<C>("training", "plateau_window", closed(0, kMaxSteps),
+                       "stop_on_plateau: steps per window; 0: a quarter of a phase", &C::training,
+                       &T::plateau_window));
+  t.push_back(field<C>("training", "plateau_tolerance", closed_open(0, 1),
+                       "stop_on_plateau: relative fall below which training stops", &C::training,
+                       &T::plateau_tolerance));
+  t.push_back(field<C>("training", "ring_lambda", closed_open(0, 1e9),
+                       "weight of the ring prior (needs a views x elements block of >= 3 "
+                       "elements); 0: off",
+                       &C::training, &T::ring_lambda));
+  t.push_back(enum_choice<C>(
+      "training", "data_term", {DataTerm::kElementMean, DataTerm::kMean, DataTerm::kSum},
+      data_term_name, "how the data term weighs the batch's rays", &C::training, &T::data_term));
+  t.push_back(field<C>("training", "data_weight", open(0, 1e6), "multiplies the data term",
+                       &C::training, &T::data_weight));
+  t.push_back(field<C>("training", "relative_beta_threshold", closed_open(0, 1e6),
+                       "> 0: an element goes off past this many times the median ray mismatch",
+                       &C::training, &T::relative_beta_threshold));
+  t.push_back(field<C>("training", "seed", closed(0, 18446744073709551615.0),
+                       "seed of the initial weights and the sampler", &C::training, &T::seed));
+}
+
+void add_rings(Table& t) {
+  t.push_back(field<C>("rings", "air_reference", {}, "2D: ring correction from the air", &C::rings,
+                       &R::air_reference));
+  for (const auto& s : rings::air_settings()) t.push_back(settings::lift<C>(s, &C::rings, &R::air));
+  t.push_back(field<C>("rings", "gradient_reference", {},
+                       "2D: ring correction from the image's radial slopes", &C::rings,
+                       &R::gradient_reference));
+  for (const auto& s : rings::gradient_settings()) {
+    t.push_back(settings::lift<C>(s, &C::rings, &R::gradient));
+  }
+  t.push_back(field<C>("rings", "response_reference", {},
+                       "2D: broad rings back from alpha's structure across the detector", &C::rings,
+                       &R::response_reference));
+  for (const auto& s : rings::response_settings()) {
+    t.push_back(settings::lift<C>(s, &C::rings, &R::response));
+  }
+}
+
+void add_plan(Table& t) {
+  t.push_back(string_choice<C>("plan", "kind", {"auto", "cpu", "gpu"},
+                               "the OpenCL engine's execution plan; auto: from the device",
+                               &C::plan, &P::kind));
+  t.push_back(string_choice<C>(
+      "plan", "float_atomics",
+      {"auto", "nvidia-ptx", "cl_ext_float_atomics", "amd-builtin", "compare-exchange"},
+      "gpu plan: how the grid gradient adds floats", &C::plan, &P::float_atomics));
+  t.push_back(field<C>("plan", "sample_group", closed(0, 4096),
+                       "work-group of the per-sample kernels; 0: the device's choice", &C::plan,
+                       &P::sample_group));
+  t.push_back(field<C>("plan", "gradient_slices", closed(0, 65536),
+                       "most work-groups of the MLP weight gradient; 0: the device's choice",
+                       &C::plan, &P::gradient_slices));
+  t.push_back(field<C>("plan", "grid_bands", closed(0, 4096),
+                       "cpu plan: owners per encoding level; 0: the device's choice", &C::plan,
+                       &P::grid_bands));
+}
+
+}  // namespace
+
+const std::vector<settings::Setting<C>>& config_settings() {
+  static const Table table = [] {
+    Table t;
+    add_encoding(t);
+    add_network(t);
+    add_training(t);
+    add_rings(t);
+    add_plan(t);
+    t.push_back(enum_choice<C>("", "engine", {Engine::kOpenCL, Engine::kReference}, engine_name,
+                               "opencl: the kernels; reference: their CPU twins (slow)",
+                               &C::engine));
+    return t;
+  }();
+  return table;
+}
+
+std::vector<std::string> config_sections() {
+  std::vector<std::string> out;
+  for (const auto& s : config_settings()) {
+    if (std::find(out.begin(), out.end(), s.section) == out.end()) out.push_back(s.section);
+  }
+  return out;
+}
+
+}  // namespace riner
