@@ -75,8 +75,8 @@ int run_demo(int argc, char** argv, int first) {
   }
   const Array image = riner.image();
   write_array(out / "riner.nii", image, {{g.voxel_mm, g.voxel_mm}});
-  write_detector_outputs(out, riner.alpha(), riner.beta());
   const std::vector<std::size_t> dead = riner.dead_elements();
+  write_detector_outputs(out, riner.alpha(), riner.beta(), dead);
 
   const std::size_t n = g.volume_shape[0];
   Array panel({n, 3 * n});

@@ -228,8 +228,9 @@ int run_reconstruct(int argc, char** argv, int first) {
   const std::filesystem::path image_path = out / ("image." + format);
   write_array(image_path, image, {std::vector<double>(image.rank(), g.voxel_mm)});
   write_png(out / "image.png", image);
-  write_detector_outputs(out, alpha, reconstructor.beta());
+  const std::vector<DeadElement> dead_report = reconstructor.dead_element_report();
   const std::vector<std::size_t> dead = reconstructor.dead_elements();
+  write_detector_outputs(out, alpha, reconstructor.beta(), dead);
   write_history(out / "loss.csv", reconstructor.history());
   write_text(out / "config.json", reconstructor.config().to_json());  // as resolved for the device
 
@@ -247,6 +248,7 @@ int run_reconstruct(int argc, char** argv, int first) {
       {"parameters", stats.parameters},
       {"non_finite_measurements", stats.non_finite},
       {"dead_elements", dead},
+      {"dead_element_reasons", dead_elements_json(dead_report)},
       {"engine", stats.engine},
       {"device", stats.device},
       {"plan", stats.plan ? nlohmann::json::parse(stats.plan->to_json()) : nlohmann::json()},

@@ -7,8 +7,8 @@
 
 namespace riner::app {
 
-void write_detector_outputs(const std::filesystem::path& dir, const Array& alpha,
-                            const Array& beta) {
+void write_detector_outputs(const std::filesystem::path& dir, const Array& alpha, const Array& beta,
+                            const std::vector<std::size_t>& dead) {
   write_array(dir / "alpha.npy", alpha);
   write_array(dir / "beta.npy", beta);
   if (alpha.rank() == 1) {
@@ -24,8 +24,17 @@ void write_detector_outputs(const std::filesystem::path& dir, const Array& alpha
       b.x.push_back(static_cast<double>(e));
       b.y.push_back(beta.data[e]);
     }
-    plot.series = {a, b};
-    plot.horizontal_lines = {{0.5, "dead below 0.5"}};
+    // What the tool decided: a red mark at 0 for every element it takes for dead, whatever its
+    // beta (an element with no finite reading is dead with beta wherever training left it).
+    PlotSeries d{"dead", {}, {}, {214, 39, 40}, true};
+    for (std::size_t e : dead) {
+      d.x.push_back(static_cast<double>(e));
+      d.y.push_back(0.0);
+    }
+    plot.title = "detector response alpha (blue), mask beta (orange), " +
+                 std::to_string(dead.size()) + " dead (red, why: summary.json)";
+    plot.series = {a, b, d};
+    plot.horizontal_lines = {{Reconstructor::kDeadBelowBeta, "dead below 0.5"}};
     write_plot_png(dir / "detector.png", plot);
   } else {
     // 3D: the two maps side by side, each windowed on its own.
@@ -39,8 +48,20 @@ void write_detector_outputs(const std::filesystem::path& dir, const Array& alpha
         both(r, cols + 4 + c) = beta(r, c);
       }
     }
+    for (std::size_t e : dead) both(e / cols, cols + 4 + e % cols) = 0.0f;
     write_png(dir / "detector.png", both, Window{0.0f, 1.0f});
   }
+}
+
+nlohmann::json dead_elements_json(const std::vector<DeadElement>& dead) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const DeadElement& d : dead) {
+    out.push_back({{"element", d.element},
+                   {"reason", d.reason},
+                   {"beta", d.beta},
+                   {"invalid_readings", d.invalid_readings}});
+  }
+  return out;
 }
 
 }  // namespace riner::app

@@ -5,13 +5,20 @@
 #include <filesystem>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "riner/array.hpp"
+#include "riner/reconstructor.hpp"
 
 namespace riner::app {
 
-// alpha.npy, beta.npy and detector.png (both against element index; in 3D, alpha and beta maps
-// side by side) in dir.
-void write_detector_outputs(const std::filesystem::path& dir, const Array& alpha,
-                            const Array& beta);
+// alpha.npy, beta.npy and detector.png in dir: alpha and beta against element index with the
+// elements taken for dead marked (`dead`, flat indices); in 3D, the alpha map beside the beta
+// map with the dead pixels at 0.
+void write_detector_outputs(const std::filesystem::path& dir, const Array& alpha, const Array& beta,
+                            const std::vector<std::size_t>& dead);
+
+// summary.json's account of each dead element: index, reason, beta, invalid readings.
+nlohmann::json dead_elements_json(const std::vector<DeadElement>& dead);
 
 }  // namespace riner::app

@@ -156,6 +156,22 @@ TEST_SUITE("cli") {
     CHECK(written["training"]["steps"] == 20);
     CHECK(written["training"]["sampler"] == "mixed");
     CHECK(written["rings"]["response_air_fraction"] == 0.05);
+    // The simulated dead elements read inf in every view: dead for that reason, said so.
+    const auto summary = nlohmann::json::parse(riner::test::read_bytes(dir / "r" / "summary.json"));
+    const auto reasons = summary["dead_element_reasons"];
+    REQUIRE(reasons.size() == summary["dead_elements"].size());
+    int unreadable = 0;
+    for (const auto& d : reasons) {
+      const std::string why = d["reason"];
+      CHECK((why == "no finite reading" || why == "beta below 0.5"));
+      if (why == "no finite reading") {
+        ++unreadable;
+        CHECK(d["invalid_readings"].get<int>() > 0);
+      } else {
+        CHECK(d["beta"].get<double>() < 0.5);
+      }
+    }
+    CHECK(unreadable == 2);
     expect_error(riner_cli("reconstruct " + sim + "/sino.npy --set training.steps=-4 --out " +
                                (dir / "s").string(),
                            dir),

@@ -11,6 +11,7 @@
 #include <functional>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "riner/array.hpp"
@@ -49,6 +50,15 @@ struct ReconstructionResult {
   std::optional<RingCorrection> air_rings;
   std::optional<RingCorrection> gradient_rings;
   std::optional<RingCorrection> response_rings;
+};
+
+// An element taken for dead, and why: its readings are all non-finite, or training switched it
+// off (beta below Reconstructor::kDeadBelowBeta).
+struct DeadElement {
+  std::size_t element = 0;  // flat index ([n_u] in 2D, row-major [n_v, n_u] in 3D)
+  double beta = 0.0;
+  std::size_t invalid_readings = 0;  // non-finite readings, of one per view
+  std::string reason;                // "no finite reading" or "beta below 0.5"
 };
 
 struct TrainingStats {
@@ -92,15 +102,19 @@ class Reconstructor {
   // the image and alpha together and keep the data fit.
   Array image() const;
   Array alpha() const;
-  Array beta() const;  // sigmoid(beta0) per element; < 0.5 marks an element as dead
-  // Flat indices of the dead elements: beta < 0.5, or no finite reading at all (where the rays
-  // miss the object, training has no reason to switch such an element off).
+  Array beta() const;  // sigmoid(beta0) per element; < kDeadBelowBeta marks an element as dead
+  static constexpr float kDeadBelowBeta = 0.5f;
+  // The dead elements: beta < kDeadBelowBeta, or no finite reading at all (where the rays miss
+  // the object, training has no reason to switch such an element off), with the reason.
+  std::vector<DeadElement> dead_element_report() const;
+  // Their flat indices.
   std::vector<std::size_t> dead_elements() const;
   // What training alone gives: the field at every voxel centre (0 where the measurements show
   // air, training.skip_air) and max(alpha0, 1e-8).
   Array field_image() const;
   Array trained_alpha() const;
-  // All of the above from one evaluation of the field.
+  // All of the above from one evaluation of the field (kept until the next training step, so
+  // image() and alpha() after result() cost nothing more).
   ReconstructionResult result() const;
   std::vector<LossRecord> history() const;
   TrainingStats stats() const;
@@ -108,6 +122,7 @@ class Reconstructor {
   const Scan& scan() const;
 
  private:
+  ReconstructionResult evaluate_result() const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

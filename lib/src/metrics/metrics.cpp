@@ -7,6 +7,7 @@
 #include "metrics/radial_profile.hpp"
 #include "riner/error.hpp"
 #include "riner/io.hpp"
+#include "rings/radial.hpp"
 
 namespace riner {
 
@@ -173,20 +174,14 @@ namespace metrics {
 
 void radial_means(const Array& image, std::size_t bins, std::vector<double>& mean,
                   std::vector<double>& count) {
-  const std::size_t ny = image.shape[0];
-  const std::size_t nx = image.shape[1];
-  const double cy = 0.5 * (static_cast<double>(ny) - 1.0);
-  const double cx = 0.5 * (static_cast<double>(nx) - 1.0);
+  const rings::PixelRadii radii(image.shape[0], image.shape[1], 1.0);
   mean.assign(bins, 0.0);
   count.assign(bins, 0.0);
-  for (std::size_t i = 0; i < ny; ++i) {
-    for (std::size_t k = 0; k < nx; ++k) {
-      const auto r = static_cast<std::size_t>(
-          std::lround(std::hypot(static_cast<double>(i) - cy, static_cast<double>(k) - cx)));
-      if (r >= bins || !std::isfinite(image(i, k))) continue;
-      mean[r] += image(i, k);
-      count[r] += 1.0;
-    }
+  for (std::size_t p = 0; p < image.size(); ++p) {
+    const std::size_t r = radii.nearest(p);
+    if (r >= bins || !std::isfinite(image.data[p])) continue;
+    mean[r] += image.data[p];
+    count[r] += 1.0;
   }
   for (std::size_t r = 0; r < bins; ++r) mean[r] = count[r] > 0 ? mean[r] / count[r] : 0.0;
 }

@@ -8,6 +8,7 @@
 #include "metrics/radial_profile.hpp"
 #include "riner/error.hpp"
 #include "riner/metrics.hpp"
+#include "rings/radial.hpp"
 
 namespace riner {
 
@@ -21,7 +22,9 @@ void require_2d(const Array& a, const char* what) {
     throw InputError(std::string(what) + " must be a 2D image of at least 16 x 16");
 }
 
-double disc_radius(const Array& a) { return 0.5 * static_cast<double>(std::min(a.shape[0], a.shape[1])) - 1.0; }
+double disc_radius(const Array& a) {
+  return 0.5 * static_cast<double>(std::min(a.shape[0], a.shape[1])) - 1.0;
+}
 
 double radius_of(const Array& a, std::size_t i, std::size_t k) {
   return std::hypot(static_cast<double>(i) - 0.5 * (a.shape[0] - 1.0),
@@ -77,32 +80,27 @@ CentreDeviation centre_deviation(const Array& image, const Array& fbp, int radiu
   require_2d(image, "the image");
   require_2d(fbp, "the FBP");
   if (image.shape != fbp.shape) throw InputError("the image and the FBP differ in shape");
-  const long reach = static_cast<long>(std::ceil(3.0 * smoothing_px));
-  const std::size_t bins = static_cast<std::size_t>(radius_px + reach) + 1;
+  const auto reach = static_cast<std::size_t>(std::ceil(rings::kGaussianReach * smoothing_px));
+  const std::size_t bins = static_cast<std::size_t>(radius_px) + reach + 1;
   std::vector<double> pi, pf, count, unused;
   metrics::radial_means(image, bins, pi, unused);
   metrics::radial_means(fbp, bins, pf, count);
   // Gaussian over radius, over the bins that hold pixels.
-  auto broad = [&](const std::vector<double>& p, long r) {
-    double wsum = 0.0, sum = 0.0;
-    for (long q = std::max(0L, r - reach); q <= r + reach; ++q) {
-      const auto b = static_cast<std::size_t>(q);
-      if (b >= bins || count[b] == 0) continue;
-      const double w = std::exp(-0.5 * (q - r) * (q - r) / (smoothing_px * smoothing_px));
-      wsum += w;
-      sum += w * p[b];
-    }
-    return wsum > 0.0 ? sum / wsum : 0.0;
-  };
+  std::vector<char> filled(bins);
+  for (std::size_t b = 0; b < bins; ++b) filled[b] = count[b] > 0;
+  const std::vector<double> image_broad =
+      rings::gaussian_smooth(pi, smoothing_px, rings::Ends::kCut, &filled);
+  const std::vector<double> fbp_broad =
+      rings::gaussian_smooth(pf, smoothing_px, rings::Ends::kCut, &filled);
   CentreDeviation c;
   c.radius_px = radius_px;
   double noise2 = 0.0;
   int used = 0;
   for (long r = 0; r <= radius_px; ++r) {
     if (count[static_cast<std::size_t>(r)] == 0) continue;
-    const double fbp_broad = broad(pf, r);
-    const double d = std::fabs(broad(pi, r) - fbp_broad);
-    noise2 += (pf[static_cast<std::size_t>(r)] - fbp_broad) * (pf[static_cast<std::size_t>(r)] - fbp_broad);
+    const auto b = static_cast<std::size_t>(r);
+    const double d = std::fabs(image_broad[b] - fbp_broad[b]);
+    noise2 += (pf[b] - fbp_broad[b]) * (pf[b] - fbp_broad[b]);
     ++used;
     if (d > c.deviation) {
       c.deviation = d;

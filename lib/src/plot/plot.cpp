@@ -95,6 +95,8 @@ std::string tick_label(double v, double step) {
   char buf[32];
   const int decimals =
       step >= 1.0 ? 0 : std::min(6, static_cast<int>(std::ceil(-std::log10(step))));
+  // A tick a rounding error off 0 would print as "-0.0".
+  if (std::fabs(v) < 1e-9 * step) v = 0.0;
   std::snprintf(buf, sizeof(buf), "%.*f", decimals, v);
   return buf;
 }

@@ -17,6 +17,9 @@ struct Reconstructor::Impl {
   double samples = 0.0;
   std::vector<LossRecord> history;
   bool plateaued = false;
+  // result() at `steps` training steps (it only changes with a step).
+  std::optional<ReconstructionResult> result;
+  int result_steps = -1;
 
   Impl(Scan scan, RinerConfig config)
       : setup(std::move(scan), std::move(config)),
@@ -134,6 +137,14 @@ Array Reconstructor::field_image() const {
 }
 
 ReconstructionResult Reconstructor::result() const {
+  if (!impl_->result || impl_->result_steps != impl_->steps) {
+    impl_->result = evaluate_result();
+    impl_->result_steps = impl_->steps;
+  }
+  return *impl_->result;
+}
+
+ReconstructionResult Reconstructor::evaluate_result() const {
   const RinerConfig& c = impl_->setup.config;
   const Geometry& g = impl_->setup.scan.geometry;
   ReconstructionResult r;
@@ -168,9 +179,9 @@ Array Reconstructor::image() const { return result().image; }
 Array Reconstructor::alpha() const {
   const RinerConfig& c = impl_->setup.config;
   // Without the corrections, alpha needs no evaluation of the field.
-  if ((!c.rings.air_reference && !c.rings.gradient_reference && !c.rings.response_reference) ||
-      impl_->setup.scan.geometry.is_3d())
-    return trained_alpha();
+  const bool corrected =
+      c.rings.air_reference || c.rings.gradient_reference || c.rings.response_reference;
+  if (!corrected || impl_->setup.scan.geometry.is_3d()) return trained_alpha();
   return result().alpha;
 }
 
@@ -194,15 +205,23 @@ Array Reconstructor::beta() const {
   return out;
 }
 
-std::vector<std::size_t> Reconstructor::dead_elements() const {
+std::vector<DeadElement> Reconstructor::dead_element_report() const {
   const Array b = beta();
   const std::vector<std::uint32_t>& invalid = impl_->setup.invalid_readings;
   const std::size_t views = impl_->setup.scan.geometry.n_views();
-  std::vector<std::size_t> dead;
+  std::vector<DeadElement> dead;
   for (std::size_t e = 0; e < b.size(); ++e) {
-    if (b.data[e] < 0.5f || invalid[e] == views) dead.push_back(e);
+    const bool no_reading = invalid[e] == views;
+    if (!no_reading && !(b.data[e] < kDeadBelowBeta)) continue;
+    dead.push_back({e, b.data[e], invalid[e], no_reading ? "no finite reading" : "beta below 0.5"});
   }
   return dead;
+}
+
+std::vector<std::size_t> Reconstructor::dead_elements() const {
+  std::vector<std::size_t> indices;
+  for (const DeadElement& d : dead_element_report()) indices.push_back(d.element);
+  return indices;
 }
 
 std::vector<LossRecord> Reconstructor::history() const {

@@ -5,6 +5,7 @@
 #include "riner/error.hpp"
 #include "riner/rays.hpp"
 #include "riner/ring_correction.hpp"
+#include "rings/radial.hpp"
 #include "rings/ring_profile.hpp"
 #include "rings/ring_settings.hpp"
 
@@ -41,34 +42,6 @@ std::vector<char> erode(std::vector<char> mask, std::size_t ny, std::size_t nx, 
   return mask;
 }
 
-// Gaussian smoothing (sigma in bins) over the measured bins only, into profile (0 elsewhere): the
-// rings training leaves are broad, and the medians of single bins carry pixel noise that would
-// otherwise come back as fine rings.
-void smooth_measured(const std::vector<double>& raw, const std::vector<char>& measured,
-                     double sigma, std::vector<double>& profile) {
-  const std::size_t bins = raw.size();
-  const auto reach = static_cast<std::ptrdiff_t>(std::ceil(3.0 * sigma));
-  for (std::size_t b = 0; b < bins; ++b) {
-    profile[b] = 0.0;
-    if (!measured[b]) continue;
-    if (reach == 0) {
-      profile[b] = raw[b];
-      continue;
-    }
-    double sum = 0.0;
-    double weight = 0.0;
-    for (std::ptrdiff_t d = -reach; d <= reach; ++d) {
-      const std::ptrdiff_t j = static_cast<std::ptrdiff_t>(b) + d;
-      if (j < 0 || j >= static_cast<std::ptrdiff_t>(bins) || !measured[static_cast<std::size_t>(j)])
-        continue;
-      const double w = std::exp(-0.5 * static_cast<double>(d * d) / (sigma * sigma));
-      sum += w * raw[static_cast<std::size_t>(j)];
-      weight += w;
-    }
-    profile[b] = sum / weight;
-  }
-}
-
 }  // namespace
 
 RingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
@@ -84,17 +57,11 @@ RingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
   const double threshold = rings::air_threshold(image, settings.air_fraction);
   if (!(threshold > 0.0)) return out;
 
-  // Radius bin of every pixel centre (the rotation axis is the grid's centre).
+  // Each pixel in the bin of its nearest node (medians need one bin per pixel).
+  const rings::PixelRadii radii(ny, nx, out.radius_step_mm / geometry.voxel_mm);
   std::vector<std::size_t> bin(n);
-  std::size_t bins = 0;
-  for (std::size_t i = 0; i < ny; ++i) {
-    for (std::size_t k = 0; k < nx; ++k) {
-      const Vec3 c = voxel_centre(geometry, static_cast<double>(k), static_cast<double>(i));
-      bin[i * nx + k] =
-          static_cast<std::size_t>(std::lround(std::hypot(c.x, c.y) / out.radius_step_mm));
-      bins = std::max(bins, bin[i * nx + k] + 1);
-    }
-  }
+  for (std::size_t p = 0; p < n; ++p) bin[p] = radii.nearest(p);
+  const std::size_t bins = radii.nearest_nodes();
 
   std::vector<double> profile(bins + 1, 0.0);  // one spare node for the interpolation
   std::vector<std::vector<float>> air_by_bin(bins);
@@ -123,7 +90,10 @@ RingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
       measured[b] = air_by_bin[b].size() >= static_cast<std::size_t>(settings.min_pixels);
       raw[b] = measured[b] ? median_of(air_by_bin[b]) - level : 0.0;
     }
-    smooth_measured(raw, measured, settings.smoothing_bins, profile);
+    // The rings training leaves are broad; single bins' medians carry pixel noise that would
+    // otherwise come back as fine rings.
+    profile = rings::gaussian_smooth(raw, settings.smoothing_bins, rings::Ends::kCut, &measured);
+    profile.push_back(0.0);
   }
 
   out.measured_radii = static_cast<std::size_t>(std::count(measured.begin(), measured.end(), 1));

@@ -3,6 +3,7 @@
 
 #include "riner/error.hpp"
 #include "riner/ring_correction.hpp"
+#include "rings/radial.hpp"
 #include "rings/ring_profile.hpp"
 #include "rings/ring_settings.hpp"
 
@@ -83,31 +84,10 @@ bool ring_slope(const PolarSamples& s, std::size_t r, double flat_fraction, doub
   return true;
 }
 
-// Index j mirrored into 0..n-1 about the first and last nodes (g(-r) = g(r): a radial profile
-// is even about the axis).
-std::ptrdiff_t mirrored(std::ptrdiff_t j, std::ptrdiff_t n) {
-  if (n == 1) return 0;
-  const std::ptrdiff_t period = 2 * (n - 1);
-  j %= period;
-  if (j < 0) j += period;
-  return j < n ? j : period - j;
-}
-
 // values minus their Gaussian smoothing (sigma in nodes), mirrored at both ends.
 std::vector<double> high_pass(const std::vector<double>& values, double sigma) {
-  const auto n = static_cast<std::ptrdiff_t>(values.size());
-  const auto reach = static_cast<std::ptrdiff_t>(std::ceil(4.0 * sigma));
-  std::vector<double> out(values.size());
-  for (std::ptrdiff_t i = 0; i < n; ++i) {
-    double sum = 0.0;
-    double weight = 0.0;
-    for (std::ptrdiff_t d = -reach; d <= reach; ++d) {
-      const double w = std::exp(-0.5 * static_cast<double>(d * d) / (sigma * sigma));
-      sum += w * values[static_cast<std::size_t>(mirrored(i + d, n))];
-      weight += w;
-    }
-    out[static_cast<std::size_t>(i)] = values[static_cast<std::size_t>(i)] - sum / weight;
-  }
+  std::vector<double> out = rings::gaussian_smooth(values, sigma, rings::Ends::kMirror);
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = values[i] - out[i];
   return out;
 }
 

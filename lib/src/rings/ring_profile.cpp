@@ -8,6 +8,7 @@
 
 #include "riner/error.hpp"
 #include "riner/rays.hpp"
+#include "rings/radial.hpp"
 
 namespace riner::rings {
 
@@ -43,7 +44,7 @@ std::vector<double> ring_projection_weights(std::size_t nodes, double step_mm, c
   const Ray ray = detector_ray(g, 0, static_cast<double>(element));
   const Segment seg = clip_to_box(g, ray);
   if (seg.empty()) return weights;
-  const double ds = 0.1 * g.voxel_mm;
+  const double ds = kIntegralStepVoxels * g.voxel_mm;
   const auto n = static_cast<std::size_t>(std::ceil(seg.length() / ds));
   const double h = seg.length() / static_cast<double>(n);
   for (std::size_t j = 0; j < n; ++j) {
@@ -73,26 +74,20 @@ std::vector<double> ring_projections(const std::vector<double>& profile, double 
 double air_threshold(const Array& image, double fraction) {
   if (image.data.empty()) return 0.0;
   std::vector<float> sorted = image.data;
-  const auto rank = static_cast<std::ptrdiff_t>(0.995 * static_cast<double>(sorted.size() - 1));
+  const auto rank =
+      static_cast<std::ptrdiff_t>(kAirReferencePercentile * static_cast<double>(sorted.size() - 1));
   std::nth_element(sorted.begin(), sorted.begin() + rank, sorted.end());
   return fraction * sorted[static_cast<std::size_t>(rank)];
 }
 
 void subtract_profile(RingCorrection& out, const Array& image, const Geometry& g) {
-  const std::size_t ny = image.shape[0];
-  const std::size_t nx = image.shape[1];
-  const double cx = 0.5 * static_cast<double>(nx - 1);
-  const double cy = 0.5 * static_cast<double>(ny - 1);
-  const double step_px = out.radius_step_mm / g.voxel_mm;
-  for (std::size_t i = 0; i < ny; ++i) {
-    for (std::size_t k = 0; k < nx; ++k) {
-      const double r =
-          std::hypot(static_cast<double>(k) - cx, static_cast<double>(i) - cy) / step_px;
-      const auto b = std::min(static_cast<std::size_t>(r), out.profile.size() - 2);
-      const double w = std::min(r - static_cast<double>(b), 1.0);
-      out.image(i, k) =
-          image(i, k) - static_cast<float>((1 - w) * out.profile[b] + w * out.profile[b + 1]);
-    }
+  const PixelRadii radii(image.shape[0], image.shape[1], out.radius_step_mm / g.voxel_mm);
+  for (std::size_t p = 0; p < image.size(); ++p) {
+    const PixelRadii::Between at = radii.between(p);
+    const std::size_t b = std::min(at.lower, out.profile.size() - 2);
+    const double w = std::min(radii[p] - static_cast<double>(b), 1.0);
+    out.image.data[p] =
+        image.data[p] - static_cast<float>((1 - w) * out.profile[b] + w * out.profile[b + 1]);
   }
 }
 

@@ -10,6 +10,13 @@
 
 namespace riner::rings {
 
+// The air rule's reference: the image's 99.5th percentile, its brightest object values
+// without the odd hot pixel.
+constexpr double kAirReferencePercentile = 0.995;
+// Step of a ring's line integrals along a ray, in voxels: fine against the profile's nodes
+// (one or half a voxel apart).
+constexpr double kIntegralStepVoxels = 0.1;
+
 // InputError (prefixed with `what`) for a 3D geometry, an image off the geometry's grid or an
 // alpha with the wrong number of elements.
 void check_inputs(const char* what, const Array& image, const Array& alpha, const Geometry& g);
@@ -28,7 +35,7 @@ std::vector<double> ring_projection_weights(std::size_t nodes, double step_mm, c
 std::vector<double> ring_projections(const std::vector<double>& profile, double step_mm,
                                      const Geometry& g);
 
-// The air rule of the corrections: pixels below fraction times the image's 99.5th percentile.
+// The air rule of the corrections: pixels below fraction times kAirReferencePercentile's value.
 // Returns that threshold (not positive when the image has no positive values).
 double air_threshold(const Array& image, double fraction);
 
