@@ -1,6 +1,7 @@
 #include "op_timer.hpp"
 
 #include "cl/context.hpp"
+#include "cl/device_access.hpp"
 
 namespace riner::bench {
 
@@ -13,7 +14,7 @@ nlohmann::json OpTiming::to_json() const {
 }
 
 OpTiming time_op(const Device& device, int warmup, int runs, const std::function<void()>& op) {
-  cl::Context& ctx = device.context();
+  cl::Context& ctx = riner::cl::context_of(device);
   for (int i = 0; i < warmup; ++i) op();
   ctx.finish();
   std::vector<double> wall, total;

@@ -9,6 +9,7 @@
 
 #include "cl/buffer.hpp"
 #include "cl/context.hpp"
+#include "cl/device_access.hpp"
 #include "op_timer.hpp"
 #include "ops/vector_ops.hpp"
 
@@ -45,7 +46,7 @@ double host_gemm_gflops(std::size_t n, int runs) {
 
 double clblast_gemm_ms(const Device& device, std::size_t m, std::size_t n, std::size_t k,
                        int warmup, int runs) {
-  cl::Context& ctx = device.context();
+  cl::Context& ctx = riner::cl::context_of(device);
   cl::Buffer<float> a(ctx, std::vector<float>(m * k, 0.5f));
   cl::Buffer<float> b(ctx, std::vector<float>(k * n, 0.25f));
   cl::Buffer<float> c(ctx, m * n);
@@ -73,7 +74,7 @@ Peaks measure_peaks(const Device& device, const Options& o) {
   p.host_gemm_gflops = host_gemm_gflops(n, runs);
   p.device_gemm_gflops = 2.0 * n * n * n / (clblast_gemm_ms(device, n, n, n, 1, runs) * 1e6);
 
-  cl::Context& ctx = device.context();
+  cl::Context& ctx = riner::cl::context_of(device);
   const std::size_t count = tiny ? (std::size_t{1} << 20) : (std::size_t{1} << 25);
   cl::Buffer<float> x(ctx, count);
   cl::Buffer<float> y(ctx, count);

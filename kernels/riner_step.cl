@@ -17,8 +17,8 @@
 //     of the batch's distinct elements: their rays' gradients in ascending ray order plus the
 //     -lambda beta^2 term into grad (each element's entries are written by one work-item:
 //     deterministic, no atomics). history[2 * slot] = data term, [2 * slot + 1] = penalties,
-//     summed by a fixed tree. When relative_threshold > 0, lambda is replaced by
-//     data_weight relative_threshold max(m, 1e-3) / 2, m the batch's median ray mismatch
+//     summed by a fixed tree. When relative_beta_threshold > 0, lambda is replaced by
+//     data_weight relative_beta_threshold max(m, 1e-3) / 2, m the batch's median ray mismatch
 //     (scratch float[n_batch]). When hold_valid_beta != 0, beta0 of every element without
 //     invalid readings gets no gradient (the beta warm-up).
 //   riner_step_backward(p, batch, segments, levels, params, d_sums, cache, grad)
@@ -26,7 +26,7 @@
 //     cache for mlp_gradient.cl; the features' gradient into the grid: with
 //     -D ATOMIC_GRADIENTS by float atomics into grad (common.cl picks the device's fastest),
 //     otherwise into the cache (CACHE_DIN, CACHE_POS) for hash_grid_gradient.cl.
-//   field_evaluate(n, first, nx, ny, nz, voxel, extent, levels, level_weights, params,
+//   riner_step_field_evaluate(n, first, nx, ny, nz, voxel, extent, levels, level_weights, params,
 //                  mlp_offset, out)
 //     one work-item per voxel index first + i of the grid [nz][ny][nx]: mu at its centre.
 //
@@ -157,7 +157,7 @@ __kernel void riner_step_loss(const StepParams p, __global const uint* batch, __
   }
   barrier(CLK_GLOBAL_MEM_FENCE | CLK_LOCAL_MEM_FENCE);
   float penalty_weight = p.lambda;
-  if (p.relative_threshold > 0.0f && p.n_batch > 0) {
+  if (p.relative_beta_threshold > 0.0f && p.n_batch > 0) {
     if (lid == 0) {
       for (uint b = 0; b < p.n_batch; ++b) {
         const uint ray = batch[p.rays_at + b];
@@ -166,7 +166,7 @@ __kernel void riner_step_loss(const StepParams p, __global const uint* batch, __
       reduce[0] = select_kth(scratch, p.n_batch, (p.n_batch - 1) / 2);
     }
     barrier(CLK_LOCAL_MEM_FENCE);
-    penalty_weight = 0.5f * p.data_weight * p.relative_threshold * fmax(reduce[0], 1e-3f);
+    penalty_weight = 0.5f * p.data_weight * p.relative_beta_threshold * fmax(reduce[0], 1e-3f);
     barrier(CLK_LOCAL_MEM_FENCE);
   }
   float data = 0.0f;
@@ -244,7 +244,7 @@ __kernel void riner_step_backward(const StepParams p, __global const uint* batch
 #endif
 }
 
-__kernel void field_evaluate(const uint n, const uint first, const uint nx, const uint ny, const uint nz,
+__kernel void riner_step_field_evaluate(const uint n, const uint first, const uint nx, const uint ny, const uint nz,
                              const float voxel, const float extent, __constant const GridLevel* levels,
                              __global const float* level_weights, __global const float* params,
                              const uint mlp_offset, __global float* out) {

@@ -53,7 +53,7 @@ typedef struct {
   uint hold_valid_beta;
   uint history_slot;
   float lambda;
-  float relative_threshold;
+  float relative_beta_threshold;
   float data_weight;
   float ring_lambda;
   uint block_first;

@@ -14,6 +14,7 @@
 #include "cases/training_step.hpp"
 #include "cl/buffer.hpp"
 #include "cl/context.hpp"
+#include "cl/device_access.hpp"
 #include "harness.hpp"
 #include "model/parameter_layout.hpp"
 #include "model/ray_segments.hpp"
@@ -97,7 +98,7 @@ double grid_backward_flops(const riner::model::ParameterLayout& l) {
 // The explicit (unfused) kernels on n samples of the default model.
 void model_ops(const riner::Device& device, const Options& o, const Peaks& peaks,
                std::vector<Result>* out) {
-  riner::cl::Context& ctx = device.context();
+  riner::cl::Context& ctx = riner::cl::context_of(device);
   const std::size_t n = o.size == "tiny" ? 4096 : (std::size_t{1} << 17);
   const int warmup = o.warmup, runs = o.runs;
   riner::RinerConfig config;
@@ -133,7 +134,7 @@ void model_ops(const riner::Device& device, const Options& o, const Peaks& peaks
     riner::ops::MlpOp mlp(ctx, l);
     OpTiming t =
         riner::bench::time_op(device, warmup, runs, [&] { mlp.forward(params, d_features, mu); });
-    out->push_back(row("mlp_forward", shape, t,
+    out->push_back(row("mlp_forward_batch", shape, t,
                        {static_cast<double>(n), "samples/s", n * mlp_forward_flops(l), 0.0},
                        peaks));
     t = riner::bench::time_op(device, warmup, runs,
@@ -216,7 +217,7 @@ void field_image(const riner::Device& device, const Options& o, const Peaks& pea
       riner::bench::time_op(device, 1, o.size == "tiny" ? 1 : 5, [&] { r.field_image(); });
   const double pixels = 512.0 * 512.0;
   out->push_back(row(
-      "field_evaluate", "512 x 512", e,
+      "riner_step_field_evaluate", "512 x 512", e,
       {pixels, "pixels/s", pixels * (grid_forward_flops(l) + mlp_forward_flops(l)), 0.0}, peaks));
 }
 
@@ -276,7 +277,7 @@ std::vector<Result> ops(const Options& o) {
   for (Result& r : riner::bench::time_training_steps(
            device, o, {"", device.info().type == "CPU" ? "gpu" : "cpu"}, {0}, &peaks))
     out.push_back(std::move(r));
-  // The field on the 512^2 grid (chunked field_evaluate).
+  // The field on the 512^2 grid (chunked riner_step_field_evaluate).
   field_image(device, o, peaks, &out);
   geometry_ops(device, o, peaks, &out);
   return out;

@@ -7,6 +7,7 @@
 #include <random>
 
 #include "cl/context.hpp"
+#include "cl/device_access.hpp"
 #include "harness.hpp"
 #include "riner/device.hpp"
 
@@ -19,9 +20,9 @@ using riner::bench::Result;
 std::vector<Result> build_once(const Options& options) {
   riner::Device device = riner::Device::open(options.device);
   const double ms = riner::bench::time_ms([&] {
-    device.context().program({"common", "vector_ops"});
+    riner::cl::context_of(device).program({"common", "vector_ops"});
   });
-  const auto stats = device.context().program_cache_stats();
+  const auto stats = riner::cl::context_of(device).program_cache_stats();
   std::printf("BUILD %.3f %s\n", ms, stats.disk_hits > 0 ? "disk" : "source");
   return {};
 }

@@ -11,8 +11,8 @@
 #include "riner/fbp.hpp"
 #include "riner/io.hpp"
 #include "riner/metrics.hpp"
-#include "riner/quality.hpp"
 #include "riner/phantom.hpp"
+#include "riner/quality.hpp"
 #include "riner/reconstructor.hpp"
 #include "riner/scan.hpp"
 #include "riner/simulate.hpp"
@@ -223,35 +223,33 @@ std::vector<Result> riner_real_scan(const Options& o) {
     riner::write_array(npy + "_alpha.npy", result.alpha);
     riner::write_array(npy + "_trained_alpha.npy", r.trained_alpha());
   }
-  return {{"riner_real_scan",
-           {{"scan", scan_path},
-            {"fbp_ring_index", riner::ring_index(fbp_image)},
-            {"riner_ring_index", riner::ring_index(image)},
-            {"noise", quality.noise},
-            {"fbp_specks_per_10k", quality.fbp_specks_per_10k},
-            {"riner_specks_per_10k", quality.specks_per_10k},
-            {"field_specks_per_10k", riner::specks_per_10k(field, quality.noise)},
-            {"centre_deviation", quality.centre.deviation},
-            {"centre_deviation_at_px", quality.centre.at_px},
-            {"centre_deviation_sigmas", quality.centre.sigmas},
-            {"centre_fbp_profile_noise", quality.centre.fbp_noise},
-            {"field_centre_deviation_sigmas",
-             riner::centre_deviation(field, fbp_image).sigmas},
-            {"samples_kept_fraction", r.stats().samples_kept_fraction},
-            {"field_ring_index", riner::ring_index(field)},
-            {"ring_correction_applied", rings && rings->applied},
-            {"ring_correction_response_change", rings ? rings->mean_response_change : 0.0},
-            {"gradient_correction_applied", gradient && gradient->applied},
-            {"gradient_correction_response_change",
-             gradient ? gradient->mean_response_change : 0.0},
-            {"response_correction_applied", response && response->applied},
-            {"response_correction_response_change",
-             response ? response->mean_response_change : 0.0},
-            {"response_correction_even_to_odd",
-             response && std::isfinite(response->even_to_odd) ? response->even_to_odd : 1e9},
-            {"elements_switched_off", off},
-            {"seconds", r.stats().seconds},
-            {"steps", r.stats().steps}}}};
+  return {
+      {"riner_real_scan",
+       {{"scan", scan_path},
+        {"fbp_ring_index", riner::ring_index(fbp_image)},
+        {"riner_ring_index", riner::ring_index(image)},
+        {"noise", quality.noise},
+        {"fbp_specks_per_10k", quality.fbp_specks_per_10k},
+        {"riner_specks_per_10k", quality.specks_per_10k},
+        {"field_specks_per_10k", riner::specks_per_10k(field, quality.noise)},
+        {"centre_deviation", quality.centre.deviation},
+        {"centre_deviation_at_px", quality.centre.at_px},
+        {"centre_deviation_sigmas", quality.centre.sigmas},
+        {"centre_fbp_profile_noise", quality.centre.fbp_noise},
+        {"field_centre_deviation_sigmas", riner::centre_deviation(field, fbp_image).sigmas},
+        {"samples_kept_fraction", r.stats().samples_kept_fraction},
+        {"field_ring_index", riner::ring_index(field)},
+        {"ring_correction_applied", rings && rings->applied},
+        {"ring_correction_response_change", rings ? rings->mean_response_change : 0.0},
+        {"gradient_correction_applied", gradient && gradient->applied},
+        {"gradient_correction_response_change", gradient ? gradient->mean_response_change : 0.0},
+        {"response_correction_applied", response && response->applied},
+        {"response_correction_response_change", response ? response->mean_response_change : 0.0},
+        {"response_correction_even_to_odd",
+         response && std::isfinite(response->even_to_odd) ? response->even_to_odd : 1e9},
+        {"elements_switched_off", off},
+        {"seconds", r.stats().seconds},
+        {"steps", r.stats().steps}}}};
 }
 
 }  // namespace

@@ -138,8 +138,8 @@ std::vector<Result> ring_corrections(const Options& o) {
                    totals[v].alpha_error / scenes};
     const std::string name = v < variants.size() ? variants[v].name : kReconstruct;
     mean[name] = {{"psnr", t.psnr}, {"ssim", t.ssim}, {"alpha_mae_live", t.alpha_error}};
-    line += riner::bench::format("\n  %-42s %6.2f dB  SSIM %.3f  alpha error %.4f",
-                                 name.c_str(), t.psnr, t.ssim, t.alpha_error);
+    line += riner::bench::format("\n  %-42s %6.2f dB  SSIM %.3f  alpha error %.4f", name.c_str(),
+                                 t.psnr, t.ssim, t.alpha_error);
   }
   results.push_back({"ring_corrections", mean, line});
   return results;

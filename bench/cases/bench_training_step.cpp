@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "cl/context.hpp"
+#include "cl/device_access.hpp"
 #include "model/parameter_layout.hpp"
 #include "riner/projector.hpp"
 #include "riner/reconstructor.hpp"
@@ -66,7 +67,7 @@ std::vector<Result> time_training_steps(const Device& device, const Options& o,
       r.step(o.size == "tiny" ? 2 : 50);  // past the program build and first allocations
       device.finish();
       const TrainingStats before = r.stats();
-      device.context().set_recording(true);
+      riner::cl::context_of(device).set_recording(true);
       const auto start = std::chrono::steady_clock::now();
       r.step(timed);
       device.finish();
@@ -74,14 +75,15 @@ std::vector<Result> time_training_steps(const Device& device, const Options& o,
           std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
               .count() /
           timed;
-      device.context().set_recording(false);
+      riner::cl::context_of(device).set_recording(false);
       std::map<std::string, double> kernel_ms;
-      for (const cl::KernelTiming& k : device.context().take_timings()) kernel_ms[k.kernel] += k.ms;
+      for (const cl::KernelTiming& k : riner::cl::context_of(device).take_timings())
+        kernel_ms[k.kernel] += k.ms;
       const TrainingStats after = r.stats();
       const double samples = (after.samples - before.samples) / timed;
       const Geometry& g = scene.sim.scan.geometry;
-      const model::ParameterLayout l = model::make_layout(
-          2, r.config().encoding, config.network, g.n_u);
+      const model::ParameterLayout l =
+          model::make_layout(2, r.config().encoding, config.network, g.n_u);
       const double gflops = samples * step_flops_per_sample(l) / (wall_ms * 1e6);
       const std::string plan_name = after.plan ? plan_kind_name(after.plan->kind) : "?";
       nlohmann::json f{{"scene", scene.name},

@@ -6,13 +6,14 @@
 
 #include "cl/buffer.hpp"
 #include "cl/context.hpp"
+#include "cl/device_access.hpp"
 #include "cl/program.hpp"
 #include "ops/vector_ops.hpp"
 #include "riner/error.hpp"
 #include "support/fixture.hpp"
 
 namespace {
-riner::cl::Context& ctx() { return riner::test::device().context(); }
+riner::cl::Context& ctx() { return riner::cl::context_of(riner::test::device()); }
 }  // namespace
 
 TEST_SUITE("cl_runtime") {
@@ -95,7 +96,7 @@ TEST_SUITE("cl_runtime") {
     setenv("RINER_KERNEL_DIR", dir.path().c_str(), 1);
     riner::Device fresh = riner::Device::open();
     try {
-      fresh.context().program({"common", "vector_ops"});
+      riner::cl::context_of(fresh).program({"common", "vector_ops"});
       FAIL("built a broken kernel");
     } catch (const riner::BuildError& e) {
       CHECK(e.status() == CL_BUILD_PROGRAM_FAILURE);
@@ -135,10 +136,10 @@ TEST_SUITE("cl_runtime") {
   TEST_CASE("interop: riner runs on a context and queue the caller owns") {
     riner::cl::Context& own = ctx();
     riner::Device shared = riner::Device::from_handles(own.get(), own.queue());
-    riner::ops::VectorOps ops(shared.context());
-    riner::cl::Buffer<float> dx(shared.context(),
+    riner::ops::VectorOps ops(riner::cl::context_of(shared));
+    riner::cl::Buffer<float> dx(riner::cl::context_of(shared),
                                 std::span<const float>(std::vector<float>(5, 2.0f)));
-    riner::cl::Buffer<float> dy(shared.context(),
+    riner::cl::Buffer<float> dy(riner::cl::context_of(shared),
                                 std::span<const float>(std::vector<float>(5, 1.0f)));
     ops.axpy(0.5f, dx, dy);
     CHECK(dy.read() == std::vector<float>(5, 2.0f));

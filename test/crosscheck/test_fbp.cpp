@@ -11,6 +11,7 @@
 #include "support/compare.hpp"
 #include "support/fixture.hpp"
 #include "support/geometries.hpp"
+#include "support/tolerances.hpp"
 
 namespace {
 
@@ -40,7 +41,7 @@ TEST_SUITE("fbp") {
         const riner::Array reference = riner::fbp(scan, options);
         // fp32 convolution over n_u taps and sums over views: ~1e-6; 1e-4 is the bar.
         const auto stats = riner::test::compare(device.data, reference.data);
-        CHECK_MESSAGE(stats.rms_rel < 1e-4, stats.describe());
+        CHECK_MESSAGE(stats.rms_rel < riner::test::tolerance::kChained, stats.describe());
       }
     }
   }

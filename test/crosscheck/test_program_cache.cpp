@@ -6,6 +6,7 @@
 #include <thread>
 
 #include "cl/context.hpp"
+#include "cl/device_access.hpp"
 #include "cl/program_builder.hpp"
 #include "ops/vector_ops.hpp"
 #include "support/fixture.hpp"
@@ -36,8 +37,8 @@ struct ScratchCache {
 
 riner::cl::ProgramCacheStats build_in_fresh_context(const std::string& options = "") {
   riner::Device device = riner::Device::open();
-  device.context().program({"common", "vector_ops"}, options);
-  return device.context().program_cache_stats();
+  riner::cl::context_of(device).program({"common", "vector_ops"}, options);
+  return riner::cl::context_of(device).program_cache_stats();
 }
 
 }  // namespace
@@ -57,9 +58,9 @@ TEST_SUITE("program_cache") {
   TEST_CASE("the same context serves repeats from memory") {
     ScratchCache cache;
     riner::Device device = riner::Device::open();
-    device.context().program({"common", "vector_ops"});
-    device.context().program({"common", "vector_ops"});
-    const auto stats = device.context().program_cache_stats();
+    riner::cl::context_of(device).program({"common", "vector_ops"});
+    riner::cl::context_of(device).program({"common", "vector_ops"});
+    const auto stats = riner::cl::context_of(device).program_cache_stats();
     CHECK(stats.source_builds == 1);
     CHECK(stats.memory_hits == 1);
   }
@@ -95,7 +96,7 @@ TEST_SUITE("program_cache") {
       threads.emplace_back([&] {
         try {
           riner::Device device = riner::Device::open();
-          riner::ops::VectorOps ops(device.context());
+          riner::ops::VectorOps ops(riner::cl::context_of(device));
         } catch (...) {
           ++failures;
         }

@@ -8,6 +8,7 @@
 #include "support/compare.hpp"
 #include "support/fixture.hpp"
 #include "support/geometries.hpp"
+#include "support/tolerances.hpp"
 
 namespace {
 
@@ -42,9 +43,9 @@ TEST_SUITE("projector") {
       // fp32 accumulation over a few hundred samples per ray: ~1e-6 relative; 1e-4 leaves room
       // for devices without fused multiply-add.
       const auto forward = riner::test::compare(device.project(x).data, reference.project(x).data);
-      CHECK_MESSAGE(forward.rms_rel < 1e-4, forward.describe());
+      CHECK_MESSAGE(forward.rms_rel < riner::test::tolerance::kChained, forward.describe());
       const auto adjoint = riner::test::compare(device.adjoint(y).data, reference.adjoint(y).data);
-      CHECK_MESSAGE(adjoint.rms_rel < 1e-4, adjoint.describe());
+      CHECK_MESSAGE(adjoint.rms_rel < riner::test::tolerance::kChained, adjoint.describe());
     }
   }
 
@@ -56,7 +57,7 @@ TEST_SUITE("projector") {
       const riner::Array y = random_array(g.measurement_shape(), 6);
       const double ax_y = inner(p.project(x), y);
       const double x_aty = inner(x, p.adjoint(y));
-      CHECK(std::fabs(ax_y - x_aty) <= 1e-4 * std::fabs(ax_y));
+      CHECK(std::fabs(ax_y - x_aty) <= riner::test::tolerance::kChained * std::fabs(ax_y));
     }
   }
 

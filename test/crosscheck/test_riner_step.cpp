@@ -8,6 +8,7 @@
 #include <random>
 
 #include "cl/buffer.hpp"
+#include "cl/device_access.hpp"
 #include "model/batch_sampler.hpp"
 #include "model/packed_batch.hpp"
 #include "model/parameter_layout.hpp"
@@ -17,10 +18,11 @@
 #include "support/compare.hpp"
 #include "support/fixture.hpp"
 #include "support/geometries.hpp"
+#include "support/tolerances.hpp"
 
 namespace {
 
-riner::cl::Context& ctx() { return riner::test::device().context(); }
+riner::cl::Context& ctx() { return riner::cl::context_of(riner::test::device()); }
 
 struct Scenario {
   const char* name;
@@ -28,7 +30,7 @@ struct Scenario {
   riner::Sampler sampler = riner::Sampler::kUniform;
   bool jitter = false;
   double ring_lambda = 0.0;
-  double relative_threshold = 0.0;
+  double relative_beta_threshold = 0.0;
   bool hold_valid_beta = false;
   bool coarse_to_fine = false;
   int hidden_layers = 1;
@@ -42,7 +44,7 @@ std::vector<Scenario> scenarios() {
   mixed.sampler = riner::Sampler::kMixed;
   mixed.jitter = true;
   mixed.ring_lambda = 3.0;
-  mixed.relative_threshold = 4.0;
+  mixed.relative_beta_threshold = 4.0;
   mixed.hold_valid_beta = true;
   mixed.coarse_to_fine = true;
   mixed.hidden_layers = 2;
@@ -158,7 +160,7 @@ TEST_SUITE("riner_step") {
           p.jitter = sc.jitter;
           p.hold_valid_beta = sc.hold_valid_beta;
           p.lambda = 0.05f;
-          p.relative_threshold = static_cast<float>(sc.relative_threshold);
+          p.relative_beta_threshold = static_cast<float>(sc.relative_beta_threshold);
           p.data_weight = 0.7f;
           p.ring_lambda = static_cast<float>(sc.ring_lambda);
           p.block_first = batch.block_first;
@@ -177,7 +179,7 @@ TEST_SUITE("riner_step") {
           in.step = step;
           in.lambda = 0.05;
           in.ring_lambda = sc.ring_lambda;
-          in.relative_beta_threshold = sc.relative_threshold;
+          in.relative_beta_threshold = sc.relative_beta_threshold;
           in.data_weight = 0.7;
           in.level_weights = level_weights;
           in.hold_valid_beta = sc.hold_valid_beta;
@@ -189,14 +191,16 @@ TEST_SUITE("riner_step") {
           std::vector<float> sums = op.ray_sums().read();
           sums.resize(n);
           const auto sum_err = riner::test::compare(sums, want.sums);
-          CHECK_MESSAGE(sum_err.rms_rel < 1e-5, sum_err.describe());
+          CHECK_MESSAGE(sum_err.rms_rel < riner::test::tolerance::kOnePass, sum_err.describe());
           std::vector<float> d_sums = op.ray_sum_gradients().read();
           d_sums.resize(n);
           const auto d_err = riner::test::compare(d_sums, want.d_sums);
-          CHECK_MESSAGE(d_err.rms_rel < 1e-5, d_err.describe());
+          CHECK_MESSAGE(d_err.rms_rel < riner::test::tolerance::kOnePass, d_err.describe());
           const std::vector<float> losses = device.history.read();
-          CHECK(losses[0] == doctest::Approx(want.data_loss).epsilon(1e-5));
-          CHECK(losses[1] == doctest::Approx(want.penalty).epsilon(1e-5));
+          CHECK(losses[0] ==
+                doctest::Approx(want.data_loss).epsilon(riner::test::tolerance::kOnePass));
+          CHECK(losses[1] ==
+                doctest::Approx(want.penalty).epsilon(riner::test::tolerance::kOnePass));
           // Gradients: sums over thousands of float32 products (the MLP's) and atomics in any
           // order (the gpu plan's grid) against double: 1e-4 of each section's norm.
           const std::vector<double> got = full_gradient(op, l, grad.read());
@@ -209,7 +213,7 @@ TEST_SUITE("riner_step") {
             CAPTURE(name);
             const auto err = riner::test::compare(section(got, range.first, range.second),
                                                   section(want.grad, range.first, range.second));
-            CHECK_MESSAGE(err.rms_rel < 1e-4, err.describe());
+            CHECK_MESSAGE(err.rms_rel < riner::test::tolerance::kChained, err.describe());
           }
         }
       }

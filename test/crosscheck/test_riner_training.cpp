@@ -7,6 +7,7 @@
 #include "riner/reconstructor.hpp"
 #include "support/fixture.hpp"
 #include "support/tiny_problem.hpp"
+#include "support/tolerances.hpp"
 
 TEST_SUITE("riner_training") {
   TEST_CASE("the first 20 steps' losses agree between OpenCL and the reference to 1e-3") {
@@ -30,8 +31,10 @@ TEST_SUITE("riner_training") {
       REQUIRE(b.size() == 20);
       for (int i = 0; i < 20; ++i) {
         CAPTURE(i);
-        CHECK(a[i].data_loss == doctest::Approx(b[i].data_loss).epsilon(1e-3));
-        CHECK(a[i].penalty == doctest::Approx(b[i].penalty).epsilon(1e-3));
+        CHECK(a[i].data_loss ==
+              doctest::Approx(b[i].data_loss).epsilon(riner::test::tolerance::kTraining));
+        CHECK(a[i].penalty ==
+              doctest::Approx(b[i].penalty).epsilon(riner::test::tolerance::kTraining));
       }
       const riner::Array ia = device.image();
       const riner::Array ib = reference.image();
@@ -40,7 +43,7 @@ TEST_SUITE("riner_training") {
         diff += (ia.data[i] - ib.data[i]) * (ia.data[i] - ib.data[i]);
         norm += static_cast<double>(ib.data[i]) * ib.data[i];
       }
-      CHECK(std::sqrt(diff / norm) < 1e-3);
+      CHECK(std::sqrt(diff / norm) < riner::test::tolerance::kTraining);
     }
   }
 
@@ -60,7 +63,7 @@ TEST_SUITE("riner_training") {
     int dead = 0;
     for (std::size_t e = 0; e < a.size(); ++e) {
       CAPTURE(e);
-      CHECK(a.data[e] == doctest::Approx(b.data[e]).epsilon(1e-3));
+      CHECK(a.data[e] == doctest::Approx(b.data[e]).epsilon(riner::test::tolerance::kTraining));
       if (t.alpha.data[e] != 0.0f) {
         CHECK(a.data[e] == before.data[e]);
         CHECK(b.data[e] == before.data[e]);

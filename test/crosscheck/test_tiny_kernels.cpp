@@ -11,6 +11,7 @@
 #include "support/fixture.hpp"
 #include "support/geometries.hpp"
 #include "support/tiny_problem.hpp"
+#include "support/tolerances.hpp"
 
 TEST_SUITE("tiny_kernels") {
   TEST_CASE("projector, adjoint and FBP on tiny geometries of every type") {
@@ -30,14 +31,17 @@ TEST_SUITE("tiny_kernels") {
       for (float& v : y.data) v = u(rng);
       const riner::Projector device(g, riner::Engine::kOpenCL, riner::test::device());
       const riner::Projector reference(g, riner::Engine::kReference);
-      CHECK(riner::test::compare(device.project(x).data, reference.project(x).data).rms_rel < 1e-4);
-      CHECK(riner::test::compare(device.adjoint(y).data, reference.adjoint(y).data).rms_rel < 1e-4);
+      CHECK(riner::test::compare(device.project(x).data, reference.project(x).data).rms_rel <
+            riner::test::tolerance::kChained);
+      CHECK(riner::test::compare(device.adjoint(y).data, reference.adjoint(y).data).rms_rel <
+            riner::test::tolerance::kChained);
       riner::FbpOptions options;
       options.device = riner::test::device();
       const riner::Scan scan{y, g, 0};
       const riner::Array fbp_device = riner::fbp(scan, options);
       options.engine = riner::Engine::kReference;
-      CHECK(riner::test::compare(fbp_device.data, riner::fbp(scan, options).data).rms_rel < 1e-4);
+      CHECK(riner::test::compare(fbp_device.data, riner::fbp(scan, options).data).rms_rel <
+            riner::test::tolerance::kChained);
     }
   }
 
@@ -69,8 +73,10 @@ TEST_SUITE("tiny_kernels") {
       device.step(3);
       const auto a = device.history();
       for (std::size_t i = 0; i < 3; ++i)
-        CHECK(a[i].data_loss == doctest::Approx(b[i].data_loss).epsilon(1e-3));
-      CHECK(riner::test::compare(device.image().data, image.data).rms_rel < 1e-3);
+        CHECK(a[i].data_loss ==
+              doctest::Approx(b[i].data_loss).epsilon(riner::test::tolerance::kTraining));
+      CHECK(riner::test::compare(device.image().data, image.data).rms_rel <
+            riner::test::tolerance::kTraining);
     }
   }
 }

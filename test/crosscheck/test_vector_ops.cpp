@@ -4,14 +4,16 @@
 #include <random>
 
 #include "cl/buffer.hpp"
+#include "cl/device_access.hpp"
 #include "ops/vector_ops.hpp"
 #include "reference/vector_ops_ref.hpp"
 #include "support/compare.hpp"
 #include "support/fixture.hpp"
+#include "support/tolerances.hpp"
 
 TEST_SUITE("vector_ops") {
   TEST_CASE("axpy matches the reference to float rounding") {
-    riner::cl::Context& ctx = riner::test::device().context();
+    riner::cl::Context& ctx = riner::cl::context_of(riner::test::device());
     std::mt19937 rng(static_cast<unsigned>(riner::test::seed()));
     std::uniform_real_distribution<float> u(-10.0f, 10.0f);
     for (std::size_t n : {1u, 31u, 1000u, 65537u}) {
@@ -28,12 +30,12 @@ TEST_SUITE("vector_ops") {
       // One multiply-add per element: the device may fuse it, so allow one rounding (2^-23)
       // relative to the operands' scale.
       const auto stats = riner::test::compare(dy.read(), y, 10.0);
-      CHECK_MESSAGE(stats.max_rel < 1e-6, stats.describe());
+      CHECK_MESSAGE(stats.max_rel < riner::test::tolerance::kElementwise, stats.describe());
     }
   }
 
   TEST_CASE("atomic sum matches the double reference; repeats agree to rounding") {
-    riner::cl::Context& ctx = riner::test::device().context();
+    riner::cl::Context& ctx = riner::cl::context_of(riner::test::device());
     std::mt19937 rng(static_cast<unsigned>(riner::test::seed()) + 1);
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     std::vector<float> x(20000);
@@ -52,7 +54,7 @@ TEST_SUITE("vector_ops") {
 
 TEST_SUITE("vector_ops") {
   TEST_CASE("fill sets every element, at odd sizes") {
-    riner::cl::Context& ctx = riner::test::device().context();
+    riner::cl::Context& ctx = riner::cl::context_of(riner::test::device());
     for (std::size_t n : {1u, 13u, 1024u}) {
       riner::cl::Buffer<float> y(ctx, n);
       riner::ops::VectorOps(ctx).fill(y, -2.5f);

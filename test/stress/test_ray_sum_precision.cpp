@@ -4,13 +4,14 @@
 #include <random>
 
 #include "cl/buffer.hpp"
+#include "cl/device_access.hpp"
 #include "ops/ray_sum.hpp"
 #include "reference/ray_sum_ref.hpp"
 #include "support/fixture.hpp"
 
 TEST_SUITE("ray_sum_precision") {
   TEST_CASE("sums of up to 4096 samples stay within 1e-5 relative of double") {
-    riner::cl::Context& ctx = riner::test::device().context();
+    riner::cl::Context& ctx = riner::cl::context_of(riner::test::device());
     std::mt19937 rng(static_cast<unsigned>(riner::test::seed()));
     std::uniform_real_distribution<float> u(0.0f, 0.05f);
     for (cl_uint n : {1u, 64u, 1000u, 4096u}) {

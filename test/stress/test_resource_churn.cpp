@@ -2,12 +2,13 @@
 #include <doctest/doctest.h>
 
 #include "cl/buffer.hpp"
+#include "cl/device_access.hpp"
 #include "ops/vector_ops.hpp"
 #include "support/fixture.hpp"
 
 TEST_SUITE("resource_churn") {
   TEST_CASE("buffers and launches in a loop leave no live buffers") {
-    riner::cl::Context& ctx = riner::test::device().context();
+    riner::cl::Context& ctx = riner::cl::context_of(riner::test::device());
     const long before = riner::cl::live_buffer_count();
     riner::ops::VectorOps ops(ctx);
     for (int i = 0; i < 2000; ++i) {
@@ -26,7 +27,7 @@ TEST_SUITE("resource_churn") {
   TEST_CASE("devices opened and closed repeatedly") {
     for (int i = 0; i < 20; ++i) {
       riner::Device device = riner::Device::open();
-      riner::ops::VectorOps ops(device.context());
+      riner::ops::VectorOps ops(riner::cl::context_of(device));
     }
   }
 }

@@ -14,6 +14,9 @@ namespace riner {
 namespace cl {
 class Context;
 }
+namespace detail {
+class DeviceAccess;  // the library's own way to a Device's context (lib/src/cl/device_access.hpp)
+}
 
 // What later kernels need to know about a device.
 struct DeviceInfo {
@@ -68,10 +71,8 @@ class Device {
   // Finishes all queued work.
   void finish() const;
 
-  // Internal access for the library's own ops.
-  cl::Context& context() const { return *context_; }
-
  private:
+  friend class detail::DeviceAccess;
   explicit Device(std::shared_ptr<cl::Context> context) : context_(std::move(context)) {}
   std::shared_ptr<cl::Context> context_;
 };

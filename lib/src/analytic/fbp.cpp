@@ -2,6 +2,7 @@
 
 #include "analytic/fbp_setup.hpp"
 #include "cl/context.hpp"
+#include "cl/device_access.hpp"
 #include "ops/fbp.hpp"
 #include "reference/fbp_ref.hpp"
 #include "riner/error.hpp"
@@ -50,7 +51,7 @@ Array fbp(const Scan& scan, const FbpOptions& options, FbpReport* report) {
     return volume;
   }
   Device device = options.device ? *options.device : Device::open();
-  cl::Context& ctx = device.context();
+  cl::Context& ctx = cl::context_of(device);
   ops::FbpOp op(ctx, g, taps, view_weights);
   cl::Buffer<float> d_in(ctx, std::span<const float>(weighted.data));
   cl::Buffer<float> d_filtered(ctx, weighted.size());

@@ -61,19 +61,26 @@ SampleType nifti_type(int code, const std::filesystem::path& path) {
 
 }  // namespace
 
-ArrayFile read_nifti(const std::filesystem::path& path) {
-  const std::string bytes = read_file_bytes(path);
+namespace {
+
+// What the header says about the data: byte order, shape (x fastest, as stored), spacing.
+struct NiftiHeader {
+  bool swap = false;
+  std::vector<std::size_t> dims;
+  std::vector<double> spacing;
+};
+
+NiftiHeader read_header(const std::string& bytes, const std::filesystem::path& path) {
   if (bytes.size() < kHeaderSize) {
     throw InputError(prefix(path) + "too short for a NIfTI-1 header (" +
                      std::to_string(bytes.size()) + " bytes)");
   }
-  const std::int32_t sizeof_hdr = field<std::int32_t>(bytes, 0, false);
-  bool swap = false;
-  if (sizeof_hdr != 348) {
+  NiftiHeader h;
+  if (field<std::int32_t>(bytes, 0, false) != 348) {
     if (field<std::int32_t>(bytes, 0, true) != 348) {
       throw InputError(prefix(path) + "not a NIfTI-1 file (sizeof_hdr is not 348)");
     }
-    swap = true;
+    h.swap = true;
   }
   if (std::memcmp(bytes.data() + 344, "n+1", 4) != 0) {
     if (std::memcmp(bytes.data() + 344, "ni1", 4) == 0) {
@@ -81,26 +88,35 @@ ArrayFile read_nifti(const std::filesystem::path& path) {
     }
     throw InputError(prefix(path) + "not a NIfTI-1 file (bad magic)");
   }
-  const int ndim = field<std::int16_t>(bytes, 40, swap);
+  const int ndim = field<std::int16_t>(bytes, 40, h.swap);
   if (ndim < 1 || ndim > 7) {
     throw InputError(prefix(path) + "dim[0] = " + std::to_string(ndim) + " is not in 1..7");
   }
-  std::vector<std::size_t> dims;
-  std::vector<double> spacing;
   for (int d = 1; d <= ndim; ++d) {
-    const int n = field<std::int16_t>(bytes, 40 + 2 * d, swap);
+    const int n = field<std::int16_t>(bytes, 40 + 2 * d, h.swap);
     if (n < 1) {
       throw InputError(prefix(path) + "dim[" + std::to_string(d) + "] = " + std::to_string(n) +
                        " is not positive");
     }
-    dims.push_back(static_cast<std::size_t>(n));
-    spacing.push_back(std::fabs(field<float>(bytes, 76 + 4 * d, swap)));
+    h.dims.push_back(static_cast<std::size_t>(n));
+    h.spacing.push_back(std::fabs(field<float>(bytes, 76 + 4 * d, h.swap)));
   }
   // Trailing singleton axes (a 2D slice stored as nx x ny x 1) carry no information.
-  while (dims.size() > 1 && dims.back() == 1) {
-    dims.pop_back();
-    spacing.pop_back();
+  while (h.dims.size() > 1 && h.dims.back() == 1) {
+    h.dims.pop_back();
+    h.spacing.pop_back();
   }
+  return h;
+}
+
+}  // namespace
+
+ArrayFile read_nifti(const std::filesystem::path& path) {
+  const std::string bytes = read_file_bytes(path);
+  const NiftiHeader header = read_header(bytes, path);
+  const bool swap = header.swap;
+  const std::vector<std::size_t>& dims = header.dims;
+  const std::vector<double>& spacing = header.spacing;
   const SampleType type = nifti_type(field<std::int16_t>(bytes, 70, swap), path);
   // Single-file images put the data after the header; 0 is a common writer's shorthand.
   float vox_offset = field<float>(bytes, 108, swap);

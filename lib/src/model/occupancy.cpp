@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "riner/array.hpp"
 #include "riner/rays.hpp"
@@ -107,30 +108,33 @@ std::vector<std::uint16_t> distance_to_inside(const std::vector<std::uint8_t>& i
 
 }  // namespace
 
-Occupancy carve_occupancy(const Scan& scan, const OccupancySettings& settings) {
-  const Geometry& g = scan.geometry;
-  const std::size_t rows = g.is_3d() ? g.n_v : 1;
-  const std::size_t per_view = rows * g.n_u;
-  const std::size_t views = g.n_views();
-  const std::size_t voxels = shape_size(g.volume_shape);
-  Occupancy o;
-  o.inside.assign(voxels, 1);
+namespace {
 
-  const std::vector<ElementStats> stats = element_stats(scan, per_view);
+// The offsets an element reading only air may have: the air elements' spread, widened for the
+// elements they miss.
+struct AirBand {
+  double lo = 0.0;
+  double hi = 0.0;
+};
+
+// The elements reading air in every view (steady, near 0): the scan's noise and their offset
+// band into `o`. Nullopt with o.note set when the scan shows too little air to trust.
+std::optional<AirBand> air_band(const std::vector<ElementStats>& stats, std::size_t views,
+                                std::size_t per_view, const OccupancySettings& settings,
+                                Occupancy& o) {
   std::vector<double> spreads;
   for (const ElementStats& s : stats) {
     if (s.finite == views) spreads.push_back(s.sigma);
   }
   if (spreads.empty()) {
     o.note = "no detector element has a finite reading in every view";
-    return o;
+    return std::nullopt;
   }
   std::sort(spreads.begin(), spreads.end());
   const double quiet = std::max(spreads[spreads.size() / 10], kNoiseFloor);
   std::vector<double> air_sigmas;
   std::vector<double> air_offsets;
-  double offset_lo = std::numeric_limits<double>::infinity();
-  double offset_hi = -offset_lo;
+  AirBand band{std::numeric_limits<double>::infinity(), -std::numeric_limits<double>::infinity()};
   for (const ElementStats& s : stats) {
     if (s.finite != views || s.sigma > kAirSpreadFactor * quiet ||
         s.range > kAirRangeSigmas * std::max(s.sigma, kNoiseFloor) ||
@@ -138,14 +142,14 @@ Occupancy carve_occupancy(const Scan& scan, const OccupancySettings& settings) {
       continue;
     air_sigmas.push_back(s.sigma);
     air_offsets.push_back(s.median);
-    offset_lo = std::min(offset_lo, s.median);
-    offset_hi = std::max(offset_hi, s.median);
+    band.lo = std::min(band.lo, s.median);
+    band.hi = std::max(band.hi, s.median);
   }
   o.air_elements = air_sigmas.size();
   if (air_sigmas.size() < std::max(kMinAirElements, per_view / 100)) {
     o.note = "too few detector elements read air in every view (" +
              std::to_string(air_sigmas.size()) + ")";
-    return o;
+    return std::nullopt;
   }
   std::nth_element(air_offsets.begin(), air_offsets.begin() + air_offsets.size() / 2,
                    air_offsets.end());
@@ -153,67 +157,102 @@ Occupancy carve_occupancy(const Scan& scan, const OccupancySettings& settings) {
   if (std::fabs(o.air_offset_median) > kMaxAirLevel) {
     o.note = "the steadiest readings average " + std::to_string(o.air_offset_median) +
              ", not the 0 of air in a flat-field-normalised scan";
-    return o;
+    return std::nullopt;
   }
   std::nth_element(air_sigmas.begin(), air_sigmas.begin() + air_sigmas.size() / 2,
                    air_sigmas.end());
   o.noise = std::max(air_sigmas[air_sigmas.size() / 2], kNoiseFloor);
-  const double tolerance = settings.noise_sigmas * o.noise;
-  // The air elements sample the responses' spread; widen it for the elements they miss.
-  const double widen = 0.25 * (offset_hi - offset_lo) + tolerance;
-  offset_lo -= widen;
-  offset_hi += widen;
+  const double widen = 0.25 * (band.hi - band.lo) + settings.noise_sigmas * o.noise;
+  band.lo -= widen;
+  band.hi += widen;
+  return band;
+}
 
-  // certified[v * per_view + e]: this reading says the ray crossed only air.
+// certified[v * per_view + e]: this reading says the ray crossed only air (within
+// `tolerance` of its element's offset, an offset inside the air band).
+std::vector<std::uint8_t> certify_readings(const Scan& scan, const std::vector<ElementStats>& stats,
+                                           std::size_t per_view, const AirBand& band, double noise,
+                                           double tolerance) {
+  const std::size_t views = scan.geometry.n_views();
   std::vector<std::uint8_t> certified(views * per_view, 0);
   for (std::size_t e = 0; e < per_view; ++e) {
     const ElementStats& s = stats[e];
     if (s.finite == 0) continue;
-    const double offset = s.min + o.noise;
-    if (offset < offset_lo || offset > offset_hi) continue;
+    const double offset = s.min + noise;
+    if (offset < band.lo || offset > band.hi) continue;
     for (std::size_t v = 0; v < views; ++v) {
       const float x = scan.measurement.data[v * per_view + e];
       certified[v * per_view + e] = std::isfinite(x) && x - offset < tolerance;
     }
   }
+  return certified;
+}
 
-  // A voxel is air when some view certifies every element of its shadow.
+// Whether view v certifies every element of the shadow of a voxel centred at p (a sphere
+// circumscribing the voxel); false when the shadow leaves the detector.
+bool shadow_certified(const Geometry& g, std::size_t v, const Vec3& p, double radius,
+                      std::size_t rows, const std::vector<std::uint8_t>& certified) {
+  const DetectorPoint d = project_to_detector(g, v, p);
+  const double hu = radius * d.magnification / g.pitch_u;
+  const double u0 = std::floor(d.u - hu), u1 = std::ceil(d.u + hu);
+  if (!(u0 >= 0.0 && u1 <= static_cast<double>(g.n_u) - 1.0)) return false;
+  double r0 = 0.0, r1 = 0.0;
+  if (g.is_3d()) {
+    const double hv = radius * d.magnification / g.pitch_v;
+    r0 = std::floor(d.v - hv);
+    r1 = std::ceil(d.v + hv);
+    if (!(r0 >= 0.0 && r1 <= static_cast<double>(rows) - 1.0)) return false;
+  }
+  for (auto r = static_cast<std::size_t>(r0); r <= static_cast<std::size_t>(r1); ++r) {
+    const std::uint8_t* line = certified.data() + (v * rows + r) * g.n_u;
+    for (auto u = static_cast<std::size_t>(u0); u <= static_cast<std::size_t>(u1); ++u) {
+      if (line[u] == 0) return false;
+    }
+  }
+  return true;
+}
+
+// 0 for the voxels some view certifies as air, 1 elsewhere.
+std::vector<std::uint8_t> carve(const Geometry& g, std::size_t rows,
+                                const std::vector<std::uint8_t>& certified) {
+  const std::size_t voxels = shape_size(g.volume_shape);
   const std::size_t rank = g.volume_shape.size();
   const std::size_t nx = g.volume_shape[rank - 1];
   const std::size_t ny = g.volume_shape[rank - 2];
   const double radius = 0.5 * g.voxel_mm * std::sqrt(static_cast<double>(rank));
-  std::vector<std::uint8_t> carved_inside(voxels, 1);
+  std::vector<std::uint8_t> inside(voxels, 1);
   util::parallel_for(voxels, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const Vec3 p =
           voxel_centre(g, static_cast<double>(i % nx), static_cast<double>((i / nx) % ny),
                        static_cast<double>(i / (nx * ny)));
-      for (std::size_t v = 0; v < views; ++v) {
-        const DetectorPoint d = project_to_detector(g, v, p);
-        const double hu = radius * d.magnification / g.pitch_u;
-        const double u0 = std::floor(d.u - hu), u1 = std::ceil(d.u + hu);
-        if (!(u0 >= 0.0 && u1 <= static_cast<double>(g.n_u) - 1.0)) continue;
-        double r0 = 0.0, r1 = 0.0;
-        if (g.is_3d()) {
-          const double hv = radius * d.magnification / g.pitch_v;
-          r0 = std::floor(d.v - hv);
-          r1 = std::ceil(d.v + hv);
-          if (!(r0 >= 0.0 && r1 <= static_cast<double>(rows) - 1.0)) continue;
-        }
-        bool air = true;
-        for (auto r = static_cast<std::size_t>(r0); air && r <= static_cast<std::size_t>(r1); ++r) {
-          const std::uint8_t* line = certified.data() + (v * rows + r) * g.n_u;
-          for (auto u = static_cast<std::size_t>(u0); air && u <= static_cast<std::size_t>(u1); ++u)
-            air = line[u] != 0;
-        }
-        if (air) {
-          carved_inside[i] = 0;
+      for (std::size_t v = 0; v < g.n_views(); ++v) {
+        if (shadow_certified(g, v, p, radius, rows, certified)) {
+          inside[i] = 0;
           break;
         }
       }
     }
   });
-  const std::vector<std::uint16_t> distance = distance_to_inside(carved_inside, g.volume_shape);
+  return inside;
+}
+
+}  // namespace
+
+Occupancy carve_occupancy(const Scan& scan, const OccupancySettings& settings) {
+  const Geometry& g = scan.geometry;
+  const std::size_t rows = g.is_3d() ? g.n_v : 1;
+  const std::size_t per_view = rows * g.n_u;
+  const std::size_t voxels = shape_size(g.volume_shape);
+  Occupancy o;
+  o.inside.assign(voxels, 1);
+  const std::vector<ElementStats> stats = element_stats(scan, per_view);
+  const std::optional<AirBand> band = air_band(stats, g.n_views(), per_view, settings, o);
+  if (!band) return o;
+  const std::vector<std::uint8_t> certified =
+      certify_readings(scan, stats, per_view, *band, o.noise, settings.noise_sigmas * o.noise);
+  const std::vector<std::uint16_t> distance =
+      distance_to_inside(carve(g, rows, certified), g.volume_shape);
   std::size_t kept = 0;
   for (std::size_t i = 0; i < voxels; ++i) {
     o.inside[i] = distance[i] <= static_cast<std::uint16_t>(std::max(0, settings.margin_px));

@@ -57,7 +57,7 @@ RinerStepOp::RinerStepOp(cl::Context& context, const model::ParameterLayout& lay
       mlp_gradient_(*program_,
                     plan.kind == PlanKind::kCpu ? "mlp_gradient_blocked" : "mlp_gradient_partial"),
       grid_gradient_(*program_, "hash_grid_gradient_accumulate"),
-      evaluate_(*program_, "field_evaluate") {}
+      evaluate_(*program_, "riner_step_field_evaluate") {}
 
 void RinerStepOp::reserve_samples(std::size_t n) {
   if (n <= cache_stride_ && cache_stride_ > 0) return;

@@ -34,7 +34,7 @@ struct StepParams {
   cl_uint hold_valid_beta = 0;
   cl_uint history_slot = 0;
   float lambda = 0.0f;
-  float relative_threshold = 0.0f;  // 0: the absolute balance
+  float relative_beta_threshold = 0.0f;  // 0: the absolute balance
   float data_weight = 1.0f;
   float ring_lambda = 0.0f;
   cl_uint block_first = 0;

@@ -112,8 +112,14 @@ double nice_step(double range, int target) {
 
 }  // namespace
 
-void write_plot_png(const std::filesystem::path& path, const LinePlot& plot) {
-  if (plot.width < 200 || plot.height < 150) throw InputError("plot too small");
+namespace {
+
+struct Bounds {
+  double x_lo, x_hi, y_lo, y_hi;
+};
+
+// The axes' ranges: the finite data and the horizontal lines (or plot.y_min/y_max), y padded.
+Bounds data_bounds(const LinePlot& plot) {
   double x_lo = INFINITY, x_hi = -INFINITY, y_lo = INFINITY, y_hi = -INFINITY;
   for (const PlotSeries& s : plot.series) {
     for (std::size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
@@ -133,8 +139,14 @@ void write_plot_png(const std::filesystem::path& path, const LinePlot& plot) {
   if (!(x_hi > x_lo)) x_hi = x_lo + 1.0;
   if (!(y_hi > y_lo)) y_hi = y_lo + 1.0;
   const double pad = 0.04 * (y_hi - y_lo);
-  y_lo -= pad;
-  y_hi += pad;
+  return {x_lo, x_hi, y_lo - pad, y_hi + pad};
+}
+
+}  // namespace
+
+void write_plot_png(const std::filesystem::path& path, const LinePlot& plot) {
+  if (plot.width < 200 || plot.height < 150) throw InputError("plot too small");
+  const auto [x_lo, x_hi, y_lo, y_hi] = data_bounds(plot);
 
   Canvas canvas(plot.width, plot.height);
   const int left = 70, right = plot.width - 20, top = 30, bottom = plot.height - 45;

@@ -1,6 +1,7 @@
 #include "riner/projector.hpp"
 
 #include "cl/context.hpp"
+#include "cl/device_access.hpp"
 #include "ops/backproject.hpp"
 #include "ops/project.hpp"
 #include "reference/project_ref.hpp"
@@ -23,8 +24,9 @@ Projector::Projector(const Geometry& geometry, Engine engine, std::optional<Devi
   impl_->engine = engine;
   if (engine == Engine::kOpenCL) {
     impl_->device = device ? *device : Device::open();
-    impl_->project = std::make_unique<ops::ProjectOp>(impl_->device->context(), geometry);
-    impl_->backproject = std::make_unique<ops::BackprojectOp>(impl_->device->context(), geometry);
+    impl_->project = std::make_unique<ops::ProjectOp>(cl::context_of(*impl_->device), geometry);
+    impl_->backproject =
+        std::make_unique<ops::BackprojectOp>(cl::context_of(*impl_->device), geometry);
   }
 }
 
@@ -46,7 +48,7 @@ Array Projector::project(const Array& volume) const {
     out.data = ref::project(g, volume.data);
     return out;
   }
-  cl::Context& ctx = impl_->device->context();
+  cl::Context& ctx = cl::context_of(*impl_->device);
   cl::Buffer<float> d_volume(ctx, std::span<const float>(volume.data));
   cl::Buffer<float> d_out(ctx, out.size());
   impl_->project->forward(d_volume, d_out);
@@ -62,7 +64,7 @@ Array Projector::adjoint(const Array& measurement) const {
     volume.data = ref::backproject_adjoint(g, measurement.data);
     return volume;
   }
-  cl::Context& ctx = impl_->device->context();
+  cl::Context& ctx = cl::context_of(*impl_->device);
   cl::Buffer<float> d_values(ctx, std::span<const float>(measurement.data));
   cl::Buffer<float> d_volume(ctx, volume.size());
   impl_->backproject->adjoint(d_values, d_volume);

@@ -24,19 +24,22 @@ void scale_levels(const model::ParameterLayout& l, const std::vector<float>& lev
   }
 }
 
-StepResult riner_step(const StepInputs& in, const model::Batch& batch,
-                      const std::vector<double>& params, bool with_gradient) {
+namespace {
+
+// The position of a ray's sample k (jittered like the kernel when the step asks for it).
+void sample_at(const StepInputs& in, std::uint32_t ray, std::uint32_t k, double pos[3]) {
+  const float u = in.jitter ? sample_jitter(in.seed, in.step, ray, k) : 0.5f;
+  float p[3];
+  model::sample_position((*in.segments)[ray], k, u, p);
+  for (int d = 0; d < 3; ++d) pos[d] = p[d];
+}
+
+// Every ray's sum of mu dx (threads own disjoint rays).
+std::vector<double> ray_sums(const StepInputs& in, const model::Batch& batch,
+                             const std::vector<double>& params) {
   const model::ParameterLayout& l = *in.layout;
-  const std::size_t n = batch.rays.size();
-  auto position = [&](std::uint32_t ray, std::uint32_t k, double pos[3]) {
-    const float u = in.jitter ? sample_jitter(in.seed, in.step, ray, k) : 0.5f;
-    float p[3];
-    model::sample_position((*in.segments)[ray], k, u, p);
-    for (int d = 0; d < 3; ++d) pos[d] = p[d];
-  };
-  // Forward: every ray's sum of mu dx (threads own disjoint rays).
-  std::vector<double> sums(n, 0.0);
-  util::parallel_for(n, [&](std::size_t begin, std::size_t end) {
+  std::vector<double> sums(batch.rays.size(), 0.0);
+  util::parallel_for(sums.size(), [&](std::size_t begin, std::size_t end) {
     std::vector<double> features(static_cast<std::size_t>(l.inputs));
     for (std::size_t b = begin; b < end; ++b) {
       const std::uint32_t ray = batch.rays[b];
@@ -44,7 +47,7 @@ StepResult riner_step(const StepInputs& in, const model::Batch& batch,
       double sum = 0.0;
       for (std::uint32_t k = 0; k < s.count; ++k) {
         double pos[3];
-        position(ray, k, pos);
+        sample_at(in, ray, k, pos);
         hash_grid_encode(l, params.data(), pos, features.data());
         scale_levels(l, in.level_weights, features.data());
         sum += mlp_forward(l, params.data(), features.data());
@@ -52,34 +55,47 @@ StepResult riner_step(const StepInputs& in, const model::Batch& batch,
       sums[b] = sum * s.dx;
     }
   });
+  return sums;
+}
 
-  // Loss, in batch order like the kernel.
-  StepResult result;
-  if (with_gradient) result.grad.assign(l.total, 0.0);
-  std::vector<double> d_sums(n, 0.0);
-  double penalty_weight = in.lambda;
-  if (in.relative_beta_threshold > 0.0 && n > 0) {
-    std::vector<double> mismatch(n);
-    for (std::size_t b = 0; b < n; ++b) {
-      const std::uint32_t ray = batch.rays[b];
-      mismatch[b] = ray_mismatch(sums[b], params[l.alpha_offset + ray % in.elements_per_view],
-                                 (*in.measurement)[ray]);
-    }
-    std::nth_element(mismatch.begin(), mismatch.begin() + static_cast<long>((n - 1) / 2),
-                     mismatch.end());
-    const double median = mismatch[(n - 1) / 2];
-    penalty_weight = 0.5 * in.data_weight * in.relative_beta_threshold * std::max(median, 1e-3);
+// lambda, or with a relative threshold, data_weight * threshold * the batch's median ray
+// mismatch / 2 (riner_step.cl, riner_step_loss).
+double penalty_weight(const StepInputs& in, const model::Batch& batch,
+                      const std::vector<double>& params, const std::vector<double>& sums) {
+  const model::ParameterLayout& l = *in.layout;
+  const std::size_t n = batch.rays.size();
+  if (!(in.relative_beta_threshold > 0.0) || n == 0) return in.lambda;
+  std::vector<double> mismatch(n);
+  for (std::size_t b = 0; b < n; ++b) {
+    const std::uint32_t ray = batch.rays[b];
+    mismatch[b] = ray_mismatch(sums[b], params[l.alpha_offset + ray % in.elements_per_view],
+                               (*in.measurement)[ray]);
   }
+  std::nth_element(mismatch.begin(), mismatch.begin() + static_cast<long>((n - 1) / 2),
+                   mismatch.end());
+  const double median = mismatch[(n - 1) / 2];
+  return 0.5 * in.data_weight * in.relative_beta_threshold * std::max(median, 1e-3);
+}
+
+// The losses in batch order like the kernel: result's losses, d_sums and (with a gradient) the
+// alpha0 and beta0 gradients.
+void losses(const StepInputs& in, const model::Batch& batch, const std::vector<double>& params,
+            bool with_gradient, StepResult& result) {
+  const model::ParameterLayout& l = *in.layout;
+  const std::size_t n = batch.rays.size();
+  result.d_sums.assign(n, 0.0);
+  const double weight = penalty_weight(in, batch, params, result.sums);
   const auto beta_learns = [&](std::size_t e) {
     return !in.hold_valid_beta || (*in.invalid_readings)[e] != 0;
   };
   for (std::size_t b = 0; b < n; ++b) {
     const std::uint32_t ray = batch.rays[b];
     const std::size_t e = ray % in.elements_per_view;
-    const RayLoss rl = ray_loss(sums[b], params[l.alpha_offset + e], params[l.beta_offset + e],
-                                (*in.measurement)[ray], batch.weights[b]);
+    const RayLoss rl =
+        ray_loss(result.sums[b], params[l.alpha_offset + e], params[l.beta_offset + e],
+                 (*in.measurement)[ray], batch.weights[b]);
     result.data_loss += rl.loss;
-    d_sums[b] = rl.d_sum;
+    result.d_sums[b] = rl.d_sum;
     if (with_gradient) {
       result.grad[l.alpha_offset + e] += rl.d_alpha0;
       if (beta_learns(e)) result.grad[l.beta_offset + e] += rl.d_beta0;
@@ -87,28 +103,30 @@ StepResult riner_step(const StepInputs& in, const model::Batch& batch,
   }
   for (std::uint32_t e : batch.elements) {
     double d_beta0 = 0.0;
-    result.penalty += beta_penalty(params[l.beta_offset + e], penalty_weight, &d_beta0);
+    result.penalty += beta_penalty(params[l.beta_offset + e], weight, &d_beta0);
     if (with_gradient && beta_learns(e)) result.grad[l.beta_offset + e] += d_beta0;
   }
-  result.penalty += ring_prior(batch, sums, in.ring_lambda, &d_sums);
-  result.sums = sums;
-  result.d_sums = d_sums;
-  if (!with_gradient) return result;
+  result.penalty += ring_prior(batch, result.sums, in.ring_lambda, &result.d_sums);
+}
 
-  // Backward: threads own contiguous rays and their own gradients, summed in order.
+// The field's gradient from d_sums: threads own contiguous rays and their own gradients,
+// summed in order.
+void backward(const StepInputs& in, const model::Batch& batch, const std::vector<double>& params,
+              StepResult& result) {
+  const model::ParameterLayout& l = *in.layout;
   std::vector<std::vector<double>> partials =
-      util::parallel_map_chunks(n, [&](std::size_t begin, std::size_t end) {
+      util::parallel_map_chunks(batch.rays.size(), [&](std::size_t begin, std::size_t end) {
         std::vector<double> grad(l.total, 0.0);
         std::vector<double> features(static_cast<std::size_t>(l.inputs));
         std::vector<double> d_features(static_cast<std::size_t>(l.inputs));
         for (std::size_t b = begin; b < end; ++b) {
           const std::uint32_t ray = batch.rays[b];
           const model::RaySegment& s = (*in.segments)[ray];
-          const double d_mu = d_sums[b] * s.dx;
+          const double d_mu = result.d_sums[b] * s.dx;
           if (d_mu == 0.0) continue;
           for (std::uint32_t k = 0; k < s.count; ++k) {
             double pos[3];
-            position(ray, k, pos);
+            sample_at(in, ray, k, pos);
             hash_grid_encode(l, params.data(), pos, features.data());
             scale_levels(l, in.level_weights, features.data());
             MlpTrace trace;
@@ -124,6 +142,17 @@ StepResult riner_step(const StepInputs& in, const model::Batch& batch,
   for (const std::vector<double>& g : partials) {
     for (std::size_t i = 0; i < l.total; ++i) result.grad[i] += g[i];
   }
+}
+
+}  // namespace
+
+StepResult riner_step(const StepInputs& in, const model::Batch& batch,
+                      const std::vector<double>& params, bool with_gradient) {
+  StepResult result;
+  if (with_gradient) result.grad.assign(in.layout->total, 0.0);
+  result.sums = ray_sums(in, batch, params);
+  losses(in, batch, params, with_gradient, result);
+  if (with_gradient) backward(in, batch, params, result);
   return result;
 }
 
@@ -153,10 +182,10 @@ double ring_prior(const model::Batch& batch, const std::vector<double>& sums, do
   return penalty;
 }
 
-std::vector<float> field_evaluate(const model::ParameterLayout& l,
-                                  const std::vector<double>& params,
-                                  const std::vector<float>& positions,
-                                  const std::vector<float>& level_weights) {
+std::vector<float> riner_step_field_evaluate(const model::ParameterLayout& l,
+                                             const std::vector<double>& params,
+                                             const std::vector<float>& positions,
+                                             const std::vector<float>& level_weights) {
   const std::size_t n = positions.size() / static_cast<std::size_t>(l.dims);
   std::vector<float> out(n);
   util::parallel_for(n, [&](std::size_t begin, std::size_t end) {

@@ -51,7 +51,7 @@ double ring_prior(const model::Batch& batch, const std::vector<double>& sums, do
 float sample_jitter(std::uint32_t seed, std::uint32_t step, std::uint32_t ray, std::uint32_t k);
 
 // mu at normalised positions [n][dims] (evaluation of the trained field).
-std::vector<float> field_evaluate(const model::ParameterLayout& l,
+std::vector<float> riner_step_field_evaluate(const model::ParameterLayout& l,
                                   const std::vector<double>& params,
                                   const std::vector<float>& positions,
                                   const std::vector<float>& level_weights);

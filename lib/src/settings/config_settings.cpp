@@ -47,7 +47,8 @@ void add_network(Table& t) {
                        &N::hidden_layers));
 }
 
-void add_training(Table& t) {
+// How a step samples rays along them.
+void add_training_sampling(Table& t) {
   t.push_back(field<C>("training", "steps", closed(0, kMaxSteps), "training steps", &C::training,
                        &T::steps));
   t.push_back(enum_choice<C>(
@@ -78,6 +79,10 @@ void add_training(Table& t) {
   t.push_back(field<C>("training", "air_margin_px", closed(0, 64),
                        "skip_air: voxels kept around what is not air", &C::training,
                        &T::air_margin_px));
+}
+
+// The optimiser, the schedule and the loss.
+void add_training_schedule(Table& t) {
   t.push_back(field<C>("training", "learning_rate", open(0, 10), "Adam's learning rate",
                        &C::training, &T::learning_rate));
   t.push_back(field<C>("training", "lr_decay_steps", closed(0, kMaxSteps),
@@ -177,7 +182,8 @@ const std::vector<settings::Setting<C>>& config_settings() {
     Table t;
     add_encoding(t);
     add_network(t);
-    add_training(t);
+    add_training_sampling(t);
+    add_training_schedule(t);
     add_rings(t);
     add_plan(t);
     t.push_back(enum_choice<C>("", "engine", {Engine::kOpenCL, Engine::kReference}, engine_name,

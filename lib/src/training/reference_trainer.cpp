@@ -1,7 +1,7 @@
 // The reference engine: the whole step in double on the CPU (reference/riner_step_ref.cpp).
 #include "reference/adam_ref.hpp"
 #include "reference/riner_step_ref.hpp"
-#include "riner/trainer.hpp"
+#include "training/trainer.hpp"
 
 namespace riner::detail {
 
@@ -51,7 +51,7 @@ class ReferenceTrainer final : public Trainer {
   std::vector<float> parameters() override { return {params_.begin(), params_.end()}; }
 
   std::vector<float> evaluate_grid() override {
-    return ref::field_evaluate(setup_.layout, params_, model::voxel_positions(setup_.scan.geometry),
+    return ref::riner_step_field_evaluate(setup_.layout, params_, model::voxel_positions(setup_.scan.geometry),
                                setup_.level_weights(steps_));
   }
 

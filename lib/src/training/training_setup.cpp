@@ -2,7 +2,7 @@
 #include <cmath>
 
 #include "riner/error.hpp"
-#include "riner/trainer.hpp"
+#include "training/trainer.hpp"
 
 namespace riner::detail {
 

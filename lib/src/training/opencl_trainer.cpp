@@ -5,12 +5,13 @@
 #include <cstring>
 
 #include "cl/context.hpp"
+#include "cl/device_access.hpp"
 #include "cl/upload_ring.hpp"
 #include "model/packed_batch.hpp"
 #include "ops/adam.hpp"
 #include "ops/riner_step.hpp"
 #include "riner/error.hpp"
-#include "riner/trainer.hpp"
+#include "training/trainer.hpp"
 
 namespace riner::detail {
 
@@ -31,7 +32,7 @@ class OpenclTrainer final : public Trainer {
   OpenclTrainer(const TrainingSetup& setup, Device device, const ExecutionPlan& plan)
       : setup_(setup),
         device_(std::move(device)),
-        ctx_(device_.context()),
+        ctx_(cl::context_of(device_)),
         plan_(plan),
         params_(ctx_, std::span<const float>(
                           model::initial_parameters(setup.layout, setup.config.training.seed))),
@@ -60,7 +61,7 @@ class OpenclTrainer final : public Trainer {
     p.hold_valid_beta = setup_.hold_valid_beta(index) ? 1 : 0;
     p.history_slot = static_cast<cl_uint>(pending_.size());
     p.lambda = static_cast<float>(t.lambda);
-    p.relative_threshold = static_cast<float>(t.relative_beta_threshold);
+    p.relative_beta_threshold = static_cast<float>(t.relative_beta_threshold);
     p.data_weight = static_cast<float>(t.data_weight);
     p.ring_lambda = static_cast<float>(t.ring_lambda);
     p.block_first = batch.block_first;
