@@ -42,9 +42,9 @@ inline float sample_detector(__global const float* view, int n_u, int n_v, float
   return value;
 }
 
-__kernel void fbp_backproject(const uint n_voxels, const ScanGeometry g, __global const float2* views,
-                              __global const float* view_weights, __global const float* filtered,
-                              __global float* volume) {
+__kernel void fbp_backproject(const uint n_voxels, const ScanGeometry g,
+                              __global const float2* views, __global const float* view_weights,
+                              __global const float* filtered, __global float* volume) {
   const uint gid = get_global_id(0);
   if (gid >= n_voxels) return;
   const int k = gid % g.nx;
@@ -68,7 +68,8 @@ __kernel void fbp_backproject(const uint n_voxels, const ScanGeometry g, __globa
       weight *= (g.sod / distance) * (g.sod / distance);
     }
     const float u = a * scale / g.pitch_u + 0.5f * (float)(g.n_u - 1) - g.offset_u;
-    const float row = g.is_3d ? z * scale / g.pitch_v + 0.5f * (float)(g.n_v - 1) - g.offset_v : 0.0f;
+    const float row =
+        g.is_3d ? z * scale / g.pitch_v + 0.5f * (float)(g.n_v - 1) - g.offset_v : 0.0f;
     sum += weight * sample_detector(filtered + v * rows * g.n_u, g.n_u, rows, u, row);
   }
   volume[gid] = sum;

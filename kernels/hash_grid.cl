@@ -153,13 +153,15 @@ RINER_INLINE void hash_grid_scatter(__constant const GridLevel* levels, __global
       float w;
       const uint index = hash_grid_corner(&levels[l], cell, frac, c, &w);
       RINER_UNROLL
-      for (int f = 0; f < N_FEATURES; ++f) GRAD_ADD(&grad[index + f], w * d_out[l * N_FEATURES + f]);
+      for (int f = 0; f < N_FEATURES; ++f)
+        GRAD_ADD(&grad[index + f], w * d_out[l * N_FEATURES + f]);
     }
   }
 }
 
-__kernel void hash_grid_forward(const uint n, __constant const GridLevel* levels, __global const float* table,
-                                __global const float* positions, __global float* features) {
+__kernel void hash_grid_forward(const uint n, __constant const GridLevel* levels,
+                                __global const float* table, __global const float* positions,
+                                __global float* features) {
   const uint i = get_global_id(0);
   if (i >= n) return;
   float pos[DIMS];

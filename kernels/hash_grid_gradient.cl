@@ -22,8 +22,8 @@ RINER_INLINE void flush_corner(__global float* table, uint entry, uint lo, uint 
   for (int f = 0; f < N_FEATURES; ++f) table[entry * N_FEATURES + f] += sum[f];
 }
 
-__kernel void hash_grid_gradient_accumulate(const uint n_samples, const uint bands, const uint stride,
-                                            __constant const GridLevel* levels,
+__kernel void hash_grid_gradient_accumulate(const uint n_samples, const uint bands,
+                                            const uint stride, __constant const GridLevel* levels,
                                             __global const float* cache, __global float* grad) {
   if (get_local_id(0) != 0) return;
   const uint g = get_group_id(0);

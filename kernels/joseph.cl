@@ -95,8 +95,8 @@ inline void joseph_cell(const JosephWalk* w, int m, int cell, int* index, float*
   const float w0 = (cell & 1) ? c0 - f0 : 1.0f - (c0 - f0);
   const float w1 = (cell >> 1) ? c1 - f1 : 1.0f - (c1 - f1);
   const int inside = i0 >= 0 && i0 < w->n[w->other0] && i1 >= 0 && i1 < w->n[w->other1];
-  *index = inside ? m * w->stride[w->main_axis] + i0 * w->stride[w->other0] +
-                        i1 * w->stride[w->other1]
-                  : 0;
+  *index = inside
+               ? m * w->stride[w->main_axis] + i0 * w->stride[w->other0] + i1 * w->stride[w->other1]
+               : 0;
   *weight = inside ? w0 * w1 * w->step_length : 0.0f;
 }

@@ -30,7 +30,7 @@
 #define MLP_V (MLP_WIDTH / 16)
 #define MLP_W_IN 0
 #define MLP_B_IN (MLP_INPUTS * MLP_WIDTH)
-#define MLP_W_HIDDEN(h) (MLP_B_IN + MLP_WIDTH + ((h) - 1) * (MLP_WIDTH * MLP_WIDTH + MLP_WIDTH))
+#define MLP_W_HIDDEN(h) (MLP_B_IN + MLP_WIDTH + ((h)-1) * (MLP_WIDTH * MLP_WIDTH + MLP_WIDTH))
 #define MLP_B_HIDDEN(h) (MLP_W_HIDDEN(h) + MLP_WIDTH * MLP_WIDTH)
 #define MLP_W_OUT MLP_W_HIDDEN(MLP_HIDDEN)
 #define MLP_B_OUT (MLP_W_OUT + MLP_WIDTH)
@@ -56,7 +56,8 @@ RINER_INLINE void grad_add16(__global float* g, int offset, float16 v) {
 }
 
 // act[h][j]: post-ReLU activations of hidden layer h, kept for the backward pass.
-RINER_INLINE float mlp_forward(__global const float* w, const float* in, float act[MLP_HIDDEN][MLP_WIDTH]) {
+RINER_INLINE float mlp_forward(__global const float* w, const float* in,
+                               float act[MLP_HIDDEN][MLP_WIDTH]) {
   float16 h[MLP_V];
   RINER_UNROLL
   for (int v = 0; v < MLP_V; ++v) h[v] = vload16(v, w + MLP_B_IN);
@@ -64,7 +65,8 @@ RINER_INLINE float mlp_forward(__global const float* w, const float* in, float a
   for (int i = 0; i < MLP_INPUTS; ++i) {
     const float x = in[i];
     RINER_UNROLL
-    for (int v = 0; v < MLP_V; ++v) h[v] = mad((float16)(x), vload16(v, w + MLP_W_IN + i * MLP_WIDTH), h[v]);
+    for (int v = 0; v < MLP_V; ++v)
+      h[v] = mad((float16)(x), vload16(v, w + MLP_W_IN + i * MLP_WIDTH), h[v]);
   }
   RINER_UNROLL
   for (int v = 0; v < MLP_V; ++v) vstore16(fmax(h[v], 0.0f), v, act[0]);
@@ -85,19 +87,21 @@ RINER_INLINE float mlp_forward(__global const float* w, const float* in, float a
   }
   float out = w[MLP_B_OUT];
   RINER_UNROLL
-  for (int v = 0; v < MLP_V; ++v) out += sum16(vload16(v, act[MLP_HIDDEN - 1]) * vload16(v, w + MLP_W_OUT));
+  for (int v = 0; v < MLP_V; ++v)
+    out += sum16(vload16(v, act[MLP_HIDDEN - 1]) * vload16(v, w + MLP_W_OUT));
   return out;
 }
 
 // Back-propagates d_out without touching any weight gradient: delta[h][j] = dloss/d(pre-
 // activation j of hidden layer h) and d_in = dloss/d(input). A layer's weight gradient is the
 // sum over samples of its input times its delta (mlp_gradient.cl reduces it).
-RINER_INLINE void mlp_deltas(__global const float* w, const float act[MLP_HIDDEN][MLP_WIDTH], float d_out,
-                       float delta[MLP_HIDDEN][MLP_WIDTH], float* d_in) {
+RINER_INLINE void mlp_deltas(__global const float* w, const float act[MLP_HIDDEN][MLP_WIDTH],
+                             float d_out, float delta[MLP_HIDDEN][MLP_WIDTH], float* d_in) {
   float16 d[MLP_V];
   RINER_UNROLL
   for (int v = 0; v < MLP_V; ++v) {
-    d[v] = select((float16)(0.0f), d_out * vload16(v, w + MLP_W_OUT), vload16(v, act[MLP_HIDDEN - 1]) > 0.0f);
+    d[v] = select((float16)(0.0f), d_out * vload16(v, w + MLP_W_OUT),
+                  vload16(v, act[MLP_HIDDEN - 1]) > 0.0f);
     vstore16(d[v], v, delta[MLP_HIDDEN - 1]);
   }
   RINER_UNROLL
@@ -107,7 +111,8 @@ RINER_INLINE void mlp_deltas(__global const float* w, const float act[MLP_HIDDEN
     for (int i = 0; i < MLP_WIDTH; ++i) {
       float16 acc = (float16)(0.0f);
       RINER_UNROLL
-      for (int v = 0; v < MLP_V; ++v) acc = mad(vload16(v, w + MLP_W_HIDDEN(layer) + i * MLP_WIDTH), d[v], acc);
+      for (int v = 0; v < MLP_V; ++v)
+        acc = mad(vload16(v, w + MLP_W_HIDDEN(layer) + i * MLP_WIDTH), d[v], acc);
       next[i] = sum16(acc);
     }
     RINER_UNROLL
@@ -128,11 +133,12 @@ RINER_INLINE void mlp_deltas(__global const float* w, const float act[MLP_HIDDEN
 // Accumulates d_out * d(output)/d(weights) into g and writes d_out * d(output)/d(input) to
 // d_in: mlp_deltas, then each layer's input times its delta.
 RINER_INLINE void mlp_backward(__global const float* w, __global float* g, const float* in,
-                         const float act[MLP_HIDDEN][MLP_WIDTH], float d_out, float* d_in) {
+                               const float act[MLP_HIDDEN][MLP_WIDTH], float d_out, float* d_in) {
   float delta[MLP_HIDDEN][MLP_WIDTH];
   mlp_deltas(w, act, d_out, delta, d_in);
   RINER_UNROLL
-  for (int v = 0; v < MLP_V; ++v) grad_add16(g, MLP_W_OUT + 16 * v, d_out * vload16(v, act[MLP_HIDDEN - 1]));
+  for (int v = 0; v < MLP_V; ++v)
+    grad_add16(g, MLP_W_OUT + 16 * v, d_out * vload16(v, act[MLP_HIDDEN - 1]));
   GRAD_ADD(&g[MLP_B_OUT], d_out);
   RINER_UNROLL
   for (int layer = MLP_HIDDEN - 1; layer >= 1; --layer) {
@@ -141,15 +147,18 @@ RINER_INLINE void mlp_backward(__global const float* w, __global float* g, const
       const float below = act[layer - 1][i];
       RINER_UNROLL
       for (int v = 0; v < MLP_V; ++v)
-        grad_add16(g, MLP_W_HIDDEN(layer) + i * MLP_WIDTH + 16 * v, below * vload16(v, delta[layer]));
+        grad_add16(g, MLP_W_HIDDEN(layer) + i * MLP_WIDTH + 16 * v,
+                   below * vload16(v, delta[layer]));
     }
     RINER_UNROLL
-    for (int v = 0; v < MLP_V; ++v) grad_add16(g, MLP_B_HIDDEN(layer) + 16 * v, vload16(v, delta[layer]));
+    for (int v = 0; v < MLP_V; ++v)
+      grad_add16(g, MLP_B_HIDDEN(layer) + 16 * v, vload16(v, delta[layer]));
   }
   RINER_UNROLL
   for (int i = 0; i < MLP_INPUTS; ++i) {
     RINER_UNROLL
-    for (int v = 0; v < MLP_V; ++v) grad_add16(g, MLP_W_IN + i * MLP_WIDTH + 16 * v, in[i] * vload16(v, delta[0]));
+    for (int v = 0; v < MLP_V; ++v)
+      grad_add16(g, MLP_W_IN + i * MLP_WIDTH + 16 * v, in[i] * vload16(v, delta[0]));
   }
   RINER_UNROLL
   for (int v = 0; v < MLP_V; ++v) grad_add16(g, MLP_B_IN + 16 * v, vload16(v, delta[0]));

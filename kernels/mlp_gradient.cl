@@ -96,7 +96,8 @@ RINER_INLINE void mlp_gradient_block(uint k, uint* shared, uint* rows, uint* par
       const uint unit = k % groups * 8;
       *shared = input < MLP_WIDTH ? CACHE_ACT(h - 1) + input : ROW_ONE;
       *rows = CACHE_DELTA(h) + unit;
-      *param = input < MLP_WIDTH ? MLP_W_HIDDEN(h) + input * MLP_WIDTH + unit : MLP_B_HIDDEN(h) + unit;
+      *param =
+          input < MLP_WIDTH ? MLP_W_HIDDEN(h) + input * MLP_WIDTH + unit : MLP_B_HIDDEN(h) + unit;
       return;
     }
     k -= BLOCKS_HIDDEN;

@@ -1,7 +1,8 @@
 // project.cl: the forward projector (Joseph's method): volume -> measurement.
 //   project_forward(n_rays, g, views, volume, out)
-//     one work-item per ray; ray r = (view, row, element) with r = (view * n_v + row) * n_u + element
-//     (row = 0 in 2D). out[r] = sum over planes of weight * volume (line integral in mm * mu).
+//     one work-item per ray; ray r = (view, row, element) with r = (view * n_v + row) * n_u +
+//     element (row = 0 in 2D). out[r] = sum over planes of weight * volume (line integral in mm *
+//     mu).
 // Needs common.cl, ray_geometry.cl, joseph.cl. No -D constants.
 // Buffers: views float2[n_views] (cos, sin); volume float[nz][ny][nx]; out float[n_rays].
 

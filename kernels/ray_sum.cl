@@ -13,8 +13,8 @@
 #define ALPHA_EPSILON 1e-8f
 
 // Returns the ray's loss; writes the gradients with respect to the ray sum, alpha0, beta0.
-RINER_INLINE float ray_loss(float ray_sum, float alpha0, float beta0, float rho, float weight, float* d_sum,
-                      float* d_alpha0, float* d_beta0) {
+RINER_INLINE float ray_loss(float ray_sum, float alpha0, float beta0, float rho, float weight,
+                            float* d_sum, float* d_alpha0, float* d_beta0) {
   if (!isfinite(rho)) rho = 0.0f;
   const int clamped = !(alpha0 > ALPHA_EPSILON);
   const float alpha = clamped ? ALPHA_EPSILON : alpha0;
@@ -40,11 +40,12 @@ RINER_INLINE float beta_penalty(float beta0, float lambda, float* d_beta0) {
   return -lambda * beta * beta;
 }
 
-__kernel void ray_sum_loss(const uint n_rays, __global const uint* offsets, __global const float* mu,
-                           __global const float* dx, __global const uint* elements,
-                           __global const float* rho, __global const float* alpha0,
-                           __global const float* beta0, const float weight, __global float* d_mu,
-                           __global float* loss, __global float* d_alpha0, __global float* d_beta0) {
+__kernel void ray_sum_loss(const uint n_rays, __global const uint* offsets,
+                           __global const float* mu, __global const float* dx,
+                           __global const uint* elements, __global const float* rho,
+                           __global const float* alpha0, __global const float* beta0,
+                           const float weight, __global float* d_mu, __global float* loss,
+                           __global float* d_alpha0, __global float* d_beta0) {
   const uint r = get_global_id(0);
   if (r >= n_rays) return;
   float sum = 0.0f;

@@ -45,9 +45,9 @@
 // Needs common.cl, hash_grid.cl, mlp.cl, ray_sum.cl, sample_cache.cl (and their -D constants).
 
 __kernel void riner_step_forward(const StepParams p, __global const uint* batch,
-                                 __global const float8* segments, __constant const GridLevel* levels,
-                                 __global const float* params, __global float* mu_dx,
-                                 __global float* cache) {
+                                 __global const float8* segments,
+                                 __constant const GridLevel* levels, __global const float* params,
+                                 __global float* mu_dx, __global float* cache) {
   const uint i = get_global_id(0);
   if (i >= p.n_samples) return;
   __global const uint* offsets = batch + p.offsets_at;
@@ -119,7 +119,8 @@ RINER_INLINE float group_sum(float value, __local float* scratch) {
 }
 
 // The ring prior on the batch's views x elements block: its value; its gradient into d_sums.
-RINER_INLINE float ring_prior(const StepParams* p, __global const float* sums, __global float* d_sums) {
+RINER_INLINE float ring_prior(const StepParams* p, __global const float* sums,
+                              __global float* d_sums) {
   if (p->ring_lambda <= 0.0f || p->block_views == 0 || p->block_elements < 3) return 0.0f;
   const uint E = p->block_elements;
   float penalty = 0.0f;
@@ -142,11 +143,12 @@ RINER_INLINE float ring_prior(const StepParams* p, __global const float* sums, _
   return penalty;
 }
 
-__kernel void riner_step_loss(const StepParams p, __global const uint* batch, __global const float* mu_dx,
-                              __global const float* rho, __global const float* params,
-                              __global const uint* invalid_readings, __global float* grad,
-                              __global float* sums, __global float* d_sums, __global float2* ray_grads,
-                              __global float* history, __global float* scratch, __local float* reduce) {
+__kernel void riner_step_loss(const StepParams p, __global const uint* batch,
+                              __global const float* mu_dx, __global const float* rho,
+                              __global const float* params, __global const uint* invalid_readings,
+                              __global float* grad, __global float* sums, __global float* d_sums,
+                              __global float2* ray_grads, __global float* history,
+                              __global float* scratch, __local float* reduce) {
   const uint lid = get_local_id(0);
   const uint size = get_local_size(0);
   __global const uint* offsets = batch + p.offsets_at;
@@ -161,7 +163,8 @@ __kernel void riner_step_loss(const StepParams p, __global const uint* batch, __
     if (lid == 0) {
       for (uint b = 0; b < p.n_batch; ++b) {
         const uint ray = batch[p.rays_at + b];
-        scratch[b] = ray_mismatch(sums[b], params[p.alpha_offset + ray % p.elements_per_view], rho[ray]);
+        scratch[b] =
+            ray_mismatch(sums[b], params[p.alpha_offset + ray % p.elements_per_view], rho[ray]);
       }
       reduce[0] = select_kth(scratch, p.n_batch, (p.n_batch - 1) / 2);
     }
@@ -204,9 +207,10 @@ __kernel void riner_step_loss(const StepParams p, __global const uint* batch, __
 }
 
 __kernel void riner_step_backward(const StepParams p, __global const uint* batch,
-                                  __global const float8* segments, __constant const GridLevel* levels,
-                                  __global const float* params, __global const float* d_sums,
-                                  __global float* cache, __global float* grad) {
+                                  __global const float8* segments,
+                                  __constant const GridLevel* levels, __global const float* params,
+                                  __global const float* d_sums, __global float* cache,
+                                  __global float* grad) {
   const uint i = get_global_id(0);
   if (i >= p.n_samples) return;
   __global const uint* offsets = batch + p.offsets_at;
@@ -244,10 +248,12 @@ __kernel void riner_step_backward(const StepParams p, __global const uint* batch
 #endif
 }
 
-__kernel void riner_step_field_evaluate(const uint n, const uint first, const uint nx, const uint ny, const uint nz,
-                             const float voxel, const float extent, __constant const GridLevel* levels,
-                             __global const float* level_weights, __global const float* params,
-                             const uint mlp_offset, __global float* out) {
+__kernel void riner_step_field_evaluate(const uint n, const uint first, const uint nx,
+                                        const uint ny, const uint nz, const float voxel,
+                                        const float extent, __constant const GridLevel* levels,
+                                        __global const float* level_weights,
+                                        __global const float* params, const uint mlp_offset,
+                                        __global float* out) {
   const uint i = get_global_id(0);
   if (i >= n) return;
   const uint index = first + i;

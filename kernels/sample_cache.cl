@@ -24,7 +24,7 @@
 // Needs hash_grid.cl and mlp.cl (their -D constants).
 
 #define CACHE_FEATURES 0
-#define CACHE_ACT(h) (N_ENCODED + (h) * MLP_WIDTH)
+#define CACHE_ACT(h) (N_ENCODED + (h)*MLP_WIDTH)
 #define CACHE_DELTA(h) (N_ENCODED + (MLP_HIDDEN + (h)) * MLP_WIDTH)
 #define CACHE_DMU (N_ENCODED + 2 * MLP_HIDDEN * MLP_WIDTH)
 #define CACHE_DIN (CACHE_DMU + 1)

@@ -35,17 +35,23 @@ void AdamOp::step(const AdamSettings& s, int step, cl::Buffer<float>& params,
   }
   const double bias1 = 1.0 - std::pow(s.beta1, step);
   const double bias2 = 1.0 - std::pow(s.beta2, step);
-  kernel_.set_args(static_cast<cl_uint>(n_params_), static_cast<float>(s.learning_rate / bias1),
-                   static_cast<cl_uint>(std::min(s.alpha_offset, n_params_)),
-                   static_cast<float>(s.alpha_learning_rate / bias1),
-                   static_cast<cl_uint>(std::min(s.beta_offset, n_params_)),
-                   static_cast<float>(s.beta_learning_rate / bias1), static_cast<float>(s.beta1),
-                   static_cast<float>(s.beta2), static_cast<float>(1.0 / std::sqrt(bias2)),
-                   static_cast<float>(s.epsilon), params, m_, v_, grad,
-                   static_cast<cl_uint>(sliced ? slices.offset : 0),
-                   static_cast<cl_uint>(sliced ? slices.count : 0),
-                   static_cast<cl_uint>(sliced ? slices.slices : 0),
-                   sliced ? *slices.buffer : no_slices_);
+  AdamParams p;
+  p.n = static_cast<cl_uint>(n_params_);
+  p.step_size = static_cast<float>(s.learning_rate / bias1);
+  p.alpha_offset = static_cast<cl_uint>(std::min(s.alpha_offset, n_params_));
+  p.alpha_step_size = static_cast<float>(s.alpha_learning_rate / bias1);
+  p.beta_offset = static_cast<cl_uint>(std::min(s.beta_offset, n_params_));
+  p.beta_step_size = static_cast<float>(s.beta_learning_rate / bias1);
+  p.beta1 = static_cast<float>(s.beta1);
+  p.beta2 = static_cast<float>(s.beta2);
+  p.inv_sqrt_bias2 = static_cast<float>(1.0 / std::sqrt(bias2));
+  p.epsilon = static_cast<float>(s.epsilon);
+  if (sliced) {
+    p.partial_offset = static_cast<cl_uint>(slices.offset);
+    p.partial_count = static_cast<cl_uint>(slices.count);
+    p.n_partials = static_cast<cl_uint>(slices.slices);
+  }
+  kernel_.set_args(p, params, m_, v_, grad, sliced ? *slices.buffer : no_slices_);
   context_.launch(kernel_, n_params_);
 }
 

@@ -21,6 +21,24 @@ struct GradientSlices {
   std::size_t slices = 0;
 };
 
+// Host mirror of AdamParams in kernels/adam.cl: one step's sizes and settings.
+struct AdamParams {
+  cl_uint n = 0;
+  float step_size = 0.0f;
+  cl_uint alpha_offset = 0;
+  float alpha_step_size = 0.0f;
+  cl_uint beta_offset = 0;
+  float beta_step_size = 0.0f;
+  float beta1 = 0.0f;
+  float beta2 = 0.0f;
+  float inv_sqrt_bias2 = 0.0f;
+  float epsilon = 0.0f;
+  cl_uint partial_offset = 0;
+  cl_uint partial_count = 0;
+  cl_uint n_partials = 0;
+};
+static_assert(sizeof(AdamParams) == 52, "must match AdamParams in adam.cl");
+
 class AdamOp {
  public:
   AdamOp(cl::Context& context, std::size_t n_params);
