@@ -26,9 +26,9 @@
 //     cache for mlp_gradient.cl; the features' gradient into the grid: with
 //     -D ATOMIC_GRADIENTS by float atomics into grad (common.cl picks the device's fastest),
 //     otherwise into the cache (CACHE_DIN, CACHE_POS) for hash_grid_gradient.cl.
-//   riner_step_field_evaluate(n, first, nx, ny, nz, voxel, extent, levels, level_weights, params,
-//                  mlp_offset, out)
-//     one work-item per voxel index first + i of the grid [nz][ny][nx]: mu at its centre.
+//   riner_step_field_evaluate(g, levels, level_weights, params, out)
+//     one work-item per voxel index g.first + i (i < g.n) of the grid [nz][ny][nx]: mu at its
+//     centre.
 //
 // Ring prior (riner's addition; off when ring_lambda = 0): a detector offset constant over
 // views can always be explained by a ring in the image instead (README, "Rings and the
@@ -248,26 +248,35 @@ __kernel void riner_step_backward(const StepParams p, __global const uint* batch
 #endif
 }
 
-__kernel void riner_step_field_evaluate(const uint n, const uint first, const uint nx,
-                                        const uint ny, const uint nz, const float voxel,
-                                        const float extent, __constant const GridLevel* levels,
+// Host mirror: ops::FieldGrid (lib/src/ops/riner_step.hpp), 8 four-byte members.
+typedef struct {
+  uint n;      // voxels this launch evaluates
+  uint first;  // the first one's flat index
+  uint nx;
+  uint ny;
+  uint nz;
+  float voxel;   // mm
+  float extent;  // mm: the encoding's cube
+  uint mlp_offset;
+} FieldGrid;
+
+__kernel void riner_step_field_evaluate(const FieldGrid g, __constant const GridLevel* levels,
                                         __global const float* level_weights,
-                                        __global const float* params, const uint mlp_offset,
-                                        __global float* out) {
+                                        __global const float* params, __global float* out) {
   const uint i = get_global_id(0);
-  if (i >= n) return;
-  const uint index = first + i;
-  const uint k = index % nx;
-  const uint row = (index / nx) % ny;
-  const uint slice = index / (nx * ny);
+  if (i >= g.n) return;
+  const uint index = g.first + i;
+  const uint k = index % g.nx;
+  const uint row = (index / g.nx) % g.ny;
+  const uint slice = index / (g.nx * g.ny);
   // Voxel centre (README, "Geometry convention") in the encoding's normalised cube.
   float pos[3];
-  pos[0] = ((float)k - 0.5f * (float)(nx - 1)) * voxel / extent + 0.5f;
-  pos[1] = (0.5f * (float)(ny - 1) - (float)row) * voxel / extent + 0.5f;
-  pos[2] = ((float)slice - 0.5f * (float)(nz - 1)) * voxel / extent + 0.5f;
+  pos[0] = ((float)k - 0.5f * (float)(g.nx - 1)) * g.voxel / g.extent + 0.5f;
+  pos[1] = (0.5f * (float)(g.ny - 1) - (float)row) * g.voxel / g.extent + 0.5f;
+  pos[2] = ((float)slice - 0.5f * (float)(g.nz - 1)) * g.voxel / g.extent + 0.5f;
   float features[N_ENCODED];
   float act[MLP_HIDDEN][MLP_WIDTH];
   hash_grid_encode(levels, params, pos, features);
   scale_levels(level_weights, features);
-  out[index] = mlp_forward(params + mlp_offset, features, act);
+  out[index] = mlp_forward(params + g.mlp_offset, features, act);
 }

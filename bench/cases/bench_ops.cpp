@@ -95,76 +95,96 @@ double grid_backward_flops(const riner::model::ParameterLayout& l) {
   return l.levels * std::pow(2.0, l.dims) * 2.0 * l.features;
 }
 
-// The explicit (unfused) kernels on n samples of the default model.
-void model_ops(const riner::Device& device, const Options& o, const Peaks& peaks,
-               std::vector<Result>* out) {
-  riner::cl::Context& ctx = riner::cl::context_of(device);
-  const std::size_t n = o.size == "tiny" ? 4096 : (std::size_t{1} << 17);
-  const int warmup = o.warmup, runs = o.runs;
+// The default model's layout with `width` (the 512^2 paper grid's finest level, 768 elements).
+riner::model::ParameterLayout bench_layout(int width) {
   riner::RinerConfig config;
   config.encoding.finest_resolution = 512;  // what auto picks on the 512^2 paper grid
+  config.network.width = width;
+  return riner::model::make_layout(2, config.encoding, config.network, 768);
+}
+
+std::size_t bench_samples(const Options& o) {
+  return o.size == "tiny" ? 4096 : (std::size_t{1} << 17);
+}
+
+// kernels/hash_grid.cl (ops::HashGridOp) on n samples.
+void hash_grid_ops(const riner::Device& device, const Options& o, const Peaks& peaks,
+                   std::vector<Result>* out) {
+  riner::cl::Context& ctx = riner::cl::context_of(device);
+  const std::size_t n = bench_samples(o);
+  const riner::model::ParameterLayout l = bench_layout(16);
+  riner::cl::Buffer<float> params(ctx,
+                                  std::span<const float>(riner::model::initial_parameters(l, 1)));
+  riner::cl::Buffer<float> grad(ctx, std::vector<float>(l.total, 0.0f));
+  riner::cl::Buffer<float> positions(ctx, std::span<const float>(uniform(2 * n, 0.0f, 1.0f, 2)));
+  riner::cl::Buffer<float> features(ctx, n * l.inputs);
+  riner::cl::Buffer<float> d_features(
+      ctx, std::span<const float>(uniform(n * l.inputs, -1.0f, 1.0f, 3)));
+  riner::ops::HashGridOp grid(ctx, l);
+  const double lookups = static_cast<double>(n) * l.levels * 4;
+  OpTiming t = riner::bench::time_op(device, o.warmup, o.runs,
+                                     [&] { grid.forward(params, positions, features); });
+  out->push_back(row("hash_grid_forward", std::to_string(n) + " pts, L=8 F=2", t,
+                     {lookups, "lookups/s", n * grid_forward_flops(l), 0.0}, peaks));
+  t = riner::bench::time_op(device, o.warmup, o.runs,
+                            [&] { grid.backward(positions, d_features, grad); });
+  out->push_back(row("hash_grid_backward", std::to_string(n) + " pts, L=8 F=2", t,
+                     {lookups, "lookups/s", n * grid_backward_flops(l), 0.0}, peaks));
+}
+
+// kernels/mlp.cl (ops::MlpOp) on n samples, widths 16 and 64, and its first layer as one
+// CLBlast SGEMM: the library path issue 4 weighed against the fused kernels (activations go
+// through global memory).
+void mlp_ops(const riner::Device& device, const Options& o, const Peaks& peaks,
+             std::vector<Result>* out) {
+  riner::cl::Context& ctx = riner::cl::context_of(device);
+  const std::size_t n = bench_samples(o);
   for (int width : {16, 64}) {
-    config.network.width = width;
-    const riner::model::ParameterLayout l =
-        riner::model::make_layout(2, config.encoding, config.network, 768);
+    const riner::model::ParameterLayout l = bench_layout(width);
     riner::cl::Buffer<float> params(ctx,
                                     std::span<const float>(riner::model::initial_parameters(l, 1)));
     riner::cl::Buffer<float> grad(ctx, std::vector<float>(l.total, 0.0f));
-    riner::cl::Buffer<float> positions(ctx, std::span<const float>(uniform(2 * n, 0.0f, 1.0f, 2)));
-    riner::cl::Buffer<float> features(ctx, n * l.inputs);
-    riner::cl::Buffer<float> d_features(
+    riner::cl::Buffer<float> features(
         ctx, std::span<const float>(uniform(n * l.inputs, -1.0f, 1.0f, 3)));
     riner::cl::Buffer<float> mu(ctx, n);
     riner::cl::Buffer<float> d_mu(ctx, std::span<const float>(uniform(n, -1.0f, 1.0f, 4)));
     riner::cl::Buffer<float> d_inputs(ctx, n * l.inputs);
     const std::string shape =
         std::to_string(n) + " x " + std::to_string(l.inputs) + " -> " + std::to_string(width);
-    if (width == 16) {
-      riner::ops::HashGridOp grid(ctx, l);
-      const double lookups = static_cast<double>(n) * l.levels * 4;
-      OpTiming t = riner::bench::time_op(device, warmup, runs,
-                                         [&] { grid.forward(params, positions, features); });
-      out->push_back(row("hash_grid_forward", std::to_string(n) + " pts, L=8 F=2", t,
-                         {lookups, "lookups/s", n * grid_forward_flops(l), 0.0}, peaks));
-      t = riner::bench::time_op(device, warmup, runs,
-                                [&] { grid.backward(positions, d_features, grad); });
-      out->push_back(row("hash_grid_backward (atomic)", std::to_string(n) + " pts, L=8 F=2", t,
-                         {lookups, "lookups/s", n * grid_backward_flops(l), 0.0}, peaks));
-    }
     riner::ops::MlpOp mlp(ctx, l);
     OpTiming t =
-        riner::bench::time_op(device, warmup, runs, [&] { mlp.forward(params, d_features, mu); });
+        riner::bench::time_op(device, o.warmup, o.runs, [&] { mlp.forward(params, features, mu); });
     out->push_back(row("mlp_forward_batch", shape, t,
                        {static_cast<double>(n), "samples/s", n * mlp_forward_flops(l), 0.0},
                        peaks));
-    t = riner::bench::time_op(device, warmup, runs,
-                              [&] { mlp.backward(params, d_features, d_mu, grad, d_inputs); });
-    out->push_back(row("mlp_backward (atomic)", shape, t,
+    t = riner::bench::time_op(device, o.warmup, o.runs,
+                              [&] { mlp.backward(params, features, d_mu, grad, d_inputs); });
+    out->push_back(row("mlp_backward_batch", shape, t,
                        {static_cast<double>(n), "samples/s", 2.0 * n * mlp_forward_flops(l), 0.0},
                        peaks));
-    // The same first layer as one CLBlast SGEMM: the library path issue 4 weighed against the
-    // fused kernels (activations go through global memory).
     const double gemm_ms =
         riner::bench::clblast_gemm_ms(device, n, static_cast<std::size_t>(width),
-                                      static_cast<std::size_t>(l.inputs), warmup, runs);
+                                      static_cast<std::size_t>(l.inputs), o.warmup, o.runs);
     OpTiming gemm;
     gemm.wall_ms.median = gemm.wall_ms.q25 = gemm.wall_ms.q75 = gemm_ms;
     out->push_back(row("clblast_first_layer", shape, gemm,
                        {static_cast<double>(n), "samples/s", 2.0 * n * l.inputs * width, 0.0},
                        peaks));
   }
+}
 
-  // The first layer's weight gradient (inputs x width, summed over a step's samples) as one
-  // CLBlast SGEMM, to weigh against mlp_gradient.cl's split-K kernels (their time is in the
-  // training_step rows: the whole MLP's gradient, mlp_gradient_*). Samples per step of the
-  // default plans: 11k (160 rays), 45k (640), 180k (2560).
+// The first layer's weight gradient (inputs x width, summed over a step's samples) as one
+// CLBlast SGEMM, to weigh against mlp_gradient.cl's split-K kernels (their time is in the
+// training_step rows: the whole MLP's gradient, mlp_gradient_*). Samples per step of the
+// default plans: 11k (160 rays), 45k (640), 180k (2560).
+void mlp_gradient_ops(const riner::Device& device, const Options& o, const Peaks& peaks,
+                      std::vector<Result>* out) {
   for (const std::size_t samples : o.size == "tiny"
                                        ? std::vector<std::size_t>{4096}
                                        : std::vector<std::size_t>{11264, 45056, 180224}) {
-    const riner::model::ParameterLayout l =
-        riner::model::make_layout(2, config.encoding, {32, 1}, 768);
+    const riner::model::ParameterLayout l = bench_layout(32);
     const double ms = riner::bench::clblast_gemm_ms(device, static_cast<std::size_t>(l.inputs), 32,
-                                                    samples, warmup, runs);
+                                                    samples, o.warmup, o.runs);
     OpTiming gemm;
     gemm.wall_ms.median = gemm.wall_ms.q25 = gemm.wall_ms.q75 = ms;
     out->push_back(row(
@@ -172,8 +192,13 @@ void model_ops(const riner::Device& device, const Options& o, const Peaks& peaks
         gemm, {static_cast<double>(samples), "samples/s", 2.0 * samples * l.inputs * 32, 0.0},
         peaks));
   }
+}
 
-  // Forward model and loss on explicit samples: 4096 rays of 128 samples (the unfused path).
+// kernels/ray_sum.cl (ops::RaySumOp), the forward model and loss on explicit samples: 4096 rays
+// of 128 samples (the unfused path).
+void ray_sum_ops(const riner::Device& device, const Options& o, const Peaks& peaks,
+                 std::vector<Result>* out) {
+  riner::cl::Context& ctx = riner::cl::context_of(device);
   const std::size_t rays = o.size == "tiny" ? 256 : 4096, per_ray = 128;
   std::vector<cl_uint> offsets(rays + 1);
   for (std::size_t r = 0; r <= rays; ++r) offsets[r] = static_cast<cl_uint>(r * per_ray);
@@ -192,7 +217,7 @@ void model_ops(const riner::Device& device, const Options& o, const Peaks& peaks
   riner::cl::Buffer<float> d_beta0(ctx, std::vector<float>(768, 0.0f));
   riner::ops::RaySumOp ray_sum(ctx);
   const riner::ops::RaySumOp::Rays r{&offsets_b, &dx, &elements_b, &rho};
-  const OpTiming t = riner::bench::time_op(device, warmup, runs, [&] {
+  const OpTiming t = riner::bench::time_op(device, o.warmup, o.runs, [&] {
     ray_sum.loss(r, mu, alpha0, beta0, 1.0f, d_mu, loss, d_alpha0, d_beta0);
   });
   out->push_back(row("ray_sum_loss", std::to_string(rays) + " rays x 128", t,
@@ -272,7 +297,10 @@ std::vector<Result> ops(const Options& o) {
   const Peaks peaks{f["host_gemm_gflops"], f["device_gemm_gflops"], f["device_gbps"], {}};
   out.front().line += riner::bench::format("\n%-24s %-22s %9s    [%7s..%7s] %9s", "op", "shape",
                                            "wall", "q25", "q75", "device");
-  model_ops(device, o, peaks, &out);
+  hash_grid_ops(device, o, peaks, &out);
+  mlp_ops(device, o, peaks, &out);
+  mlp_gradient_ops(device, o, peaks, &out);
+  ray_sum_ops(device, o, peaks, &out);
   // The training step under the device's own plan, then the other one (both run everywhere).
   for (Result& r : riner::bench::time_training_steps(
            device, o, {"", device.info().type == "CPU" ? "gpu" : "cpu"}, {0}, &peaks))

@@ -172,6 +172,11 @@ TEST_SUITE("cli") {
       }
     }
     CHECK(unreadable == 2);
+    // Memory: the process held at least the scan (360 views x 500 floats) on the device, and
+    // the host at least that too.
+    const double scan_mb = 360.0 * 500 * 4 / 1048576;
+    CHECK(summary["memory"]["peak_device_buffers_mb"].get<double>() > scan_mb);
+    CHECK(summary["memory"]["peak_host_mb"].get<double>() > scan_mb);
     expect_error(riner_cli("reconstruct " + sim + "/sino.npy --set training.steps=-4 --out " +
                                (dir / "s").string(),
                            dir),

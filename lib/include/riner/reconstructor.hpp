@@ -79,6 +79,10 @@ struct TrainingStats {
   double samples_kept_fraction = 1.0;
   double noise = 0.0;  // the readings' noise sigma the carving used
   std::string air_note;
+  // Memory, so far: the process's peak resident set (host) and the most bytes of device
+  // buffers it held at once (0 on the reference engine).
+  std::size_t peak_host_bytes = 0;
+  std::size_t peak_device_bytes = 0;
 };
 
 class Reconstructor {

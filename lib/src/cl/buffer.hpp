@@ -16,10 +16,12 @@
 
 namespace riner::cl {
 
-// Buffers alive in this process, for leak checks in stress tests.
+// Buffers alive in this process, for leak checks in stress tests, and the most bytes they held
+// at once (device memory the process asked for: summary.json's memory report).
 long live_buffer_count();
-void note_buffer_created();
-void note_buffer_released();
+std::size_t peak_buffer_bytes();
+void note_buffer_created(std::size_t bytes);
+void note_buffer_released(std::size_t bytes);
 
 template <typename T>
 class Buffer {
@@ -34,7 +36,7 @@ class Buffer {
     cl_mem mem = clCreateBuffer(context.get(), flags, count * sizeof(T), nullptr, &status);
     check(status, "clCreateBuffer", RINER_HERE);
     mem_ = Handle<cl_mem>(mem);
-    note_buffer_created();
+    note_buffer_created(count * sizeof(T));
   }
   Buffer(Context& context, std::span<const T> host, cl_mem_flags flags = CL_MEM_READ_WRITE)
       : Buffer(context, host.size(), flags) {
@@ -107,7 +109,7 @@ class Buffer {
   void release() noexcept {
     if (mem_) {
       mem_.reset();
-      note_buffer_released();
+      note_buffer_released(count_ * sizeof(T));
     }
   }
 

@@ -6,11 +6,23 @@ namespace riner::cl {
 
 namespace {
 std::atomic<long> g_live_buffers{0};
+std::atomic<std::size_t> g_live_bytes{0};
+std::atomic<std::size_t> g_peak_bytes{0};
 }
 
 long live_buffer_count() { return g_live_buffers.load(); }
-void note_buffer_created() { ++g_live_buffers; }
-void note_buffer_released() { --g_live_buffers; }
+std::size_t peak_buffer_bytes() { return g_peak_bytes.load(); }
+void note_buffer_created(std::size_t bytes) {
+  ++g_live_buffers;
+  const std::size_t live = g_live_bytes += bytes;
+  std::size_t peak = g_peak_bytes.load();
+  while (live > peak && !g_peak_bytes.compare_exchange_weak(peak, live)) {
+  }
+}
+void note_buffer_released(std::size_t bytes) {
+  --g_live_buffers;
+  g_live_bytes -= bytes;
+}
 
 Kernel::Kernel(const Program& program, const std::string& name) : name_(name) {
   cl_int status = CL_SUCCESS;

@@ -109,11 +109,16 @@ void RinerStepOp::evaluate(cl_uint first, cl_uint n, const std::vector<std::size
                            float voxel_mm, float extent_mm, const cl::Buffer<float>& level_weights,
                            const cl::Buffer<float>& params, cl::Buffer<float>& out) {
   const std::size_t rank = shape.size();
-  const auto nx = static_cast<cl_uint>(shape[rank - 1]);
-  const auto ny = static_cast<cl_uint>(shape[rank - 2]);
-  const auto nz = static_cast<cl_uint>(rank == 3 ? shape[0] : 1);
-  evaluate_.set_args(n, first, nx, ny, nz, voxel_mm, extent_mm, levels_, level_weights, params,
-                     static_cast<cl_uint>(layout_.mlp_offset), out);
+  FieldGrid g;
+  g.n = n;
+  g.first = first;
+  g.nx = static_cast<cl_uint>(shape[rank - 1]);
+  g.ny = static_cast<cl_uint>(shape[rank - 2]);
+  g.nz = static_cast<cl_uint>(rank == 3 ? shape[0] : 1);
+  g.voxel = voxel_mm;
+  g.extent = extent_mm;
+  g.mlp_offset = static_cast<cl_uint>(layout_.mlp_offset);
+  evaluate_.set_args(g, levels_, level_weights, params, out);
   context_.launch(evaluate_, n);
 }
 

@@ -45,6 +45,20 @@ struct StepParams {
 };
 static_assert(sizeof(StepParams) == 108);
 
+// Host mirror of FieldGrid in kernels/riner_step.cl: which voxels of which grid one launch of
+// riner_step_field_evaluate evaluates.
+struct FieldGrid {
+  cl_uint n = 0;
+  cl_uint first = 0;
+  cl_uint nx = 0;
+  cl_uint ny = 0;
+  cl_uint nz = 0;
+  float voxel = 0.0f;
+  float extent = 0.0f;
+  cl_uint mlp_offset = 0;
+};
+static_assert(sizeof(FieldGrid) == 32, "must match FieldGrid in riner_step.cl");
+
 // The batch's sizes and section starts (the rest of StepParams is the step's settings).
 void set_batch_shape(const model::PackedBatch& batch, StepParams& p);
 

@@ -1,8 +1,11 @@
 #include "riner/reconstructor.hpp"
 
+#include <sys/resource.h>
+
 #include <chrono>
 #include <cmath>
 
+#include "cl/buffer.hpp"
 #include "riner/error.hpp"
 #include "training/trainer.hpp"
 
@@ -248,6 +251,11 @@ TrainingStats Reconstructor::stats() const {
       setup.samples_in_grid > 0.0 ? setup.samples_kept / setup.samples_in_grid : 1.0;
   s.noise = setup.occupancy.noise;
   s.air_note = setup.occupancy.note;
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) == 0) {
+    s.peak_host_bytes = static_cast<std::size_t>(usage.ru_maxrss) * 1024;  // kB on Linux
+  }
+  s.peak_device_bytes = cl::peak_buffer_bytes();
   return s;
 }
 
