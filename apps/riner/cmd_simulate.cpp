@@ -7,31 +7,67 @@
 #include "riner/error.hpp"
 #include "riner/io.hpp"
 #include "riner/phantom.hpp"
+#include "riner/resample.hpp"
 #include "riner/simulate.hpp"
 
 namespace riner::app {
 
 namespace {
 
+// --phantom-spacing-mm: "" (the image is on the grid), "file" (the file's voxel size) or
+// numbers, one per axis in array order (z,y,x).
+std::vector<double> phantom_spacing(const Args& args, const ArrayFile& file) {
+  const std::string text = args.get("phantom-spacing-mm");
+  if (text.empty()) return {};
+  if (text == "file") {
+    if (file.voxel_size.size() != file.array.rank()) {
+      throw InputError(args.get("phantom") + " stores no voxel size; give --phantom-spacing-mm");
+    }
+    return file.voxel_size;
+  }
+  std::vector<double> spacing;
+  std::size_t begin = 0;
+  while (begin <= text.size()) {
+    const std::size_t end = std::min(text.find(',', begin), text.size());
+    try {
+      std::size_t used = 0;
+      const std::string item = text.substr(begin, end - begin);
+      spacing.push_back(std::stod(item, &used));
+      if (used != item.size()) throw std::invalid_argument(item);
+    } catch (const std::exception&) {
+      throw UsageError("--phantom-spacing-mm takes numbers separated by commas, or 'file'");
+    }
+    begin = end + 1;
+  }
+  return spacing;
+}
+
 Array load_ground_truth(const Args& args, const Geometry& g, Console& console) {
   ArrayFile file = read_array(args.get("phantom"));
-  if (file.array.shape != g.volume_shape) {
+  const std::vector<double> spacing = phantom_spacing(args, file);
+  if (!spacing.empty()) {
+    file.array = resample_to_grid(file.array, spacing, g);
+    console.line("resampled " + args.get("phantom") + " onto the geometry's " +
+                 shape_string(g.volume_shape) + " grid");
+  } else if (file.array.shape != g.volume_shape) {
     throw InputError(args.get("phantom") + " has shape " + shape_string(file.array.shape) +
-                     " but the geometry's grid is " + shape_string(g.volume_shape));
+                     " but the geometry's grid is " + shape_string(g.volume_shape) +
+                     " (--phantom-spacing-mm resamples it)");
+  } else {
+    for (double s : file.voxel_size) {
+      if (std::fabs(s - g.voxel_mm) > 1e-3 * g.voxel_mm) {
+        console.line(
+            "note: the image's voxel size differs from the geometry's voxel_mm; the "
+            "geometry's is used (--phantom-spacing-mm file resamples it)");
+        break;
+      }
+    }
   }
   if (file.non_finite > 0) throw InputError(args.get("phantom") + " holds NaN or infinite values");
   const std::string unit = args.get("mu-unit");
   if (unit != "mm" && unit != "cm") throw UsageError("--mu-unit must be mm or cm");
   if (unit == "cm") {
     for (float& v : file.array.data) v *= 0.1f;  // 1/cm -> 1/mm
-  }
-  for (double s : file.voxel_size) {
-    if (std::fabs(s - g.voxel_mm) > 1e-3 * g.voxel_mm) {
-      console.line(
-          "note: the image's voxel size differs from the geometry's voxel_mm; the "
-          "geometry's is used");
-      break;
-    }
   }
   return std::move(file.array);
 }
@@ -65,10 +101,14 @@ int run_simulate(int argc, char** argv, int first) {
             "simulation.json into the output folder.");
   args.option("phantom", "NAME|FILE", "shepp-logan, or an image/volume file on the grid",
               "shepp-logan")
-      .option("geometry", "PRESET|FILE", "fan2d-paper, cone3d-paper, or a geometry JSON",
-              "fan2d-paper")
+      .option("geometry", "PRESET|FILE",
+              "fan2d-paper, cone3d-paper, parallel3d, or a geometry JSON", "fan2d-paper")
       .option("out", "DIR", "output folder (created if missing)")
       .option("seed", "N", "random seed (responses and noise)", "0")
+      .option("phantom-spacing-mm", "Z,Y,X|file",
+              "resample the image onto the geometry's grid from this voxel size (mm per axis, "
+              "array order; 'file': the file's own); default: the image is on the grid",
+              "")
       .option("mu-unit", "mm|cm", "unit of the image's values (DeepLesion: cm)", "mm")
       .option("mu-scale", "MU", "Shepp-Logan: 1/mm per head unit (brain = 0.2 units)", "0.1")
       .option("photons", "I0", "incident photons per ray; 0 disables noise", "1e7")

@@ -129,6 +129,29 @@ TEST_SUITE("cli") {
     CHECK(clean(0, 249) == doctest::Approx(256 * 0.02).epsilon(0.01));
   }
 
+  TEST_CASE("simulate resamples an image of another voxel size onto the grid") {
+    riner::test::TempDir dir;
+    riner::Array image({64, 64}, 0.02f);  // a 128 mm square of water at 2 mm
+    riner::write_array(dir / "coarse.npy", image);
+    const std::string common = "simulate --quiet --phantom " + (dir / "coarse.npy").string() +
+                               " --photons 0 --dead 0 --nonideal-fraction 0 --out ";
+    const std::string path = (dir / "coarse.npy").string();
+    expect_error(riner_cli(common + (dir / "a").string(), dir), 2,
+                 path +
+                     " has shape [64, 64] but the geometry's grid is [256, 256] "
+                     "(--phantom-spacing-mm resamples it)");
+    expect_error(riner_cli(common + (dir / "b").string() + " --phantom-spacing-mm file", dir), 2,
+                 path + " stores no voxel size; give --phantom-spacing-mm");
+    REQUIRE(riner_cli(common + (dir / "c").string() + " --phantom-spacing-mm 2,2", dir).code == 0);
+    const riner::Array truth = riner::read_array(dir / "c" / "ground_truth.nii").array;
+    CHECK(truth.shape == std::vector<std::size_t>{256, 256});
+    CHECK(truth(128, 128) == doctest::Approx(0.02));
+    CHECK(truth(128, 10) == 0.0f);  // 118 mm from the centre: beyond the 64 mm half-width
+    // The central ray crosses the 128 mm square.
+    const riner::Array clean = riner::read_array(dir / "c" / "sino_clean.npy").array;
+    CHECK(clean(0, 249) == doctest::Approx(128 * 0.02).epsilon(0.02));
+  }
+
   TEST_CASE("settings: one table for the list, the README, --set and config.json") {
     riner::test::TempDir dir;
     const Run list = riner_cli("settings --json", dir);

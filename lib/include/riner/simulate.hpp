@@ -49,7 +49,8 @@ SimulatedScan simulate(const Array& ground_truth, const Projector& projector,
                        const RingModel& model);
 
 // Named geometries of METHOD.md §4: "fan2d-paper" (the DeepLesion/LIDC setting) and
-// "cone3d-paper" (the AAPM setting); InputError for other names.
+// "cone3d-paper" (the AAPM setting), and "parallel3d" (that volume in a parallel beam over
+// 180 degrees); InputError for other names.
 Geometry preset_geometry(std::string_view name);
 bool is_preset_geometry(std::string_view name);
 

@@ -8,7 +8,7 @@ namespace {
 std::atomic<long> g_live_buffers{0};
 std::atomic<std::size_t> g_live_bytes{0};
 std::atomic<std::size_t> g_peak_bytes{0};
-}
+}  // namespace
 
 long live_buffer_count() { return g_live_buffers.load(); }
 std::size_t peak_buffer_bytes() { return g_peak_bytes.load(); }

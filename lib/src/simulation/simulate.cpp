@@ -124,7 +124,7 @@ SimulatedScan simulate(const Array& ground_truth, const Projector& projector,
 }
 
 bool is_preset_geometry(std::string_view name) {
-  return name == "fan2d-paper" || name == "cone3d-paper";
+  return name == "fan2d-paper" || name == "cone3d-paper" || name == "parallel3d";
 }
 
 Geometry preset_geometry(std::string_view name) {
@@ -146,9 +146,19 @@ Geometry preset_geometry(std::string_view name) {
     g.source_origin_mm = 300.0;
     g.origin_detector_mm = 300.0;
     g.volume_shape = {100, 256, 256};
+  } else if (name == "parallel3d") {
+    // The cone preset's volume in a synchrotron's parallel beam: 360 views over 180 degrees, a
+    // 1 mm detector wide enough for the grid's diagonal (362 mm).
+    g.type = GeometryType::kParallel3d;
+    g.n_u = 384;
+    g.n_v = 100;
+    g.pitch_u = 1.0;
+    g.pitch_v = 1.0;
+    g.volume_shape = {100, 256, 256};
+    angles = {360, 0.0, M_PI};
   } else {
     throw InputError("unknown preset geometry \"" + std::string(name) +
-                     "\" (presets: fan2d-paper, cone3d-paper)");
+                     "\" (presets: fan2d-paper, cone3d-paper, parallel3d)");
   }
   g.voxel_mm = 1.0;
   g.uniform_angles = angles;
