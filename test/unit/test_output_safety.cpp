@@ -58,3 +58,23 @@ TEST_SUITE("output_safety") {
     CHECK_THROWS_AS(riner::write_png(dir / "bad.png", riner::Array({5})), riner::InputError);
   }
 }
+
+TEST_SUITE("previews") {
+  TEST_CASE("a volume previews as its three central slices, +z up") {
+    // value = 100 z + 10 y + x on a [5, 3, 4] volume
+    riner::Array v({5, 3, 4});
+    for (std::size_t z = 0; z < 5; ++z)
+      for (std::size_t y = 0; y < 3; ++y)
+        for (std::size_t x = 0; x < 4; ++x)
+          v.data[(z * 3 + y) * 4 + x] = 100.0f * z + 10.0f * y + x;
+    const riner::Array p = riner::preview_image(v);
+    REQUIRE(p.shape == std::vector<std::size_t>{5, 4 + 4 + 4 + 4 + 3});
+    CHECK(p(1, 2) == 212.0f);       // axial: slice 2, row 1, column 2
+    CHECK(p(3, 0) == 0.0f);         // below the 3-row axial slice: padding
+    CHECK(p(0, 8 + 3) == 413.0f);   // coronal: top row is z = 4, row y = 1
+    CHECK(p(4, 8 + 0) == 10.0f);    // bottom row z = 0
+    CHECK(p(0, 16 + 2) == 422.0f);  // sagittal: z = 4, y = 2, column x = 2
+    CHECK(riner::preview_image(riner::Array({3, 2})).shape == std::vector<std::size_t>{3, 2});
+    CHECK_THROWS_AS(riner::preview_image(riner::Array({2, 2, 2, 2})), riner::InputError);
+  }
+}

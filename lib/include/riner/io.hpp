@@ -53,7 +53,13 @@ struct Window {
 // Window from the given percentiles of the finite values (1 and 99 by default).
 Window percentile_window(const Array& image, double lo_percent = 1.0, double hi_percent = 99.0);
 
-// 8-bit grey PNG of a 2D array (or of the middle slice of a 3D one) mapped through the window.
+// What a preview shows: a 2D image as it is; of a 3D volume [z, y, x], its three central slices
+// side by side, 4 pixels apart: axial (slice z/2), coronal (row y/2) and sagittal (column x/2),
+// the last two with +z up. InputError for other ranks.
+Array preview_image(const Array& image);
+
+// 8-bit grey PNG of a 2D array mapped through the window; of a 3D one, its three central slices
+// side by side (axial, coronal, sagittal; +z up), the percentile window taken over all three.
 void write_png(const std::filesystem::path& path, const Array& image, const Window& window);
 void write_png(const std::filesystem::path& path, const Array& image);  // percentile window
 

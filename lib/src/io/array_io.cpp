@@ -30,21 +30,6 @@ void write_atomically(const std::filesystem::path& path, WriteFn&& write) {
   file.commit();
 }
 
-// The 2D image a preview shows: the array itself, or the middle slice of a 3D stack.
-Array preview_slice(const Array& image) {
-  if (image.rank() == 2) return image;
-  if (image.rank() == 3) {
-    const std::size_t rows = image.shape[1];
-    const std::size_t cols = image.shape[2];
-    const std::size_t middle = image.shape[0] / 2;
-    Array slice({rows, cols});
-    std::copy_n(image.ptr() + middle * rows * cols, rows * cols, slice.ptr());
-    return slice;
-  }
-  throw InputError("a preview needs a 2D image or a 3D volume, not rank " +
-                   std::to_string(image.rank()));
-}
-
 }  // namespace
 
 FileFormat format_from_path(const std::filesystem::path& path) {
@@ -150,8 +135,34 @@ Window percentile_window(const Array& image, double lo_percent, double hi_percen
   return window;
 }
 
+// 2D: the image. 3D: the three central slices side by side, 4 pixels apart: axial (the middle
+// slice, as a 2D image), coronal (the middle row) and sagittal (the middle column), the last
+// two with +z up.
+Array preview_image(const Array& image) {
+  if (image.rank() == 2) return image;
+  if (image.rank() != 3) {
+    throw InputError("a preview needs a 2D image or a 3D volume, not rank " +
+                     std::to_string(image.rank()));
+  }
+  const std::size_t nz = image.shape[0], ny = image.shape[1], nx = image.shape[2];
+  constexpr std::size_t kGap = 4;
+  Array panel({std::max(ny, nz), nx + kGap + nx + kGap + ny}, 0.0f);
+  auto at = [&](std::size_t z, std::size_t y, std::size_t x) {
+    return image.data[(z * ny + y) * nx + x];
+  };
+  for (std::size_t y = 0; y < ny; ++y) {
+    for (std::size_t x = 0; x < nx; ++x) panel(y, x) = at(nz / 2, y, x);
+  }
+  for (std::size_t z = 0; z < nz; ++z) {
+    const std::size_t row = nz - 1 - z;
+    for (std::size_t x = 0; x < nx; ++x) panel(row, nx + kGap + x) = at(z, ny / 2, x);
+    for (std::size_t y = 0; y < ny; ++y) panel(row, 2 * (nx + kGap) + y) = at(z, y, nx / 2);
+  }
+  return panel;
+}
+
 void write_png(const std::filesystem::path& path, const Array& image, const Window& window) {
-  const Array slice = preview_slice(image);
+  const Array slice = preview_image(image);
   const float scale = 255.0f / (window.hi - window.lo);
   std::vector<unsigned char> pixels(slice.size());
   for (std::size_t i = 0; i < slice.size(); ++i) {
@@ -166,7 +177,7 @@ void write_png(const std::filesystem::path& path, const Array& image, const Wind
 }
 
 void write_png(const std::filesystem::path& path, const Array& image) {
-  write_png(path, image, percentile_window(preview_slice(image)));
+  write_png(path, image, percentile_window(preview_image(image)));
 }
 
 void write_png_rgb(const std::filesystem::path& path, const std::vector<unsigned char>& rgb,
