@@ -152,6 +152,46 @@ TEST_SUITE("cli") {
     CHECK(clean(0, 249) == doctest::Approx(128 * 0.02).epsilon(0.02));
   }
 
+  TEST_CASE("3D: mismatched stacks exit 2; a detector row that reads NaN is dead, and said so") {
+    riner::test::TempDir dir;
+    riner::test::write_bytes(dir / "g3.json", R"({"type": "cone3d",
+      "detector": {"count": [30, 20], "pitch_mm": [2.0, 2.0]}, "source_origin_mm": 300,
+      "origin_detector_mm": 300, "angles": {"count": 36, "range_rad": 6.283185307179586},
+      "volume": {"shape": [10, 24, 24], "voxel_mm": 1.0}})");
+    const std::string sim3 = (dir / "sim3").string(), sim2 = (dir / "sim2").string();
+    REQUIRE(riner_cli(
+                "simulate --quiet --geometry " + (dir / "g3.json").string() + " --out " + sim3, dir)
+                .code == 0);
+    REQUIRE(riner_cli("simulate --quiet --out " + sim2, dir).code == 0);
+    expect_error(riner_cli("reconstruct " + sim3 + "/sino.npy --geometry " + sim2 +
+                               "/geometry.json --out " + (dir / "a").string(),
+                           dir),
+                 2, sim3 + "/sino.npy has shape [36, 20, 30] but the fan2d geometry expects");
+    expect_error(riner_cli("reconstruct " + sim2 + "/sino.npy --geometry " + sim3 +
+                               "/geometry.json --out " + (dir / "b").string(),
+                           dir),
+                 2, sim2 + "/sino.npy has shape [360, 500] but the cone3d geometry expects");
+    // Detector row 5 reads NaN in every view: its 30 pixels are dead for that reason.
+    riner::Array stack = riner::read_array(sim3 + "/sino.npy").array;
+    for (std::size_t v = 0; v < 36; ++v) {
+      for (std::size_t c = 0; c < 30; ++c) stack.data[(v * 20 + 5) * 30 + c] = NAN;
+    }
+    riner::write_array(dir / "nan_row.npy", stack);
+    REQUIRE(riner_cli("reconstruct " + (dir / "nan_row.npy").string() + " --geometry " + sim3 +
+                          "/geometry.json --steps 20 --quiet --out " + (dir / "c").string(),
+                      dir)
+                .code == 0);
+    const auto summary = nlohmann::json::parse(riner::test::read_bytes(dir / "c" / "summary.json"));
+    int row_five = 0;
+    for (const auto& d : summary["dead_element_reasons"]) {
+      const std::size_t e = d["element"];
+      if (e / 30 == 5 && d["reason"] == "no finite reading") ++row_five;
+    }
+    CHECK(row_five == 30);
+    const riner::Array image = riner::read_array(dir / "c" / "image.nii").array;
+    for (float v : image.data) REQUIRE(std::isfinite(v));
+  }
+
   TEST_CASE("settings: one table for the list, the README, --set and config.json") {
     riner::test::TempDir dir;
     const Run list = riner_cli("settings --json", dir);
