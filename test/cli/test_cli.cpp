@@ -240,6 +240,18 @@ TEST_SUITE("cli") {
     const double scan_mb = 360.0 * 500 * 4 / 1048576;
     CHECK(summary["memory"]["peak_device_buffers_mb"].get<double>() > scan_mb);
     CHECK(summary["memory"]["peak_host_mb"].get<double>() > scan_mb);
+    // Coverage: every drawn ray counted once: 20 steps of the mixed sampler's uniform rays plus
+    // its views x elements block.
+    const auto coverage = summary["coverage"];
+    const auto& t = written["training"];
+    CHECK(coverage["rays"].get<long>() ==
+          20 * (t["rays_per_step"].get<long>() +
+                t["views_per_step"].get<long>() * t["elements_per_step"].get<long>()));
+    CHECK(coverage["rays_per_element_fewest"].get<long>() <=
+          coverage["rays_per_element_median"].get<long>());
+    CHECK(coverage["rays_per_element_median"].get<long>() <=
+          coverage["rays_per_element_most"].get<long>());
+    CHECK(coverage["elements_under_10_rays"].get<long>() <= 500);
     expect_error(riner_cli("reconstruct " + sim + "/sino.npy --set training.steps=-4 --out " +
                                (dir / "s").string(),
                            dir),

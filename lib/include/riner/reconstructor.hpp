@@ -8,6 +8,7 @@
 //   riner::Array alpha = r.alpha();        // estimated response per detector element
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -61,6 +62,16 @@ struct DeadElement {
   std::string reason;                // "no finite reading" or "beta below 0.5"
 };
 
+// How the training's rays covered the detector: an element's (pixel's, in 3D) alpha and beta
+// learn only from its own rays, so one with few is estimated from little.
+struct RayCoverage {
+  std::uint64_t rays = 0;    // drawn so far, in all
+  std::uint32_t fewest = 0;  // rays per element: the least, median and most
+  std::uint32_t median = 0;
+  std::uint32_t most = 0;
+  std::size_t elements_under_10 = 0;  // elements with fewer than 10 rays
+};
+
 struct TrainingStats {
   int steps = 0;
   int steps_planned = 0;            // training.steps
@@ -83,6 +94,7 @@ struct TrainingStats {
   // buffers it held at once (0 on the reference engine).
   std::size_t peak_host_bytes = 0;
   std::size_t peak_device_bytes = 0;
+  RayCoverage coverage;
 };
 
 class Reconstructor {

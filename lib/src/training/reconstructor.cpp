@@ -2,6 +2,7 @@
 
 #include <sys/resource.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -20,6 +21,8 @@ struct Reconstructor::Impl {
   double samples = 0.0;
   std::vector<LossRecord> history;
   bool plateaued = false;
+  // Rays drawn so far per detector element (pixel in 3D): alpha and beta learn from these.
+  std::vector<std::uint32_t> element_rays;
   // result() at `steps` training steps (it only changes with a step).
   std::optional<ReconstructionResult> result;
   int result_steps = -1;
@@ -82,7 +85,12 @@ void Reconstructor::step(int n) {
   for (int i = 0; i < n; ++i) {
     const int index = impl_->steps;
     const model::Batch batch = impl_->sampler.batch(static_cast<std::uint32_t>(index));
-    for (std::uint32_t r : batch.rays) impl_->samples += impl_->setup.segments[r].count;
+    const std::size_t per_view = impl_->setup.elements_per_view;
+    if (impl_->element_rays.empty()) impl_->element_rays.assign(per_view, 0);
+    for (std::uint32_t r : batch.rays) {
+      impl_->samples += impl_->setup.segments[r].count;
+      ++impl_->element_rays[r % per_view];
+    }
     impl_->trainer->step(index, batch);
     ++impl_->steps;
   }
@@ -232,6 +240,24 @@ std::vector<LossRecord> Reconstructor::history() const {
   return impl_->history;
 }
 
+namespace {
+
+RayCoverage ray_coverage(std::vector<std::uint32_t> rays, std::size_t elements) {
+  RayCoverage c;
+  if (rays.empty()) rays.assign(elements, 0);
+  for (std::uint32_t n : rays) {
+    c.rays += n;
+    c.elements_under_10 += n < 10;
+  }
+  std::sort(rays.begin(), rays.end());
+  c.fewest = rays.front();
+  c.median = rays[rays.size() / 2];
+  c.most = rays.back();
+  return c;
+}
+
+}  // namespace
+
 TrainingStats Reconstructor::stats() const {
   TrainingStats s;
   s.steps = impl_->steps;
@@ -256,6 +282,7 @@ TrainingStats Reconstructor::stats() const {
     s.peak_host_bytes = static_cast<std::size_t>(usage.ru_maxrss) * 1024;  // kB on Linux
   }
   s.peak_device_bytes = cl::peak_buffer_bytes();
+  s.coverage = ray_coverage(impl_->element_rays, setup.elements_per_view);
   return s;
 }
 
