@@ -1,5 +1,6 @@
 #include "cli_common.hpp"
 
+#include <algorithm>
 #include <cstdio>
 
 #include "riner/error.hpp"
@@ -46,6 +47,17 @@ void Console::summary(const nlohmann::json& json) const {
 nlohmann::json metrics_json(double psnr, double ssim, double mae, double rmse, double data_range) {
   return {
       {"psnr_db", psnr}, {"ssim", ssim}, {"mae", mae}, {"rmse", rmse}, {"data_range", data_range}};
+}
+
+std::vector<std::string> split_commas(const std::string& list) {
+  std::vector<std::string> items;
+  std::size_t begin = 0;
+  while (begin <= list.size()) {
+    const std::size_t end = std::min(list.find(',', begin), list.size());
+    items.push_back(list.substr(begin, end - begin));
+    begin = end + 1;
+  }
+  return items;
 }
 
 }  // namespace riner::app

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "cli_args.hpp"
 #include "riner/array.hpp"
@@ -22,6 +23,9 @@ std::optional<Device> device_from(const Args& args, Engine engine);
 
 // Creates the folder (and parents) if needed; InputError if it is a file.
 std::filesystem::path make_output_dir(const std::string& path);
+
+// "a,b,,c" -> {"a", "b", "", "c"}: the items of an option's comma-separated list.
+std::vector<std::string> split_commas(const std::string& list);
 
 // A preset name or a geometry JSON file.
 Geometry geometry_from(const std::string& name_or_path);

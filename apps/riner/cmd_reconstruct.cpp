@@ -108,16 +108,12 @@ RinerConfig config_from(const Args& args) {
   if (auto v = args.maybe("lr"); v && !v->empty())
     config.training.learning_rate = args.number("lr");
   if (const std::string list = args.get("set"); !list.empty()) {
-    std::size_t begin = 0;
-    while (begin <= list.size()) {
-      const std::size_t end = std::min(list.find(',', begin), list.size());
-      const std::string item = list.substr(begin, end - begin);
+    for (const std::string& item : split_commas(list)) {
       const std::size_t eq = item.find('=');
       if (eq == std::string::npos || eq == 0) {
         throw UsageError("--set takes NAME=VALUE pairs separated by commas (got '" + item + "')");
       }
       config.set(item.substr(0, eq), item.substr(eq + 1));
-      begin = end + 1;
     }
   }
   if (args.is_set("no-ring-correction")) {
@@ -229,7 +225,8 @@ int run_reconstruct(int argc, char** argv, int first) {
   write_array(image_path, image, {std::vector<double>(image.rank(), g.voxel_mm)});
   write_png(out / "image.png", image);
   const std::vector<DeadElement> dead_report = reconstructor.dead_element_report();
-  const std::vector<std::size_t> dead = reconstructor.dead_elements();
+  std::vector<std::size_t> dead;
+  for (const DeadElement& d : dead_report) dead.push_back(d.element);
   write_detector_outputs(out, alpha, reconstructor.beta(), dead);
   write_history(out / "loss.csv", reconstructor.history());
   write_text(out / "config.json", reconstructor.config().to_json());  // as resolved for the device

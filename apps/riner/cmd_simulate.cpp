@@ -26,18 +26,14 @@ std::vector<double> phantom_spacing(const Args& args, const ArrayFile& file) {
     return file.voxel_size;
   }
   std::vector<double> spacing;
-  std::size_t begin = 0;
-  while (begin <= text.size()) {
-    const std::size_t end = std::min(text.find(',', begin), text.size());
+  for (const std::string& item : split_commas(text)) {
     try {
       std::size_t used = 0;
-      const std::string item = text.substr(begin, end - begin);
       spacing.push_back(std::stod(item, &used));
       if (used != item.size()) throw std::invalid_argument(item);
     } catch (const std::exception&) {
       throw UsageError("--phantom-spacing-mm takes numbers separated by commas, or 'file'");
     }
-    begin = end + 1;
   }
   return spacing;
 }

@@ -20,11 +20,11 @@ void require(bool ok, const std::string& message) {
 // value (already of the setting's type) against its range, before it is stored: an integer
 // outside its member's range would otherwise wrap.
 void check_value(const settings::Setting<RinerConfig>& s, const json& value) {
-  require(settings::type_mismatch(s.type, s.choices, value).empty(),
-          s.name() + " " + settings::type_mismatch(s.type, s.choices, value));
+  const std::string mismatch = settings::type_mismatch(s.type, s.choices, value);
+  require(mismatch.empty(), s.name() + " " + mismatch);
   if (s.type == settings::Type::kInteger || s.type == settings::Type::kNumber) {
-    require(s.range.contains(value.get<double>()),
-            s.name() + " must be " + settings::allowed(s) + " (" + s.help + ")");
+    const std::string problem = settings::out_of_range(s, value.get<double>());
+    require(problem.empty(), problem);
   }
 }
 

@@ -27,6 +27,12 @@ std::string describe_range(Type type, const Range& range) {
          bound(type, range.hi) + (range.hi_open ? ")" : "]");
 }
 
+std::string join_choices(const std::vector<std::string>& choices) {
+  std::string list;
+  for (std::size_t i = 0; i < choices.size(); ++i) list += (i ? ", " : "") + choices[i];
+  return list;
+}
+
 std::string type_mismatch(Type type, const std::vector<std::string>& choices,
                           const nlohmann::json& value) {
   switch (type) {
@@ -37,13 +43,11 @@ std::string type_mismatch(Type type, const std::vector<std::string>& choices,
     case Type::kNumber:
       return value.is_number() ? "" : "must be a number";
     case Type::kChoice: {
-      std::string list;
-      for (std::size_t i = 0; i < choices.size(); ++i) list += (i ? ", " : "") + choices[i];
-      if (!value.is_string()) return "must be a string: one of " + list;
+      if (!value.is_string()) return "must be a string: one of " + join_choices(choices);
       for (const std::string& c : choices) {
         if (value.get<std::string>() == c) return "";
       }
-      return "must be one of " + list;
+      return "must be one of " + join_choices(choices);
     }
   }
   return "has an unknown type";

@@ -52,19 +52,28 @@ decltype(auto) member_at(Owner& owner, Members... path) {
   return (owner.*....*path);
 }
 
+// A setting's description, without its accessors.
+template <typename Owner>
+Setting<Owner> described(std::string section, std::string key, Type type, std::string help) {
+  Setting<Owner> s;
+  s.section = std::move(section);
+  s.key = std::move(key);
+  s.type = type;
+  s.help = std::move(help);
+  return s;
+}
+
 // A bool, integer or floating-point member reached by `path` from Owner.
 template <typename Owner, typename... Members>
 Setting<Owner> field(std::string section, std::string key, Range range, std::string help,
                      Members... path) {
   using T = std::remove_reference_t<decltype(member_at(std::declval<Owner&>(), path...))>;
-  Setting<Owner> s;
-  s.section = std::move(section);
-  s.key = std::move(key);
-  s.type = std::is_same_v<T, bool> ? Type::kBool
-           : std::is_integral_v<T> ? Type::kInteger
-                                   : Type::kNumber;
+  Setting<Owner> s = described<Owner>(std::move(section), std::move(key),
+                                      std::is_same_v<T, bool> ? Type::kBool
+                                      : std::is_integral_v<T> ? Type::kInteger
+                                                              : Type::kNumber,
+                                      std::move(help));
   s.range = range;
-  s.help = std::move(help);
   s.get = [=](const Owner& o) { return nlohmann::json(member_at(o, path...)); };
   s.set = [=](Owner& o, const nlohmann::json& v) { member_at(o, path...) = v.get<T>(); };
   return s;
@@ -75,12 +84,9 @@ Setting<Owner> field(std::string section, std::string key, Range range, std::str
 template <typename Owner, typename... Members>
 Setting<Owner> string_choice(std::string section, std::string key, std::vector<std::string> choices,
                              std::string help, Members... path) {
-  Setting<Owner> s;
-  s.section = std::move(section);
-  s.key = std::move(key);
-  s.type = Type::kChoice;
+  Setting<Owner> s =
+      described<Owner>(std::move(section), std::move(key), Type::kChoice, std::move(help));
   s.choices = std::move(choices);
-  s.help = std::move(help);
   s.get = [=](const Owner& o) { return nlohmann::json(member_at(o, path...)); };
   s.set = [=](Owner& o, const nlohmann::json& v) { member_at(o, path...) = v.get<std::string>(); };
   return s;
@@ -89,12 +95,9 @@ Setting<Owner> string_choice(std::string section, std::string key, std::vector<s
 template <typename Owner, typename Enum, typename... Members>
 Setting<Owner> enum_choice(std::string section, std::string key, std::vector<Enum> values,
                            const char* (*name_of)(Enum), std::string help, Members... path) {
-  Setting<Owner> s;
-  s.section = std::move(section);
-  s.key = std::move(key);
-  s.type = Type::kChoice;
+  Setting<Owner> s =
+      described<Owner>(std::move(section), std::move(key), Type::kChoice, std::move(help));
   for (Enum e : values) s.choices.emplace_back(name_of(e));
-  s.help = std::move(help);
   s.get = [=](const Owner& o) { return nlohmann::json(name_of(member_at(o, path...))); };
   s.set = [=](Owner& o, const nlohmann::json& v) {
     const std::string name = v.get<std::string>();
@@ -108,13 +111,9 @@ Setting<Owner> enum_choice(std::string section, std::string key, std::vector<Enu
 // The same setting seen from an Outer struct that holds Owner at `path`.
 template <typename Outer, typename Owner, typename... Members>
 Setting<Outer> lift(const Setting<Owner>& inner, Members... path) {
-  Setting<Outer> s;
-  s.section = inner.section;
-  s.key = inner.key;
-  s.type = inner.type;
+  Setting<Outer> s = described<Outer>(inner.section, inner.key, inner.type, inner.help);
   s.range = inner.range;
   s.choices = inner.choices;
-  s.help = inner.help;
   s.get = [get = inner.get, path...](const Outer& o) { return get(member_at(o, path...)); };
   s.set = [set = inner.set, path...](Outer& o, const nlohmann::json& v) {
     set(member_at(o, path...), v);
@@ -122,10 +121,11 @@ Setting<Outer> lift(const Setting<Owner>& inner, Members... path) {
   return s;
 }
 
-// "must be in 0..64" / "must be in (0, 1]" / "must be one of a, b".
-template <typename Owner>
-std::string allowed(const Setting<Owner>& s);
+// "in 0..64" / "in (0, 1]".
 std::string describe_range(Type type, const Range& range);
+
+// "a, b, c".
+std::string join_choices(const std::vector<std::string>& choices);
 
 // The JSON value's type against the setting's: an empty string when it fits, else why not.
 std::string type_mismatch(Type type, const std::vector<std::string>& choices,
@@ -134,12 +134,16 @@ std::string type_mismatch(Type type, const std::vector<std::string>& choices,
 template <typename Owner>
 std::string allowed(const Setting<Owner>& s) {
   if (s.type == Type::kBool) return "true or false";
-  if (s.type == Type::kChoice) {
-    std::string out = "one of ";
-    for (std::size_t i = 0; i < s.choices.size(); ++i) out += (i ? ", " : "") + s.choices[i];
-    return out;
-  }
+  if (s.type == Type::kChoice) return "one of " + join_choices(s.choices);
   return describe_range(s.type, s.range);
+}
+
+// Why a number `v` does not fit setting s ("section.key must be in ... (help)"); empty when it
+// does.
+template <typename Owner>
+std::string out_of_range(const Setting<Owner>& s, double v) {
+  if (s.range.contains(v)) return {};
+  return s.name() + " must be " + allowed(s) + " (" + s.help + ")";
 }
 
 // The first setting of `table` whose value in `owner` is outside its range, as
@@ -148,8 +152,8 @@ template <typename Owner>
 std::string first_violation(const Owner& owner, const std::vector<Setting<Owner>>& table) {
   for (const Setting<Owner>& s : table) {
     if (s.type != Type::kInteger && s.type != Type::kNumber) continue;
-    const double v = s.get(owner).template get<double>();
-    if (!s.range.contains(v)) return s.name() + " must be " + allowed(s) + " (" + s.help + ")";
+    std::string problem = out_of_range(s, s.get(owner).template get<double>());
+    if (!problem.empty()) return problem;
   }
   return {};
 }

@@ -29,7 +29,8 @@ struct Reconstructor::Impl {
 
   Impl(Scan scan, RinerConfig config)
       : setup(std::move(scan), std::move(config)),
-        sampler(setup.scan.geometry, setup.config.training) {}
+        sampler(setup.scan.geometry, setup.config.training),
+        element_rays(setup.elements_per_view, 0) {}
 
   // The air training skipped reads 0 (the measurements certified it).
   void zero_skipped_air(Array& image) const {
@@ -86,7 +87,6 @@ void Reconstructor::step(int n) {
     const int index = impl_->steps;
     const model::Batch batch = impl_->sampler.batch(static_cast<std::uint32_t>(index));
     const std::size_t per_view = impl_->setup.elements_per_view;
-    if (impl_->element_rays.empty()) impl_->element_rays.assign(per_view, 0);
     for (std::uint32_t r : batch.rays) {
       impl_->samples += impl_->setup.segments[r].count;
       ++impl_->element_rays[r % per_view];
@@ -242,9 +242,8 @@ std::vector<LossRecord> Reconstructor::history() const {
 
 namespace {
 
-RayCoverage ray_coverage(std::vector<std::uint32_t> rays, std::size_t elements) {
+RayCoverage ray_coverage(std::vector<std::uint32_t> rays) {
   RayCoverage c;
-  if (rays.empty()) rays.assign(elements, 0);
   for (std::uint32_t n : rays) {
     c.rays += n;
     c.elements_under_10 += n < 10;
@@ -282,7 +281,7 @@ TrainingStats Reconstructor::stats() const {
     s.peak_host_bytes = static_cast<std::size_t>(usage.ru_maxrss) * 1024;  // kB on Linux
   }
   s.peak_device_bytes = cl::peak_buffer_bytes();
-  s.coverage = ray_coverage(impl_->element_rays, setup.elements_per_view);
+  s.coverage = ray_coverage(impl_->element_rays);
   return s;
 }
 
