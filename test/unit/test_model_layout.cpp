@@ -7,6 +7,7 @@
 #include <map>
 
 #include "model/batch_sampler.hpp"
+#include "model/counter_rng.hpp"
 #include "model/packed_batch.hpp"
 #include "model/parameter_layout.hpp"
 #include "model/ray_segments.hpp"
@@ -106,6 +107,55 @@ TEST_SUITE("model_layout") {
     for (std::size_t i = 0; i < b.rays.size(); ++i) per_element[b.rays[i] % g.n_u] += b.weights[i];
     for (const auto& [e, w] : per_element) CHECK(w == doctest::Approx(0.2));
     CHECK(per_element.size() == b.elements.size());
+  }
+
+  TEST_CASE("shuffled_index is a permutation of 0..n-1 for every key, and keys differ") {
+    for (std::uint32_t n : {1u, 2u, 3u, 7u, 64u, 100u, 1000u, 4097u}) {
+      for (std::uint32_t key : {0u, 1u, 12345u}) {
+        std::vector<int> seen(n, 0);
+        for (std::uint32_t k = 0; k < n; ++k) {
+          const std::uint32_t x = riner::model::shuffled_index(k, n, key);
+          REQUIRE(x < n);
+          ++seen[x];
+        }
+        for (std::uint32_t i = 0; i < n; ++i) CHECK(seen[i] == 1);
+      }
+    }
+    int moved = 0;
+    for (std::uint32_t k = 0; k < 1000; ++k) {
+      moved += riner::model::shuffled_index(k, 1000, 1) != riner::model::shuffled_index(k, 1000, 2);
+    }
+    CHECK(moved > 900);
+  }
+
+  TEST_CASE("even sampler: every detector pixel exactly once per epoch, views spread") {
+    const riner::Geometry g = riner::test::small_cone3d();
+    const std::size_t pixels = g.n_u * g.n_v;
+    riner::TrainingConfig t;
+    t.sampler = riner::Sampler::kEven;
+    t.rays_per_step = 7;  // does not divide the pixel count: epochs straddle steps
+    const riner::model::BatchSampler sampler(g, t);
+    CHECK(sampler.rays_per_step() == 7);
+    CHECK(sampler.batch(5).rays == sampler.batch(5).rays);
+    std::vector<int> count(pixels, 0);
+    std::vector<int> view_count(g.n_views(), 0);
+    const std::size_t epochs = 3;
+    const std::size_t rays = epochs * pixels;
+    std::size_t drawn = 0;
+    for (std::uint32_t step = 0; drawn < rays; ++step) {
+      const riner::model::Batch b = sampler.batch(step);
+      CHECK(b.block_views == 0);
+      for (std::uint32_t r : b.rays) {
+        if (drawn++ >= rays) break;
+        REQUIRE(r < g.n_views() * pixels);
+        ++count[r % pixels];
+        ++view_count[r / pixels];
+      }
+    }
+    for (std::size_t p = 0; p < pixels; ++p) CHECK(count[p] == static_cast<int>(epochs));
+    int views_hit = 0;
+    for (int c : view_count) views_hit += c > 0;
+    CHECK(views_hit > static_cast<int>(g.n_views()) * 3 / 4);
   }
 
   TEST_CASE("packed batches: offsets, rays grouped by element, weights and level scales") {

@@ -67,7 +67,7 @@ TEST_SUITE("riner_config") {
     expect(R"({"training": {"learning_rate": -1}})",
            "c.json: config: training.learning_rate must be in (0, 10) (Adam's learning rate)");
     expect(R"({"training": {"sampler": "random"}})",
-           "c.json: config: training.sampler must be one of uniform, views-x-elements, mixed");
+           "c.json: config: training.sampler must be one of uniform, views-x-elements, mixed, even");
     expect(R"({"training": {"ring_lambda": 1}})",
            "c.json: config: training.ring_lambda needs the views-x-elements or mixed sampler "
            "with elements_per_step >= 3");
@@ -86,8 +86,8 @@ TEST_SUITE("riner_config") {
     expect(R"({"plan": {"lanes": 4}})", "c.json: config: unknown setting plan.lanes");
     expect(R"({"plan": 4})", "c.json: config: plan must be an object");
     expect(R"({"training": {"rays_per_step": -3}})",
-           "c.json: config: training.rays_per_step must be in 0..1048576 (uniform sampler's rays "
-           "per step; 0: the execution plan's)");
+           "c.json: config: training.rays_per_step must be in 0..1048576 (uniform and even "
+           "samplers' rays per step; 0: the execution plan's)");
     // A value beyond an int's range is refused, not wrapped.
     expect(R"({"training": {"steps": 5000000000}})",
            "c.json: config: training.steps must be in 0..10000000 (training steps)");

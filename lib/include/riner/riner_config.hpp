@@ -43,14 +43,18 @@ enum class Sampler {
   kUniform,             // rays drawn uniformly over (view, element)
   kMixed,               // both in one batch: uniform rays for the image, a views x elements
                         // block that shows a few elements from many views for alpha and beta
+  kEven,                // every detector element (pixel in 3D) equally often: the elements in
+                        // a shuffled order that visits each once per epoch, each ray at a
+                        // random view; alpha and beta of every element learn from as many rays
 };
 
 struct TrainingConfig {
   int steps = 24000;
-  Sampler sampler = Sampler::kUniform;
-  int rays_per_step = 0;      // uniform sampler; 0: the execution plan's (riner/execution_plan.hpp)
-  int views_per_step = 40;    // views x elements sampler
-  int elements_per_step = 2;  // views x elements sampler: adjacent elements
+  Sampler sampler = Sampler::kEven;
+  int rays_per_step =
+      0;  // uniform and even samplers; 0: the execution plan's (riner/execution_plan.hpp)
+  int views_per_step = 40;      // views x elements sampler
+  int elements_per_step = 2;    // views x elements sampler: adjacent elements
   double sample_spacing = 1.5;  // along each ray, in voxels (the paper uses a fixed interval)
   bool jitter = false;          // stratified random offsets while training (midpoints if off)
   bool circle_region = false;   // sample the inscribed circle instead of the whole grid
@@ -164,6 +168,10 @@ struct RinerConfig {
 };
 
 const char* sampler_name(Sampler sampler);
+// Whether the sampler draws a views x elements block (what ring_lambda's prior needs).
+constexpr bool draws_block(Sampler s) {
+  return s == Sampler::kViewsTimesElements || s == Sampler::kMixed;
+}
 const char* data_term_name(DataTerm term);
 
 }  // namespace riner

@@ -24,8 +24,7 @@ BatchSampler::BatchSampler(const Geometry& g, const TrainingConfig& config)
     throw Error("BatchSampler: rays_per_step " + std::to_string(config.rays_per_step) +
                 " (0 is for the execution plan to resolve first)");
   }
-  if (config.sampler != Sampler::kUniform &&
-      static_cast<std::size_t>(config.elements_per_step) > n_u_) {
+  if (draws_block(config.sampler) && static_cast<std::size_t>(config.elements_per_step) > n_u_) {
     throw InputError("elements_per_step (" + std::to_string(config.elements_per_step) +
                      ") exceeds the detector's " + std::to_string(n_u_) + " elements");
   }
@@ -36,6 +35,7 @@ std::size_t BatchSampler::rays_per_step() const {
   const auto block = static_cast<std::size_t>(config_.views_per_step) * config_.elements_per_step;
   switch (config_.sampler) {
     case Sampler::kUniform:
+    case Sampler::kEven:
       return uniform;
     case Sampler::kViewsTimesElements:
       return block;
@@ -49,14 +49,32 @@ Batch BatchSampler::batch(std::uint32_t step) const {
   const auto seed = static_cast<std::uint32_t>(config_.seed ^ (config_.seed >> 32));
   const std::size_t per_view = rows_ * n_u_;
   Batch b;
-  if (config_.sampler != Sampler::kViewsTimesElements) {
+  if (config_.sampler == Sampler::kEven) {
+    // Ray i of step s is the (s R + i)-th of an endless sequence of epochs, each a shuffled
+    // order of all elements.
+    const auto n = static_cast<std::uint32_t>(per_view);
+    for (int i = 0; i < config_.rays_per_step; ++i) {
+      const std::uint64_t position =
+          static_cast<std::uint64_t>(step) * static_cast<std::uint64_t>(config_.rays_per_step) +
+          static_cast<std::uint64_t>(i);
+      const std::uint64_t epoch = position / n;
+      const std::uint32_t key = hash_keys(seed, static_cast<std::uint32_t>(epoch),
+                                          static_cast<std::uint32_t>(epoch >> 32));
+      const std::uint32_t element =
+          shuffled_index(static_cast<std::uint32_t>(position % n), n, key);
+      const std::uint32_t view =
+          draw(seed, step, static_cast<std::uint32_t>(i), static_cast<std::uint32_t>(views_));
+      b.rays.push_back(static_cast<std::uint32_t>(view * per_view + element));
+      b.elements.push_back(element);
+    }
+  } else if (config_.sampler != Sampler::kViewsTimesElements) {
     const auto total = static_cast<std::uint32_t>(views_ * per_view);
     for (int i = 0; i < config_.rays_per_step; ++i) {
       b.rays.push_back(draw(seed, step, static_cast<std::uint32_t>(i), total));
     }
     for (std::uint32_t r : b.rays) b.elements.push_back(static_cast<std::uint32_t>(r % per_view));
   }
-  if (config_.sampler != Sampler::kUniform) {
+  if (draws_block(config_.sampler)) {
     b.block_first = static_cast<std::uint32_t>(b.rays.size());
     b.block_views = static_cast<std::uint32_t>(config_.views_per_step);
     b.block_elements = static_cast<std::uint32_t>(config_.elements_per_step);

@@ -52,11 +52,12 @@ void add_training_sampling(Table& t) {
   t.push_back(field<C>("training", "steps", closed(0, kMaxSteps), "training steps", &C::training,
                        &T::steps));
   t.push_back(enum_choice<C>(
-      "training", "sampler", {Sampler::kUniform, Sampler::kViewsTimesElements, Sampler::kMixed},
-      sampler_name, "how a step's rays are drawn", &C::training, &T::sampler));
+      "training", "sampler",
+      {Sampler::kUniform, Sampler::kViewsTimesElements, Sampler::kMixed, Sampler::kEven},
+      sampler_name, "how a step's rays are drawn; even: every detector element equally often, each at a random view", &C::training, &T::sampler));
   t.push_back(field<C>("training", "rays_per_step", closed(0, 1 << 20),
-                       "uniform sampler's rays per step; 0: the execution plan's", &C::training,
-                       &T::rays_per_step));
+                       "uniform and even samplers' rays per step; 0: the execution plan's",
+                       &C::training, &T::rays_per_step));
   t.push_back(field<C>("training", "views_per_step", closed(1, 65536),
                        "views x elements sampler: views", &C::training, &T::views_per_step));
   t.push_back(field<C>("training", "elements_per_step", closed(1, 65536),

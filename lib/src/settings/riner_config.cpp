@@ -58,6 +58,8 @@ const char* sampler_name(Sampler s) {
       return "views-x-elements";
     case Sampler::kMixed:
       return "mixed";
+    case Sampler::kEven:
+      return "even";
   }
   return "unknown";
 }
@@ -70,7 +72,7 @@ void RinerConfig::validate() const {
           "encoding.finest_resolution must be 0 (the grid's size) or >= base_resolution");
   require(network.width % 16 == 0, "network.width must be a multiple of 16");
   const TrainingConfig& t = training;
-  require(t.ring_lambda == 0.0 || (t.sampler != Sampler::kUniform && t.elements_per_step >= 3),
+  require(t.ring_lambda == 0.0 || (draws_block(t.sampler) && t.elements_per_step >= 3),
           "training.ring_lambda needs the views-x-elements or mixed sampler with elements_per_step "
           ">= 3");
 }
