@@ -6,6 +6,7 @@
 #include "riner/fbp.hpp"
 #include "riner/io.hpp"
 #include "riner/scan.hpp"
+#include "scan_options.hpp"
 
 namespace riner::app {
 
@@ -14,16 +15,17 @@ int run_fbp(int argc, char** argv, int first) {
             "Filtered backprojection of a scan: FBP for parallel and fan beam, FDK for cone "
             "beam. NaN/inf measurements (dead elements) are interpolated from their neighbours "
             "first. The image is written in the format of --out's extension.");
-  args.positional("SCAN", "the measurement (rho = -ln(I/I0)): .npy, .nii, .tif, .raw")
-      .option("geometry", "FILE", "geometry JSON (default: geometry.json beside SCAN)", "")
-      .option("out", "IMAGE", "output image/volume (.nii, .npy, .tif, .raw)")
+  add_scan_options(args);
+  args.option("out", "IMAGE", "output image/volume (.nii, .npy, .tif, .raw)")
       .option("filter", "NAME", "ram-lak, shepp-logan or hann", "ram-lak")
       .flag("png", "also write a PNG preview beside the output");
   add_engine_flags(args);
   args.output_flags();
   if (!args.parse(argc, argv, first)) return 0;
   Console console(args);
-  const Scan scan = load_scan(args.get("SCAN"), args.get("geometry"));
+  const LoadedScan loaded = scan_from(args);
+  const Scan& scan = loaded.scan;
+  if (loaded.flat_field) console.line(flat_field_line(*loaded.flat_field));
   const std::filesystem::path out = args.get("out");
   format_from_path(out);  // reject an unknown extension before the work
   FbpOptions options;
@@ -56,7 +58,9 @@ int run_fbp(int argc, char** argv, int first) {
                    {"engine", engine_name(options.engine)},
                    {"seconds", seconds},
                    {"non_finite_replaced", report.non_finite_replaced},
-                   {"short_scan", report.short_scan}});
+                   {"short_scan", report.short_scan},
+                   {"flat_field", loaded.flat_field ? flat_field_json(*loaded.flat_field)
+                                                    : nlohmann::json(nullptr)}});
   return 0;
 }
 

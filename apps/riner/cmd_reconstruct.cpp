@@ -14,6 +14,7 @@
 #include "riner/quality.hpp"
 #include "riner/reconstructor.hpp"
 #include "riner/scan.hpp"
+#include "scan_options.hpp"
 
 namespace riner::app {
 
@@ -37,40 +38,40 @@ nlohmann::json ring_summary(const std::optional<RingCorrection>& rings) {
 }
 
 // What a user without a ground truth can check (riner/quality.hpp): rings, specks and the
-// centre against the FBP of the same scan, for the image and (the centre) the trained field.
+// centre against the FBP of the same scan, for the image and (the centre, 2D) the trained field.
 struct QualityCheck {
   QualityReport image;
-  CentreDeviation field;
+  std::optional<CentreDeviation> field;  // 2D only
 };
 
-// 2D only (nullopt in 3D).
-std::optional<QualityCheck> check_quality(const Reconstructor& r,
-                                          const ReconstructionResult& result,
-                                          const std::optional<Device>& device) {
-  if (r.scan().geometry.is_3d()) return std::nullopt;
+QualityCheck check_quality(const Reconstructor& r, const ReconstructionResult& result,
+                           const std::optional<Device>& device) {
   FbpOptions options;
   options.engine = r.config().engine;
   options.device = device;
   const Array fbp_image = fbp(r.scan(), options);
-  return QualityCheck{quality_against_fbp(result.image, fbp_image),
-                      centre_deviation(result.field_image, fbp_image)};
+  QualityCheck check{quality_against_fbp(result.image, fbp_image), {}};
+  if (fbp_image.rank() == 2) check.field = centre_deviation(result.field_image, fbp_image);
+  return check;
 }
 
-nlohmann::json quality_summary(const std::optional<QualityCheck>& check) {
-  if (!check) return nullptr;
-  const QualityReport& q = check->image;
-  return {{"fbp_noise_per_mm", q.noise},
-          {"ring_index", q.ring_index},
-          {"fbp_ring_index", q.fbp_ring_index},
-          {"specks_per_10k_pixels", q.specks_per_10k},
-          {"fbp_specks_per_10k_pixels", q.fbp_specks_per_10k},
-          {"centre",
-           {{"radius_px", q.centre.radius_px},
-            {"largest_broad_deviation_from_fbp_per_mm", q.centre.deviation},
-            {"at_px", q.centre.at_px},
-            {"fbp_profile_noise_per_mm", q.centre.fbp_noise},
-            {"fbp_noise_sigmas", q.centre.sigmas},
-            {"field_fbp_noise_sigmas", check->field.sigmas}}}};
+nlohmann::json quality_summary(const QualityCheck& check) {
+  const QualityReport& q = check.image;
+  nlohmann::json out = {{"fbp_noise_per_mm", q.noise},
+                        {"ring_index", q.ring_index},
+                        {"fbp_ring_index", q.fbp_ring_index},
+                        {"specks_per_10k_pixels", q.specks_per_10k},
+                        {"fbp_specks_per_10k_pixels", q.fbp_specks_per_10k},
+                        {"centre", nullptr}};
+  if (check.field) {
+    out["centre"] = {{"radius_px", q.centre.radius_px},
+                     {"largest_broad_deviation_from_fbp_per_mm", q.centre.deviation},
+                     {"at_px", q.centre.at_px},
+                     {"fbp_profile_noise_per_mm", q.centre.fbp_noise},
+                     {"fbp_noise_sigmas", q.centre.sigmas},
+                     {"field_fbp_noise_sigmas", check.field->sigmas}};
+  }
+  return out;
 }
 
 // Where the tool has doubts, say so.
@@ -145,9 +146,8 @@ int run_reconstruct(int argc, char** argv, int first) {
             "detector element's response alpha and validity beta, then writes the image "
             "(image.<format>, image.png), alpha.npy, beta.npy, detector.png, loss.csv, "
             "config.json and summary.json into the output folder.");
-  args.positional("SCAN", "the measurement (rho = -ln(I/I0)): .npy, .nii, .tif, .raw")
-      .option("geometry", "FILE", "geometry JSON (default: geometry.json beside SCAN)", "")
-      .option("out", "DIR", "output folder (created if missing)")
+  add_scan_options(args);
+  args.option("out", "DIR", "output folder (created if missing)")
       .option("format", "EXT", "image format: nii, npy, tif or raw", "nii")
       .option("config", "FILE", "settings JSON ({\"training\": {\"steps\": 4000}, ...})", "")
       .option("set", "NAME=VALUE,...",
@@ -173,7 +173,9 @@ int run_reconstruct(int argc, char** argv, int first) {
   args.output_flags();
   if (!args.parse(argc, argv, first)) return 0;
   Console console(args);
-  Scan scan = load_scan(args.get("SCAN"), args.get("geometry"));
+  LoadedScan loaded = scan_from(args);
+  Scan& scan = loaded.scan;
+  if (loaded.flat_field) console.line(flat_field_line(*loaded.flat_field));
   if (auto v = args.maybe("offset-px"); v && !v->empty())
     scan.geometry.offset_u = args.number("offset-px");
   const RinerConfig config = config_from(args);
@@ -232,7 +234,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   write_text(out / "config.json", reconstructor.config().to_json());  // as resolved for the device
 
   const TrainingStats stats = reconstructor.stats();
-  const std::optional<QualityCheck> quality = check_quality(reconstructor, result, device);
+  const QualityCheck quality = check_quality(reconstructor, result, device);
   nlohmann::json summary = {
       {"image", image_path.string()},
       {"shape", image.shape},
@@ -244,6 +246,8 @@ int run_reconstruct(int argc, char** argv, int first) {
       {"samples_per_second", stats.seconds > 0 ? stats.samples / stats.seconds : 0.0},
       {"parameters", stats.parameters},
       {"non_finite_measurements", stats.non_finite},
+      {"flat_field",
+       loaded.flat_field ? flat_field_json(*loaded.flat_field) : nlohmann::json(nullptr)},
       {"dead_elements", dead},
       {"dead_element_reasons", dead_elements_json(dead_report)},
       {"engine", stats.engine},
@@ -274,7 +278,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   console.line("reconstructed " + shape_string(image.shape) + " in " +
                format_duration(stats.seconds) + " (" + std::to_string(stats.steps) + " steps, " +
                std::to_string(dead.size()) + " elements flagged dead) -> " + out.string());
-  if (quality) print_doubts(console, quality->image);
+  print_doubts(console, quality.image);
   console.summary(summary);
   return 0;
 }

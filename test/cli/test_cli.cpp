@@ -192,6 +192,96 @@ TEST_SUITE("cli") {
     for (float v : image.data) REQUIRE(std::isfinite(v));
   }
 
+  TEST_CASE("raw projections: a TIFF folder with flats and darks gives the measurement's image") {
+    riner::test::TempDir dir;
+    riner::test::write_bytes(dir / "g3.json", R"({"type": "parallel3d",
+      "detector": {"count": [30, 20], "pitch_mm": [1.0, 1.0]},
+      "angles": {"count": 36, "range_rad": 3.141592653589793},
+      "volume": {"shape": [20, 24, 24], "voxel_mm": 1.0}})");
+    const std::string sim = (dir / "sim").string();
+    REQUIRE(riner_cli("simulate --quiet --seed 3 --geometry " + (dir / "g3.json").string() +
+                          " --out " + sim,
+                      dir)
+                .code == 0);
+    const riner::Array rho = riner::read_array(sim + "/sino_clean.npy").array;
+    // The scanner's files: I = D + (F - D) exp(-rho), a flat that varies across the detector
+    // (three frames, averaged), a dark of two frames, one reading at the dark.
+    const std::size_t pixels = 20 * 30;
+    riner::Array flats({3, 20, 30}), darks({2, 20, 30});
+    for (std::size_t p = 0; p < pixels; ++p) {
+      for (std::size_t f = 0; f < 3; ++f) {
+        flats.data[f * pixels + p] = 4000.0f + 10.0f * static_cast<float>(p % 30) + 100.0f * f;
+      }
+      darks.data[p] = 90.0f;
+      darks.data[pixels + p] = 110.0f;
+    }
+    std::filesystem::create_directory(dir / "raw");
+    std::filesystem::create_directory(dir / "raw" / "projections");
+    for (std::size_t v = 0; v < 36; ++v) {
+      riner::Array view({20, 30});
+      for (std::size_t p = 0; p < pixels; ++p) {
+        const float flat = 4100.0f + 10.0f * static_cast<float>(p % 30);
+        view.data[p] = 100.0f + (flat - 100.0f) * std::exp(-rho.data[v * pixels + p]);
+      }
+      if (v == 7) view.data[31] = 100.0f;  // at the dark: invalid
+      riner::write_array(dir / "raw" / "projections" / ("proj_" + std::to_string(v) + ".tif"),
+                         view);
+    }
+    for (std::size_t f = 0; f < 3; ++f) {
+      riner::write_array(
+          dir / "raw" / ("flat_" + std::to_string(f) + ".tif"),
+          riner::Array({20, 30}, std::vector<float>(flats.data.begin() + f * pixels,
+                                                    flats.data.begin() + (f + 1) * pixels)));
+    }
+    riner::write_array(dir / "raw" / "dark.npy", darks);
+    std::filesystem::copy_file(dir / "g3.json", dir / "raw" / "geometry.json");
+    const std::string raw = (dir / "raw").string();
+    // The geometry is found beside the folder; the flats are a quoted pattern.
+    const Run fbp =
+        riner_cli("fbp " + raw + "/projections --flat '" + raw + "/flat_*.tif' --dark " + raw +
+                      "/dark.npy --out " + raw + "/fbp.nii --json",
+                  dir);
+    REQUIRE(fbp.code == 0);
+    const auto summary = nlohmann::json::parse(fbp.out);
+    CHECK(summary["flat_field"]["flat_frames"] == 3);
+    CHECK(summary["flat_field"]["dark_frames"] == 2);
+    CHECK(summary["flat_field"]["invalid_readings"] == 1);
+    CHECK(summary["non_finite_replaced"] == 1);
+    REQUIRE(riner_cli("fbp " + sim + "/sino_clean.npy --out " + raw + "/fbp_rho.nii --quiet", dir)
+                .code == 0);
+    const Run compare =
+        riner_cli("compare " + raw + "/fbp.nii " + raw + "/fbp_rho.nii --json", dir);
+    REQUIRE(compare.code == 0);
+    CHECK(nlohmann::json::parse(compare.out)["psnr_db"].get<double>() > 60.0);
+    // Reconstruct reads the same and reports the normalisation in summary.json.
+    REQUIRE(riner_cli("reconstruct " + raw + "/projections --flat '" + raw +
+                          "/flat_*.tif' --dark " + raw + "/dark.npy --steps 20 --quiet --out " +
+                          raw + "/rec",
+                      dir)
+                .code == 0);
+    const auto rec = nlohmann::json::parse(riner::test::read_bytes(dir / "raw/rec/summary.json"));
+    CHECK(rec["flat_field"]["invalid_readings"] == 1);
+    CHECK(rec["non_finite_measurements"] == 1);
+    // Bad raw input: one line, exit 2.
+    expect_error(
+        riner_cli("fbp " + raw + "/projections --dark " + raw + "/dark.npy --out " + raw + "/x.nii",
+                  dir),
+        2, "--dark needs --flat");
+    expect_error(riner_cli("fbp " + raw + "/projections --flat " + raw + "/dark.npy --dark " + raw +
+                               "/flat_0.tif --out " + raw + "/x.nii",
+                           dir),
+                 2, raw + "/projections: no projection reading is above its dark field");
+    riner::write_array(dir / "raw" / "wide.tif", riner::Array({20, 31}, 1.0f));
+    expect_error(
+        riner_cli("fbp " + raw + "/projections --flat " + raw + "/wide.tif --out " + raw + "/x.nii",
+                  dir),
+        2, raw + "/projections: the flat field is [20, 31]; it must be one frame");
+    expect_error(riner_cli("fbp '" + raw + "/nothing_*.tif' --flat " + raw + "/wide.tif --out " +
+                               raw + "/x.nii",
+                           dir),
+                 2, raw + "/nothing_*.tif: no file matches the pattern");
+  }
+
   TEST_CASE("settings: one table for the list, the README, --set and config.json") {
     riner::test::TempDir dir;
     const Run list = riner_cli("settings --json", dir);

@@ -45,7 +45,10 @@ TEST_SUITE("io_bad_files") {
                          riner::InputError);
     std::filesystem::create_directory(dir / "d.npy");
     CHECK_THROWS_WITH_AS(riner::read_array(dir / "d.npy"),
-                         ((dir / "d.npy").string() + ": is a directory").c_str(),
+                         ((dir / "d.npy").string() +
+                          ": is a folder without .tif/.tiff files (a folder reads as a stack of "
+                          "TIFFs)")
+                             .c_str(),
                          riner::InputError);
     CHECK_THROWS_AS(riner::read_array(dir / "x.dcm"), riner::InputError);
     CHECK_THROWS_AS(riner::read_array(dir / "x.nii.gz"), riner::InputError);

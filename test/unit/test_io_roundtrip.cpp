@@ -5,6 +5,8 @@
 #include <cmath>
 #include <random>
 
+#include "io/stack.hpp"
+#include "riner/error.hpp"
 #include "riner/io.hpp"
 #include "support/crafted_files.hpp"
 #include "support/fixture.hpp"
@@ -238,5 +240,51 @@ TEST_SUITE("io_roundtrip") {
       CHECK(f.array.shape == e.shape);
       CHECK(f.non_finite == e.non_finite);
     }
+  }
+}
+
+TEST_SUITE("image stacks") {
+  TEST_CASE("natural order: digit runs compare as numbers") {
+    CHECK(riner::io::natural_less("raw_2.tif", "raw_10.tif"));
+    CHECK_FALSE(riner::io::natural_less("raw_10.tif", "raw_2.tif"));
+    CHECK(riner::io::natural_less("raw_00009.tif", "raw_00010.tif"));
+    CHECK(riner::io::natural_less("a.tif", "b.tif"));
+    CHECK(riner::io::natural_less("raw_9.tif", "raw_9b.tif"));
+  }
+
+  TEST_CASE("a folder or a pattern of 2D TIFFs reads as [files, rows, cols] in natural order") {
+    riner::test::TempDir dir;
+    std::filesystem::create_directory(dir / "tiffs");
+    for (int i : {10, 2, 1}) {
+      riner::write_array(dir / "tiffs" / ("raw_" + std::to_string(i) + ".tif"),
+                         Array({2, 3}, static_cast<float>(i)));
+    }
+    riner::write_array(dir / "tiffs" / "flat_1.tif", Array({2, 3}, 100.0f));
+    const riner::ArrayFile pattern = riner::read_array(dir / "tiffs" / "raw_*.tif");
+    REQUIRE(pattern.array.shape == std::vector<std::size_t>{3, 2, 3});
+    CHECK(pattern.array(0, 0, 0) == 1.0f);
+    CHECK(pattern.array(1, 1, 2) == 2.0f);
+    CHECK(pattern.array(2, 0, 1) == 10.0f);
+    const riner::ArrayFile folder = riner::read_array(dir / "tiffs");
+    CHECK(folder.array.shape == std::vector<std::size_t>{4, 2, 3});  // flat_1 comes first
+    CHECK(folder.array(0, 0, 0) == 100.0f);
+  }
+
+  TEST_CASE("stacks refuse empty matches and frames of another shape, naming the file") {
+    riner::test::TempDir dir;
+    auto message = [](const std::filesystem::path& p) -> std::string {
+      try {
+        riner::read_array(p);
+      } catch (const riner::InputError& e) {
+        return e.what();
+      }
+      return "accepted";
+    };
+    CHECK(message(dir.path()).find("is a folder without .tif/.tiff files") != std::string::npos);
+    CHECK(message(dir / "raw_*.tif").find("no file matches the pattern") != std::string::npos);
+    riner::write_array(dir / "raw_1.tif", Array({2, 3}, 1.0f));
+    riner::write_array(dir / "raw_2.tif", Array({3, 3}, 1.0f));
+    const std::string m = message(dir / "raw_*.tif");
+    CHECK(m.find("raw_2.tif: is [3, 3] where raw_1.tif is [2, 3]") != std::string::npos);
   }
 }

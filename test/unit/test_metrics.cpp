@@ -80,5 +80,15 @@ TEST_SUITE("metrics") {
     CHECK(clean < 0.01);
     CHECK(rings > 0.05);
     CHECK_THROWS_AS(riner::ring_index(riner::Array({4, 4, 4})), riner::InputError);
+    // A volume: every slice's radii count, over the volume's range. Three copies of the ringed
+    // slice read as that slice; with a smooth slice among them, lower.
+    riner::Array stack({3, 64, 64});
+    for (std::size_t z = 0; z < 3; ++z) {
+      std::copy(ringed.data.begin(), ringed.data.end(), stack.data.begin() + z * 4096);
+    }
+    CHECK(riner::ring_index(stack) == doctest::Approx(rings).epsilon(1e-6));
+    std::copy(smooth.data.begin(), smooth.data.end(), stack.data.begin() + 4096);
+    CHECK(riner::ring_index(stack) < 0.9 * rings);
+    CHECK(riner::ring_index(stack) > 0.5 * rings);
   }
 }

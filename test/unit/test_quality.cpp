@@ -34,7 +34,8 @@ TEST_SUITE("quality") {
     // White noise has (almost) no 6-sigma outliers; ten planted spikes of 20 sigma are ten.
     CHECK(riner::specks_per_10k(a, na) < 1.0);
     riner::Array spiky = a;
-    for (std::size_t s = 0; s < 10; ++s) spiky(30 + 6 * s, 40 + 5 * s) += 20.0f * static_cast<float>(na);
+    for (std::size_t s = 0; s < 10; ++s)
+      spiky(30 + 6 * s, 40 + 5 * s) += 20.0f * static_cast<float>(na);
     const double pixels = M_PI * 63.0 * 63.0;  // the inscribed disc, roughly
     CHECK(riner::specks_per_10k(spiky, na) == doctest::Approx(1e4 * 10 / pixels).epsilon(0.1));
   }
@@ -58,8 +59,18 @@ TEST_SUITE("quality") {
     CHECK(d.sigmas > 3.0);
     CHECK_THROWS_AS(riner::quality_against_fbp(riner::Array({8, 8}), riner::Array({8, 8})),
                     riner::InputError);
-    CHECK_THROWS_AS(riner::centre_deviation(disc, riner::Array({n, n + 1})),
-                    riner::InputError);
+    // A volume: its slices' specks and noise, no centre.
+    riner::Array volume({2, n, n}), fbp_volume({2, n, n});
+    std::copy(disc.data.begin(), disc.data.end(), volume.data.begin());
+    std::copy(clean.data.begin(), clean.data.end(), volume.data.begin() + n * n);
+    std::copy(fbp.data.begin(), fbp.data.end(), fbp_volume.data.begin());
+    std::copy(fbp.data.begin(), fbp.data.end(), fbp_volume.data.begin() + n * n);
+    const riner::QualityReport q3 = riner::quality_against_fbp(volume, fbp_volume);
+    CHECK(q3.noise == doctest::Approx(noise).epsilon(1e-6));
+    CHECK(q3.fbp_specks_per_10k ==
+          doctest::Approx(riner::specks_per_10k(fbp, noise)).epsilon(1e-6));
+    CHECK(q3.centre.sigmas == 0.0);
+    CHECK_THROWS_AS(riner::centre_deviation(disc, riner::Array({n, n + 1})), riner::InputError);
     const riner::QualityReport q = riner::quality_against_fbp(disc, fbp);
     CHECK(q.noise == noise);
     CHECK(q.specks_per_10k < q.fbp_specks_per_10k + 1.0);

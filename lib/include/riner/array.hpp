@@ -35,6 +35,9 @@ struct Array {
 // Number of elements a shape holds; throws InputError if the product overflows.
 std::size_t shape_size(const std::vector<std::size_t>& shape);
 
+// Slice z of a volume [z, y, x] as a 2D image [y, x] (a copy).
+Array axial_slice(const Array& volume, std::size_t z);
+
 // "[360, 500]"
 std::string shape_string(const std::vector<std::size_t>& shape);
 

@@ -7,9 +7,11 @@
 //                  float32/uint16/uint8 (read), float32 (written)
 //   .raw/.bin      raw samples described by a JSON sidecar "<file>.json":
 //                  {"dtype": "float32", "shape": [..], "byte_order": "little", "offset_bytes": 0}
-// Every reader checks the header against the file size and throws InputError naming the file
-// and what is wrong. Every writer writes a temporary file and renames it into place, and
-// refuses to write over a file this process has read.
+// A folder of .tif/.tiff files, or a file-name pattern with * ? [ ] ("tiffs/raw_*.tif", quoted
+// on the command line), reads as one stack [files, rows, cols] of 2D images in natural order
+// (raw_2 before raw_10). Every reader checks the header against the file size and throws InputError
+// naming the file and what is wrong. Every writer writes a temporary file and renames it into
+// place, and refuses to write over a file this process has read.
 #pragma once
 
 #include <filesystem>

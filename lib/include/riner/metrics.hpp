@@ -33,7 +33,9 @@ double psnr(const Array& image, const Array& reference, double data_range = 0.0)
 // How ringed an image is, without a reference (the measure in ../shared/data/*/SOURCE.md):
 // the RMS over radius of the angular-mean radial profile about the grid centre (the rotation
 // axis) minus its 7-pixel running median, divided by the image's 1st-99th percentile range.
-// 2D images only; radii up to the inscribed circle. Clean FBP of the DeepLesion simulations
+// Radii up to the inscribed circle. Of a volume [z, y, x]: the RMS over every axial slice's
+// radii (rings of a parallel or cone beam are circles in the slices), divided by the volume's
+// range. Clean FBP of the DeepLesion simulations
 // scores 0.003-0.006, ring-corrupted FBP 0.10-0.14.
 double ring_index(const Array& image);
 double ssim(const Array& image, const Array& reference, double data_range = 0.0);

@@ -1,6 +1,7 @@
-// No-reference quality of a 2D reconstruction, against the FBP of the same scan: what a user
+// No-reference quality of a reconstruction, against the FBP of the same scan: what a user
 // without a ground truth can check (issue 13). Every measure is about the rotation axis at the
-// grid centre, inside the inscribed disc.
+// grid centre, inside the inscribed disc; of a volume, over its axial slices (the centre
+// deviation only in 2D).
 //   ring index   riner::ring_index (metrics.hpp)
 //   specks       pixels whose difference from their 3 x 3 median exceeds 6 noise sigmas, per
 //                10^4 pixels of the disc; sigma is the FBP's pixel noise (1.4826 x the median
@@ -42,7 +43,8 @@ struct QualityReport {
   CentreDeviation centre;
 };
 
-// InputError unless both are 2D, of the same shape, at least 16 x 16.
+// InputError unless both are 2D images or volumes of the same shape, slices at least 16 x 16.
+// Of a volume, `centre` stays zero.
 QualityReport quality_against_fbp(const Array& image, const Array& fbp);
 
 }  // namespace riner

@@ -15,9 +15,15 @@ struct Scan {
   std::size_t non_finite = 0;  // NaN/inf measurements (dead elements), kept as they are
 };
 
-// Reads both files and checks they belong together. With an empty geometry path, looks for
-// "geometry.json" beside the measurement. Throws InputError when the shapes disagree or no
-// measurement is finite.
+// The geometry file of a measurement: `geometry` when given, else "geometry.json" beside the
+// measurement (for a folder or pattern of images, riner/io.hpp: in its folder, then beside
+// that folder). InputError when there is none.
+std::filesystem::path find_geometry(const std::filesystem::path& measurement,
+                                    const std::filesystem::path& geometry = {});
+
+// Reads both files and checks they belong together; the geometry as find_geometry finds it.
+// The measurement is a file, a folder of TIFFs or a pattern (read_array). Throws InputError
+// when the shapes disagree or no measurement is finite.
 Scan load_scan(const std::filesystem::path& measurement,
                const std::filesystem::path& geometry = {});
 

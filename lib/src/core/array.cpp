@@ -65,4 +65,15 @@ ArrayStats compute_stats(const Array& array) {
   return stats;
 }
 
+Array axial_slice(const Array& volume, std::size_t z) {
+  if (volume.rank() != 3 || z >= volume.shape[0]) {
+    throw InputError("no slice " + std::to_string(z) + " in an array of shape " +
+                     shape_string(volume.shape));
+  }
+  const std::size_t pixels = volume.shape[1] * volume.shape[2];
+  const auto first = volume.data.begin() + static_cast<std::ptrdiff_t>(z * pixels);
+  return Array({volume.shape[1], volume.shape[2]},
+               std::vector<float>(first, first + static_cast<std::ptrdiff_t>(pixels)));
+}
+
 }  // namespace riner

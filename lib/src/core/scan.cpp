@@ -1,6 +1,7 @@
 #include "riner/scan.hpp"
 
 #include "io/file_access.hpp"
+#include "io/stack.hpp"
 
 #include "riner/error.hpp"
 #include "riner/io.hpp"
@@ -15,18 +16,32 @@ void check_scan(const Scan& scan, std::string_view what) {
   }
 }
 
-Scan load_scan(const std::filesystem::path& measurement, const std::filesystem::path& geometry) {
-  io::input_file_size(measurement);  // a missing scan is the first thing to report
-  std::filesystem::path geometry_path = geometry;
-  if (geometry_path.empty()) {
-    geometry_path = measurement.parent_path() / "geometry.json";
-    if (!std::filesystem::exists(geometry_path)) {
-      throw InputError(measurement.string() +
-                       ": no geometry given and no geometry.json beside it (use --geometry)");
-    }
+std::filesystem::path find_geometry(const std::filesystem::path& measurement,
+                                    const std::filesystem::path& geometry) {
+  if (!io::is_stack_path(measurement)) {
+    io::input_file_size(measurement);  // a missing scan is the first thing to report
   }
+  if (!geometry.empty()) return geometry;
+  std::vector<std::filesystem::path> folders;
+  if (io::is_stack_path(measurement)) {
+    std::filesystem::path folder = measurement;
+    if (folder.filename().empty()) folder = folder.parent_path();               // "tiffs/"
+    if (!std::filesystem::is_directory(folder)) folder = folder.parent_path();  // a pattern
+    folders = {folder, folder.parent_path()};
+  } else {
+    folders = {measurement.parent_path()};
+  }
+  for (const std::filesystem::path& folder : folders) {
+    const std::filesystem::path candidate = folder / "geometry.json";
+    if (std::filesystem::exists(candidate)) return candidate;
+  }
+  throw InputError(measurement.string() +
+                   ": no geometry given and no geometry.json beside it (use --geometry)");
+}
+
+Scan load_scan(const std::filesystem::path& measurement, const std::filesystem::path& geometry) {
   Scan scan;
-  scan.geometry = Geometry::load(geometry_path);
+  scan.geometry = Geometry::load(find_geometry(measurement, geometry));
   ArrayFile file = read_array(measurement);
   scan.measurement = std::move(file.array);
   scan.non_finite = file.non_finite;

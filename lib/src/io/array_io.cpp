@@ -6,6 +6,7 @@
 
 #include "io/file_access.hpp"
 #include "io/formats.hpp"
+#include "io/stack.hpp"
 #include "riner/error.hpp"
 #include "riner/io.hpp"
 #include "util/atomic_file.hpp"
@@ -66,6 +67,7 @@ const char* format_name(FileFormat format) {
 }
 
 ArrayFile read_array(const std::filesystem::path& path) {
+  if (io::is_stack_path(path)) return io::read_stack(path, &read_array);
   switch (format_from_path(path)) {
     case FileFormat::kNpy:
       return io::read_npy(path);

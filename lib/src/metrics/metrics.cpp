@@ -188,11 +188,13 @@ void radial_means(const Array& image, std::size_t bins, std::vector<double>& mea
 
 }  // namespace metrics
 
-double ring_index(const Array& image) {
-  if (image.rank() != 2) throw InputError("the ring index takes a 2D image");
+namespace {
+
+// Sum of squares of a 2D image's radial profile about its 7-bin running median, and the number
+// of radii it sums over.
+std::pair<double, std::size_t> ring_residual(const Array& image) {
   const auto bins =
       static_cast<std::size_t>(0.5 * static_cast<double>(std::min(image.shape[0], image.shape[1])));
-  if (bins < 8) throw InputError("the ring index needs an image of at least 16 x 16");
   std::vector<double> mean, count;
   metrics::radial_means(image, bins, mean, count);
   // Radii no pixel centre rounds to (0 on an even grid) are left out, not taken as 0.
@@ -210,6 +212,25 @@ double ring_index(const Array& image) {
                      window.end());
     const double d = profile[r] - window[window.size() / 2];
     residual += d * d;
+  }
+  return {residual, n};
+}
+
+}  // namespace
+
+double ring_index(const Array& image) {
+  const std::size_t rank = image.rank();
+  if (rank != 2 && rank != 3) throw InputError("the ring index takes a 2D image or a volume");
+  if (std::min(image.shape[rank - 2], image.shape[rank - 1]) < 16 || image.size() == 0) {
+    throw InputError("the ring index needs an image of at least 16 x 16");
+  }
+  double residual = 0.0;
+  std::size_t n = 0;
+  const std::size_t slices = rank == 3 ? image.shape[0] : 1;
+  for (std::size_t z = 0; z < slices; ++z) {
+    const auto [sum, radii] = ring_residual(rank == 3 ? axial_slice(image, z) : image);
+    residual += sum;
+    n += radii;
   }
   const Window w = percentile_window(image, 1.0, 99.0);
   return std::sqrt(residual / static_cast<double>(n)) /

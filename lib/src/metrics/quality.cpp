@@ -22,6 +22,14 @@ void require_2d(const Array& a, const char* what) {
     throw InputError(std::string(what) + " must be a 2D image of at least 16 x 16");
 }
 
+// A 2D image, or a volume whose axial slices are images.
+void require_2d_or_slices(const Array& a, const char* what) {
+  const std::size_t r = a.rank();
+  if ((r != 2 && r != 3) || a.shape[r - 2] < 16 || a.shape[r - 1] < 16 || a.size() == 0)
+    throw InputError(std::string(what) +
+                     " must be a 2D image or a volume of slices, at least 16 x 16");
+}
+
 double disc_radius(const Array& a) {
   return 0.5 * static_cast<double>(std::min(a.shape[0], a.shape[1])) - 1.0;
 }
@@ -51,12 +59,24 @@ std::vector<double> median_residuals(const Array& a) {
   return out;
 }
 
+// median_residuals of every axial slice, one after the other.
+std::vector<double> slice_median_residuals(const Array& a) {
+  if (a.rank() == 2) return median_residuals(a);
+  std::vector<double> out;
+  out.reserve(a.size());
+  for (std::size_t z = 0; z < a.shape[0]; ++z) {
+    const std::vector<double> r = median_residuals(axial_slice(a, z));
+    out.insert(out.end(), r.begin(), r.end());
+  }
+  return out;
+}
+
 }  // namespace
 
 double residual_noise(const Array& image) {
-  require_2d(image, "the image");
+  require_2d_or_slices(image, "the image");
   std::vector<double> r;
-  for (double v : median_residuals(image)) {
+  for (double v : slice_median_residuals(image)) {
     if (v >= 0.0) r.push_back(v);
   }
   if (r.empty()) return 0.0;
@@ -65,9 +85,9 @@ double residual_noise(const Array& image) {
 }
 
 double specks_per_10k(const Array& image, double noise) {
-  require_2d(image, "the image");
+  require_2d_or_slices(image, "the image");
   std::size_t specks = 0, pixels = 0;
-  for (double v : median_residuals(image)) {
+  for (double v : slice_median_residuals(image)) {
     if (v < 0.0) continue;
     ++pixels;
     specks += v > kSpeckSigmas * noise;
@@ -113,8 +133,8 @@ CentreDeviation centre_deviation(const Array& image, const Array& fbp, int radiu
 }
 
 QualityReport quality_against_fbp(const Array& image, const Array& fbp) {
-  require_2d(image, "the image");
-  require_2d(fbp, "the FBP");
+  require_2d_or_slices(image, "the image");
+  require_2d_or_slices(fbp, "the FBP");
   if (image.shape != fbp.shape) throw InputError("the image and the FBP differ in shape");
   QualityReport q;
   q.noise = residual_noise(fbp);
@@ -122,7 +142,7 @@ QualityReport quality_against_fbp(const Array& image, const Array& fbp) {
   q.fbp_ring_index = ring_index(fbp);
   q.specks_per_10k = specks_per_10k(image, q.noise);
   q.fbp_specks_per_10k = specks_per_10k(fbp, q.noise);
-  q.centre = centre_deviation(image, fbp);
+  if (image.rank() == 2) q.centre = centre_deviation(image, fbp);
   return q;
 }
 

@@ -1,0 +1,52 @@
+#include "scan_options.hpp"
+
+namespace riner::app {
+
+void add_scan_options(Args& args) {
+  args.positional("SCAN",
+                  "the measurement (rho = -ln(I/I0)), or with --flat the raw projections: "
+                  ".npy, .nii, .tif, .raw, a folder of TIFFs or a quoted pattern ('raw_*.tif')")
+      .option("geometry", "FILE",
+              "geometry JSON (default: geometry.json beside SCAN; for a folder or pattern, in its "
+              "folder or beside it)",
+              "")
+      .option("flat", "FILE",
+              "flat field (beam, no sample): SCAN then holds raw intensities I and riner uses "
+              "-ln((I - dark) / (flat - dark)); one frame, or a stack, folder or pattern of "
+              "frames (averaged)",
+              "")
+      .option("dark", "FILE", "dark field (no beam) for --flat, likewise; default: none (0)", "");
+}
+
+LoadedScan scan_from(const Args& args) {
+  const std::string flat = args.get("flat");
+  const std::string dark = args.get("dark");
+  LoadedScan loaded;
+  if (flat.empty()) {
+    if (!dark.empty()) throw UsageError("--dark needs --flat (and SCAN holding raw projections)");
+    loaded.scan = load_scan(args.get("SCAN"), args.get("geometry"));
+    return loaded;
+  }
+  FlatFieldReport report;
+  loaded.scan = load_raw_scan(args.get("SCAN"), flat, dark, args.get("geometry"), &report);
+  loaded.flat_field = report;
+  return loaded;
+}
+
+std::string flat_field_line(const FlatFieldReport& r) {
+  return "raw projections: flat field of " + std::to_string(r.flat_frames) + " frame(s), " +
+         (r.dark_frames ? "dark field of " + std::to_string(r.dark_frames) + " frame(s)"
+                        : std::string("no dark field")) +
+         "; " + std::to_string(r.invalid_readings) +
+         " readings invalid (at or below the dark, or on " + std::to_string(r.pixels_without_beam) +
+         " pixels without beam)";
+}
+
+nlohmann::json flat_field_json(const FlatFieldReport& r) {
+  return {{"flat_frames", r.flat_frames},
+          {"dark_frames", r.dark_frames},
+          {"invalid_readings", r.invalid_readings},
+          {"pixels_without_beam", r.pixels_without_beam}};
+}
+
+}  // namespace riner::app
