@@ -23,9 +23,8 @@ int run_fbp(int argc, char** argv, int first) {
   args.output_flags();
   if (!args.parse(argc, argv, first)) return 0;
   Console console(args);
-  const LoadedScan loaded = scan_from(args);
+  const LoadedScan loaded = scan_from(args, console);
   const Scan& scan = loaded.scan;
-  if (loaded.flat_field) console.line(flat_field_line(*loaded.flat_field));
   const std::filesystem::path out = args.get("out");
   format_from_path(out);  // reject an unknown extension before the work
   FbpOptions options;
@@ -52,15 +51,17 @@ int run_fbp(int argc, char** argv, int first) {
                engine_name(options.engine) + "): " + shape_string(image.shape) + " in " +
                std::to_string(seconds) + " s, " + std::to_string(report.non_finite_replaced) +
                " non-finite measurements interpolated -> " + out.string());
-  console.summary({{"out", out.string()},
-                   {"shape", image.shape},
-                   {"filter", fbp_filter_name(options.filter)},
-                   {"engine", engine_name(options.engine)},
-                   {"seconds", seconds},
-                   {"non_finite_replaced", report.non_finite_replaced},
-                   {"short_scan", report.short_scan},
-                   {"flat_field", loaded.flat_field ? flat_field_json(*loaded.flat_field)
-                                                    : nlohmann::json(nullptr)}});
+  console.summary(
+      {{"out", out.string()},
+       {"shape", image.shape},
+       {"filter", fbp_filter_name(options.filter)},
+       {"engine", engine_name(options.engine)},
+       {"seconds", seconds},
+       {"non_finite_replaced", report.non_finite_replaced},
+       {"short_scan", report.short_scan},
+       {"flat_field",
+        loaded.flat_field ? flat_field_json(*loaded.flat_field) : nlohmann::json(nullptr)},
+       {"centre", loaded.centre ? centre_json(*loaded.centre) : nlohmann::json(nullptr)}});
   return 0;
 }
 

@@ -164,7 +164,6 @@ int run_reconstruct(int argc, char** argv, int first) {
               "640 on a GPU)",
               "")
       .option("lr", "RATE", "initial learning rate", "")
-      .option("offset-px", "PX", "override the detector's centre-of-rotation offset", "")
       .option("report-every", "N", "steps between progress reports", "200")
       .flag("paper", "use the paper's settings (L=10, T=2^10, F=8, width 128, 4000 steps, ...)")
       .flag("no-ring-correction",
@@ -173,11 +172,8 @@ int run_reconstruct(int argc, char** argv, int first) {
   args.output_flags();
   if (!args.parse(argc, argv, first)) return 0;
   Console console(args);
-  LoadedScan loaded = scan_from(args);
+  LoadedScan loaded = scan_from(args, console);
   Scan& scan = loaded.scan;
-  if (loaded.flat_field) console.line(flat_field_line(*loaded.flat_field));
-  if (auto v = args.maybe("offset-px"); v && !v->empty())
-    scan.geometry.offset_u = args.number("offset-px");
   const RinerConfig config = config_from(args);
   const std::string format = args.get("format");
   if (format != "nii" && format != "npy" && format != "tif" && format != "raw") {
@@ -248,6 +244,7 @@ int run_reconstruct(int argc, char** argv, int first) {
       {"non_finite_measurements", stats.non_finite},
       {"flat_field",
        loaded.flat_field ? flat_field_json(*loaded.flat_field) : nlohmann::json(nullptr)},
+      {"centre", loaded.centre ? centre_json(*loaded.centre) : nlohmann::json(nullptr)},
       {"dead_elements", dead},
       {"dead_element_reasons", dead_elements_json(dead_report)},
       {"engine", stats.engine},

@@ -12,5 +12,6 @@ int run_compare(int argc, char** argv, int first);
 int run_reconstruct(int argc, char** argv, int first);
 int run_demo(int argc, char** argv, int first);
 int run_settings(int argc, char** argv, int first);
+int run_center(int argc, char** argv, int first);
 
 }  // namespace riner::app

@@ -25,6 +25,7 @@ constexpr Command kCommands[] = {
     {"info", riner::app::run_info, "describe an array file or a geometry file"},
     {"simulate", riner::app::run_simulate, "simulate a ring-corrupted scan (paper protocol)"},
     {"fbp", riner::app::run_fbp, "filtered backprojection (FBP / FDK) of a scan"},
+    {"center", riner::app::run_center, "estimate the centre of rotation from the scan"},
     {"compare", riner::app::run_compare, "PSNR / SSIM / MAE of an image against a reference"},
     {"settings", riner::app::run_settings, "every reconstruct setting: default, range, meaning"},
 };

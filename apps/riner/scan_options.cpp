@@ -1,5 +1,7 @@
 #include "scan_options.hpp"
 
+#include <cstdio>
+
 namespace riner::app {
 
 void add_scan_options(Args& args) {
@@ -15,21 +17,36 @@ void add_scan_options(Args& args) {
               "-ln((I - dark) / (flat - dark)); one frame, or a stack, folder or pattern of "
               "frames (averaged)",
               "")
-      .option("dark", "FILE", "dark field (no beam) for --flat, likewise; default: none (0)", "");
+      .option("dark", "FILE", "dark field (no beam) for --flat, likewise; default: none (0)", "")
+      .option("offset-px", "PX|auto",
+              "the detector's centre-of-rotation offset instead of the geometry's; auto: "
+              "estimated from views half a turn apart (parallel beam, `riner center`)",
+              "");
 }
 
-LoadedScan scan_from(const Args& args) {
+LoadedScan scan_from(const Args& args, const Console& console) {
   const std::string flat = args.get("flat");
   const std::string dark = args.get("dark");
   LoadedScan loaded;
   if (flat.empty()) {
     if (!dark.empty()) throw UsageError("--dark needs --flat (and SCAN holding raw projections)");
     loaded.scan = load_scan(args.get("SCAN"), args.get("geometry"));
-    return loaded;
+  } else {
+    FlatFieldReport report;
+    loaded.scan = load_raw_scan(args.get("SCAN"), flat, dark, args.get("geometry"), &report);
+    loaded.flat_field = report;
+    console.line(flat_field_line(report));
   }
-  FlatFieldReport report;
-  loaded.scan = load_raw_scan(args.get("SCAN"), flat, dark, args.get("geometry"), &report);
-  loaded.flat_field = report;
+  if (args.has("offset-px")) {
+    const std::string offset = args.get("offset-px");
+    if (offset == "auto") {
+      loaded.centre = estimate_centre(loaded.scan);
+      loaded.scan.geometry.offset_u = loaded.centre->offset_px;
+      console.line(centre_line(*loaded.centre));
+    } else if (!offset.empty()) {
+      loaded.scan.geometry.offset_u = args.number("offset-px");
+    }
+  }
   return loaded;
 }
 
@@ -40,6 +57,23 @@ std::string flat_field_line(const FlatFieldReport& r) {
          "; " + std::to_string(r.invalid_readings) +
          " readings invalid (at or below the dark, or on " + std::to_string(r.pixels_without_beam) +
          " pixels without beam)";
+}
+
+std::string centre_line(const CentreEstimate& e) {
+  char line[200];
+  std::snprintf(line, sizeof(line),
+                "centre of rotation: offset %.2f px (axis at column %.2f), spread %.2f px over "
+                "%zu view pair(s) x %zu row(s)",
+                e.offset_px, e.axis_column, e.spread_px, e.pairs, e.rows);
+  return line;
+}
+
+nlohmann::json centre_json(const CentreEstimate& e) {
+  return {{"offset_px", e.offset_px},
+          {"axis_column", e.axis_column},
+          {"spread_px", e.spread_px},
+          {"view_pairs", e.pairs},
+          {"rows", e.rows}};
 }
 
 nlohmann::json flat_field_json(const FlatFieldReport& r) {

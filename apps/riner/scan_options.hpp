@@ -6,6 +6,8 @@
 #include <optional>
 
 #include "cli_args.hpp"
+#include "cli_common.hpp"
+#include "riner/centre.hpp"
 #include "riner/flat_field.hpp"
 #include "riner/scan.hpp"
 
@@ -16,14 +18,19 @@ void add_scan_options(Args& args);
 struct LoadedScan {
   Scan scan;
   std::optional<FlatFieldReport> flat_field;  // set when SCAN held raw projections
+  std::optional<CentreEstimate> centre;       // set by --offset-px auto
 };
 
 // The measurement SCAN names, or, with --flat, raw projections normalised by their flat and
-// dark fields.
-LoadedScan scan_from(const Args& args);
+// dark fields; its detector offset from --offset-px (a number, or auto: estimated).
+// Console lines say what was done.
+LoadedScan scan_from(const Args& args, const Console& console);
 
 // One line for the console: how many frames went into each field, what became invalid.
 std::string flat_field_line(const FlatFieldReport& report);
 nlohmann::json flat_field_json(const FlatFieldReport& report);
+
+std::string centre_line(const CentreEstimate& estimate);
+nlohmann::json centre_json(const CentreEstimate& estimate);
 
 }  // namespace riner::app

@@ -282,6 +282,39 @@ TEST_SUITE("cli") {
                  2, raw + "/nothing_*.tif: no file matches the pattern");
   }
 
+  TEST_CASE("center finds a forgotten offset; --offset-px auto uses it") {
+    riner::test::TempDir dir;
+    std::string angles;
+    for (int i = 0; i <= 90; ++i) angles += (i ? ", " : "") + std::to_string(M_PI * i / 90.0);
+    auto geometry = [&](double offset) {
+      return R"({"type": "parallel2d", "detector": {"count": 120, "pitch_mm": 1.0, "offset_px": )" +
+             std::to_string(offset) + R"(}, "angles_rad": [)" + angles +
+             R"(], "volume": {"shape": [96, 96], "voxel_mm": 1.0}})";
+    };
+    riner::test::write_bytes(dir / "true.json", geometry(4.6));
+    riner::test::write_bytes(dir / "forgot.json", geometry(0.0));
+    const std::string sim = (dir / "sim").string();
+    REQUIRE(riner_cli("simulate --quiet --seed 2 --geometry " + (dir / "true.json").string() +
+                          " --out " + sim,
+                      dir)
+                .code == 0);
+    const Run center = riner_cli(
+        "center " + sim + "/sino.npy --geometry " + (dir / "forgot.json").string() + " --json",
+        dir);
+    REQUIRE(center.code == 0);
+    const auto e = nlohmann::json::parse(center.out);
+    CHECK(std::fabs(e["offset_px"].get<double>() - 4.6) < 0.2);
+    CHECK(e["geometry_offset_px"] == 0.0);
+    const Run fbp =
+        riner_cli("fbp " + sim + "/sino.npy --geometry " + (dir / "forgot.json").string() +
+                      " --offset-px auto --out " + sim + "/auto.nii --json",
+                  dir);
+    REQUIRE(fbp.code == 0);
+    CHECK(nlohmann::json::parse(fbp.out)["centre"]["offset_px"] == e["offset_px"]);
+    expect_error(riner_cli("center " + sim + "/sino.npy --geometry " + sim + "/missing.json", dir),
+                 2, sim + "/missing.json");
+  }
+
   TEST_CASE("settings: one table for the list, the README, --set and config.json") {
     riner::test::TempDir dir;
     const Run list = riner_cli("settings --json", dir);

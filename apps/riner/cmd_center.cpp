@@ -1,0 +1,28 @@
+// riner center SCAN: the centre-of-rotation offset the scan's own views point to.
+#include "cli_common.hpp"
+#include "commands.hpp"
+#include "scan_options.hpp"
+
+namespace riner::app {
+
+int run_center(int argc, char** argv, int first) {
+  Args args("center",
+            "Estimates where the rotation axis projects on the detector (the geometry's "
+            "detector.offset_px) from views half a turn apart, which a parallel beam sees as "
+            "mirror images. Use the result with --offset-px, or pass --offset-px auto to "
+            "reconstruct and fbp.");
+  add_scan_options(args);
+  args.output_flags();
+  if (!args.parse(argc, argv, first)) return 0;
+  Console console(args);
+  const LoadedScan loaded = scan_from(args, console);
+  const CentreEstimate e = estimate_centre(loaded.scan);
+  console.line(centre_line(e) + "; the geometry says " +
+               std::to_string(loaded.scan.geometry.offset_u));
+  nlohmann::json summary = centre_json(e);
+  summary["geometry_offset_px"] = loaded.scan.geometry.offset_u;
+  console.summary(summary);
+  return 0;
+}
+
+}  // namespace riner::app

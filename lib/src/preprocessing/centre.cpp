@@ -1,0 +1,203 @@
+#include "riner/centre.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "riner/error.hpp"
+
+namespace riner {
+
+namespace {
+
+// Enough pairs and rows for a stable sum, few enough to stay a fraction of a second.
+constexpr std::size_t kMostPairs = 32;
+constexpr std::size_t kMostRows = 24;
+constexpr double kCoarseStepPx = 0.5;
+constexpr double kFineStepPx = 0.02;
+
+// View `first` and the view half a turn later: exactly one view, or two views either side of
+// it, interpolated in angle (a 360-degree scan with an odd number of views).
+struct ViewPair {
+  std::size_t first;
+  std::size_t before;
+  std::size_t after;
+  double weight;  // of `after`
+};
+
+std::vector<ViewPair> opposite_views(const std::vector<double>& angles) {
+  const std::size_t n = angles.size();
+  double span = 0.0;
+  for (std::size_t i = 1; i < n; ++i) span += std::fabs(angles[i] - angles[i - 1]);
+  const double step = n > 1 ? span / static_cast<double>(n - 1) : 0.0;
+  std::vector<ViewPair> pairs;
+  for (std::size_t i = 0; i < n; ++i) {
+    // The nearest views at or before and at or after angle i + pi, modulo a full turn.
+    double below = -std::numeric_limits<double>::infinity();
+    double above = std::numeric_limits<double>::infinity();
+    std::size_t before = n, after = n;
+    for (std::size_t k = 0; k < n; ++k) {
+      if (k == i) continue;
+      const double d = std::remainder(angles[k] - angles[i] - M_PI, 2.0 * M_PI);
+      if (d <= 0.0 && d > below) {
+        below = d;
+        before = k;
+      }
+      if (d >= 0.0 && d < above) {
+        above = d;
+        after = k;
+      }
+    }
+    // An exact pair once (from its earlier view), not again from the other end.
+    if (before < n && -below <= 0.25 * step) {
+      if (i < before) pairs.push_back({i, before, before, 0.0});
+    } else if (after < n && above <= 0.25 * step) {
+      if (i < after) pairs.push_back({i, after, after, 0.0});
+    } else if (before < n && after < n && above - below <= 1.5 * step) {
+      pairs.push_back({i, before, after, -below / (above - below)});
+    }
+  }
+  return pairs;
+}
+
+// Indices 0..n-1 thinned to at most `most`, evenly.
+std::vector<std::size_t> evenly(std::size_t n, std::size_t most) {
+  std::vector<std::size_t> out;
+  const std::size_t m = std::min(n, most);
+  for (std::size_t i = 0; i < m; ++i) out.push_back(i * n / m);
+  return out;
+}
+
+// One detector line of view v, row r.
+const float* line_of(const Scan& s, std::size_t view, std::size_t row) {
+  const Geometry& g = s.geometry;
+  const std::size_t rows = g.is_3d() ? g.n_v : 1;
+  return s.measurement.ptr() + (view * rows + row) * g.n_u;
+}
+
+// A pair's two lines in one row: the first view's, and half a turn later's.
+struct LinePair {
+  const float* first;
+  std::vector<float> opposite;
+};
+
+std::vector<LinePair> line_pairs(const Scan& s, const std::vector<ViewPair>& pairs,
+                                 const std::vector<std::size_t>& rows) {
+  std::vector<LinePair> out;
+  const std::size_t n = s.geometry.n_u;
+  for (const ViewPair& p : pairs) {
+    for (std::size_t r : rows) {
+      const float* a = line_of(s, p.before, r);
+      const float* b = line_of(s, p.after, r);
+      LinePair lp{line_of(s, p.first, r), std::vector<float>(n)};
+      for (std::size_t j = 0; j < n; ++j) {
+        lp.opposite[j] = static_cast<float>((1.0 - p.weight) * a[j] + p.weight * b[j]);
+      }
+      out.push_back(std::move(lp));
+    }
+  }
+  return out;
+}
+
+// Mean squared difference between line a and line b mirrored about column `axis`
+// (a[j] against b[2 axis - j], linearly interpolated), over the columns both see; the
+// sums accumulate into sum and count.
+void mirror_mismatch(const float* a, const float* b, std::size_t n, double axis, double& sum,
+                     double& count) {
+  for (std::size_t j = 0; j < n; ++j) {
+    const double x = 2.0 * axis - static_cast<double>(j);
+    if (x < 0.0 || x > static_cast<double>(n - 1)) continue;
+    const auto k = static_cast<std::size_t>(x);
+    const double t = x - static_cast<double>(k);
+    const float va = a[j];
+    const float b0 = b[k];
+    const float b1 = b[std::min(k + 1, n - 1)];
+    if (!std::isfinite(va) || !std::isfinite(b0) || !std::isfinite(b1)) continue;
+    const double d = va - ((1.0 - t) * b0 + t * b1);
+    sum += d * d;
+    count += 1.0;
+  }
+}
+
+// The cost of a candidate axis over the given line pairs.
+double cost_at(const std::vector<LinePair>& lines, std::size_t n, double axis) {
+  double sum = 0.0, count = 0.0;
+  for (const LinePair& p : lines) mirror_mismatch(p.first, p.opposite.data(), n, axis, sum, count);
+  return count > 0.0 ? sum / count : std::numeric_limits<double>::infinity();
+}
+
+// The best axis: a coarse scan over the central half of the detector (the pair must overlap
+// by at least half its width), then a fine one around the coarse minimum. `width`: how far the
+// cost takes to rise 10% above its minimum (a shallow minimum is unsure).
+double best_axis(const std::vector<LinePair>& lines, std::size_t n_u, double* width = nullptr) {
+  auto cost = [&](double a) { return cost_at(lines, n_u, a); };
+  const double n = static_cast<double>(n_u);
+  const double centre = 0.5 * (n - 1.0);
+  double best = centre, best_cost = std::numeric_limits<double>::infinity();
+  auto consider = [&](double a) {
+    const double c = cost(a);
+    if (c < best_cost) {
+      best_cost = c;
+      best = a;
+    }
+  };
+  for (double a = centre - 0.25 * n; a <= centre + 0.25 * n; a += kCoarseStepPx) consider(a);
+  const double coarse = best;
+  for (double a = coarse - kCoarseStepPx; a <= coarse + kCoarseStepPx + 1e-9; a += kFineStepPx) {
+    consider(a);
+  }
+  if (width) {
+    *width = kCoarseStepPx;
+    for (double a = best; a <= best + 4.0; a += kFineStepPx) {
+      if (cost(a) > 1.1 * best_cost) {
+        *width = a - best;
+        break;
+      }
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+CentreEstimate estimate_centre(const Scan& scan) {
+  const Geometry& g = scan.geometry;
+  if (g.is_divergent()) {
+    throw InputError(std::string("centre finding needs a parallel beam (this scan is ") +
+                     geometry_type_name(g.type) + "); pass the offset with --offset-px");
+  }
+  if (g.n_u < 8) throw InputError("centre finding needs a detector of at least 8 elements");
+  std::vector<ViewPair> all = opposite_views(g.angles);
+  if (all.empty()) {
+    throw InputError(
+        "no two views are half a turn apart, or either side of it (a 180-degree scan needs its "
+        "endpoint view); pass the offset with --offset-px");
+  }
+  std::vector<ViewPair> pairs;
+  for (std::size_t i : evenly(all.size(), kMostPairs)) pairs.push_back(all[i]);
+  const std::vector<std::size_t> rows = evenly(g.is_3d() ? g.n_v : 1, kMostRows);
+
+  CentreEstimate e;
+  e.pairs = pairs.size();
+  e.rows = rows.size();
+  double width = 0.0;
+  const std::vector<LinePair> lines = line_pairs(scan, pairs, rows);
+  e.axis_column = best_axis(lines, g.n_u, &width);
+  e.offset_px = 0.5 * (static_cast<double>(g.n_u) - 1.0) - e.axis_column;
+  if (pairs.size() == 1) {
+    e.spread_px = width;
+  } else {
+    double sum2 = 0.0;
+    for (std::size_t p = 0; p < pairs.size(); ++p) {
+      const auto first = lines.begin() + static_cast<std::ptrdiff_t>(p * rows.size());
+      const std::vector<LinePair> one(first, first + static_cast<std::ptrdiff_t>(rows.size()));
+      const double a = best_axis(one, g.n_u);
+      sum2 += (a - e.axis_column) * (a - e.axis_column);
+    }
+    e.spread_px = std::sqrt(sum2 / static_cast<double>(pairs.size()));
+  }
+  return e;
+}
+
+}  // namespace riner

@@ -1,0 +1,92 @@
+// Centre of rotation from the scan: projections of an off-centre object with a known detector
+// offset, the offset forgotten, then found again.
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include "riner/centre.hpp"
+#include "riner/error.hpp"
+#include "riner/projector.hpp"
+#include "support/geometries.hpp"
+
+namespace {
+
+// An object with no symmetry about the grid centre: a bar, a disc and a ramp.
+riner::Array asymmetric(const std::vector<std::size_t>& shape) {
+  riner::Array a(shape);
+  const std::size_t ny = shape[shape.size() - 2], nx = shape.back();
+  const std::size_t slices = shape.size() == 3 ? shape[0] : 1;
+  for (std::size_t z = 0; z < slices; ++z) {
+    for (std::size_t i = 0; i < ny; ++i) {
+      for (std::size_t k = 0; k < nx; ++k) {
+        const double x = static_cast<double>(k) - 0.5 * nx, y = static_cast<double>(i) - 0.5 * ny;
+        float v = 0.0f;
+        if (x > 4 && x < 12 && y > -14 && y < 6) v += 0.02f;
+        if (std::hypot(x + 8, y - 7) < 5) v += 0.03f;
+        if (std::hypot(x, y) < 0.4 * nx) v += 0.005f * static_cast<float>(1.0 + x / nx + 0.1 * z);
+        a.data[(z * ny + i) * nx + k] = v;
+      }
+    }
+  }
+  return a;
+}
+
+riner::Scan scan_with_offset(riner::Geometry g, double offset) {
+  g.offset_u = offset;
+  riner::Scan s;
+  s.measurement =
+      riner::Projector(g, riner::Engine::kReference).project(asymmetric(g.volume_shape));
+  s.geometry = g;
+  s.geometry.offset_u = 0.0;  // forgotten
+  return s;
+}
+
+riner::Geometry with_angles(riner::Geometry g, std::size_t views, double range, bool endpoint) {
+  g.uniform_angles.reset();
+  g.angles.clear();
+  const double step = range / static_cast<double>(endpoint ? views - 1 : views);
+  for (std::size_t i = 0; i < views; ++i) g.angles.push_back(0.3 + step * static_cast<double>(i));
+  return g;
+}
+
+}  // namespace
+
+TEST_SUITE("centre") {
+  TEST_CASE(
+      "parallel 2D, 180 degrees with its endpoint, 360 with an even and an odd count: 0.1 px") {
+    const riner::Geometry base = riner::test::small_parallel2d();
+    for (const auto& [views, range, endpoint] :
+         {std::tuple{61, M_PI, true}, std::tuple{90, 2.0 * M_PI, false},
+          std::tuple{91, 2.0 * M_PI, false}}) {
+      const riner::Geometry g = with_angles(base, static_cast<std::size_t>(views), range, endpoint);
+      for (double offset : {3.4, -6.35, 0.0}) {
+        const riner::CentreEstimate e = riner::estimate_centre(scan_with_offset(g, offset));
+        CAPTURE(views);
+        CAPTURE(offset);
+        CHECK(std::fabs(e.offset_px - offset) < 0.1);
+        CHECK(e.axis_column == doctest::Approx(0.5 * (g.n_u - 1.0) - e.offset_px));
+        CHECK(e.pairs >= 1);
+        CHECK(e.spread_px < 1.0);
+      }
+    }
+  }
+
+  TEST_CASE("parallel 3D: every row shares the axis") {
+    const riner::Geometry g = with_angles(riner::test::small_parallel3d(), 31, M_PI, true);
+    const riner::CentreEstimate e = riner::estimate_centre(scan_with_offset(g, -2.7));
+    CHECK(std::fabs(e.offset_px + 2.7) < 0.1);
+    CHECK(e.rows > 1);
+  }
+
+  TEST_CASE("no pair half a turn apart, or a divergent beam: InputError saying what to do") {
+    const riner::Geometry open = with_angles(riner::test::small_parallel2d(), 60, M_PI, false);
+    CHECK_THROWS_WITH_AS(riner::estimate_centre(scan_with_offset(open, 1.0)),
+                         doctest::Contains("no two views are half a turn apart"),
+                         riner::InputError);
+    riner::Scan fan;
+    fan.geometry = riner::test::small_fan2d();
+    fan.measurement = riner::Array(fan.geometry.measurement_shape());
+    CHECK_THROWS_WITH_AS(riner::estimate_centre(fan), doctest::Contains("needs a parallel beam"),
+                         riner::InputError);
+  }
+}
