@@ -20,10 +20,21 @@ namespace {
 constexpr int kHistoryBlock = 256;   // steps between reads of the loss history
 constexpr int kUploadsInFlight = 3;  // steps the host may prepare ahead of the device
 
-std::vector<cl_float8> segment_table(const std::vector<model::RaySegment>& segments) {
-  std::vector<cl_float8> table(segments.size());
+constexpr std::size_t kSegmentUploadChunk = 1 << 20;  // segments per upload: 32 MiB staged
+
+// The ray table on the device, uploaded in chunks: a whole host copy in cl_float8 would double
+// the host's largest allocation (2.7 GB for a 512 x 512 x 200 cone-beam scan).
+cl::Buffer<cl_float8> segment_table(cl::Context& ctx,
+                                    const std::vector<model::RaySegment>& segments) {
   static_assert(sizeof(cl_float8) == sizeof(model::RaySegment));
-  std::memcpy(table.data(), segments.data(), segments.size() * sizeof(cl_float8));
+  cl::Buffer<cl_float8> table(ctx, segments.size(), CL_MEM_READ_ONLY);
+  std::vector<cl_float8> staged;
+  for (std::size_t first = 0; first < segments.size(); first += kSegmentUploadChunk) {
+    const std::size_t n = std::min(kSegmentUploadChunk, segments.size() - first);
+    staged.resize(n);
+    std::memcpy(staged.data(), segments.data() + first, n * sizeof(cl_float8));
+    table.write(staged, first);
+  }
   return table;
 }
 
@@ -38,8 +49,7 @@ class OpenclTrainer final : public Trainer {
                           model::initial_parameters(setup.layout, setup.config.training.seed))),
         grad_(ctx_, std::vector<float>(setup.layout.total, 0.0f)),
         history_(ctx_, static_cast<std::size_t>(kHistoryBlock) * 2),
-        segments_(ctx_, std::span<const cl_float8>(segment_table(setup.segments)),
-                  CL_MEM_READ_ONLY),
+        segments_(segment_table(ctx_, setup.segments)),
         rho_(ctx_, std::span<const float>(setup.scan.measurement.data), CL_MEM_READ_ONLY),
         invalid_readings_(ctx_, std::span<const cl_uint>(setup.invalid_readings), CL_MEM_READ_ONLY),
         level_weights_(ctx_, static_cast<std::size_t>(setup.layout.levels)),

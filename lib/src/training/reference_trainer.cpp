@@ -51,8 +51,9 @@ class ReferenceTrainer final : public Trainer {
   std::vector<float> parameters() override { return {params_.begin(), params_.end()}; }
 
   std::vector<float> evaluate_grid() override {
-    return ref::riner_step_field_evaluate(setup_.layout, params_, model::voxel_positions(setup_.scan.geometry),
-                               setup_.level_weights(steps_));
+    return ref::riner_step_field_evaluate(setup_.layout, params_,
+                                          model::voxel_positions(setup_.scan.geometry),
+                                          setup_.level_weights(steps_));
   }
 
   std::string device_name() const override { return "CPU reference"; }
