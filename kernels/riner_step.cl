@@ -6,10 +6,10 @@
 // then the weight gradients are reduced by mlp_gradient.cl, the grid's by atomics here
 // (-D ATOMIC_GRADIENTS) or by ownership in hash_grid_gradient.cl, and adam.cl applies them.
 //
-//   riner_step_forward(p, batch, segments, levels, params, mu_dx, cache)
+//   riner_step_forward(p, batch, levels, params, mu_dx, cache)
 //     sample i of batch ray b (batch_ray_of): mu_dx[i] = mu * dx at the sample; its features
 //     and activations into the cache (sample_cache.cl).
-//   riner_step_loss(p, batch, mu_dx, rho, params, invalid_readings, grad, sums, d_sums,
+//   riner_step_loss(p, batch, mu_dx, params, invalid_readings, grad, sums, d_sums,
 //                   ray_grads, history, scratch)
 //     one work-group of any size (the plan's): work-items take rays b = lid, lid + size, ...:
 //     sums[b] = sum of mu dx over the ray's samples (in sample order), the ray's loss
@@ -21,7 +21,7 @@
 //     data_weight relative_beta_threshold max(m, 1e-3) / 2, m the batch's median ray mismatch
 //     (scratch float[n_batch]). When hold_valid_beta != 0, beta0 of every element without
 //     invalid readings gets no gradient (the beta warm-up).
-//   riner_step_backward(p, batch, segments, levels, params, d_sums, cache, grad)
+//   riner_step_backward(p, batch, levels, params, d_sums, cache, grad)
 //     sample i: d_mu = d_sums[b] dx through the MLP (mlp_deltas); deltas and d_mu into the
 //     cache for mlp_gradient.cl; the features' gradient into the grid: with
 //     -D ATOMIC_GRADIENTS by float atomics into grad (common.cl picks the device's fastest),
@@ -37,15 +37,13 @@
 // r_e = mean over the block's views of sums(v, e - 1) - 2 sums(v, e) + sums(v, e + 1), and the
 // prior adds ring_lambda * sum_e r_e^2, so per-element offsets go to alpha.
 //
-// Buffers: batch uint[] packed as sample_cache.cl describes, StepParams p says where;
-// segments float8[rays] = (start xyz, step xyz, dx, count as uint bits) in normalised
-// coordinates (lib/src/model/ray_segments.hpp); rho float[rays]; params/grad float[n_params]
+// Buffers: batch uint[] packed as sample_cache.cl describes (the rays' segments and readings
+// included), StepParams p says where; params/grad float[n_params]
 // as lib/src/model/parameter_layout.hpp lays them out; sums, d_sums float[n_batch], ray_grads
 // float2[n_batch].
 // Needs common.cl, hash_grid.cl, mlp.cl, ray_sum.cl, sample_cache.cl (and their -D constants).
 
 __kernel void riner_step_forward(const StepParams p, __global const uint* batch,
-                                 __global const float8* segments,
                                  __constant const GridLevel* levels, __global const float* params,
                                  __global float* mu_dx, __global float* cache) {
   const uint i = get_global_id(0);
@@ -53,7 +51,7 @@ __kernel void riner_step_forward(const StepParams p, __global const uint* batch,
   __global const uint* offsets = batch + p.offsets_at;
   const uint b = batch_ray_of(offsets, p.n_batch, i);
   const uint ray = batch[p.rays_at + b];
-  const float8 s = segments[ray];
+  const float8 s = batch_segment(batch, &p, b);
   const uint k = i - offsets[b];
   float pos[DIMS];
   float features[N_ENCODED];
@@ -144,9 +142,9 @@ RINER_INLINE float ring_prior(const StepParams* p, __global const float* sums,
 }
 
 __kernel void riner_step_loss(const StepParams p, __global const uint* batch,
-                              __global const float* mu_dx, __global const float* rho,
-                              __global const float* params, __global const uint* invalid_readings,
-                              __global float* grad, __global float* sums, __global float* d_sums,
+                              __global const float* mu_dx, __global const float* params,
+                              __global const uint* invalid_readings, __global float* grad,
+                              __global float* sums, __global float* d_sums,
                               __global float2* ray_grads, __global float* history,
                               __global float* scratch, __local float* reduce) {
   const uint lid = get_local_id(0);
@@ -163,8 +161,8 @@ __kernel void riner_step_loss(const StepParams p, __global const uint* batch,
     if (lid == 0) {
       for (uint b = 0; b < p.n_batch; ++b) {
         const uint ray = batch[p.rays_at + b];
-        scratch[b] =
-            ray_mismatch(sums[b], params[p.alpha_offset + ray % p.elements_per_view], rho[ray]);
+        scratch[b] = ray_mismatch(sums[b], params[p.alpha_offset + ray % p.elements_per_view],
+                                  batch_rho(batch, &p, b));
       }
       reduce[0] = select_kth(scratch, p.n_batch, (p.n_batch - 1) / 2);
     }
@@ -179,8 +177,9 @@ __kernel void riner_step_loss(const StepParams p, __global const uint* batch,
     float d_sum;
     float d_alpha0;
     float d_beta0;
-    data += ray_loss(sums[b], params[p.alpha_offset + e], params[p.beta_offset + e], rho[ray],
-                     as_float(batch[p.weights_at + b]), &d_sum, &d_alpha0, &d_beta0);
+    data += ray_loss(sums[b], params[p.alpha_offset + e], params[p.beta_offset + e],
+                     batch_rho(batch, &p, b), as_float(batch[p.weights_at + b]), &d_sum, &d_alpha0,
+                     &d_beta0);
     d_sums[b] = d_sum;
     ray_grads[b] = (float2)(d_alpha0, d_beta0);
   }
@@ -207,7 +206,6 @@ __kernel void riner_step_loss(const StepParams p, __global const uint* batch,
 }
 
 __kernel void riner_step_backward(const StepParams p, __global const uint* batch,
-                                  __global const float8* segments,
                                   __constant const GridLevel* levels, __global const float* params,
                                   __global const float* d_sums, __global float* cache,
                                   __global float* grad) {
@@ -216,7 +214,7 @@ __kernel void riner_step_backward(const StepParams p, __global const uint* batch
   __global const uint* offsets = batch + p.offsets_at;
   const uint b = batch_ray_of(offsets, p.n_batch, i);
   const uint ray = batch[p.rays_at + b];
-  const float8 s = segments[ray];
+  const float8 s = batch_segment(batch, &p, b);
   const float d_mu = d_sums[b] * s.s6;
   const uint stride = p.cache_stride;
   float act[MLP_HIDDEN][MLP_WIDTH];

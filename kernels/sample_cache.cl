@@ -21,6 +21,11 @@
 //                              by element (ascending within an element)
 //   elements [n_elements]      the distinct detector elements, ascending
 //   level_weights [N_LEVELS]   coarse-to-fine scale per encoding level (float)
+//   segments [8 n_batch]       each batch ray's segment: start xyz, step xyz, dx (float),
+//                              sample count (lib/src/model/ray_segments.hpp)
+//   rho [n_batch]              each batch ray's reading (float; NaN: invalid)
+// The step reads only its own rays' segments and readings, so the scan's tables stay on the
+// host and device memory does not grow with the scan.
 // Needs hash_grid.cl and mlp.cl (their -D constants).
 
 #define CACHE_FEATURES 0
@@ -31,7 +36,7 @@
 #define CACHE_POS (CACHE_DIN + N_ENCODED)
 #define CACHE_ROWS (CACHE_POS + DIMS)
 
-// One training step's shape and scalars (host mirror: riner::ops::StepParams, 27 four-byte
+// One training step's shape and scalars (host mirror: riner::ops::StepParams, 28 four-byte
 // members).
 typedef struct {
   uint n_batch;
@@ -60,8 +65,17 @@ typedef struct {
   uint block_views;
   uint block_elements;
   uint cache_stride;
-  uint reserved;
+  uint segments_at;
+  uint rho_at;
 } StepParams;
+
+// Batch ray b's segment and reading.
+RINER_INLINE float8 batch_segment(__global const uint* batch, const StepParams* p, uint b) {
+  return as_float8(vload8(b, batch + p->segments_at));
+}
+RINER_INLINE float batch_rho(__global const uint* batch, const StepParams* p, uint b) {
+  return as_float(batch[p->rho_at + b]);
+}
 
 // The batch ray that owns sample i: the last b with offsets[b] <= i (rays with no samples own
 // none, so they are skipped).

@@ -57,24 +57,18 @@ std::vector<Scenario> scenarios() {
 
 // A step's fixed inputs on the device, and its loss history.
 struct DeviceInputs {
-  riner::cl::Buffer<cl_float8> segments;
-  riner::cl::Buffer<float> rho;
   riner::cl::Buffer<cl_uint> invalid;
   riner::cl::Buffer<float> params;
   riner::cl::Buffer<float> history;
 
-  DeviceInputs(const std::vector<riner::model::RaySegment>& s, const std::vector<float>& r,
-               const std::vector<std::uint32_t>& inv, const std::vector<float>& p)
-      : segments(ctx(), std::span<const cl_float8>(reinterpret_cast<const cl_float8*>(s.data()),
-                                                   s.size())),
-        rho(ctx(), std::span<const float>(r)),
-        invalid(ctx(), std::span<const cl_uint>(inv)),
+  DeviceInputs(const std::vector<std::uint32_t>& inv, const std::vector<float>& p)
+      : invalid(ctx(), std::span<const cl_uint>(inv)),
         params(ctx(), std::span<const float>(p)),
         history(ctx(), 2) {}
 
   void step(riner::ops::RinerStepOp& op, const riner::ops::StepParams& p,
             const riner::cl::Buffer<cl_uint>& words, riner::cl::Buffer<float>& grad) {
-    op.step(p, words, {&segments, &rho, &invalid}, params, grad, history);
+    op.step(p, words, {&invalid}, params, grad, history);
   }
 };
 
@@ -135,7 +129,7 @@ TEST_SUITE("riner_step") {
       std::vector<float> level_weights(static_cast<std::size_t>(l.levels), 1.0f);
       if (sc.coarse_to_fine) level_weights.back() = 0.3f;
 
-      DeviceInputs device(segments, rho, invalid, params);
+      DeviceInputs device(invalid, params);
       const std::vector<double> params_d(params.begin(), params.end());
       const riner::model::BatchSampler sampler(g, t);
 
@@ -150,7 +144,7 @@ TEST_SUITE("riner_step") {
           CAPTURE(step);
           const riner::model::Batch batch = sampler.batch(step);
           riner::model::PackedBatch packed;
-          riner::model::pack_batch(batch, segments, per_view, level_weights, packed);
+          riner::model::pack_batch(batch, segments, rho, per_view, level_weights, packed);
           const riner::cl::Buffer<cl_uint> words(ctx(), std::span<const cl_uint>(packed.words));
           riner::ops::StepParams p;
           riner::ops::set_batch_shape(packed, p);
@@ -233,14 +227,14 @@ TEST_SUITE("riner_step") {
     for (std::size_t i = 0; i < l.grid_params; ++i) params[i] = u(rng);
     std::vector<float> rho(g.n_views() * g.n_u, 0.5f);
     std::vector<std::uint32_t> invalid(g.n_u, 0);
-    DeviceInputs device(segments, rho, invalid, params);
+    DeviceInputs device(invalid, params);
     c.training.rays_per_step = 200;
     const riner::model::BatchSampler sampler(g, c.training);
     riner::PlanConfig pc;
     pc.kind = "cpu";
     riner::ops::RinerStepOp op(ctx(), l, riner::choose_execution_plan(ctx().info(), pc), 200);
     riner::model::PackedBatch packed;
-    riner::model::pack_batch(sampler.batch(1), segments, g.n_u, std::vector<float>(6, 1.0f),
+    riner::model::pack_batch(sampler.batch(1), segments, rho, g.n_u, std::vector<float>(6, 1.0f),
                              packed);
     const riner::cl::Buffer<cl_uint> words(ctx(), std::span<const cl_uint>(packed.words));
     riner::ops::StepParams p;

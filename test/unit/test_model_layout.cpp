@@ -169,8 +169,10 @@ TEST_SUITE("model_layout") {
     const riner::model::Batch b = sampler.batch(7);
     const std::vector<riner::model::RaySegment> segments =
         riner::model::ray_segments(g, 1.0, false);
+    std::vector<float> rho(g.n_views() * g.n_u);
+    for (std::size_t i = 0; i < rho.size(); ++i) rho[i] = 0.001f * static_cast<float>(i);
     riner::model::PackedBatch p;
-    riner::model::pack_batch(b, segments, g.n_u, {1.0f, 0.5f, 0.25f}, p);
+    riner::model::pack_batch(b, segments, rho, g.n_u, {1.0f, 0.5f, 0.25f}, p);
     const std::vector<std::uint32_t>& w = p.words;
     REQUIRE(p.n_batch == b.rays.size());
     REQUIRE(p.n_elements == b.elements.size());
@@ -182,6 +184,11 @@ TEST_SUITE("model_layout") {
       float weight;
       std::memcpy(&weight, &w[p.weights_at + i], 4);
       CHECK(weight == b.weights[i]);
+      // The ray's own segment and reading travel with it.
+      CHECK(std::memcmp(&w[p.segments_at + 8 * i], &segments[b.rays[i]], 32) == 0);
+      float reading;
+      std::memcpy(&reading, &w[p.rho_at + i], 4);
+      CHECK(reading == rho[b.rays[i]]);
     }
     CHECK(w[p.offsets_at + p.n_batch] == samples);
     CHECK(p.n_samples == samples);
@@ -206,6 +213,8 @@ TEST_SUITE("model_layout") {
     float scale;
     std::memcpy(&scale, &w[p.level_weights_at + 2], 4);
     CHECK(scale == 0.25f);
-    CHECK(w.size() == p.level_weights_at + 3);
+    CHECK(p.segments_at == p.level_weights_at + 3);
+    CHECK(p.rho_at == p.segments_at + 8 * p.n_batch);
+    CHECK(w.size() == p.rho_at + p.n_batch);
   }
 }

@@ -18,8 +18,9 @@ std::uint32_t bits(float v) {
 }  // namespace
 
 void pack_batch(const Batch& batch, const std::vector<RaySegment>& segments,
-                std::size_t elements_per_view, const std::vector<float>& level_weights,
-                PackedBatch& out) {
+                const std::vector<float>& rho, std::size_t elements_per_view,
+                const std::vector<float>& level_weights, PackedBatch& out) {
+  static_assert(sizeof(RaySegment) == 8 * sizeof(std::uint32_t));
   const auto n = static_cast<std::uint32_t>(batch.rays.size());
   const auto e = static_cast<std::uint32_t>(batch.elements.size());
   out.n_batch = n;
@@ -30,8 +31,10 @@ void pack_batch(const Batch& batch, const std::vector<RaySegment>& segments,
   out.element_rays_at = 3 * n + 1;
   out.elements_at = out.element_rays_at + e + 1 + n;
   out.level_weights_at = out.elements_at + e;
+  out.segments_at = out.level_weights_at + static_cast<std::uint32_t>(level_weights.size());
+  out.rho_at = out.segments_at + 8 * n;
   std::vector<std::uint32_t>& w = out.words;
-  w.assign(out.level_weights_at + level_weights.size(), 0);
+  w.assign(out.rho_at + n, 0);
   std::uint32_t samples = 0;
   for (std::uint32_t b = 0; b < n; ++b) {
     const std::uint32_t ray = batch.rays[b];
@@ -39,6 +42,8 @@ void pack_batch(const Batch& batch, const std::vector<RaySegment>& segments,
     w[out.offsets_at + b] = samples;
     samples += segments[ray].count;
     w[out.weights_at + b] = bits(batch.weights[b]);
+    std::memcpy(w.data() + out.segments_at + 8 * b, &segments[ray], sizeof(RaySegment));
+    w[out.rho_at + b] = bits(rho[ray]);
   }
   w[out.offsets_at + n] = samples;
   out.n_samples = samples;

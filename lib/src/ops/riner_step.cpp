@@ -30,6 +30,8 @@ void set_batch_shape(const model::PackedBatch& b, StepParams& p) {
   p.element_rays_at = b.element_rays_at;
   p.elements_at = b.elements_at;
   p.level_weights_at = b.level_weights_at;
+  p.segments_at = b.segments_at;
+  p.rho_at = b.rho_at;
 }
 
 RinerStepOp::RinerStepOp(cl::Context& context, const model::ParameterLayout& layout,
@@ -82,15 +84,15 @@ void RinerStepOp::step(StepParams p, const cl::Buffer<cl_uint>& batch, const Ste
   p.mlp_offset = static_cast<cl_uint>(layout_.mlp_offset);
   const std::size_t samples = p.n_samples;
   if (samples > 0) {
-    forward_.set_args(p, batch, *scan.segments, levels_, params, mu_dx_, cache_);
+    forward_.set_args(p, batch, levels_, params, mu_dx_, cache_);
     context_.launch(forward_, samples, plan_.sample_group);
   }
-  loss_.set_args(p, batch, mu_dx_, *scan.rho, params, *scan.invalid_readings, grad, sums_, d_sums_,
-                 ray_grads_, history, scratch_, cl::LocalMemory{plan_.loss_group * sizeof(float)});
+  loss_.set_args(p, batch, mu_dx_, params, *scan.invalid_readings, grad, sums_, d_sums_, ray_grads_,
+                 history, scratch_, cl::LocalMemory{plan_.loss_group * sizeof(float)});
   context_.launch(loss_, plan_.loss_group, plan_.loss_group);
   slices_ = 0;
   if (samples == 0) return;
-  backward_.set_args(p, batch, *scan.segments, levels_, params, d_sums_, cache_, grad);
+  backward_.set_args(p, batch, levels_, params, d_sums_, cache_, grad);
   context_.launch(backward_, samples, plan_.sample_group);
   if (plan_.kind == PlanKind::kCpu) {
     const auto bands = static_cast<cl_uint>(plan_.grid_bands);

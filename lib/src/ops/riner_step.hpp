@@ -13,7 +13,7 @@
 
 namespace riner::ops {
 
-// Host mirror of StepParams in kernels/sample_cache.cl (27 four-byte members).
+// Host mirror of StepParams in kernels/sample_cache.cl (28 four-byte members).
 struct StepParams {
   cl_uint n_batch = 0;
   cl_uint n_samples = 0;
@@ -41,9 +41,10 @@ struct StepParams {
   cl_uint block_views = 0;
   cl_uint block_elements = 0;
   cl_uint cache_stride = 0;  // set by RinerStepOp
-  cl_uint reserved = 0;
+  cl_uint segments_at = 0;
+  cl_uint rho_at = 0;
 };
-static_assert(sizeof(StepParams) == 108);
+static_assert(sizeof(StepParams) == 112);
 
 // Host mirror of FieldGrid in kernels/riner_step.cl: which voxels of which grid one launch of
 // riner_step_field_evaluate evaluates.
@@ -62,10 +63,8 @@ static_assert(sizeof(FieldGrid) == 32, "must match FieldGrid in riner_step.cl");
 // The batch's sizes and section starts (the rest of StepParams is the step's settings).
 void set_batch_shape(const model::PackedBatch& batch, StepParams& p);
 
-// The scan-wide inputs of every step.
+// The scan-wide inputs of every step (the rays' segments and readings come in the batch).
 struct StepScan {
-  const cl::Buffer<cl_float8>* segments;        // every ray of the scan
-  const cl::Buffer<float>* rho;                 // every ray of the scan
   const cl::Buffer<cl_uint>* invalid_readings;  // per element: its non-finite readings
 };
 

@@ -20,24 +20,6 @@ namespace {
 constexpr int kHistoryBlock = 256;   // steps between reads of the loss history
 constexpr int kUploadsInFlight = 3;  // steps the host may prepare ahead of the device
 
-constexpr std::size_t kSegmentUploadChunk = 1 << 20;  // segments per upload: 32 MiB staged
-
-// The ray table on the device, uploaded in chunks: a whole host copy in cl_float8 would double
-// the host's largest allocation (2.7 GB for a 512 x 512 x 200 cone-beam scan).
-cl::Buffer<cl_float8> segment_table(cl::Context& ctx,
-                                    const std::vector<model::RaySegment>& segments) {
-  static_assert(sizeof(cl_float8) == sizeof(model::RaySegment));
-  cl::Buffer<cl_float8> table(ctx, segments.size(), CL_MEM_READ_ONLY);
-  std::vector<cl_float8> staged;
-  for (std::size_t first = 0; first < segments.size(); first += kSegmentUploadChunk) {
-    const std::size_t n = std::min(kSegmentUploadChunk, segments.size() - first);
-    staged.resize(n);
-    std::memcpy(staged.data(), segments.data() + first, n * sizeof(cl_float8));
-    table.write(staged, first);
-  }
-  return table;
-}
-
 class OpenclTrainer final : public Trainer {
  public:
   OpenclTrainer(const TrainingSetup& setup, Device device, const ExecutionPlan& plan)
@@ -49,8 +31,6 @@ class OpenclTrainer final : public Trainer {
                           model::initial_parameters(setup.layout, setup.config.training.seed))),
         grad_(ctx_, std::vector<float>(setup.layout.total, 0.0f)),
         history_(ctx_, static_cast<std::size_t>(kHistoryBlock) * 2),
-        segments_(segment_table(ctx_, setup.segments)),
-        rho_(ctx_, std::span<const float>(setup.scan.measurement.data), CL_MEM_READ_ONLY),
         invalid_readings_(ctx_, std::span<const cl_uint>(setup.invalid_readings), CL_MEM_READ_ONLY),
         level_weights_(ctx_, static_cast<std::size_t>(setup.layout.levels)),
         uploads_(ctx_, kUploadsInFlight),
@@ -60,8 +40,8 @@ class OpenclTrainer final : public Trainer {
 
   void step(int index, const model::Batch& batch) override {
     const TrainingConfig& t = setup_.config.training;
-    model::pack_batch(batch, setup_.segments, setup_.elements_per_view, setup_.level_weights(index),
-                      packed_);
+    model::pack_batch(batch, setup_.segments, setup_.scan.measurement.data,
+                      setup_.elements_per_view, setup_.level_weights(index), packed_);
     ops::StepParams p;
     ops::set_batch_shape(packed_, p);
     p.elements_per_view = static_cast<cl_uint>(setup_.elements_per_view);
@@ -78,7 +58,7 @@ class OpenclTrainer final : public Trainer {
     p.block_views = batch.block_views;
     p.block_elements = batch.block_elements;
     const cl::Buffer<cl_uint>& words = uploads_.upload(packed_.words);
-    step_op_.step(p, words, {&segments_, &rho_, &invalid_readings_}, params_, grad_, history_);
+    step_op_.step(p, words, {&invalid_readings_}, params_, grad_, history_);
     const AdamRates rates = setup_.adam_rates(index);
     adam_.step({rates.field, setup_.layout.alpha_offset, rates.alpha, setup_.layout.beta_offset,
                 rates.beta, t.adam_beta1, t.adam_beta2, t.adam_epsilon},
@@ -138,8 +118,6 @@ class OpenclTrainer final : public Trainer {
   cl::Buffer<float> params_;
   cl::Buffer<float> grad_;
   cl::Buffer<float> history_;
-  cl::Buffer<cl_float8> segments_;
-  cl::Buffer<float> rho_;
   cl::Buffer<cl_uint> invalid_readings_;
   cl::Buffer<float> level_weights_;
   cl::UploadRing<cl_uint> uploads_;

@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 
 #include "cl/buffer.hpp"
 #include "riner/error.hpp"
@@ -65,26 +64,6 @@ RinerConfig resolved(RinerConfig config, const std::optional<ExecutionPlan>& pla
 
 }  // namespace
 
-namespace {
-
-// The OpenCL engine holds the scan's ray table (32 bytes per ray) in one device buffer: say so
-// before minutes of set-up, not at the allocation.
-void check_ray_table_fits(const Scan& scan, const DeviceInfo& device) {
-  const double rays = static_cast<double>(shape_size(scan.geometry.measurement_shape()));
-  const double bytes = rays * static_cast<double>(sizeof(model::RaySegment));
-  if (device.max_alloc_bytes == 0 || bytes <= static_cast<double>(device.max_alloc_bytes)) return;
-  char message[320];
-  std::snprintf(message, sizeof(message),
-                "the scan's %.0f rays need a %.2f GiB ray table, more than %s's largest buffer "
-                "(%.2f GiB, CL_DEVICE_MAX_MEM_ALLOC_SIZE); bin the projections or use fewer "
-                "views",
-                rays, bytes / 1073741824.0, device.name.c_str(),
-                static_cast<double>(device.max_alloc_bytes) / 1073741824.0);
-  throw Error(message);
-}
-
-}  // namespace
-
 Reconstructor::Reconstructor(Scan scan, RinerConfig config, std::optional<Device> device) {
   config.validate();
   if (config.engine == Engine::kReference) {
@@ -93,7 +72,6 @@ Reconstructor::Reconstructor(Scan scan, RinerConfig config, std::optional<Device
     return;
   }
   Device d = device ? *device : Device::open();
-  check_ray_table_fits(scan, d.info());
   const ExecutionPlan plan = choose_execution_plan(d.info(), config.plan);
   impl_ = std::make_unique<Impl>(std::move(scan), resolved(std::move(config), plan));
   impl_->trainer = detail::make_opencl_trainer(impl_->setup, std::move(d), plan);
