@@ -5,7 +5,7 @@ packages=(
   cmake g++ make pkg-config git
   ocl-icd-opencl-dev opencl-headers pocl-opencl-icd clinfo
   libclblast-dev libeigen3-dev doctest-dev nlohmann-json3-dev
-  libtiff-dev libpng-dev
+  libtiff-dev libpng-dev libhdf5-dev
   oclgrind valgrind
   python3-numpy python3-skimage
 )

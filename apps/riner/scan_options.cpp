@@ -1,13 +1,20 @@
 #include "scan_options.hpp"
 
+#include <cmath>
 #include <cstdio>
+
+#include "riner/error.hpp"
+#include "riner/io.hpp"
+#include "riner/tomo_file.hpp"
 
 namespace riner::app {
 
 void add_scan_options(Args& args) {
   args.positional("SCAN",
                   "the measurement (rho = -ln(I/I0)), or with --flat the raw projections: "
-                  ".npy, .nii, .tif, .raw, a folder of TIFFs or a quoted pattern ('raw_*.tif')")
+                  ".npy, .nii, .tif, .raw, a folder of TIFFs or a quoted pattern ('raw_*.tif'), "
+                  "FILE.h5:/dataset; or a Data Exchange / NXtomo file (.h5, .nxs) with its own "
+                  "flats and darks")
       .option("geometry", "FILE",
               "geometry JSON (default: geometry.json beside SCAN; for a folder or pattern, in its "
               "folder or beside it)",
@@ -18,6 +25,8 @@ void add_scan_options(Args& args) {
               "frames (averaged)",
               "")
       .option("dark", "FILE", "dark field (no beam) for --flat, likewise; default: none (0)", "")
+      .option("row", "N",
+              "reconstruct detector row N of a projection stack with a 2D geometry (one slice)", "")
       .option("offset-px", "PX|auto",
               "the detector's centre-of-rotation offset instead of the geometry's; auto: "
               "estimated from views half a turn apart (parallel beam, `riner center`)",
@@ -27,13 +36,41 @@ void add_scan_options(Args& args) {
 LoadedScan scan_from(const Args& args, const Console& console) {
   const std::string flat = args.get("flat");
   const std::string dark = args.get("dark");
+  const std::string path = args.get("SCAN");
+  std::optional<std::size_t> row;
+  if (const std::string r = args.get("row"); !r.empty()) {
+    const long n = args.integer("row");
+    if (n < 0) throw UsageError("--row must be 0 or more");
+    row = static_cast<std::size_t>(n);
+  }
   LoadedScan loaded;
-  if (flat.empty()) {
+  FlatFieldReport report;
+  if (flat.empty() && is_hdf5_path(path) && !split_hdf5_dataset(path)) {
+    // A tomography file holds its own flats and darks.
+    if (!dark.empty()) throw UsageError("--dark needs --flat");
+    const TomoFile file = read_tomo_file(path);
+    if (file.flats.shape.empty()) {
+      throw InputError(path + ": the file holds no flat field (" + file.layout +
+                       "); pass one with --flat");
+    }
+    loaded.scan = raw_scan(Geometry::load(find_geometry(path, args.get("geometry"))),
+                           file.projections, file.flats, file.darks, row, path, &report);
+    loaded.flat_field = report;
+    console.line(file.layout + " file: " + flat_field_line(report));
+  } else if (flat.empty()) {
     if (!dark.empty()) throw UsageError("--dark needs --flat (and SCAN holding raw projections)");
-    loaded.scan = load_scan(args.get("SCAN"), args.get("geometry"));
+    if (row) {
+      Scan s;
+      s.geometry = Geometry::load(find_geometry(path, args.get("geometry")));
+      s.measurement = detector_row(read_array(path).array, *row);
+      for (float x : s.measurement.data) s.non_finite += !std::isfinite(x);
+      check_scan(s, path);
+      loaded.scan = std::move(s);
+    } else {
+      loaded.scan = load_scan(path, args.get("geometry"));
+    }
   } else {
-    FlatFieldReport report;
-    loaded.scan = load_raw_scan(args.get("SCAN"), flat, dark, args.get("geometry"), &report);
+    loaded.scan = load_raw_scan(path, flat, dark, args.get("geometry"), &report, row);
     loaded.flat_field = report;
     console.line(flat_field_line(report));
   }

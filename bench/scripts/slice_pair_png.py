@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Axial slices of two volumes side by side in one 8-bit PNG, same window per slice (the first
+"""Axial slices of two volumes (or two 2D images, slice 0) side by side in one 8-bit PNG, same window per slice (the first
 volume's 1st-99th percentile), for the PNG pairs in bench/RESULTS.md. Python's standard library
 only: reads float32 .npy and NIfTI-1 (.nii) volumes [z, y, x] as riner writes them.
 
@@ -28,6 +28,8 @@ def read_volume(path):
         offset = int(struct.unpack("<f", data[108:112])[0])
     else:
         sys.exit(f"{path}: .npy or .nii")
+    if len(shape) == 2:
+        shape = (1,) + shape  # a 2D image is one slice
     values = array.array("f")
     values.frombytes(data[offset:offset + 4 * shape[0] * shape[1] * shape[2]])
     return shape, values

@@ -315,6 +315,35 @@ TEST_SUITE("cli") {
                  2, sim + "/missing.json");
   }
 
+  TEST_CASE("a Data Exchange file (shared tooth): its flats and darks, one row, the shared rho") {
+    const std::filesystem::path tooth = riner::test::shared_data("tooth/tooth.h5");
+    if (tooth.empty()) {
+      MESSAGE("skipped: ../shared/data/tooth is not beside the checkout");
+      return;
+    }
+    riner::test::TempDir dir;
+    const std::string out = dir.path().string();
+    const Run fbp =
+        riner_cli("fbp " + tooth.string() + " --row 0 --out " + out + "/raw.nii --json", dir);
+    REQUIRE(fbp.code == 0);
+    const auto summary = nlohmann::json::parse(fbp.out);
+    CHECK(summary["flat_field"]["flat_frames"] == 10);
+    CHECK(summary["flat_field"]["dark_frames"] == 10);
+    REQUIRE(riner_cli("fbp " + tooth.parent_path().string() + "/sino_row0.npy --out " + out +
+                          "/shared.nii --quiet",
+                      dir)
+                .code == 0);
+    const Run compare = riner_cli("compare " + out + "/raw.nii " + out + "/shared.nii --json", dir);
+    REQUIRE(compare.code == 0);
+    CHECK(nlohmann::json::parse(compare.out)["mae"].get<double>() < 1e-6);
+    expect_error(riner_cli("fbp " + tooth.string() + " --out " + out + "/x.nii", dir), 2,
+                 tooth.string() +
+                     " is a stack [181, 2, 640] and the parallel2d geometry is 2D: "
+                     "pick a detector row with --row");
+    expect_error(riner_cli("fbp " + tooth.string() + " --row 2 --out " + out + "/x.nii", dir), 2,
+                 tooth.string() + ": no detector row 2 in frames of shape [181, 2, 640]");
+  }
+
   TEST_CASE("settings: one table for the list, the README, --set and config.json") {
     riner::test::TempDir dir;
     const Run list = riner_cli("settings --json", dir);

@@ -5,6 +5,8 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <optional>
+#include <string>
 
 #include "riner/array.hpp"
 #include "riner/scan.hpp"
@@ -28,10 +30,20 @@ struct FlatFieldReport {
 Array flat_field_normalise(const Array& projections, const Array& flats, const Array& darks,
                            FlatFieldReport* report = nullptr);
 
+// Detector row `row` of a stack [frames, rows, columns]: [frames, columns]. InputError when
+// there is no such row.
+Array detector_row(const Array& stack, std::size_t row);
+
+// A scan from raw arrays: normalised, with only detector row `row` (when set: a 2D slice of a
+// 3D stack) and checked against the geometry. `what` names the data in messages.
+Scan raw_scan(Geometry geometry, const Array& projections, const Array& flats, const Array& darks,
+              std::optional<std::size_t> row, const std::string& what,
+              FlatFieldReport* report = nullptr);
+
 // The same from files: each a file, a folder of TIFFs or a pattern (riner/io.hpp's read_array);
 // `darks` may be empty. The geometry as load_scan finds it.
 Scan load_raw_scan(const std::filesystem::path& projections, const std::filesystem::path& flats,
                    const std::filesystem::path& darks, const std::filesystem::path& geometry = {},
-                   FlatFieldReport* report = nullptr);
+                   FlatFieldReport* report = nullptr, std::optional<std::size_t> row = {});
 
 }  // namespace riner

@@ -7,6 +7,8 @@
 //                  float32/uint16/uint8 (read), float32 (written)
 //   .raw/.bin      raw samples described by a JSON sidecar "<file>.json":
 //                  {"dtype": "float32", "shape": [..], "byte_order": "little", "offset_bytes": 0}
+// .h5/.hdf5/.nxs (read only): "file.h5:/group/dataset" names one dataset; a file alone reads as
+// the projections of a Data Exchange or NXtomo file (riner/tomo_file.hpp).
 // A folder of .tif/.tiff files, or a file-name pattern with * ? [ ] ("tiffs/raw_*.tif", quoted
 // on the command line), reads as one stack [files, rows, cols] of 2D images in natural order
 // (raw_2 before raw_10). Every reader checks the header against the file size and throws InputError
@@ -23,7 +25,7 @@
 
 namespace riner {
 
-enum class FileFormat { kNpy, kNifti, kTiff, kRaw, kPng, kJson };
+enum class FileFormat { kNpy, kNifti, kTiff, kRaw, kPng, kJson, kHdf5 };
 
 // Format implied by the extension; throws InputError for one riner does not know.
 FileFormat format_from_path(const std::filesystem::path& path);

@@ -5,6 +5,7 @@
 
 #include "riner/error.hpp"
 #include "riner/io.hpp"
+#include "riner/tomo_file.hpp"
 
 namespace riner {
 
@@ -18,6 +19,9 @@ void check_scan(const Scan& scan, std::string_view what) {
 
 std::filesystem::path find_geometry(const std::filesystem::path& measurement,
                                     const std::filesystem::path& geometry) {
+  if (const auto named = split_hdf5_dataset(measurement)) {
+    return find_geometry(named->first, geometry);
+  }
   if (!io::is_stack_path(measurement)) {
     io::input_file_size(measurement);  // a missing scan is the first thing to report
   }

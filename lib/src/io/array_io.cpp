@@ -3,12 +3,15 @@
 #include <cctype>
 #include <cmath>
 #include <fstream>
+#include <optional>
+#include <utility>
 
 #include "io/file_access.hpp"
 #include "io/formats.hpp"
 #include "io/stack.hpp"
 #include "riner/error.hpp"
 #include "riner/io.hpp"
+#include "riner/tomo_file.hpp"
 #include "util/atomic_file.hpp"
 
 namespace riner {
@@ -31,9 +34,19 @@ void write_atomically(const std::filesystem::path& path, WriteFn&& write) {
   file.commit();
 }
 
+ArrayFile array_file(Array array, FileFormat format) {
+  ArrayFile f;
+  f.array = std::move(array);
+  f.format = format;
+  f.dtype = "float32";
+  for (float v : f.array.data) f.non_finite += !std::isfinite(v);
+  return f;
+}
+
 }  // namespace
 
 FileFormat format_from_path(const std::filesystem::path& path) {
+  if (split_hdf5_dataset(path)) return FileFormat::kHdf5;
   const std::string ext = lower_extension(path);
   if (ext == ".npy") return FileFormat::kNpy;
   if (ext == ".nii") return FileFormat::kNifti;
@@ -41,11 +54,13 @@ FileFormat format_from_path(const std::filesystem::path& path) {
   if (ext == ".raw" || ext == ".bin") return FileFormat::kRaw;
   if (ext == ".png") return FileFormat::kPng;
   if (ext == ".json") return FileFormat::kJson;
+  if (is_hdf5_path(path)) return FileFormat::kHdf5;
   if (ext == ".gz") {
     throw InputError(io::prefix(path) + "compressed files are not supported; decompress first");
   }
-  throw InputError(io::prefix(path) + "unknown file type '" + ext +
-                   "' (riner reads .npy, .nii, .tif/.tiff, .raw/.bin with a .json sidecar)");
+  throw InputError(
+      io::prefix(path) + "unknown file type '" + ext +
+      "' (riner reads .npy, .nii, .tif/.tiff, .raw/.bin with a .json sidecar, .h5/.nxs)");
 }
 
 const char* format_name(FileFormat format) {
@@ -62,11 +77,16 @@ const char* format_name(FileFormat format) {
       return "png";
     case FileFormat::kJson:
       return "json";
+    case FileFormat::kHdf5:
+      return "hdf5";
   }
   return "unknown";
 }
 
 ArrayFile read_array(const std::filesystem::path& path) {
+  if (const auto named = split_hdf5_dataset(path)) {
+    return array_file(read_hdf5_dataset(named->first, named->second), FileFormat::kHdf5);
+  }
   if (io::is_stack_path(path)) return io::read_stack(path, &read_array);
   switch (format_from_path(path)) {
     case FileFormat::kNpy:
@@ -81,6 +101,8 @@ ArrayFile read_array(const std::filesystem::path& path) {
       throw InputError(io::prefix(path) + "PNG files are previews; riner does not read them");
     case FileFormat::kJson:
       throw InputError(io::prefix(path) + "is JSON, not an array file");
+    case FileFormat::kHdf5:
+      return array_file(read_tomo_file(path).projections, FileFormat::kHdf5);
   }
   throw InputError(io::prefix(path) + "unknown file type");
 }
@@ -116,6 +138,8 @@ void write_array(const std::filesystem::path& path, const Array& array,
       return write_png(path, array);
     case FileFormat::kJson:
       throw InputError(io::prefix(path) + "arrays are not written as JSON");
+    case FileFormat::kHdf5:
+      throw InputError(io::prefix(path) + "riner reads HDF5 but does not write it");
   }
 }
 

@@ -1,5 +1,6 @@
 #include "riner/flat_field.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -93,24 +94,57 @@ Array flat_field_normalise(const Array& projections, const Array& flats, const A
   return rho;
 }
 
+Array detector_row(const Array& stack, std::size_t row) {
+  if (stack.rank() != 3 || row >= stack.shape[1]) {
+    throw InputError("no detector row " + std::to_string(row) + " in frames of shape " +
+                     shape_string(stack.shape));
+  }
+  const std::size_t frames = stack.shape[0], rows = stack.shape[1], columns = stack.shape[2];
+  Array out({frames, columns});
+  for (std::size_t f = 0; f < frames; ++f) {
+    std::copy_n(stack.data.begin() + static_cast<std::ptrdiff_t>((f * rows + row) * columns),
+                columns, out.data.begin() + static_cast<std::ptrdiff_t>(f * columns));
+  }
+  return out;
+}
+
+Scan raw_scan(Geometry geometry, const Array& projections, const Array& flats, const Array& darks,
+              std::optional<std::size_t> row, const std::string& what, FlatFieldReport* report) {
+  Scan scan;
+  scan.geometry = std::move(geometry);
+  FlatFieldReport r;
+  try {
+    if (row) {
+      // The projections first: their rows are what the user asked for.
+      const Array projection_row = detector_row(projections, *row);
+      const Array flat_row = detector_row(flats, *row);
+      const Array dark_row = darks.shape.empty() ? Array() : detector_row(darks, *row);
+      scan.measurement = flat_field_normalise(projection_row, flat_row, dark_row, &r);
+    } else {
+      scan.measurement = flat_field_normalise(projections, flats, darks, &r);
+    }
+  } catch (const InputError& e) {
+    throw InputError(what + ": " + e.what());
+  }
+  for (float x : scan.measurement.data) scan.non_finite += !std::isfinite(x);
+  if (!row && scan.measurement.rank() == 3 && !scan.geometry.is_3d()) {
+    throw InputError(what + " is a stack " + shape_string(scan.measurement.shape) + " and the " +
+                     geometry_type_name(scan.geometry.type) +
+                     " geometry is 2D: pick a detector row with --row");
+  }
+  check_scan(scan, what);
+  if (report) *report = r;
+  return scan;
+}
+
 Scan load_raw_scan(const std::filesystem::path& projections, const std::filesystem::path& flats,
                    const std::filesystem::path& darks, const std::filesystem::path& geometry,
-                   FlatFieldReport* report) {
-  Scan scan;
-  scan.geometry = Geometry::load(find_geometry(projections, geometry));
+                   FlatFieldReport* report, std::optional<std::size_t> row) {
+  Geometry g = Geometry::load(find_geometry(projections, geometry));
   const ArrayFile raw = read_array(projections);
   const Array flat = read_array(flats).array;
   const Array dark = darks.empty() ? Array() : read_array(darks).array;
-  FlatFieldReport r;
-  try {
-    scan.measurement = flat_field_normalise(raw.array, flat, dark, &r);
-  } catch (const InputError& e) {
-    throw InputError(projections.string() + ": " + e.what());
-  }
-  for (float x : scan.measurement.data) scan.non_finite += !std::isfinite(x);
-  check_scan(scan, projections.string());
-  if (report) *report = r;
-  return scan;
+  return raw_scan(std::move(g), raw.array, flat, dark, row, projections.string(), report);
 }
 
 }  // namespace riner

@@ -1,0 +1,43 @@
+// Tomography HDF5 files as synchrotrons write them, read directly (libhdf5):
+//   Data Exchange (APS, tomopy): /exchange/data, /exchange/data_white, /exchange/data_dark,
+//                                /exchange/theta (degrees)
+//   NeXus NXtomo (ESRF, Diamond): /entry/data/data (or /entry/instrument/detector/data) with
+//                                 image_key 0/1/2 (projection/flat/dark) per frame and
+//                                 /entry/sample/rotation_angle (degrees)
+// and one dataset by its path ("file.h5:/group/dataset") wherever riner reads an array.
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "riner/array.hpp"
+
+namespace riner {
+
+struct TomoFile {
+  std::string layout;              // "data exchange" or "nxtomo"
+  Array projections;               // [views, rows, columns]
+  Array flats;                     // [frames, rows, columns]; empty shape when the file has none
+  Array darks;                     // likewise
+  std::vector<double> angles_deg;  // per projection, as the file states them (may be empty)
+};
+
+// Whether the path names an HDF5 file by its extension (.h5, .hdf5, .hdf, .nxs, .nx).
+bool is_hdf5_path(const std::filesystem::path& path);
+
+// InputError naming the file and the dataset for a file that is neither layout, a missing
+// dataset, a rank other than 3, or counts that do not match (image_key against the frames,
+// angles against the projections).
+TomoFile read_tomo_file(const std::filesystem::path& path);
+
+// One dataset as float32.
+Array read_hdf5_dataset(const std::filesystem::path& file, const std::string& dataset);
+
+// "file.h5:/group/dataset" -> {"file.h5", "/group/dataset"}; nullopt for any other path.
+std::optional<std::pair<std::filesystem::path, std::string>> split_hdf5_dataset(
+    const std::filesystem::path& path);
+
+}  // namespace riner

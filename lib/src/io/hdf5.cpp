@@ -1,0 +1,214 @@
+// HDF5 through libhdf5's C API: datasets read as float32 (the library converts any integer or
+// float type), tomography layouts recognised by their paths.
+#include <hdf5.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <type_traits>
+
+#include "io/file_access.hpp"
+#include "riner/error.hpp"
+#include "riner/io.hpp"
+#include "riner/tomo_file.hpp"
+
+namespace riner {
+
+namespace {
+
+// One HDF5 identifier, closed with its own function.
+class Hid {
+ public:
+  Hid(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+  Hid(const Hid&) = delete;
+  Hid& operator=(const Hid&) = delete;
+  ~Hid() {
+    if (id_ >= 0) close_(id_);
+  }
+  hid_t get() const { return id_; }
+  bool ok() const { return id_ >= 0; }
+
+ private:
+  hid_t id_;
+  herr_t (*close_)(hid_t);
+};
+
+std::string where(const std::filesystem::path& file, const std::string& dataset) {
+  return file.string() + ":" + dataset + ": ";
+}
+
+Hid open_file(const std::filesystem::path& path) {
+  io::input_file_size(path);
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors come back as return codes
+  if (H5Fis_hdf5(path.c_str()) <= 0) throw InputError(io::prefix(path) + "is not an HDF5 file");
+  const hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (id < 0) throw InputError(io::prefix(path) + "cannot be opened as HDF5");
+  register_input(path);
+  return Hid(id, H5Fclose);
+}
+
+bool exists(const Hid& file, const std::string& path) {
+  // Each link along the path must exist before the next is asked about.
+  std::size_t at = 1;
+  while (at <= path.size()) {
+    const std::size_t next = std::min(path.find('/', at), path.size());
+    if (H5Lexists(file.get(), path.substr(0, next).c_str(), H5P_DEFAULT) <= 0) return false;
+    at = next + 1;
+  }
+  return true;
+}
+
+// A dataset's shape and values as float64 or float32.
+template <typename T>
+std::vector<T> read_values(const Hid& file, const std::filesystem::path& path,
+                           const std::string& dataset, std::vector<std::size_t>& shape) {
+  if (!exists(file, dataset)) throw InputError(where(path, dataset) + "no such dataset");
+  Hid set(H5Dopen2(file.get(), dataset.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!set.ok()) throw InputError(where(path, dataset) + "is not a dataset");
+  Hid space(H5Dget_space(set.get()), H5Sclose);
+  const int rank = H5Sget_simple_extent_ndims(space.get());
+  if (rank < 0 || rank > 8) throw InputError(where(path, dataset) + "has an unreadable shape");
+  std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
+  H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr);
+  shape.assign(dims.begin(), dims.end());
+  Hid type(H5Dget_type(set.get()), H5Tclose);
+  const H5T_class_t type_class = H5Tget_class(type.get());
+  if (type_class != H5T_INTEGER && type_class != H5T_FLOAT) {
+    throw InputError(where(path, dataset) + "holds neither integers nor floats");
+  }
+  std::vector<T> values(shape_size(shape));
+  const hid_t memory_type = std::is_same_v<T, double> ? H5T_NATIVE_DOUBLE : H5T_NATIVE_FLOAT;
+  if (!values.empty() &&
+      H5Dread(set.get(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0) {
+    throw InputError(where(path, dataset) + "read failed (truncated or corrupt file?)");
+  }
+  return values;
+}
+
+Array read_float_array(const Hid& file, const std::filesystem::path& path,
+                       const std::string& dataset) {
+  std::vector<std::size_t> shape;
+  std::vector<float> values = read_values<float>(file, path, dataset, shape);
+  return Array(std::move(shape), std::move(values));
+}
+
+Array require_rank3(Array a, const std::filesystem::path& path, const std::string& dataset) {
+  if (a.rank() != 3) {
+    throw InputError(where(path, dataset) + "is " + shape_string(a.shape) +
+                     "; expected [frames, rows, columns]");
+  }
+  return a;
+}
+
+// Frames of `all` whose key equals `key`, in file order.
+Array frames_with_key(const Array& all, const std::vector<double>& keys, int key) {
+  const std::size_t frame = all.shape[1] * all.shape[2];
+  Array out;
+  std::size_t count = 0;
+  for (std::size_t f = 0; f < keys.size(); ++f) {
+    if (static_cast<int>(keys[f]) != key) continue;
+    out.data.insert(out.data.end(), all.data.begin() + static_cast<std::ptrdiff_t>(f * frame),
+                    all.data.begin() + static_cast<std::ptrdiff_t>((f + 1) * frame));
+    ++count;
+  }
+  if (count > 0) out.shape = {count, all.shape[1], all.shape[2]};
+  return out;
+}
+
+TomoFile read_data_exchange(const Hid& file, const std::filesystem::path& path) {
+  TomoFile t;
+  t.layout = "data exchange";
+  t.projections =
+      require_rank3(read_float_array(file, path, "/exchange/data"), path, "/exchange/data");
+  if (exists(file, "/exchange/data_white")) {
+    t.flats = require_rank3(read_float_array(file, path, "/exchange/data_white"), path,
+                            "/exchange/data_white");
+  }
+  if (exists(file, "/exchange/data_dark")) {
+    t.darks = require_rank3(read_float_array(file, path, "/exchange/data_dark"), path,
+                            "/exchange/data_dark");
+  }
+  if (exists(file, "/exchange/theta")) {
+    std::vector<std::size_t> shape;
+    t.angles_deg = read_values<double>(file, path, "/exchange/theta", shape);
+  }
+  return t;
+}
+
+TomoFile read_nxtomo(const Hid& file, const std::filesystem::path& path, const std::string& data,
+                     const std::string& keys_path, const std::string& angles_path) {
+  const Array all = require_rank3(read_float_array(file, path, data), path, data);
+  std::vector<std::size_t> shape;
+  const std::vector<double> keys = read_values<double>(file, path, keys_path, shape);
+  if (keys.size() != all.shape[0]) {
+    throw InputError(where(path, keys_path) + std::to_string(keys.size()) + " image keys for " +
+                     std::to_string(all.shape[0]) + " frames in " + data);
+  }
+  TomoFile t;
+  t.layout = "nxtomo";
+  t.projections = frames_with_key(all, keys, 0);
+  t.flats = frames_with_key(all, keys, 1);
+  t.darks = frames_with_key(all, keys, 2);
+  if (t.projections.shape.empty()) {
+    throw InputError(where(path, keys_path) + "no frame has image_key 0 (a projection)");
+  }
+  if (!angles_path.empty() && exists(file, angles_path)) {
+    const std::vector<double> angles = read_values<double>(file, path, angles_path, shape);
+    if (angles.size() != keys.size()) {
+      throw InputError(where(path, angles_path) + std::to_string(angles.size()) + " angles for " +
+                       std::to_string(keys.size()) + " frames");
+    }
+    for (std::size_t f = 0; f < keys.size(); ++f) {
+      if (static_cast<int>(keys[f]) == 0) t.angles_deg.push_back(angles[f]);
+    }
+  }
+  return t;
+}
+
+}  // namespace
+
+bool is_hdf5_path(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext == ".h5" || ext == ".hdf5" || ext == ".hdf" || ext == ".nxs" || ext == ".nx";
+}
+
+TomoFile read_tomo_file(const std::filesystem::path& path) {
+  const Hid file = open_file(path);
+  if (exists(file, "/exchange/data")) return read_data_exchange(file, path);
+  for (const char* entry_name : {"/entry", "/entry1"}) {
+    const std::string entry = entry_name;
+    for (const std::string& data : {entry + "/data/data", entry + "/instrument/detector/data"}) {
+      if (!exists(file, data)) continue;
+      for (const std::string& keys :
+           {entry + "/instrument/detector/image_key", entry + "/data/image_key"}) {
+        if (exists(file, keys)) {
+          return read_nxtomo(file, path, data, keys, entry + "/sample/rotation_angle");
+        }
+      }
+      throw InputError(where(path, data) + "has no image_key beside it (NXtomo)");
+    }
+  }
+  throw InputError(io::prefix(path) +
+                   "holds neither /exchange/data (Data Exchange) nor /entry/data/data (NXtomo); "
+                   "name a dataset as FILE:/path");
+}
+
+std::optional<std::pair<std::filesystem::path, std::string>> split_hdf5_dataset(
+    const std::filesystem::path& path) {
+  const std::string text = path.string();
+  for (std::size_t colon = text.find(":/"); colon != std::string::npos;
+       colon = text.find(":/", colon + 1)) {
+    const std::filesystem::path file = text.substr(0, colon);
+    if (is_hdf5_path(file)) return std::make_pair(file, text.substr(colon + 1));
+  }
+  return std::nullopt;
+}
+
+Array read_hdf5_dataset(const std::filesystem::path& path, const std::string& dataset) {
+  const Hid file = open_file(path);
+  return read_float_array(file, path, dataset);
+}
+
+}  // namespace riner
