@@ -1,6 +1,5 @@
 #include "scan_options.hpp"
 
-#include <cmath>
 #include <cstdio>
 
 #include "riner/error.hpp"
@@ -59,16 +58,7 @@ LoadedScan scan_from(const Args& args, const Console& console) {
     console.line(file.layout + " file: " + flat_field_line(report));
   } else if (flat.empty()) {
     if (!dark.empty()) throw UsageError("--dark needs --flat (and SCAN holding raw projections)");
-    if (row) {
-      Scan s;
-      s.geometry = Geometry::load(find_geometry(path, args.get("geometry")));
-      s.measurement = detector_row(read_array(path).array, *row);
-      for (float x : s.measurement.data) s.non_finite += !std::isfinite(x);
-      check_scan(s, path);
-      loaded.scan = std::move(s);
-    } else {
-      loaded.scan = load_scan(path, args.get("geometry"));
-    }
+    loaded.scan = load_scan(path, args.get("geometry"), row);
   } else {
     loaded.scan = load_raw_scan(path, flat, dark, args.get("geometry"), &report, row);
     loaded.flat_field = report;

@@ -38,6 +38,10 @@ std::size_t shape_size(const std::vector<std::size_t>& shape);
 // Slice z of a volume [z, y, x] as a 2D image [y, x] (a copy).
 Array axial_slice(const Array& volume, std::size_t z);
 
+// Detector row `row` of a stack [frames, rows, columns]: [frames, columns] (a copy).
+// InputError when there is no such row.
+Array detector_row(const Array& stack, std::size_t row);
+
 // "[360, 500]"
 std::string shape_string(const std::vector<std::size_t>& shape);
 

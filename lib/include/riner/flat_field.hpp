@@ -30,10 +30,6 @@ struct FlatFieldReport {
 Array flat_field_normalise(const Array& projections, const Array& flats, const Array& darks,
                            FlatFieldReport* report = nullptr);
 
-// Detector row `row` of a stack [frames, rows, columns]: [frames, columns]. InputError when
-// there is no such row.
-Array detector_row(const Array& stack, std::size_t row);
-
 // A scan from raw arrays: normalised, with only detector row `row` (when set: a 2D slice of a
 // 3D stack) and checked against the geometry. `what` names the data in messages.
 Scan raw_scan(Geometry geometry, const Array& projections, const Array& flats, const Array& darks,

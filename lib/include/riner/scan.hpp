@@ -3,6 +3,7 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
 
 #include "riner/array.hpp"
 #include "riner/geometry.hpp"
@@ -22,10 +23,11 @@ std::filesystem::path find_geometry(const std::filesystem::path& measurement,
                                     const std::filesystem::path& geometry = {});
 
 // Reads both files and checks they belong together; the geometry as find_geometry finds it.
-// The measurement is a file, a folder of TIFFs or a pattern (read_array). Throws InputError
-// when the shapes disagree or no measurement is finite.
-Scan load_scan(const std::filesystem::path& measurement,
-               const std::filesystem::path& geometry = {});
+// The measurement is a file, a folder of TIFFs or a pattern (read_array); with `row`, only that
+// detector row of a stack (a 2D slice). Throws InputError when the shapes disagree or no
+// measurement is finite.
+Scan load_scan(const std::filesystem::path& measurement, const std::filesystem::path& geometry = {},
+               std::optional<std::size_t> row = {});
 
 // Checks a measurement array against its geometry (shape, at least one finite value).
 void check_scan(const Scan& scan, std::string_view what = "measurement");

@@ -1,5 +1,7 @@
 #include "riner/array.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 #include <limits>
 
@@ -74,6 +76,20 @@ Array axial_slice(const Array& volume, std::size_t z) {
   const auto first = volume.data.begin() + static_cast<std::ptrdiff_t>(z * pixels);
   return Array({volume.shape[1], volume.shape[2]},
                std::vector<float>(first, first + static_cast<std::ptrdiff_t>(pixels)));
+}
+
+Array detector_row(const Array& stack, std::size_t row) {
+  if (stack.rank() != 3 || row >= stack.shape[1]) {
+    throw InputError("no detector row " + std::to_string(row) + " in frames of shape " +
+                     shape_string(stack.shape));
+  }
+  const std::size_t frames = stack.shape[0], rows = stack.shape[1], columns = stack.shape[2];
+  Array out({frames, columns});
+  for (std::size_t f = 0; f < frames; ++f) {
+    std::copy_n(stack.data.begin() + static_cast<std::ptrdiff_t>((f * rows + row) * columns),
+                columns, out.data.begin() + static_cast<std::ptrdiff_t>(f * columns));
+  }
+  return out;
 }
 
 }  // namespace riner

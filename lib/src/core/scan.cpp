@@ -43,12 +43,18 @@ std::filesystem::path find_geometry(const std::filesystem::path& measurement,
                    ": no geometry given and no geometry.json beside it (use --geometry)");
 }
 
-Scan load_scan(const std::filesystem::path& measurement, const std::filesystem::path& geometry) {
+Scan load_scan(const std::filesystem::path& measurement, const std::filesystem::path& geometry,
+               std::optional<std::size_t> row) {
   Scan scan;
   scan.geometry = Geometry::load(find_geometry(measurement, geometry));
   ArrayFile file = read_array(measurement);
-  scan.measurement = std::move(file.array);
-  scan.non_finite = file.non_finite;
+  if (row) {
+    scan.measurement = detector_row(file.array, *row);
+    scan.non_finite = compute_stats(scan.measurement).non_finite();
+  } else {
+    scan.measurement = std::move(file.array);
+    scan.non_finite = file.non_finite;
+  }
   check_scan(scan, measurement.string());
   return scan;
 }

@@ -1,6 +1,5 @@
 // Format dispatch, atomic outputs and previews.
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <fstream>
 #include <optional>
@@ -18,13 +17,6 @@ namespace riner {
 
 namespace {
 
-std::string lower_extension(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext;
-}
-
 // Writes through a temporary file in the target's directory, renamed into place at the end.
 template <typename WriteFn>
 void write_atomically(const std::filesystem::path& path, WriteFn&& write) {
@@ -39,7 +31,7 @@ ArrayFile array_file(Array array, FileFormat format) {
   f.array = std::move(array);
   f.format = format;
   f.dtype = "float32";
-  for (float v : f.array.data) f.non_finite += !std::isfinite(v);
+  f.non_finite = compute_stats(f.array).non_finite();
   return f;
 }
 
@@ -47,7 +39,7 @@ ArrayFile array_file(Array array, FileFormat format) {
 
 FileFormat format_from_path(const std::filesystem::path& path) {
   if (split_hdf5_dataset(path)) return FileFormat::kHdf5;
-  const std::string ext = lower_extension(path);
+  const std::string ext = io::lower_extension(path);
   if (ext == ".npy") return FileFormat::kNpy;
   if (ext == ".nii") return FileFormat::kNifti;
   if (ext == ".tif" || ext == ".tiff") return FileFormat::kTiff;

@@ -1,5 +1,7 @@
 #include "io/file_access.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <fstream>
 #include <iterator>
 #include <mutex>
@@ -40,6 +42,13 @@ void register_input(const std::filesystem::path& path) {
 namespace io {
 
 std::string prefix(const std::filesystem::path& path) { return path.string() + ": "; }
+
+std::string lower_extension(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
 
 std::size_t element_count(const std::filesystem::path& path,
                           const std::vector<std::size_t>& shape) {

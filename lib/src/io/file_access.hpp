@@ -22,6 +22,9 @@ void check_output_path(const std::filesystem::path& path);
 // Number of elements in `shape`; InputError naming the file when it overflows.
 std::size_t element_count(const std::filesystem::path& path, const std::vector<std::size_t>& shape);
 
+// The extension in lower case (".TIF" -> ".tif"), for choosing a format.
+std::string lower_extension(const std::filesystem::path& path);
+
 // "file.npy: " for error messages.
 std::string prefix(const std::filesystem::path& path);
 

@@ -3,7 +3,6 @@
 #include <hdf5.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <type_traits>
 
@@ -168,9 +167,7 @@ TomoFile read_nxtomo(const Hid& file, const std::filesystem::path& path, const s
 }  // namespace
 
 bool is_hdf5_path(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = io::lower_extension(path);
   return ext == ".h5" || ext == ".hdf5" || ext == ".hdf" || ext == ".nxs" || ext == ".nx";
 }
 

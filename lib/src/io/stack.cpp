@@ -17,9 +17,7 @@ bool has_wildcard(const std::string& name) {
 }
 
 bool is_image_file(const std::filesystem::path& path) {
-  std::string ext = path.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const std::string ext = lower_extension(path);
   return ext == ".tif" || ext == ".tiff";
 }
 

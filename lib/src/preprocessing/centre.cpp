@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "riner/error.hpp"
@@ -121,7 +122,7 @@ void mirror_mismatch(const float* a, const float* b, std::size_t n, double axis,
 }
 
 // The cost of a candidate axis over the given line pairs.
-double cost_at(const std::vector<LinePair>& lines, std::size_t n, double axis) {
+double cost_at(std::span<const LinePair> lines, std::size_t n, double axis) {
   double sum = 0.0, count = 0.0;
   for (const LinePair& p : lines) mirror_mismatch(p.first, p.opposite.data(), n, axis, sum, count);
   return count > 0.0 ? sum / count : std::numeric_limits<double>::infinity();
@@ -130,7 +131,7 @@ double cost_at(const std::vector<LinePair>& lines, std::size_t n, double axis) {
 // The best axis: a coarse scan over the central half of the detector (the pair must overlap
 // by at least half its width), then a fine one around the coarse minimum. `width`: how far the
 // cost takes to rise 10% above its minimum (a shallow minimum is unsure).
-double best_axis(const std::vector<LinePair>& lines, std::size_t n_u, double* width = nullptr) {
+double best_axis(std::span<const LinePair> lines, std::size_t n_u, double* width = nullptr) {
   auto cost = [&](double a) { return cost_at(lines, n_u, a); };
   const double n = static_cast<double>(n_u);
   const double centre = 0.5 * (n - 1.0);
@@ -190,8 +191,7 @@ CentreEstimate estimate_centre(const Scan& scan) {
   } else {
     double sum2 = 0.0;
     for (std::size_t p = 0; p < pairs.size(); ++p) {
-      const auto first = lines.begin() + static_cast<std::ptrdiff_t>(p * rows.size());
-      const std::vector<LinePair> one(first, first + static_cast<std::ptrdiff_t>(rows.size()));
+      const std::span<const LinePair> one(lines.data() + p * rows.size(), rows.size());
       const double a = best_axis(one, g.n_u);
       sum2 += (a - e.axis_column) * (a - e.axis_column);
     }

@@ -94,20 +94,6 @@ Array flat_field_normalise(const Array& projections, const Array& flats, const A
   return rho;
 }
 
-Array detector_row(const Array& stack, std::size_t row) {
-  if (stack.rank() != 3 || row >= stack.shape[1]) {
-    throw InputError("no detector row " + std::to_string(row) + " in frames of shape " +
-                     shape_string(stack.shape));
-  }
-  const std::size_t frames = stack.shape[0], rows = stack.shape[1], columns = stack.shape[2];
-  Array out({frames, columns});
-  for (std::size_t f = 0; f < frames; ++f) {
-    std::copy_n(stack.data.begin() + static_cast<std::ptrdiff_t>((f * rows + row) * columns),
-                columns, out.data.begin() + static_cast<std::ptrdiff_t>(f * columns));
-  }
-  return out;
-}
-
 Scan raw_scan(Geometry geometry, const Array& projections, const Array& flats, const Array& darks,
               std::optional<std::size_t> row, const std::string& what, FlatFieldReport* report) {
   Scan scan;
@@ -126,7 +112,7 @@ Scan raw_scan(Geometry geometry, const Array& projections, const Array& flats, c
   } catch (const InputError& e) {
     throw InputError(what + ": " + e.what());
   }
-  for (float x : scan.measurement.data) scan.non_finite += !std::isfinite(x);
+  scan.non_finite = compute_stats(scan.measurement).non_finite();
   if (!row && scan.measurement.rank() == 3 && !scan.geometry.is_3d()) {
     throw InputError(what + " is a stack " + shape_string(scan.measurement.shape) + " and the " +
                      geometry_type_name(scan.geometry.type) +
