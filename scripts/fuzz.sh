@@ -15,7 +15,7 @@ if ! command -v clang++ >/dev/null; then
   $sudo apt-get install -y --no-install-recommends clang libclang-rt-dev
 fi
 cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=RelWithDebInfo -DCMAKE_CXX_COMPILER=clang++ \
-  -DRINER_BUILD_FUZZERS=ON -DRINER_BUILD_TESTS=OFF -DRINER_BUILD_BENCH=OFF -DRINER_BUILD_APPS=OFF \
+  -DRINER_BUILD_FUZZERS=ON -DRINER_BUILD_PYTHON=OFF -DRINER_BUILD_TESTS=OFF -DRINER_BUILD_BENCH=OFF -DRINER_BUILD_APPS=OFF \
   -DRINER_SANITIZE=address,undefined,fuzzer-no-link
 cmake --build build-fuzz -j "$(nproc)"
 mkdir -p build-fuzz/findings

@@ -7,7 +7,7 @@ packages=(
   libclblast-dev libeigen3-dev doctest-dev nlohmann-json3-dev
   libtiff-dev libpng-dev libhdf5-dev
   oclgrind valgrind
-  python3-numpy python3-skimage
+  python3-dev pybind11-dev python3-numpy python3-pytest python3-skimage
 )
 if [ "$(id -u)" -eq 0 ]; then sudo=""; else sudo="sudo"; fi
 export DEBIAN_FRONTEND=noninteractive

@@ -1,6 +1,7 @@
 // riner center SCAN: the centre-of-rotation offset the scan's own views point to.
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "summary_json.hpp"
 #include "scan_options.hpp"
 
 namespace riner::app {

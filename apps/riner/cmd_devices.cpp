@@ -6,6 +6,7 @@
 
 #include "cli_args.hpp"
 #include "commands.hpp"
+#include "summary_json.hpp"
 #include "riner/device.hpp"
 
 namespace riner::app {
@@ -22,32 +23,6 @@ std::string bytes_text(std::uint64_t bytes) {
     std::snprintf(buf, sizeof(buf), "%.1f KiB", static_cast<double>(bytes) / 1024.0);
   }
   return buf;
-}
-
-nlohmann::json to_json(const DeviceInfo& d) {
-  return {{"index", d.index},
-          {"platform", d.platform},
-          {"platform_version", d.platform_version},
-          {"name", d.name},
-          {"vendor", d.vendor},
-          {"type", d.type},
-          {"version", d.version},
-          {"driver_version", d.driver_version},
-          {"opencl_c_version", d.opencl_c_version},
-          {"compute_units", d.compute_units},
-          {"max_clock_mhz", d.max_clock_mhz},
-          {"max_work_group_size", d.max_work_group_size},
-          {"local_mem_bytes", d.local_mem_bytes},
-          {"local_mem_is_global", d.local_mem_is_global},
-          {"global_mem_bytes", d.global_mem_bytes},
-          {"max_alloc_bytes", d.max_alloc_bytes},
-          {"fp64", d.fp64},
-          {"preferred_vector_width_float", d.preferred_vector_width_float},
-          {"native_vector_width_float", d.native_vector_width_float},
-          {"preferred_vector_width_int", d.preferred_vector_width_int},
-          {"native_vector_width_int", d.native_vector_width_int},
-          {"fp32_global_atomic_add", d.fp32_global_atomic_add},
-          {"training_plan", nlohmann::json::parse(choose_execution_plan(d).to_json())}};
 }
 
 void print_table(const std::vector<DeviceInfo>& devices) {
@@ -88,7 +63,7 @@ int run_devices(int argc, char** argv, int first) {
   const std::vector<DeviceInfo> devices = list_devices();
   if (args.is_set("json")) {
     nlohmann::json out = nlohmann::json::array();
-    for (const DeviceInfo& d : devices) out.push_back(to_json(d));
+    for (const DeviceInfo& d : devices) out.push_back(device_json(d));
     std::printf("%s\n", out.dump(1).c_str());
   } else if (!args.is_set("quiet")) {
     if (devices.empty()) {

@@ -6,6 +6,7 @@
 #include "riner/fbp.hpp"
 #include "riner/io.hpp"
 #include "riner/scan.hpp"
+#include "summary_json.hpp"
 #include "scan_options.hpp"
 
 namespace riner::app {

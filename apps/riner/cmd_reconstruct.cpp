@@ -14,65 +14,12 @@
 #include "riner/quality.hpp"
 #include "riner/reconstructor.hpp"
 #include "riner/scan.hpp"
+#include "summary_json.hpp"
 #include "scan_options.hpp"
 
 namespace riner::app {
 
 namespace {
-
-nlohmann::json ring_summary(const std::optional<RingCorrection>& rings) {
-  if (!rings) return {{"applied", false}};
-  double largest = 0.0;
-  for (double v : rings->profile) largest = std::max(largest, std::fabs(v));
-  nlohmann::json out{{"applied", rings->applied},
-                     {"measured_radii", rings->measured_radii},
-                     {"mean_response_change", rings->mean_response_change},
-                     {"radius_step_mm", rings->radius_step_mm},
-                     {"largest_ring_per_mm", largest}};
-  // The detector-response correction's evidence (null: no odd structure at all).
-  if (rings->even_to_odd != 0.0) {
-    out["even_to_odd"] = std::isfinite(rings->even_to_odd) ? nlohmann::json(rings->even_to_odd)
-                                                           : nlohmann::json(nullptr);
-  }
-  return out;
-}
-
-// What a user without a ground truth can check (riner/quality.hpp): rings, specks and the
-// centre against the FBP of the same scan, for the image and (the centre, 2D) the trained field.
-struct QualityCheck {
-  QualityReport image;
-  std::optional<CentreDeviation> field;  // 2D only
-};
-
-QualityCheck check_quality(const Reconstructor& r, const ReconstructionResult& result,
-                           const std::optional<Device>& device) {
-  FbpOptions options;
-  options.engine = r.config().engine;
-  options.device = device;
-  const Array fbp_image = fbp(r.scan(), options);
-  QualityCheck check{quality_against_fbp(result.image, fbp_image), {}};
-  if (fbp_image.rank() == 2) check.field = centre_deviation(result.field_image, fbp_image);
-  return check;
-}
-
-nlohmann::json quality_summary(const QualityCheck& check) {
-  const QualityReport& q = check.image;
-  nlohmann::json out = {{"fbp_noise_per_mm", q.noise},
-                        {"ring_index", q.ring_index},
-                        {"fbp_ring_index", q.fbp_ring_index},
-                        {"specks_per_10k_pixels", q.specks_per_10k},
-                        {"fbp_specks_per_10k_pixels", q.fbp_specks_per_10k},
-                        {"centre", nullptr}};
-  if (check.field) {
-    out["centre"] = {{"radius_px", q.centre.radius_px},
-                     {"largest_broad_deviation_from_fbp_per_mm", q.centre.deviation},
-                     {"at_px", q.centre.at_px},
-                     {"fbp_profile_noise_per_mm", q.centre.fbp_noise},
-                     {"fbp_noise_sigmas", q.centre.sigmas},
-                     {"field_fbp_noise_sigmas", check.field->sigmas}};
-  }
-  return out;
-}
 
 // Where the tool has doubts, say so.
 void print_doubts(Console& console, const QualityReport& q) {
@@ -231,46 +178,11 @@ int run_reconstruct(int argc, char** argv, int first) {
 
   const TrainingStats stats = reconstructor.stats();
   const QualityCheck quality = check_quality(reconstructor, result, device);
-  nlohmann::json summary = {
-      {"image", image_path.string()},
-      {"shape", image.shape},
-      {"steps", stats.steps},
-      {"steps_planned", stats.steps_planned},
-      {"stopped_on_plateau", stats.stopped_on_plateau},
-      {"seconds", stats.seconds},
-      {"samples", stats.samples},
-      {"samples_per_second", stats.seconds > 0 ? stats.samples / stats.seconds : 0.0},
-      {"parameters", stats.parameters},
-      {"non_finite_measurements", stats.non_finite},
-      {"flat_field",
-       loaded.flat_field ? flat_field_json(*loaded.flat_field) : nlohmann::json(nullptr)},
-      {"centre", loaded.centre ? centre_json(*loaded.centre) : nlohmann::json(nullptr)},
-      {"dead_elements", dead},
-      {"dead_element_reasons", dead_elements_json(dead_report)},
-      {"engine", stats.engine},
-      {"device", stats.device},
-      {"plan", stats.plan ? nlohmann::json::parse(stats.plan->to_json()) : nlohmann::json()},
-      {"skip_air",
-       {{"applied", stats.air_skipped},
-        {"grid_fraction_sampled", stats.inside_fraction},
-        {"samples_kept_fraction", stats.samples_kept_fraction},
-        {"noise_sigma", stats.noise},
-        {"note", config.training.skip_air ? stats.air_note : "off (training.skip_air)"}}},
-      {"coverage",
-       {{"rays", stats.coverage.rays},
-        {"rays_per_element_fewest", stats.coverage.fewest},
-        {"rays_per_element_median", stats.coverage.median},
-        {"rays_per_element_most", stats.coverage.most},
-        {"elements_under_10_rays", stats.coverage.elements_under_10}}},
-      {"memory",
-       {{"peak_host_mb", static_cast<double>(stats.peak_host_bytes) / 1048576.0},
-        {"peak_device_buffers_mb", static_cast<double>(stats.peak_device_bytes) / 1048576.0}}},
-      {"quality", quality_summary(quality)},
-      {"air_ring_correction", ring_summary(result.air_rings)},
-      {"gradient_ring_correction", ring_summary(result.gradient_rings)},
-      {"response_ring_correction", ring_summary(result.response_rings)},
-      {"final_loss",
-       reconstructor.history().empty() ? 0.0 : reconstructor.history().back().data_loss}};
+  nlohmann::json summary = {{"image", image_path.string()}};
+  summary.update(run_summary(reconstructor, result, quality));
+  summary["flat_field"] =
+      loaded.flat_field ? flat_field_json(*loaded.flat_field) : nlohmann::json(nullptr);
+  summary["centre"] = loaded.centre ? centre_json(*loaded.centre) : nlohmann::json(nullptr);
   write_text(out / "summary.json", summary.dump(1) + "\n");
   console.line("reconstructed " + shape_string(image.shape) + " in " +
                format_duration(stats.seconds) + " (" + std::to_string(stats.steps) + " steps, " +

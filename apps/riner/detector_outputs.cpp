@@ -53,15 +53,4 @@ void write_detector_outputs(const std::filesystem::path& dir, const Array& alpha
   }
 }
 
-nlohmann::json dead_elements_json(const std::vector<DeadElement>& dead) {
-  nlohmann::json out = nlohmann::json::array();
-  for (const DeadElement& d : dead) {
-    out.push_back({{"element", d.element},
-                   {"reason", d.reason},
-                   {"beta", d.beta},
-                   {"invalid_readings", d.invalid_readings}});
-  }
-  return out;
-}
-
 }  // namespace riner::app

@@ -5,8 +5,6 @@
 #include <filesystem>
 #include <vector>
 
-#include <nlohmann/json.hpp>
-
 #include "riner/array.hpp"
 #include "riner/reconstructor.hpp"
 
@@ -17,8 +15,5 @@ namespace riner::app {
 // map with the dead pixels at 0.
 void write_detector_outputs(const std::filesystem::path& dir, const Array& alpha, const Array& beta,
                             const std::vector<std::size_t>& dead);
-
-// summary.json's account of each dead element: index, reason, beta, invalid readings.
-nlohmann::json dead_elements_json(const std::vector<DeadElement>& dead);
 
 }  // namespace riner::app

@@ -95,19 +95,4 @@ std::string centre_line(const CentreEstimate& e) {
   return line;
 }
 
-nlohmann::json centre_json(const CentreEstimate& e) {
-  return {{"offset_px", e.offset_px},
-          {"axis_column", e.axis_column},
-          {"spread_px", e.spread_px},
-          {"view_pairs", e.pairs},
-          {"rows", e.rows}};
-}
-
-nlohmann::json flat_field_json(const FlatFieldReport& r) {
-  return {{"flat_frames", r.flat_frames},
-          {"dark_frames", r.dark_frames},
-          {"invalid_readings", r.invalid_readings},
-          {"pixels_without_beam", r.pixels_without_beam}};
-}
-
 }  // namespace riner::app

@@ -2,7 +2,6 @@
 // projections --flat and --dark.
 #pragma once
 
-#include <nlohmann/json.hpp>
 #include <optional>
 
 #include "cli_args.hpp"
@@ -28,9 +27,7 @@ LoadedScan scan_from(const Args& args, const Console& console);
 
 // One line for the console: how many frames went into each field, what became invalid.
 std::string flat_field_line(const FlatFieldReport& report);
-nlohmann::json flat_field_json(const FlatFieldReport& report);
 
 std::string centre_line(const CentreEstimate& estimate);
-nlohmann::json centre_json(const CentreEstimate& estimate);
 
 }  // namespace riner::app

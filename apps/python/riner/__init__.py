@@ -1,0 +1,267 @@
+"""riner: ring-artifact removal for CT by an implicit neural representation, on OpenCL.
+
+    import numpy as np, riner
+    geometry = riner.parallel_beam(np.linspace(0, np.pi, 181), columns=640, center=295.6)
+    image, alpha, beta, summary = riner.reconstruct(sino, geometry, steps=12000)
+
+Arrays are numpy arrays: a sinogram [views, columns] (2D) or a projection stack
+[views, rows, columns] (3D), images [y, x] or volumes [z, y, x] in 1/mm. A geometry is the
+scan contract of riner's README (a dict, a JSON file, or a preset name); parallel_beam() and
+divergent_beam() build one from tomopy/algotom-style arguments. Errors raise riner.InputError
+(also a ValueError) for bad input, riner.OpenCLError for device failures (both riner.Error, a
+RuntimeError), TypeError for arrays of the wrong kind; Ctrl-C during training raises
+KeyboardInterrupt once training has stopped.
+"""
+
+import json
+import os
+from typing import NamedTuple
+
+from . import _riner
+from ._riner import Error, InputError, OpenCLError
+
+__all__ = [
+    "Error", "InputError", "OpenCLError", "Reconstruction",
+    "devices", "settings", "geometry", "parallel_beam", "divergent_beam",
+    "reconstruct", "fbp", "simulate", "center", "flat_field",
+    "read_array", "write_array", "compare",
+]
+__version__ = "0.1.0"
+
+
+def devices():
+    """Every OpenCL device: its capabilities and the training plan riner would use on it."""
+    return json.loads(_riner.devices_json())
+
+
+def settings():
+    """Every setting reconstruct() takes: name, type, allowed values, default, meaning."""
+    return json.loads(_riner.settings_json())
+
+
+def geometry(spec):
+    """A validated geometry dict from a dict, a JSON file's path, or a preset name
+    ("fan2d-paper", "cone3d-paper", "parallel3d")."""
+    return json.loads(_geometry_json(spec))
+
+
+def _geometry_json(spec):
+    if isinstance(spec, dict):
+        return _riner.geometry_json(json.dumps(spec), "geometry")
+    if isinstance(spec, (str, os.PathLike)):
+        path = os.fspath(spec)
+        if os.path.exists(path):
+            return _riner.load_geometry_json(path)
+        if "/" not in path and not path.endswith(".json"):
+            return _riner.preset_geometry_json(path)
+        raise InputError(f"{path}: no such geometry file")
+    raise TypeError(f"geometry must be a dict, a JSON file's path or a preset name "
+                    f"(got {type(spec).__name__})")
+
+
+def _image_grid(columns, pitch, magnification, rows, image_shape, voxel_size):
+    if voxel_size is None:
+        voxel_size = pitch / magnification
+    if image_shape is None:
+        image_shape = (columns, columns) if rows is None else (rows, columns, columns)
+    return {"shape": [int(n) for n in image_shape], "voxel_mm": float(voxel_size)}
+
+
+def _detector(columns, rows, pitch, center, row_center):
+    # center: the 0-based, fractional column the rotation axis projects to (tomopy's and
+    # algotom's "center"); riner's offset_px is its distance from the detector's middle.
+    offset = 0.0 if center is None else (columns - 1) / 2.0 - float(center)
+    if rows is None:
+        return {"count": int(columns), "pitch_mm": float(pitch), "offset_px": offset}
+    row_offset = 0.0 if row_center is None else (rows - 1) / 2.0 - float(row_center)
+    return {"count": [int(columns), int(rows)], "pitch_mm": [float(pitch), float(pitch)],
+            "offset_px": [offset, row_offset]}
+
+
+def parallel_beam(angles, columns, center=None, rows=None, pixel_size=1.0,
+                  image_shape=None, voxel_size=None):
+    """A parallel-beam geometry, tomopy-style: angles in radians (one per view), columns of
+    the detector, center = the column the rotation axis projects to (0-based; default the
+    middle), rows for a 3D stack, pixel_size in mm. The image defaults to columns x columns
+    (x rows slices) of pixel_size."""
+    detector = _detector(columns, rows, pixel_size, center, None)
+    return geometry({
+        "type": "parallel2d" if rows is None else "parallel3d",
+        "detector": detector,
+        "angles_rad": [float(a) for a in angles],
+        "volume": _image_grid(columns, pixel_size, 1.0, rows, image_shape, voxel_size),
+    })
+
+
+def divergent_beam(angles, columns, source_origin, origin_detector, center=None, rows=None,
+                   pixel_size=1.0, image_shape=None, voxel_size=None):
+    """A fan-beam (2D) or, with rows, cone-beam (3D) geometry with a flat detector: distances
+    in mm from the source to the rotation axis and from the axis to the detector. The image
+    defaults to columns x columns of pixel_size / magnification."""
+    magnification = (source_origin + origin_detector) / source_origin
+    return geometry({
+        "type": "fan2d" if rows is None else "cone3d",
+        "detector": _detector(columns, rows, pixel_size, center, None),
+        "source_origin_mm": float(source_origin),
+        "origin_detector_mm": float(origin_detector),
+        "angles_rad": [float(a) for a in angles],
+        "volume": _image_grid(columns, pixel_size, magnification, rows, image_shape, voxel_size),
+    })
+
+
+def _array(value):
+    import numpy
+    return value if isinstance(value, numpy.ndarray) else numpy.asarray(value)
+
+
+def _device(device):
+    return "" if device is None else str(device)
+
+
+def flat_field(projections, flat, dark=None):
+    """rho = -ln((I - D) / (F - D)) with F and D the per-pixel means of the flat and dark frames
+    (one frame or a stack); invalid readings become NaN. Returns (rho, report dict)."""
+    rho, report = _riner.flat_field(_array(projections), _array(flat),
+                                    None if dark is None else _array(dark))
+    return rho, json.loads(report)
+
+
+def _scan(sino, geometry_spec, flat, dark, center_spec):
+    """The normalised measurement, the geometry JSON and what was done to get them."""
+    notes = {"flat_field": None, "centre": None}
+    if flat is not None:
+        sino, notes["flat_field"] = flat_field(sino, flat, dark)
+    elif dark is not None:
+        raise InputError("dark needs flat")
+    else:
+        sino = _array(sino)
+    geometry_json = _geometry_json(geometry_spec)
+    if center_spec is not None:
+        g = json.loads(geometry_json)
+        if center_spec == "auto":
+            notes["centre"] = json.loads(_riner.center(sino, geometry_json))
+            offset = notes["centre"]["offset_px"]
+        else:
+            columns = g["detector"]["count"]
+            columns = columns[0] if isinstance(columns, list) else columns
+            offset = (columns - 1) / 2.0 - float(center_spec)
+        if isinstance(g["detector"]["offset_px"], list):
+            g["detector"]["offset_px"][0] = offset
+        else:
+            g["detector"]["offset_px"] = offset
+        geometry_json = _riner.geometry_json(json.dumps(g), "geometry")
+    return sino, geometry_json, notes
+
+
+def center(sino, geometry, flat=None, dark=None):
+    """The centre of rotation a parallel-beam scan's own views point to (mirrored views half
+    a turn apart): a dict with offset_px (riner's), axis_column (tomopy's center), spread_px."""
+    sino, geometry_json, _ = _scan(sino, geometry, flat, dark, None)
+    return json.loads(_riner.center(sino, geometry_json))
+
+
+def fbp(sino, geometry, flat=None, dark=None, center=None, filter="ram-lak", device=None,
+        engine="opencl"):
+    """FBP (parallel, fan), FDK (cone) or slice-wise FBP (parallel 3D) of a scan, mu in 1/mm.
+    center: the axis column, or "auto" to estimate it (parallel beam)."""
+    sino, geometry_json, _ = _scan(sino, geometry, flat, dark, center)
+    return _riner.fbp(sino, geometry_json, filter, engine, _device(device))
+
+
+def simulate(image=None, geometry="fan2d-paper", seed=0, photons=1e7, nonideal_fraction=0.75,
+             alpha_min=0.75, alpha_max=1.25, dead=2, dead_rows=0, dead_columns=0,
+             mu_unit="mm", mu_scale=0.1, projector="exact", device=None, engine="opencl"):
+    """A ring-corrupted scan by the paper's protocol (METHOD.md §4) of `image` (on the
+    geometry's grid; mu_unit "cm" for DeepLesion's 1/cm) or, when None, of the built-in
+    Shepp-Logan phantom. Returns a dict: sino, clean, alpha (0 = dead), ground_truth,
+    geometry."""
+    if mu_unit not in ("mm", "cm"):
+        raise InputError(f"mu_unit must be mm or cm (got {mu_unit!r})")
+    if image is not None:
+        image = _array(image)
+        if mu_unit == "cm":
+            image = image * 0.1
+    geometry_json = _geometry_json(geometry)
+    out = _riner.simulate(image, geometry_json, mu_scale, seed, photons, nonideal_fraction,
+                          alpha_min, alpha_max, dead, dead_rows, dead_columns, projector,
+                          engine, _device(device))
+    out["geometry"] = json.loads(geometry_json)
+    return out
+
+
+class Reconstruction(NamedTuple):
+    image: object    # mu in 1/mm on the geometry's grid, rings corrected
+    alpha: object    # the detector's estimated response per element ([columns] or [rows, columns])
+    beta: object     # validity per element; < 0.5 marks a dead element
+    summary: dict    # what `riner reconstruct` writes to summary.json
+    field: object    # the trained field before the ring corrections
+
+
+def _settings_list(kwargs):
+    names = [s["name"] for s in settings()]
+    pairs = []
+    for key, value in kwargs.items():
+        if key in names:
+            name = key
+        else:
+            matches = [n for n in names if n.rsplit(".", 1)[-1] == key]
+            if len(matches) != 1:
+                hint = (f"it could be {', '.join(matches)}" if matches
+                        else "riner.settings() lists them")
+                raise InputError(f"unknown setting {key!r} ({hint}; pass settings={{name: value}})")
+            name = matches[0]
+        pairs.append((name, json.dumps(value)))
+    return pairs
+
+
+def reconstruct(sino, geometry, flat=None, dark=None, center=None, config=None, settings=None,
+                progress=None, progress_every=200, quality=True, device=None, engine="opencl",
+                **short_settings):
+    """Riner on a scan: returns Reconstruction(image, alpha, beta, summary, field).
+
+    sino: the log-normalised measurement, or raw intensities when flat (and dark) are given.
+    geometry: a dict, a JSON path or a preset name. center: the axis column, or "auto".
+    config: a settings dict or JSON file as `riner reconstruct --config` takes; settings: a
+    dict {"training.steps": 12000, ...}; keyword arguments name settings by their last part
+    (steps=12000, seed=1, alpha_lr_scale=0.3); riner.settings() lists them.
+    progress: called with a dict (step, total, loss, seconds) every progress_every steps;
+    returning False stops training early. quality: the no-reference quality report against
+    FBP in the summary. Ctrl-C stops training and raises KeyboardInterrupt.
+    """
+    sino, geometry_json, notes = _scan(sino, geometry, flat, dark, center)
+    if config is None:
+        config_json = ""
+    elif isinstance(config, dict):
+        config_json = json.dumps(config)
+    else:
+        with open(config, encoding="utf-8") as f:
+            config_json = f.read()
+    pairs = _settings_list(dict(settings or {}, **short_settings))
+    image, alpha, beta, summary, field = _riner.reconstruct(
+        sino, geometry_json, config_json, pairs, engine, _device(device), progress,
+        int(progress_every), bool(quality))
+    summary = json.loads(summary)
+    summary.update(notes)
+    return Reconstruction(image, alpha, beta, summary, field)
+
+
+def read_array(path):
+    """An array file (.npy, .nii, .tif, .raw with its sidecar, HDF5 "file.h5:/dataset", a TIFF
+    folder or pattern) as float32."""
+    array, _, _ = _riner.read_array(os.fspath(path))
+    return array
+
+
+def write_array(path, array, voxel_size=None):
+    """Writes an array (format by extension), atomically; voxel_size per axis (mm) for NIfTI."""
+    array = _array(array)
+    _riner.write_array(os.fspath(path), array,
+                       [] if voxel_size is None else [float(v) for v in voxel_size])
+
+
+def compare(image, reference, mask=None):
+    """PSNR, SSIM (scikit-image's definition), MAE, RMSE of image against reference;
+    mask="circle" restricts them to the inscribed circle."""
+    if mask not in (None, "circle"):
+        raise InputError(f"mask must be None or 'circle' (got {mask!r})")
+    return _riner.compare(_array(image), _array(reference), mask == "circle")

@@ -1,0 +1,123 @@
+// reconstruct(): Riner on a scan from Python. Training runs with the GIL released; every
+// `check_every` steps it takes the GIL back to look for Ctrl-C (the KeyboardInterrupt is raised
+// once training has stopped cleanly) and to call the progress callback, which may return False
+// to stop early or raise to abort.
+#include <pybind11/stl.h>
+
+#include <memory>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "bindings.hpp"
+#include "numpy_arrays.hpp"
+#include "riner/error.hpp"
+#include "riner/reconstructor.hpp"
+#include "summary_json.hpp"
+
+namespace riner::python {
+
+namespace {
+
+RinerConfig config_from(const std::string& config_json,
+                        const std::vector<std::pair<std::string, std::string>>& settings,
+                        const std::string& engine) {
+  RinerConfig config;
+  if (!config_json.empty()) config.update_from_json(config_json, "config");
+  for (const auto& [name, value] : settings) config.set(name, value);
+  config.engine = parse_engine(engine);
+  config.validate();
+  return config;
+}
+
+// Calls the user's callback every `every` steps (and at the end) and watches for Ctrl-C; the
+// first Python error it meets stops training and is kept to be raised afterwards.
+class ProgressRelay {
+ public:
+  ProgressRelay(py::object callback, int every)
+      : callback_(std::move(callback)), every_(every), next_report_(every) {}
+
+  bool operator()(const TrainingProgress& p) {
+    py::gil_scoped_acquire acquire;
+    if (PyErr_CheckSignals() != 0) {
+      failure_.emplace();
+      return false;
+    }
+    if (callback_.is_none() || (p.step < next_report_ && p.step < p.total)) return true;
+    next_report_ = (p.step / every_ + 1) * every_;
+    try {
+      py::dict progress;
+      progress["step"] = p.step;
+      progress["total"] = p.total;
+      progress["loss"] = p.loss;
+      progress["seconds"] = p.seconds;
+      const py::object keep_going = callback_(progress);
+      return keep_going.is_none() || keep_going.cast<bool>();
+    } catch (py::error_already_set& e) {
+      failure_.emplace(std::move(e));
+      return false;
+    }
+  }
+
+  // Raises what stopped training, if anything did (call with the GIL held).
+  void raise_failure() {
+    if (failure_) throw std::move(*failure_);
+  }
+
+ private:
+  py::object callback_;
+  int every_;
+  int next_report_;
+  std::optional<py::error_already_set> failure_;
+};
+
+py::tuple reconstruct(const py::handle& measurement, const std::string& geometry_json,
+                      const std::string& config_json,
+                      const std::vector<std::pair<std::string, std::string>>& settings,
+                      const std::string& engine, const std::string& device,
+                      const py::object& progress, int progress_every, bool quality) {
+  if (progress_every < 1) throw InputError("progress_every must be >= 1");
+  Scan scan{to_array(measurement, "sino"), Geometry::from_json(geometry_json, "geometry"), 0};
+  scan.non_finite = compute_stats(scan.measurement).non_finite();
+  const RinerConfig config = config_from(config_json, settings, engine);
+
+  std::unique_ptr<Reconstructor> reconstructor;
+  std::optional<Device> dev;
+  {
+    py::gil_scoped_release release;
+    dev = device_for(config.engine, device);
+    reconstructor = std::make_unique<Reconstructor>(std::move(scan), config, dev);
+  }
+  // Often enough for Ctrl-C to feel immediate on a CPU (50 steps: about 0.1 s), rarely enough
+  // not to stall a GPU (each check drains the queue).
+  constexpr int kCheckEvery = 50;
+  ProgressRelay relay(progress, progress_every);
+  {
+    py::gil_scoped_release release;
+    reconstructor->run(std::ref(relay), std::min(kCheckEvery, progress_every));
+  }
+  relay.raise_failure();
+
+  ReconstructionResult result;
+  std::string summary;
+  Array beta;
+  {
+    py::gil_scoped_release release;
+    result = reconstructor->result();
+    beta = reconstructor->beta();
+    const app::QualityCheck check =
+        quality ? app::check_quality(*reconstructor, result, dev) : app::QualityCheck{};
+    nlohmann::json json = app::run_summary(*reconstructor, result, check);
+    if (!quality) json["quality"] = nullptr;
+    summary = json.dump();
+  }
+  return py::make_tuple(to_numpy(std::move(result.image)), to_numpy(std::move(result.alpha)),
+                        to_numpy(std::move(beta)), summary,
+                        to_numpy(std::move(result.field_image)));
+}
+
+}  // namespace
+
+void bind_reconstruct(py::module_& m) { m.def("reconstruct", &reconstruct); }
+
+}  // namespace riner::python

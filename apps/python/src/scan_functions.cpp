@@ -1,0 +1,164 @@
+// What works on a scan without training: FBP, simulation, the centre of rotation, flat-field
+// normalisation, array files and image metrics. Every call releases the GIL while riner works.
+#include <pybind11/stl.h>
+
+#include "bindings.hpp"
+#include "numpy_arrays.hpp"
+#include "riner/centre.hpp"
+#include "riner/error.hpp"
+#include "riner/fbp.hpp"
+#include "riner/flat_field.hpp"
+#include "riner/io.hpp"
+#include "riner/metrics.hpp"
+#include "riner/phantom.hpp"
+#include "riner/simulate.hpp"
+#include "summary_json.hpp"
+
+namespace riner::python {
+
+namespace {
+
+Scan scan_from(const py::handle& measurement, const std::string& geometry_json) {
+  Scan scan{to_array(measurement, "sino"), Geometry::from_json(geometry_json, "geometry"), 0};
+  scan.non_finite = compute_stats(scan.measurement).non_finite();
+  check_scan(scan, "sino");
+  return scan;
+}
+
+py::array fbp_of(const py::handle& measurement, const std::string& geometry_json,
+                 const std::string& filter, const std::string& engine,
+                 const std::string& device) {
+  const Scan scan = scan_from(measurement, geometry_json);
+  FbpOptions options;
+  options.filter = parse_fbp_filter(filter);
+  options.engine = parse_engine(engine);
+  Array image;
+  {
+    py::gil_scoped_release release;
+    options.device = device_for(options.engine, device);
+    image = fbp(scan, options);
+  }
+  return to_numpy(std::move(image));
+}
+
+// The protocol of METHOD.md §4 on `image` (mu in 1/mm on the geometry's grid), or on the
+// built-in Shepp-Logan phantom when image is None (then with exact projections unless
+// projector is "joseph").
+py::dict simulate_scan(const py::object& image, const std::string& geometry_json,
+                       double mu_scale, const RingModel& model, std::string projector,
+                       const std::string& engine, const std::string& device) {
+  const Geometry g = Geometry::from_json(geometry_json, "geometry");
+  model.validate();
+  if (projector != "exact" && projector != "joseph") {
+    throw InputError("projector must be exact or joseph (got '" + projector + "')");
+  }
+  SimulatedScan sim;
+  const bool phantom = image.is_none();
+  if (!phantom) {
+    projector = "joseph";  // an image has no analytic projections
+    sim.ground_truth = to_array(image, "image");
+    if (sim.ground_truth.shape != g.volume_shape) {
+      throw InputError("image has shape " + shape_string(sim.ground_truth.shape) +
+                       " but the geometry's grid is " + shape_string(g.volume_shape));
+    }
+    if (compute_stats(sim.ground_truth).non_finite() > 0) {
+      throw InputError("image holds NaN or infinite values");
+    }
+  }
+  const Engine e = parse_engine(engine);
+  {
+    py::gil_scoped_release release;
+    if (phantom) {
+      const Phantom p = shepp_logan(g, mu_scale);
+      sim.ground_truth = rasterize(p, g);
+      if (projector == "exact") sim.clean = exact_projections(p, g);
+    }
+    if (projector == "joseph") {
+      const Projector forward(g, e, device_for(e, device));
+      sim.clean = forward.project(sim.ground_truth);
+    }
+    sim.alpha = draw_responses(g, model);
+    sim.scan.measurement = corrupt_measurement(sim.clean, sim.alpha, model);
+  }
+  py::dict out;
+  out["sino"] = to_numpy(std::move(sim.scan.measurement));
+  out["clean"] = to_numpy(std::move(sim.clean));
+  out["alpha"] = to_numpy(std::move(sim.alpha));
+  out["ground_truth"] = to_numpy(std::move(sim.ground_truth));
+  return out;
+}
+
+}  // namespace
+
+void bind_scan_functions(py::module_& m) {
+  m.def("fbp", &fbp_of);
+  m.def("simulate", [](const py::object& image, const std::string& geometry_json, double mu_scale,
+                       std::uint64_t seed, double photons, double nonideal_fraction,
+                       double alpha_min, double alpha_max, std::size_t dead,
+                       std::size_t dead_rows, std::size_t dead_columns,
+                       const std::string& projector, const std::string& engine,
+                       const std::string& device) {
+    RingModel model;
+    model.seed = seed;
+    model.photons = photons;
+    model.nonideal_fraction = nonideal_fraction;
+    model.alpha_min = alpha_min;
+    model.alpha_max = alpha_max;
+    model.dead_elements = dead;
+    model.dead_rows = dead_rows;
+    model.dead_columns = dead_columns;
+    return simulate_scan(image, geometry_json, mu_scale, model, projector, engine, device);
+  });
+  m.def("center", [](const py::handle& measurement, const std::string& geometry_json) {
+    const Scan scan = scan_from(measurement, geometry_json);
+    CentreEstimate estimate;
+    {
+      py::gil_scoped_release release;
+      estimate = estimate_centre(scan);
+    }
+    return app::centre_json(estimate).dump();
+  });
+  // Raw intensities, flats and darks (None: D = 0) -> rho and the report's JSON.
+  m.def("flat_field", [](const py::handle& raw, const py::handle& flats, const py::object& darks) {
+    const Array projections = to_array(raw, "projections");
+    const Array flat = to_array(flats, "flat");
+    const Array dark = darks.is_none() ? Array() : to_array(darks, "dark");
+    FlatFieldReport report;
+    Array rho;
+    {
+      py::gil_scoped_release release;
+      rho = flat_field_normalise(projections, flat, dark, &report);
+    }
+    return py::make_tuple(to_numpy(std::move(rho)), app::flat_field_json(report).dump());
+  });
+  m.def("read_array", [](const std::string& path) {
+    ArrayFile file;
+    {
+      py::gil_scoped_release release;
+      file = read_array(path);
+    }
+    return py::make_tuple(to_numpy(std::move(file.array)), file.voxel_size, file.dtype);
+  });
+  m.def("write_array", [](const std::string& path, const py::handle& array,
+                          const std::vector<double>& voxel_size) {
+    const Array data = to_array(array, "array");
+    py::gil_scoped_release release;
+    write_array(path, data, {voxel_size});
+  });
+  m.def("compare", [](const py::handle& image, const py::handle& reference, bool circle) {
+    const Array a = to_array(image, "image");
+    const Array b = to_array(reference, "reference");
+    const Array mask = circle ? circle_mask(b.shape) : Array();
+    const ImageMetrics metrics = compare_images(a, b, circle ? &mask : nullptr);
+    py::dict out;
+    out["psnr"] = metrics.psnr;
+    out["ssim"] = metrics.ssim;
+    out["mae"] = metrics.mae;
+    out["rmse"] = metrics.rmse;
+    out["data_range"] = metrics.data_range;
+    out["pixels"] = metrics.pixels;
+    return out;
+  });
+}
+
+}  // namespace riner::python

@@ -1,0 +1,158 @@
+#include "summary_json.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "riner/execution_plan.hpp"
+#include "riner/fbp.hpp"
+
+namespace riner::app {
+
+namespace {
+
+nlohmann::json ring_summary(const std::optional<RingCorrection>& rings) {
+  if (!rings) return {{"applied", false}};
+  double largest = 0.0;
+  for (double v : rings->profile) largest = std::max(largest, std::fabs(v));
+  nlohmann::json out{{"applied", rings->applied},
+                     {"measured_radii", rings->measured_radii},
+                     {"mean_response_change", rings->mean_response_change},
+                     {"radius_step_mm", rings->radius_step_mm},
+                     {"largest_ring_per_mm", largest}};
+  // The detector-response correction's evidence (null: no odd structure at all).
+  if (rings->even_to_odd != 0.0) {
+    out["even_to_odd"] = std::isfinite(rings->even_to_odd) ? nlohmann::json(rings->even_to_odd)
+                                                           : nlohmann::json(nullptr);
+  }
+  return out;
+}
+
+nlohmann::json quality_summary(const QualityCheck& check) {
+  const QualityReport& q = check.image;
+  nlohmann::json out = {{"fbp_noise_per_mm", q.noise},
+                        {"ring_index", q.ring_index},
+                        {"fbp_ring_index", q.fbp_ring_index},
+                        {"specks_per_10k_pixels", q.specks_per_10k},
+                        {"fbp_specks_per_10k_pixels", q.fbp_specks_per_10k},
+                        {"centre", nullptr}};
+  if (check.field) {
+    out["centre"] = {{"radius_px", q.centre.radius_px},
+                     {"largest_broad_deviation_from_fbp_per_mm", q.centre.deviation},
+                     {"at_px", q.centre.at_px},
+                     {"fbp_profile_noise_per_mm", q.centre.fbp_noise},
+                     {"fbp_noise_sigmas", q.centre.sigmas},
+                     {"field_fbp_noise_sigmas", check.field->sigmas}};
+  }
+  return out;
+}
+
+}  // namespace
+
+QualityCheck check_quality(const Reconstructor& r, const ReconstructionResult& result,
+                           const std::optional<Device>& device) {
+  FbpOptions options;
+  options.engine = r.config().engine;
+  options.device = device;
+  const Array fbp_image = fbp(r.scan(), options);
+  QualityCheck check{quality_against_fbp(result.image, fbp_image), {}};
+  if (fbp_image.rank() == 2) check.field = centre_deviation(result.field_image, fbp_image);
+  return check;
+}
+
+nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& result,
+                           const QualityCheck& quality) {
+  const TrainingStats stats = r.stats();
+  const std::vector<DeadElement> dead_report = r.dead_element_report();
+  std::vector<std::size_t> dead;
+  for (const DeadElement& d : dead_report) dead.push_back(d.element);
+  const std::vector<LossRecord> history = r.history();
+  return {
+      {"shape", result.image.shape},
+      {"steps", stats.steps},
+      {"steps_planned", stats.steps_planned},
+      {"stopped_on_plateau", stats.stopped_on_plateau},
+      {"seconds", stats.seconds},
+      {"samples", stats.samples},
+      {"samples_per_second", stats.seconds > 0 ? stats.samples / stats.seconds : 0.0},
+      {"parameters", stats.parameters},
+      {"non_finite_measurements", stats.non_finite},
+      {"dead_elements", dead},
+      {"dead_element_reasons", dead_elements_json(dead_report)},
+      {"engine", stats.engine},
+      {"device", stats.device},
+      {"plan", stats.plan ? nlohmann::json::parse(stats.plan->to_json()) : nlohmann::json()},
+      {"skip_air",
+       {{"applied", stats.air_skipped},
+        {"grid_fraction_sampled", stats.inside_fraction},
+        {"samples_kept_fraction", stats.samples_kept_fraction},
+        {"noise_sigma", stats.noise},
+        {"note", r.config().training.skip_air ? stats.air_note : "off (training.skip_air)"}}},
+      {"coverage",
+       {{"rays", stats.coverage.rays},
+        {"rays_per_element_fewest", stats.coverage.fewest},
+        {"rays_per_element_median", stats.coverage.median},
+        {"rays_per_element_most", stats.coverage.most},
+        {"elements_under_10_rays", stats.coverage.elements_under_10}}},
+      {"memory",
+       {{"peak_host_mb", static_cast<double>(stats.peak_host_bytes) / 1048576.0},
+        {"peak_device_buffers_mb", static_cast<double>(stats.peak_device_bytes) / 1048576.0}}},
+      {"quality", quality_summary(quality)},
+      {"air_ring_correction", ring_summary(result.air_rings)},
+      {"gradient_ring_correction", ring_summary(result.gradient_rings)},
+      {"response_ring_correction", ring_summary(result.response_rings)},
+      {"final_loss", history.empty() ? 0.0 : history.back().data_loss}};
+}
+
+nlohmann::json dead_elements_json(const std::vector<DeadElement>& dead) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const DeadElement& d : dead) {
+    out.push_back({{"element", d.element},
+                   {"reason", d.reason},
+                   {"beta", d.beta},
+                   {"invalid_readings", d.invalid_readings}});
+  }
+  return out;
+}
+
+nlohmann::json centre_json(const CentreEstimate& e) {
+  return {{"offset_px", e.offset_px},
+          {"axis_column", e.axis_column},
+          {"spread_px", e.spread_px},
+          {"view_pairs", e.pairs},
+          {"rows", e.rows}};
+}
+
+nlohmann::json flat_field_json(const FlatFieldReport& r) {
+  return {{"flat_frames", r.flat_frames},
+          {"dark_frames", r.dark_frames},
+          {"invalid_readings", r.invalid_readings},
+          {"pixels_without_beam", r.pixels_without_beam}};
+}
+
+nlohmann::json device_json(const DeviceInfo& d) {
+  return {{"index", d.index},
+          {"platform", d.platform},
+          {"platform_version", d.platform_version},
+          {"name", d.name},
+          {"vendor", d.vendor},
+          {"type", d.type},
+          {"version", d.version},
+          {"driver_version", d.driver_version},
+          {"opencl_c_version", d.opencl_c_version},
+          {"compute_units", d.compute_units},
+          {"max_clock_mhz", d.max_clock_mhz},
+          {"max_work_group_size", d.max_work_group_size},
+          {"local_mem_bytes", d.local_mem_bytes},
+          {"local_mem_is_global", d.local_mem_is_global},
+          {"global_mem_bytes", d.global_mem_bytes},
+          {"max_alloc_bytes", d.max_alloc_bytes},
+          {"fp64", d.fp64},
+          {"preferred_vector_width_float", d.preferred_vector_width_float},
+          {"native_vector_width_float", d.native_vector_width_float},
+          {"preferred_vector_width_int", d.preferred_vector_width_int},
+          {"native_vector_width_int", d.native_vector_width_int},
+          {"fp32_global_atomic_add", d.fp32_global_atomic_add},
+          {"training_plan", nlohmann::json::parse(choose_execution_plan(d).to_json())}};
+}
+
+}  // namespace riner::app

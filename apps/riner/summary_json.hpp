@@ -1,0 +1,42 @@
+// The JSON riner reports, shared by the CLI and the Python module: a device's capabilities and
+// training plan, and what summary.json says about a reconstruction (the run: steps, time,
+// memory, coverage, air, dead elements; the ring corrections; the no-reference quality report
+// against the FBP of the same scan).
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <vector>
+
+#include "riner/centre.hpp"
+#include "riner/device.hpp"
+#include "riner/flat_field.hpp"
+#include "riner/quality.hpp"
+#include "riner/reconstructor.hpp"
+
+namespace riner::app {
+
+// `riner devices --json`: the capabilities riner relies on and the plan it would train with.
+nlohmann::json device_json(const DeviceInfo& device);
+
+// What a user without a ground truth can check (riner/quality.hpp): rings, specks and the
+// centre against the FBP of the same scan, for the image and (the centre, 2D) the trained field.
+struct QualityCheck {
+  QualityReport image;
+  std::optional<CentreDeviation> field;  // 2D only
+};
+
+QualityCheck check_quality(const Reconstructor& r, const ReconstructionResult& result,
+                           const std::optional<Device>& device);
+
+// Every field of summary.json that the reconstruction itself decides (the caller adds where
+// the outputs went, the flat field and the centre).
+nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& result,
+                           const QualityCheck& quality);
+
+// summary.json's account of each dead element: index, reason, beta, invalid readings.
+nlohmann::json dead_elements_json(const std::vector<DeadElement>& dead);
+nlohmann::json flat_field_json(const FlatFieldReport& report);
+nlohmann::json centre_json(const CentreEstimate& estimate);
+
+}  // namespace riner::app

@@ -1,0 +1,242 @@
+# The Python module against the CLI and against known answers; its error cases each raise the
+# stated exception. Run by ctest (label python) with the build's package on PYTHONPATH.
+import json
+import os
+import signal
+import subprocess
+import threading
+
+import numpy as np
+import pytest
+
+import riner
+
+
+def small_fan():
+    angles = np.linspace(0, 2 * np.pi, 120, endpoint=False)
+    return riner.divergent_beam(angles, columns=96, source_origin=150.0, origin_detector=150.0,
+                                image_shape=(64, 64), voxel_size=1.0)
+
+
+@pytest.fixture(scope="module")
+def fan_scan():
+    g = small_fan()
+    return riner.simulate(None, g, seed=3), g
+
+
+def test_devices_lists_the_opencl_devices_with_their_plans():
+    devices = riner.devices()
+    assert len(devices) >= 1
+    assert {"index", "name", "platform", "type", "training_plan"} <= set(devices[0])
+
+
+def test_settings_are_the_cli_table():
+    names = {s["name"] for s in riner.settings()}
+    assert {"training.steps", "training.seed", "training.alpha_lr_scale"} <= names
+
+
+def test_parallel_beam_puts_the_axis_at_center():
+    g = riner.parallel_beam(np.linspace(0, np.pi, 181), columns=640, center=295.6)
+    assert g["type"] == "parallel2d"
+    assert g["detector"]["offset_px"] == pytest.approx(23.9)  # tooth's geometry.json
+    assert g["volume"] == {"shape": [640, 640], "voxel_mm": 1.0}
+    g3 = riner.parallel_beam([0.0, 1.0], columns=8, rows=4, center=3.5)
+    assert g3["type"] == "parallel3d" and g3["volume"]["shape"] == [4, 8, 8]
+    assert g3["detector"]["offset_px"] == [0.0, 0.0]
+
+
+def test_geometry_from_preset_file_and_dict(tmp_path):
+    preset = riner.geometry("fan2d-paper")
+    path = tmp_path / "g.json"
+    path.write_text(json.dumps(preset))
+    assert riner.geometry(path) == preset
+    assert riner.geometry(str(path)) == riner.geometry(dict(preset))
+
+
+@pytest.mark.parametrize("change, message", [
+    ({"type": "fan9d"}, "type"),
+    ({"detector": {"count": 96, "pitch_mm": -2.0}}, "detector.pitch_mm must be > 0"),
+    ({"source_origin_mm": 0.0}, "source_origin_mm"),
+])
+def test_bad_geometry_raises_input_error(change, message):
+    g = dict(small_fan(), **change)
+    with pytest.raises(riner.InputError, match=message):
+        riner.geometry(g)
+    with pytest.raises(ValueError):  # InputError is a ValueError too
+        riner.geometry(g)
+
+
+def test_geometry_of_the_wrong_kind_raises_type_error():
+    with pytest.raises(TypeError, match="geometry must be"):
+        riner.geometry(42)
+    with pytest.raises(riner.InputError, match="preset"):
+        riner.geometry("fan2d-nonsense")
+
+
+def test_simulate_matches_the_cli_bit_for_bit(cli, tmp_path):
+    sim = riner.simulate(None, "fan2d-paper", seed=5)
+    subprocess.run([cli, "simulate", "--geometry", "fan2d-paper", "--seed", "5", "--out",
+                    str(tmp_path), "--quiet"], check=True)
+    assert np.array_equal(sim["sino"], riner.read_array(tmp_path / "sino.npy"))
+    assert np.array_equal(sim["alpha"], riner.read_array(tmp_path / "alpha.npy"))
+    assert (sim["alpha"] == 0).sum() == 2
+
+
+def test_fbp_matches_the_cli(cli, tmp_path, fan_scan):
+    sim, g = fan_scan
+    riner.write_array(tmp_path / "sino.npy", sim["sino"])
+    (tmp_path / "geometry.json").write_text(json.dumps(g))
+    subprocess.run([cli, "fbp", str(tmp_path / "sino.npy"), "--out", str(tmp_path / "fbp.npy"),
+                    "--quiet"], check=True)
+    assert np.array_equal(riner.fbp(sim["sino"], g), riner.read_array(tmp_path / "fbp.npy"))
+
+
+def test_arrays_come_out_as_float32_without_a_copy(tmp_path, fan_scan):
+    sim, g = fan_scan
+    image = riner.fbp(sim["sino"], g)
+    assert image.dtype == np.float32 and image.shape == (64, 64)
+    assert not image.flags.owndata and image.flags.c_contiguous  # riner's buffer, handed over
+    # Other real dtypes and layouts are converted: the same numbers give the same image.
+    assert np.array_equal(riner.fbp(sim["sino"].astype(np.float64), g), image)
+    assert np.array_equal(riner.fbp(np.asfortranarray(sim["sino"]), g), image)
+
+
+def test_reconstruct_returns_image_alpha_beta_summary(fan_scan):
+    sim, g = fan_scan
+    r = riner.reconstruct(sim["sino"], g, steps=300, seed=1)
+    image, alpha, beta, summary, field = r
+    assert image.shape == (64, 64) and field.shape == (64, 64)
+    assert alpha.shape == (96,) and beta.shape == (96,)
+    assert summary["steps"] == 300
+    # The two dead elements of the simulation are reported dead.
+    assert set(np.flatnonzero(sim["alpha"] == 0)) <= set(summary["dead_elements"])
+    assert summary["quality"]["ring_index"] < summary["quality"]["fbp_ring_index"]
+    fbp = riner.compare(riner.fbp(sim["sino"], g), sim["ground_truth"])["psnr"]
+    assert riner.compare(image, sim["ground_truth"])["psnr"] > fbp
+
+
+def test_the_gil_is_released_while_training(fan_scan):
+    sim, g = fan_scan
+    done = threading.Event()
+    ticks = 0
+
+    def train():
+        riner.reconstruct(sim["sino"], g, steps=600, quality=False)
+        done.set()
+
+    worker = threading.Thread(target=train)
+    worker.start()
+    while not done.is_set():
+        ticks += 1
+    worker.join()
+    assert ticks > 10000  # this thread kept running Python while the other trained
+
+
+def test_progress_callback_sees_every_report_and_can_stop_training(fan_scan):
+    sim, g = fan_scan
+    seen = []
+    r = riner.reconstruct(sim["sino"], g, steps=500, quality=False, progress_every=100,
+                          progress=lambda p: seen.append((p["step"], p["total"])))
+    assert seen == [(100, 500), (200, 500), (300, 500), (400, 500), (500, 500)]
+    r = riner.reconstruct(sim["sino"], g, steps=500, quality=False, progress_every=100,
+                          progress=lambda p: p["step"] < 200)
+    assert r.summary["steps"] == 200
+
+
+def test_an_exception_in_the_callback_aborts_training(fan_scan):
+    sim, g = fan_scan
+
+    def fail(progress):
+        raise ArithmeticError(f"stop at {progress['step']}")
+
+    with pytest.raises(ArithmeticError, match="stop at 50"):
+        riner.reconstruct(sim["sino"], g, steps=500, progress=fail, progress_every=50)
+
+
+def test_ctrl_c_cancels_training_cleanly(fan_scan):
+    sim, g = fan_scan
+    timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))
+    timer.start()
+    with pytest.raises(KeyboardInterrupt):
+        riner.reconstruct(sim["sino"], g, steps=10_000_000)
+    timer.join()
+    # Nothing is left in a bad state: the next run works.
+    assert riner.reconstruct(sim["sino"], g, steps=50, quality=False).summary["steps"] == 50
+
+
+@pytest.mark.parametrize("sino, error, message", [
+    (lambda s: s.astype(np.complex64), TypeError, "must hold real numbers"),
+    (lambda s: s.astype(bool), TypeError, "must hold real numbers"),
+    (lambda s: "a sinogram", TypeError, "must hold real numbers"),
+    (lambda s: s[:, :90], riner.InputError, r"shape \[120, 90\]"),
+    (lambda s: s[None], riner.InputError, "shape"),
+    (lambda s: np.full_like(s, np.nan), riner.InputError, "finite"),
+])
+def test_bad_measurements_raise(fan_scan, sino, error, message):
+    sim, g = fan_scan
+    with pytest.raises(error, match=message):
+        riner.reconstruct(sino(sim["sino"]), g, steps=10)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"stepz": 3}, "unknown setting 'stepz'"),
+    ({"steps": -3}, "training.steps must be in"),
+    ({"settings": {"training.sampler": "sideways"}}, "training.sampler"),
+    ({"device": "no such device anywhere"}, "no such device"),
+])
+def test_bad_settings_raise(fan_scan, kwargs, message):
+    sim, g = fan_scan
+    with pytest.raises(riner.Error, match=message):
+        riner.reconstruct(sim["sino"], g, **kwargs)
+
+
+def test_missing_and_corrupt_files_raise_input_error(tmp_path):
+    with pytest.raises(riner.InputError, match="missing.npy"):
+        riner.read_array(tmp_path / "missing.npy")
+    (tmp_path / "bad.npy").write_bytes(b"\x93NUMPY garbage")
+    with pytest.raises(riner.InputError, match="bad.npy"):
+        riner.read_array(tmp_path / "bad.npy")
+
+
+def test_flat_field_and_center_on_raw_parallel_projections():
+    angles = np.linspace(0, np.pi, 121)  # 180 degrees with the endpoint view
+    g = riner.parallel_beam(angles, columns=80, center=41.5, image_shape=(64, 64))
+    sim = riner.simulate(None, g, seed=2, photons=0, dead=0, nonideal_fraction=0)
+    flat = np.full((2, 80), 1000.0)
+    dark = np.full((80,), 100.0)
+    raw = dark + (flat[0] - dark) * np.exp(-sim["sino"])
+    rho, report = riner.flat_field(raw, flat, dark)
+    assert report["flat_frames"] == 2 and report["dark_frames"] == 1
+    assert np.allclose(rho, sim["sino"], atol=1e-4)
+    found = riner.center(raw, g, flat=flat, dark=dark)
+    assert found["axis_column"] == pytest.approx(41.5, abs=0.1)
+    assert found["offset_px"] == pytest.approx(g["detector"]["offset_px"], abs=0.1)
+
+
+def test_a_small_cone_beam_volume():
+    angles = np.linspace(0, 2 * np.pi, 60, endpoint=False)
+    g = riner.divergent_beam(angles, columns=40, rows=24, source_origin=100.0,
+                             origin_detector=100.0, image_shape=(16, 32, 32), voxel_size=1.0)
+    sim = riner.simulate(None, g, seed=1)
+    r = riner.reconstruct(sim["sino"], g, steps=100, seed=1)
+    assert r.image.shape == (16, 32, 32)
+    assert r.alpha.shape == (24, 40) and r.beta.shape == (24, 40)
+
+
+def test_deeplesion_slice_reconstructs_to_the_clis_psnr(cli, shared, tmp_path):
+    # The same scan, seed and settings through the CLI and through Python (300 steps here; the
+    # closing measurement at the defaults is in bench/RESULTS.md).
+    truth = riner.read_array(shared / "deeplesion" / "slice_0.nii") * 0.1  # 1/cm -> 1/mm
+    sim = riner.simulate(truth, "fan2d-paper", seed=0)
+    riner.write_array(tmp_path / "sino.npy", sim["sino"])
+    (tmp_path / "geometry.json").write_text(json.dumps(sim["geometry"]))
+    subprocess.run([cli, "reconstruct", str(tmp_path / "sino.npy"), "--steps", "300", "--seed",
+                    "7", "--format", "npy", "--out", str(tmp_path / "cli"), "--quiet"],
+                   check=True)
+    cli_image = riner.read_array(tmp_path / "cli" / "image.npy")
+    r = riner.reconstruct(sim["sino"], "fan2d-paper", steps=300, seed=7)
+    cli_psnr = riner.compare(cli_image, truth)["psnr"]
+    py_psnr = riner.compare(r.image, truth)["psnr"]
+    assert py_psnr == pytest.approx(cli_psnr, abs=0.01)
+    assert np.abs(r.image - cli_image).max() < 1e-4
+    assert np.array_equal(r.alpha, riner.read_array(tmp_path / "cli" / "alpha.npy"))
