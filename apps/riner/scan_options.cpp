@@ -4,7 +4,6 @@
 
 #include "riner/error.hpp"
 #include "riner/io.hpp"
-#include "riner/tomo_file.hpp"
 
 namespace riner::app {
 
@@ -33,66 +32,25 @@ void add_scan_options(Args& args) {
 }
 
 LoadedScan scan_from(const Args& args, const Console& console) {
-  const std::string flat = args.get("flat");
-  const std::string dark = args.get("dark");
-  const std::string path = args.get("SCAN");
-  std::optional<std::size_t> row;
+  ScanSource source{args.get("SCAN"), args.get("geometry"), args.get("flat"), args.get("dark"),
+                    std::nullopt, args.has("offset-px") ? args.get("offset-px") : ""};
   if (const std::string r = args.get("row"); !r.empty()) {
     const long n = args.integer("row");
     if (n < 0) throw UsageError("--row must be 0 or more");
-    row = static_cast<std::size_t>(n);
+    source.row = static_cast<std::size_t>(n);
   }
-  LoadedScan loaded;
-  FlatFieldReport report;
-  if (flat.empty() && is_hdf5_path(path) && !split_hdf5_dataset(path)) {
-    // A tomography file holds its own flats and darks.
-    if (!dark.empty()) throw UsageError("--dark needs --flat");
-    const TomoFile file = read_tomo_file(path);
-    if (file.flats.shape.empty()) {
-      throw InputError(path + ": the file holds no flat field (" + file.layout +
-                       "); pass one with --flat");
-    }
-    loaded.scan = raw_scan(Geometry::load(find_geometry(path, args.get("geometry"))),
-                           file.projections, file.flats, file.darks, row, path, &report);
-    loaded.flat_field = report;
-    console.line(file.layout + " file: " + flat_field_line(report));
-  } else if (flat.empty()) {
-    if (!dark.empty()) throw UsageError("--dark needs --flat (and SCAN holding raw projections)");
-    loaded.scan = load_scan(path, args.get("geometry"), row);
-  } else {
-    loaded.scan = load_raw_scan(path, flat, dark, args.get("geometry"), &report, row);
-    loaded.flat_field = report;
-    console.line(flat_field_line(report));
+  const bool scan_json = std::filesystem::path(source.path).extension() == ".json";
+  if (scan_json && !(source.flat.empty() && source.dark.empty() && source.geometry.empty())) {
+    throw UsageError("a scan JSON names its own data and geometry: drop --flat, --dark and "
+                     "--geometry");
   }
-  if (args.has("offset-px")) {
-    const std::string offset = args.get("offset-px");
-    if (offset == "auto") {
-      loaded.centre = estimate_centre(loaded.scan);
-      loaded.scan.geometry.offset_u = loaded.centre->offset_px;
-      console.line(centre_line(*loaded.centre));
-    } else if (!offset.empty()) {
-      loaded.scan.geometry.offset_u = args.number("offset-px");
-    }
+  if (!scan_json && !source.dark.empty() && source.flat.empty()) {
+    throw UsageError("--dark needs --flat (and SCAN holding raw projections)");
   }
+  if (source.offset_px != "auto" && !source.offset_px.empty()) args.number("offset-px");
+  LoadedScan loaded = load_scan_source(std::move(source));
+  for (const std::string& note : loaded.notes) console.line(note);
   return loaded;
-}
-
-std::string flat_field_line(const FlatFieldReport& r) {
-  return "raw projections: flat field of " + std::to_string(r.flat_frames) + " frame(s), " +
-         (r.dark_frames ? "dark field of " + std::to_string(r.dark_frames) + " frame(s)"
-                        : std::string("no dark field")) +
-         "; " + std::to_string(r.invalid_readings) +
-         " readings invalid (at or below the dark, or on " + std::to_string(r.pixels_without_beam) +
-         " pixels without beam)";
-}
-
-std::string centre_line(const CentreEstimate& e) {
-  char line[200];
-  std::snprintf(line, sizeof(line),
-                "centre of rotation: offset %.2f px (axis at column %.2f), spread %.2f px over "
-                "%zu view pair(s) x %zu row(s)",
-                e.offset_px, e.axis_column, e.spread_px, e.pairs, e.rows);
-  return line;
 }
 
 }  // namespace riner::app

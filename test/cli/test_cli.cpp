@@ -262,6 +262,32 @@ TEST_SUITE("cli") {
     const auto rec = nlohmann::json::parse(riner::test::read_bytes(dir / "raw/rec/summary.json"));
     CHECK(rec["flat_field"]["invalid_readings"] == 1);
     CHECK(rec["non_finite_measurements"] == 1);
+    // One scan JSON naming the same files (relative to it) gives the same image.
+    nlohmann::json scan = nlohmann::json::parse(riner::test::read_bytes(dir / "g3.json"));
+    scan["files"] = {{"projections", "projections"}, {"flat", "flat_*.tif"}, {"dark", "dark.npy"}};
+    riner::test::write_bytes(dir / "raw" / "scan.json", scan.dump());
+    REQUIRE(riner_cli("fbp " + raw + "/scan.json --out " + raw + "/fbp_scan.nii --quiet", dir)
+                .code == 0);
+    CHECK(riner::read_array(dir / "raw/fbp_scan.nii").array.data ==
+          riner::read_array(dir / "raw/fbp.nii").array.data);
+    expect_error(riner_cli("fbp " + raw + "/scan.json --flat " + raw + "/dark.npy --out " + raw +
+                               "/x.nii",
+                           dir),
+                 2, "a scan JSON names its own data and geometry");
+    scan["files"] = {{"projections", "projections"}, {"dark", "dark.npy"}};
+    riner::test::write_bytes(dir / "raw" / "no_flat.json", scan.dump());
+    expect_error(riner_cli("fbp " + raw + "/no_flat.json --out " + raw + "/x.nii", dir), 2,
+                 raw + "/no_flat.json: files.dark needs files.flat");
+    scan["files"] = {{"projections", "projections"}};
+    riner::test::write_bytes(dir / "raw" / "no_flat.json", scan.dump());
+    expect_error(riner_cli("fbp " + raw + "/no_flat.json --out " + raw + "/x.nii", dir), 2,
+                 raw + "/no_flat.json: files.projections needs files.flat");
+    scan["files"] = {{"measurement", "sino.npy"}, {"flats", "flat_0.tif"}};
+    riner::test::write_bytes(dir / "raw" / "typo.json", scan.dump());
+    expect_error(riner_cli("fbp " + raw + "/typo.json --out " + raw + "/x.nii", dir), 2,
+                 raw + "/typo.json: files.flats is not a scan file");
+    expect_error(riner_cli("fbp " + (dir / "g3.json").string() + " --out " + raw + "/x.nii", dir),
+                 2, (dir / "g3.json").string() + ": a geometry without \"files\"");
     // Bad raw input: one line, exit 2.
     expect_error(
         riner_cli("fbp " + raw + "/projections --dark " + raw + "/dark.npy --out " + raw + "/x.nii",

@@ -240,3 +240,29 @@ def test_deeplesion_slice_reconstructs_to_the_clis_psnr(cli, shared, tmp_path):
     assert py_psnr == pytest.approx(cli_psnr, abs=0.01)
     assert np.abs(r.image - cli_image).max() < 1e-4
     assert np.array_equal(r.alpha, riner.read_array(tmp_path / "cli" / "alpha.npy"))
+
+
+def test_load_scan_reads_a_tomography_file_and_finds_its_centre(shared):
+    sino, g, notes = riner.load_scan(shared / "tooth" / "tooth.h5", row=0, center="auto")
+    assert notes["flat_field"]["flat_frames"] == 10 and notes["flat_field"]["dark_frames"] == 10
+    assert np.allclose(sino, riner.read_array(shared / "tooth" / "sino_row0.npy"), atol=1e-5,
+                       equal_nan=True)
+    assert notes["centre"]["offset_px"] == pytest.approx(23.9, abs=1.0)  # geometry.json: 23.9
+    assert g["detector"]["offset_px"] == notes["centre"]["offset_px"]
+
+
+def test_load_scan_reads_a_scan_json_naming_raw_files(tmp_path):
+    g = riner.parallel_beam(np.linspace(0, np.pi, 31), columns=40, image_shape=(32, 32))
+    sim = riner.simulate(None, g, seed=4, photons=0, dead=0)
+    flat = np.full((40,), 5000.0, dtype=np.float32)
+    riner.write_array(tmp_path / "raw.npy", flat * np.exp(-sim["sino"]))
+    riner.write_array(tmp_path / "flat.npy", flat)
+    (tmp_path / "scan.json").write_text(json.dumps(
+        dict(g, files={"projections": "raw.npy", "flat": "flat.npy"})))
+    sino, geometry, notes = riner.load_scan(tmp_path / "scan.json")
+    assert np.allclose(sino, sim["sino"], atol=1e-4, equal_nan=True)
+    assert geometry == g and notes["flat_field"]["dark_frames"] == 0
+    with pytest.raises(riner.InputError, match="give no flat, dark or geometry"):
+        riner.load_scan(tmp_path / "scan.json", flat=tmp_path / "flat.npy")
+    with pytest.raises(riner.InputError, match="nothing.npy"):
+        riner.load_scan(tmp_path / "nothing.npy", geometry=tmp_path / "scan.json")

@@ -23,7 +23,7 @@ from ._riner import Error, InputError, OpenCLError
 __all__ = [
     "Error", "InputError", "OpenCLError", "Reconstruction",
     "devices", "settings", "geometry", "parallel_beam", "divergent_beam",
-    "reconstruct", "fbp", "simulate", "center", "flat_field",
+    "reconstruct", "fbp", "simulate", "center", "flat_field", "load_scan",
     "read_array", "write_array", "compare",
 ]
 __version__ = "0.1.0"
@@ -243,6 +243,25 @@ def reconstruct(sino, geometry, flat=None, dark=None, center=None, config=None, 
     summary = json.loads(summary)
     summary.update(notes)
     return Reconstruction(image, alpha, beta, summary, field)
+
+
+def load_scan(path, geometry=None, flat=None, dark=None, row=None, center=None):
+    """A scan from files, as `riner reconstruct SCAN` reads it: a measurement (.npy, .nii, .tif,
+    a TIFF folder or pattern, "file.h5:/dataset"), raw projections with flat (and dark) files,
+    a Data Exchange / NXtomo file with its own flats and darks, or a scan JSON naming its
+    files. geometry: a JSON path (default: geometry.json beside the scan); row: one detector
+    row of a stack (a 2D slice); center "auto" estimates the offset. Returns (sino, geometry
+    dict, notes dict with flat_field and centre)."""
+    if center not in (None, "auto"):
+        raise InputError(f"center must be None or 'auto' here (got {center!r}); "
+                         "set the geometry's detector.offset_px instead")
+    if dark is not None and flat is None and not os.fspath(path).endswith(".json"):
+        raise InputError("dark needs flat")
+    sino, geometry_json, notes = _riner.load_scan(
+        os.fspath(path), "" if geometry is None else os.fspath(geometry),
+        "" if flat is None else os.fspath(flat), "" if dark is None else os.fspath(dark),
+        row, "" if center is None else center)
+    return sino, json.loads(geometry_json), json.loads(notes)
 
 
 def read_array(path):

@@ -15,7 +15,8 @@ namespace py = pybind11;
 
 // devices(), settings(), the geometry helpers.
 void bind_environment(py::module_& m);
-// fbp(), simulate(), center(), flat_field(), read_array(), write_array(), compare().
+// fbp(), simulate(), center(), flat_field(), load_scan(), read_array(), write_array(),
+// compare().
 void bind_scan_functions(py::module_& m);
 // reconstruct(): training with the GIL released, progress callback, Ctrl-C.
 void bind_reconstruct(py::module_& m);

@@ -12,6 +12,7 @@
 #include "riner/metrics.hpp"
 #include "riner/phantom.hpp"
 #include "riner/simulate.hpp"
+#include "scan_source.hpp"
 #include "summary_json.hpp"
 
 namespace riner::python {
@@ -130,6 +131,22 @@ void bind_scan_functions(py::module_& m) {
       rho = flat_field_normalise(projections, flat, dark, &report);
     }
     return py::make_tuple(to_numpy(std::move(rho)), app::flat_field_json(report).dump());
+  });
+  // A scan as the CLI's SCAN options name it -> (measurement, geometry JSON, notes JSON).
+  m.def("load_scan", [](const std::string& path, const std::string& geometry,
+                        const std::string& flat, const std::string& dark,
+                        std::optional<std::size_t> row, const std::string& offset_px) {
+    app::LoadedScan loaded;
+    {
+      py::gil_scoped_release release;
+      loaded = app::load_scan_source({path, geometry, flat, dark, row, offset_px});
+    }
+    const nlohmann::json notes = {
+        {"flat_field", loaded.flat_field ? app::flat_field_json(*loaded.flat_field)
+                                         : nlohmann::json(nullptr)},
+        {"centre", loaded.centre ? app::centre_json(*loaded.centre) : nlohmann::json(nullptr)}};
+    return py::make_tuple(to_numpy(std::move(loaded.scan.measurement)),
+                          loaded.scan.geometry.to_json(), notes.dump());
   });
   m.def("read_array", [](const std::string& path) {
     ArrayFile file;

@@ -29,6 +29,24 @@ std::filesystem::path find_geometry(const std::filesystem::path& measurement,
 Scan load_scan(const std::filesystem::path& measurement, const std::filesystem::path& geometry = {},
                std::optional<std::size_t> row = {});
 
+// A scan JSON: a geometry file whose "files" member names the scan's data, so one file
+// describes a scan. Paths are relative to the JSON's folder; each may be a file, a folder of
+// TIFFs, a pattern or FILE.h5:/dataset:
+//   "files": {"measurement": "sino.npy"}                       (rho, log-normalised)
+//   "files": {"projections": "tiffs", "flat": "flat_*.tif", "dark": "dark.tif"}  (raw)
+//   "files": {"projections": "scan.h5"}           (a Data Exchange / NXtomo file's own fields)
+struct ScanFiles {
+  std::filesystem::path measurement;  // the log-normalised measurement, or
+  std::filesystem::path projections;  // raw intensities, with
+  std::filesystem::path flat;         // their flat field (may be empty for a tomography file)
+  std::filesystem::path dark;         // and dark field (may be empty: D = 0)
+};
+
+// The "files" of a scan JSON; std::nullopt when it has none. InputError naming the JSON for
+// a malformed block (not an object, an unknown or non-string member, both or neither of
+// measurement and projections, a flat or dark beside a measurement).
+std::optional<ScanFiles> read_scan_files(const std::filesystem::path& scan_json);
+
 // Checks a measurement array against its geometry (shape, at least one finite value).
 void check_scan(const Scan& scan, std::string_view what = "measurement");
 

@@ -1,5 +1,7 @@
 #include "riner/scan.hpp"
 
+#include <nlohmann/json.hpp>
+
 #include "io/file_access.hpp"
 #include "io/stack.hpp"
 
@@ -57,6 +59,47 @@ Scan load_scan(const std::filesystem::path& measurement, const std::filesystem::
   }
   check_scan(scan, measurement.string());
   return scan;
+}
+
+std::optional<ScanFiles> read_scan_files(const std::filesystem::path& scan_json) {
+  const std::string where = scan_json.string();
+  nlohmann::json root;
+  try {
+    root = nlohmann::json::parse(read_text(scan_json));
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(where + ": invalid JSON: " + e.what());
+  }
+  if (!root.is_object() || !root.contains("files")) return std::nullopt;
+  const nlohmann::json& files = root["files"];
+  if (!files.is_object()) throw InputError(where + ": files must be an object");
+  const std::filesystem::path folder = scan_json.parent_path();
+  ScanFiles out;
+  for (const auto& [key, value] : files.items()) {
+    std::filesystem::path* slot = key == "measurement"   ? &out.measurement
+                                  : key == "projections" ? &out.projections
+                                  : key == "flat"        ? &out.flat
+                                  : key == "dark"        ? &out.dark
+                                                         : nullptr;
+    if (!slot) {
+      throw InputError(where + ": files." + key +
+                       " is not a scan file (measurement, projections, flat, dark)");
+    }
+    if (!value.is_string() || value.get<std::string>().empty()) {
+      throw InputError(where + ": files." + key + " must be a path");
+    }
+    *slot = folder / value.get<std::string>();
+  }
+  if (out.measurement.empty() == out.projections.empty()) {
+    throw InputError(where + ": files needs either measurement (rho) or projections (raw)");
+  }
+  if (!out.measurement.empty() && !(out.flat.empty() && out.dark.empty())) {
+    throw InputError(where +
+                     ": files.flat and files.dark go with projections (raw), not measurement");
+  }
+  if (out.flat.empty() && !out.dark.empty()) {
+    throw InputError(where + ": files.dark needs files.flat");
+  }
+  return out;
 }
 
 }  // namespace riner
