@@ -87,6 +87,7 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
         {"samples_kept_fraction", stats.samples_kept_fraction},
         {"noise_sigma", stats.noise},
         {"note", r.config().training.skip_air ? stats.air_note : "off (training.skip_air)"}}},
+      {"alpha_rate", {{"scale", stats.alpha_rate}, {"stripe_rms", stats.stripe_rms}}},
       {"coverage",
        {{"rays", stats.coverage.rays},
         {"rays_per_element_fewest", stats.coverage.fewest},

@@ -90,6 +90,10 @@ struct TrainingStats {
   double samples_kept_fraction = 1.0;
   double noise = 0.0;  // the readings' noise sigma the carving used
   std::string air_note;
+  // alpha's learning rate over the field's as trained (training.alpha_lr_scale and the
+  // measurement's stripe evidence, training.alpha_stripe_scale) and that evidence.
+  double alpha_rate = 1.0;
+  double stripe_rms = 0.0;
   // Memory, so far: the process's peak resident set (host) and the most bytes of device
   // buffers it held at once (0 on the reference engine).
   std::size_t peak_host_bytes = 0;

@@ -81,6 +81,12 @@ struct TrainingConfig {
   // most where rays are longest; an element with invalid readings learns from the start (the
   // readings are the evidence).
   double alpha_lr_scale = 1.0;
+  // alpha's rate follows the evidence: it is further multiplied by min(1, stripe / this), where
+  // stripe is the RMS of the element-to-element offsets of the measurement's per-element means
+  // (model/stripe_evidence.hpp). Adam moves a parameter by about its rate whatever the
+  // gradient, so an alpha as fast as the field on a detector whose offsets are 0.002 learns
+  // the object's edges instead (the halo of bench/RESULTS.md, issue 13). 0 turns it off.
+  double alpha_stripe_scale = 0.05;
   double beta_lr_scale = 3.0;
   int alpha_warmup_steps = 0;
   int beta_warmup_steps = -1;  // -1: the first learning-rate phase (decay_interval())

@@ -100,8 +100,12 @@ void add_training_schedule(Table& t) {
   t.push_back(field<C>("training", "lambda", closed_open(0, 1e6),
                        "weight of the -beta^2 term (dead-element mask)", &C::training, &T::lambda));
   t.push_back(field<C>("training", "alpha_lr_scale", closed_open(0, 1000),
-                       "alpha's learning rate over the field's (0.3: fewer specks on real scans)",
-                       &C::training, &T::alpha_lr_scale));
+                       "alpha's learning rate over the field's", &C::training,
+                       &T::alpha_lr_scale));
+  t.push_back(field<C>("training", "alpha_stripe_scale", closed(0, 10),
+                       "alpha's rate is further scaled by min(1, the measurement's stripe RMS / "
+                       "this); 0: off",
+                       &C::training, &T::alpha_stripe_scale));
   t.push_back(field<C>("training", "beta_lr_scale", closed_open(0, 1000),
                        "beta's learning rate over the field's", &C::training, &T::beta_lr_scale));
   t.push_back(field<C>("training", "alpha_warmup_steps", closed(0, kMaxSteps),

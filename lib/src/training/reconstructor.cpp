@@ -276,6 +276,8 @@ TrainingStats Reconstructor::stats() const {
       setup.samples_in_grid > 0.0 ? setup.samples_kept / setup.samples_in_grid : 1.0;
   s.noise = setup.occupancy.noise;
   s.air_note = setup.occupancy.note;
+  s.alpha_rate = setup.alpha_rate;
+  s.stripe_rms = setup.stripe_rms;
   rusage usage{};
   if (getrusage(RUSAGE_SELF, &usage) == 0) {
     s.peak_host_bytes = static_cast<std::size_t>(usage.ru_maxrss) * 1024;  // kB on Linux

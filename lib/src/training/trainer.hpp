@@ -34,6 +34,8 @@ struct TrainingSetup {
   model::Occupancy occupancy;                   // where the object can be (all, without skip_air)
   double samples_in_grid = 0.0;                 // samples of every ray inside the grid
   double samples_kept = 0.0;                    // of those, inside the occupied region
+  double stripe_rms = 0.0;                      // model/stripe_evidence.hpp
+  double alpha_rate = 1.0;  // alpha_lr_scale times the stripe evidence's factor
 
   TrainingSetup(Scan scan, RinerConfig config);
   double learning_rate(int step) const;

@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "model/stripe_evidence.hpp"
 #include "riner/error.hpp"
 #include "training/trainer.hpp"
 
@@ -33,6 +34,11 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c) : scan(std::move(s)), config
         scan, {config.training.air_noise_sigmas, config.training.air_margin_px});
     samples_kept = model::clip_segments(segments, g, occupancy, config.training.sample_spacing);
   }
+  stripe_rms = model::stripe_rms(scan);
+  alpha_rate = config.training.alpha_lr_scale;
+  if (config.training.alpha_stripe_scale > 0) {
+    alpha_rate *= std::min(1.0, stripe_rms / config.training.alpha_stripe_scale);
+  }
   seed = static_cast<std::uint32_t>(config.training.seed ^ (config.training.seed >> 32));
   invalid_readings.assign(elements_per_view, 0);
   const std::vector<float>& rho = scan.measurement.data;
@@ -60,7 +66,7 @@ std::vector<float> TrainingSetup::level_weights(int step) const {
 AdamRates TrainingSetup::adam_rates(int step) const {
   const TrainingConfig& t = config.training;
   const double lr = learning_rate(step);
-  return {lr, step < t.alpha_warmup_steps ? 0.0 : lr * t.alpha_lr_scale, lr * t.beta_lr_scale};
+  return {lr, step < t.alpha_warmup_steps ? 0.0 : lr * alpha_rate, lr * t.beta_lr_scale};
 }
 
 }  // namespace riner::detail

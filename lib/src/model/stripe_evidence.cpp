@@ -1,0 +1,52 @@
+#include "model/stripe_evidence.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+namespace riner::model {
+
+double stripe_rms(const Scan& scan) {
+  const Geometry& g = scan.geometry;
+  const std::size_t views = g.n_views();
+  const std::size_t per_view = g.n_u * (g.is_3d() ? g.n_v : 1);
+  std::vector<double> sum(per_view, 0.0);
+  std::vector<char> finite(per_view, 1);
+  const std::vector<float>& rho = scan.measurement.data;
+  for (std::size_t v = 0; v < views; ++v) {
+    for (std::size_t e = 0; e < per_view; ++e) {
+      const float r = rho[v * per_view + e];
+      if (std::isfinite(r)) {
+        sum[e] += r;
+      } else {
+        finite[e] = 0;
+      }
+    }
+  }
+  constexpr std::size_t kWindow = 7;
+  double squares = 0.0;
+  std::size_t count = 0;
+  std::vector<double> row;
+  for (std::size_t r = 0; r < per_view / g.n_u; ++r) {
+    row.clear();
+    for (std::size_t u = 0; u < g.n_u; ++u) {
+      const std::size_t e = r * g.n_u + u;
+      if (finite[e]) row.push_back(sum[e] / static_cast<double>(views));
+    }
+    if (row.size() < kWindow) continue;
+    // Only where the window is centred: at a row's ends a sloping object would read as stripes.
+    for (std::size_t i = kWindow / 2; i + kWindow / 2 < row.size(); ++i) {
+      std::array<double, kWindow> window;
+      std::copy(row.begin() + static_cast<std::ptrdiff_t>(i - kWindow / 2),
+                row.begin() + static_cast<std::ptrdiff_t>(i + kWindow / 2 + 1), window.begin());
+      std::nth_element(window.begin(), window.begin() + kWindow / 2, window.end());
+      const double d = row[i] - window[kWindow / 2];
+      squares += d * d;
+      ++count;
+    }
+  }
+  return count > 0 ? std::sqrt(squares / static_cast<double>(count)) : 0.0;
+}
+
+}  // namespace riner::model

@@ -1,0 +1,16 @@
+// How large the detector's element-to-element offsets are, read off the measurement before
+// training: each element's mean reading over the views, less the median of the seven elements
+// centred on it along the row (what the object leaves is smooth across elements once averaged
+// over views; a ring-causing offset is not), as an RMS over the elements whose readings are
+// all finite. On the paper's simulated detectors (alpha ~ U[0.75, 1.25]) it reads ~0.12; on
+// the shared real scans 0.0015-0.0043 (bench/RESULTS.md, issue 13).
+#pragma once
+
+#include "riner/scan.hpp"
+
+namespace riner::model {
+
+// 0 when no row has seven elements with finite readings.
+double stripe_rms(const Scan& scan);
+
+}  // namespace riner::model
