@@ -173,17 +173,15 @@ int run_reconstruct(int argc, char** argv, int first) {
   const std::filesystem::path image_path = out / ("image." + format);
   write_array(image_path, image, {std::vector<double>(image.rank(), g.voxel_mm)});
   write_png(out / "image.png", image);
-  const std::vector<DeadElement> dead_report = reconstructor.dead_element_report();
-  std::vector<std::size_t> dead;
-  for (const DeadElement& d : dead_report) dead.push_back(d.element);
-  write_detector_outputs(out, alpha, reconstructor.beta(), dead);
-  write_history(out / "loss.csv", reconstructor.history());
-  write_text(out / "config.json", reconstructor.config().to_json());  // as resolved for the device
-
   const TrainingStats stats = reconstructor.stats();
   const QualityCheck quality = check_quality(reconstructor, result, device);
   nlohmann::json summary = {{"image", image_path.string()}};
   summary.update(run_summary(reconstructor, result, quality));
+  const std::vector<std::size_t> dead = summary["dead_elements"];
+  write_detector_outputs(out, alpha, reconstructor.beta(), dead);
+  write_history(out / "loss.csv", reconstructor.history());
+  write_text(out / "config.json", reconstructor.config().to_json());  // as resolved for the device
+
   summary["flat_field"] =
       loaded.flat_field ? flat_field_json(*loaded.flat_field) : nlohmann::json(nullptr);
   summary["centre"] = loaded.centre ? centre_json(*loaded.centre) : nlohmann::json(nullptr);

@@ -67,15 +67,18 @@ def _image_grid(columns, pitch, magnification, rows, image_shape, voxel_size):
     return {"shape": [int(n) for n in image_shape], "voxel_mm": float(voxel_size)}
 
 
-def _detector(columns, rows, pitch, center, row_center):
+def _offset(columns, center):
     # center: the 0-based, fractional column the rotation axis projects to (tomopy's and
     # algotom's "center"); riner's offset_px is its distance from the detector's middle.
-    offset = 0.0 if center is None else (columns - 1) / 2.0 - float(center)
+    return 0.0 if center is None else (columns - 1) / 2.0 - float(center)
+
+
+def _detector(columns, rows, pitch, center):
+    offset = _offset(columns, center)
     if rows is None:
         return {"count": int(columns), "pitch_mm": float(pitch), "offset_px": offset}
-    row_offset = 0.0 if row_center is None else (rows - 1) / 2.0 - float(row_center)
     return {"count": [int(columns), int(rows)], "pitch_mm": [float(pitch), float(pitch)],
-            "offset_px": [offset, row_offset]}
+            "offset_px": [offset, 0.0]}
 
 
 def parallel_beam(angles, columns, center=None, rows=None, pixel_size=1.0,
@@ -84,7 +87,7 @@ def parallel_beam(angles, columns, center=None, rows=None, pixel_size=1.0,
     the detector, center = the column the rotation axis projects to (0-based; default the
     middle), rows for a 3D stack, pixel_size in mm. The image defaults to columns x columns
     (x rows slices) of pixel_size."""
-    detector = _detector(columns, rows, pixel_size, center, None)
+    detector = _detector(columns, rows, pixel_size, center)
     return geometry({
         "type": "parallel2d" if rows is None else "parallel3d",
         "detector": detector,
@@ -101,7 +104,7 @@ def divergent_beam(angles, columns, source_origin, origin_detector, center=None,
     magnification = (source_origin + origin_detector) / source_origin
     return geometry({
         "type": "fan2d" if rows is None else "cone3d",
-        "detector": _detector(columns, rows, pixel_size, center, None),
+        "detector": _detector(columns, rows, pixel_size, center),
         "source_origin_mm": float(source_origin),
         "origin_detector_mm": float(origin_detector),
         "angles_rad": [float(a) for a in angles],
@@ -143,8 +146,7 @@ def _scan(sino, geometry_spec, flat, dark, center_spec):
             offset = notes["centre"]["offset_px"]
         else:
             columns = g["detector"]["count"]
-            columns = columns[0] if isinstance(columns, list) else columns
-            offset = (columns - 1) / 2.0 - float(center_spec)
+            offset = _offset(columns[0] if isinstance(columns, list) else columns, center_spec)
         if isinstance(g["detector"]["offset_px"], list):
             g["detector"]["offset_px"][0] = offset
         else:

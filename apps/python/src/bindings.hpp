@@ -8,6 +8,7 @@
 
 #include "riner/device.hpp"
 #include "riner/engine.hpp"
+#include "riner/scan.hpp"
 
 namespace riner::python {
 
@@ -20,6 +21,10 @@ void bind_environment(py::module_& m);
 void bind_scan_functions(py::module_& m);
 // reconstruct(): training with the GIL released, progress callback, Ctrl-C.
 void bind_reconstruct(py::module_& m);
+
+// A scan from a numpy measurement and geometry JSON, checked (check_scan) and its non-finite
+// readings counted.
+Scan scan_from(const py::handle& measurement, const std::string& geometry_json);
 
 // The device an engine runs on: none for the reference engine, else Device::open(selector).
 std::optional<Device> device_for(Engine engine, const std::string& selector);

@@ -77,8 +77,7 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
                       const std::string& engine, const std::string& device,
                       const py::object& progress, int progress_every, bool quality) {
   if (progress_every < 1) throw InputError("progress_every must be >= 1");
-  Scan scan{to_array(measurement, "sino"), Geometry::from_json(geometry_json, "geometry"), 0};
-  scan.non_finite = compute_stats(scan.measurement).non_finite();
+  Scan scan = scan_from(measurement, geometry_json);
   const RinerConfig config = config_from(config_json, settings, engine);
 
   std::unique_ptr<Reconstructor> reconstructor;

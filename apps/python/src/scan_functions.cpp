@@ -17,14 +17,14 @@
 
 namespace riner::python {
 
-namespace {
-
 Scan scan_from(const py::handle& measurement, const std::string& geometry_json) {
   Scan scan{to_array(measurement, "sino"), Geometry::from_json(geometry_json, "geometry"), 0};
   scan.non_finite = compute_stats(scan.measurement).non_finite();
   check_scan(scan, "sino");
   return scan;
 }
+
+namespace {
 
 py::array fbp_of(const py::handle& measurement, const std::string& geometry_json,
                  const std::string& filter, const std::string& engine,
