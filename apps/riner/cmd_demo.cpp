@@ -64,7 +64,8 @@ int run_demo(int argc, char** argv, int first) {
   }
   Reconstructor riner(sim.scan, config, device);
   {
-    Progress progress("riner", static_cast<std::size_t>(config.training.steps), console.quiet());
+    Progress progress("riner", static_cast<std::size_t>(riner.config().training.steps),
+                      console.quiet());
     riner.run(
         [&](const TrainingProgress& p) {
           progress.update(static_cast<std::size_t>(p.step));

@@ -103,8 +103,9 @@ int run_reconstruct(int argc, char** argv, int first) {
               "lists them)",
               "")
       .option("steps", "N",
-              "training steps (default " + std::to_string(RinerConfig().training.steps) +
-                  "; the learning rate halves every quarter of them)",
+              "training steps (default " + std::to_string(TrainingConfig::kSteps2d) +
+                  " for a slice, " + std::to_string(TrainingConfig::kSteps3d) +
+                  " for a volume; the learning rate halves every quarter of them)",
               "")
       .option("seed", "N", "random seed", "")
       .option("rays-per-step", "N",
@@ -153,7 +154,8 @@ int run_reconstruct(int argc, char** argv, int first) {
     }
   }
   {
-    Progress progress("reconstruct", static_cast<std::size_t>(config.training.steps),
+    Progress progress("reconstruct",
+                      static_cast<std::size_t>(reconstructor.config().training.steps),
                       console.quiet());
     reconstructor.run(
         [&](const TrainingProgress& p) {

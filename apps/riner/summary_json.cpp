@@ -88,6 +88,8 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
         {"noise_sigma", stats.noise},
         {"note", r.config().training.skip_air ? stats.air_note : "off (training.skip_air)"}}},
       {"alpha_rate", {{"scale", stats.alpha_rate}, {"stripe_rms", stats.stripe_rms}}},
+      {"level_warmup",
+       {{"steps", stats.level_warmup_steps}, {"relative_noise", stats.relative_noise}}},
       {"coverage",
        {{"rays", stats.coverage.rays},
         {"rays_per_element_fewest", stats.coverage.fewest},

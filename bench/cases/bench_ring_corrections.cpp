@@ -38,7 +38,7 @@ std::vector<Result> ring_corrections(const Options& o) {
   const int first = o.get_int("first", 0);
   const int last = o.get_int("last", o.size == "tiny" ? first : 9);
   riner::RinerConfig config = riner::bench::config_from(o);
-  if (o.size == "tiny") config.training.steps = std::min(config.training.steps, 200);
+  if (o.size == "tiny") config.training.steps = std::min(config.training.steps_for(false), 200);
   riner::Device device = riner::Device::open(o.device);
   const riner::Projector projector(riner::preset_geometry("fan2d-paper"), riner::Engine::kOpenCL,
                                    device);

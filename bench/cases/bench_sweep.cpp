@@ -79,7 +79,7 @@ std::vector<Result> sweep(const Options& o) {
     riner::RinerConfig config = defaults;
     if (sweep.contains("base")) config.update_from_json(sweep["base"].dump(), "sweep base");
     if (v.contains("config")) config.update_from_json(v["config"].dump(), name);
-    if (o.size == "tiny") config.training.steps = std::min(config.training.steps, 200);
+    if (o.size == "tiny") config.training.steps = std::min(config.training.steps_for(false), 200);
     config.validate();
     riner::Device device = riner::Device::open(v.value("device", o.device));
     const riner::Projector projector(riner::preset_geometry("fan2d-paper"), riner::Engine::kOpenCL,
@@ -91,8 +91,9 @@ std::vector<Result> sweep(const Options& o) {
       riner::Reconstructor r(scene.sim.scan, config, device);
       nlohmann::json curve = nlohmann::json::array();
       std::size_t k = 0;
-      while (r.steps_done() < config.training.steps) {
-        r.step(std::min(every, config.training.steps - r.steps_done()));
+      const int steps = r.config().training.steps;
+      while (r.steps_done() < steps) {
+        r.step(std::min(every, steps - r.steps_done()));
         const riner::ImageMetrics m = riner::compare_images(r.image(), scene.sim.ground_truth);
         if (k == mean.size()) mean.push_back({name, r.steps_done(), 0.0, 0.0, 0.0});
         mean[k].seconds += r.stats().seconds;

@@ -6,6 +6,7 @@
 #include "riner/metrics.hpp"
 #include "riner/reconstructor.hpp"
 #include "support/fixture.hpp"
+#include "support/geometries.hpp"
 #include "support/tiny_problem.hpp"
 #include "support/tolerances.hpp"
 
@@ -165,6 +166,26 @@ TEST_SUITE("riner_training") {
     CHECK_THROWS_WITH_AS(riner::Reconstructor(offside, c, riner::test::device()),
                          doctest::Contains("no detector ray crosses the reconstruction grid"),
                          riner::InputError);
+  }
+
+  TEST_CASE("training.steps -1 is the scan's: 24000 for a slice, 12000 for a volume") {
+    riner::RinerConfig c = riner::test::tiny_config();
+    c.training.steps = riner::TrainingConfig::kScanSteps;
+    c.training.lr_decay_steps = 0;
+    const riner::TrainingConfig& slice =
+        riner::Reconstructor(riner::test::tiny_problem(3).scan, c, riner::test::device())
+            .config()
+            .training;
+    CHECK(slice.steps == 24000);
+    CHECK(slice.decay_interval() == 6000);  // a quarter of the resolved steps
+    const riner::Geometry g = riner::test::small_cone3d();
+    riner::Array sino(g.measurement_shape());
+    for (std::size_t i = 0; i < sino.size(); ++i) sino.data[i] = 0.1f + 0.01f * (i % 7);
+    const riner::Scan volume{sino, g, 0};
+    CHECK(riner::Reconstructor(volume, c, riner::test::device()).config().training.steps ==
+          12000);
+    c.training.steps = 77;  // an explicit count stays
+    CHECK(riner::Reconstructor(volume, c, riner::test::device()).config().training.steps == 77);
   }
 
   TEST_CASE("zero steps leave the initial field; alpha and beta start at 1 and sigmoid(1)") {

@@ -142,3 +142,35 @@ TEST_SUITE("occupancy") {
     CHECK(kept >= inside_samples);
   }
 }
+
+TEST_SUITE("occupancy output") {
+  TEST_CASE("the output ramps to 0 over the region's outer voxels; 0 outside; deep voxels kept") {
+    // A 9 x 9 region (rows and columns 2..10) in a 13 x 13 grid; the image is all 3.
+    riner::model::Occupancy o;
+    o.carved = true;
+    o.inside.assign(13 * 13, 0);
+    for (int r = 2; r <= 10; ++r)
+      for (int c = 2; c <= 10; ++c) o.inside[static_cast<std::size_t>(r * 13 + c)] = 1;
+    std::vector<float> image(13 * 13, 3.0f);
+    riner::model::fade_into_skipped_air(o, {13, 13}, 2, image);
+    auto at = [&](int r, int c) { return image[static_cast<std::size_t>(r * 13 + c)]; };
+    CHECK(at(0, 0) == 0.0f);
+    CHECK(at(1, 6) == 0.0f);
+    CHECK(at(2, 6) == doctest::Approx(1.0));  // outline: depth 1 of 3
+    CHECK(at(2, 2) == doctest::Approx(1.0));  // a corner too
+    CHECK(at(3, 6) == doctest::Approx(2.0));
+    CHECK(at(4, 6) == doctest::Approx(3.0));
+    CHECK(at(6, 6) == doctest::Approx(3.0));
+    // No taper: a step, as before; and nothing at all without carving.
+    std::fill(image.begin(), image.end(), 3.0f);
+    riner::model::fade_into_skipped_air(o, {13, 13}, 0, image);
+    CHECK(at(2, 6) == 3.0f);
+    CHECK(at(1, 6) == 0.0f);
+    o.carved = false;
+    std::fill(image.begin(), image.end(), 3.0f);
+    riner::model::fade_into_skipped_air(o, {13, 13}, 2, image);
+    CHECK(at(0, 0) == 3.0f);
+    CHECK(riner::model::air_taper_px(4) == 2);
+    CHECK(riner::model::air_taper_px(1) == 0);
+  }
+}

@@ -90,7 +90,7 @@ TEST_SUITE("riner_config") {
            "samplers' rays per step; 0: the execution plan's)");
     // A value beyond an int's range is refused, not wrapped.
     expect(R"({"training": {"steps": 5000000000}})",
-           "c.json: config: training.steps must be in 0..10000000 (training steps)");
+           "c.json: config: training.steps must be in -1..10000000 (training steps; -1: the scan's, 24000 in 2D, 12000 in 3D)");
     expect(R"({"training": {"seed": -1}})",
            "c.json: config: training.seed must be in 0..1.84467e+19 (seed of the initial "
            "weights and the sampler)");

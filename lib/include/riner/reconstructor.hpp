@@ -94,6 +94,10 @@ struct TrainingStats {
   // measurement's stripe evidence, training.alpha_stripe_scale) and that evidence.
   double alpha_rate = 1.0;
   double stripe_rms = 0.0;
+  // Coarse to fine as trained (training.level_warmup_steps) and the noise evidence that set it
+  // when -1: the readings' noise sigma over their 99th percentile.
+  int level_warmup_steps = 0;
+  double relative_noise = 0.0;
   // Memory, so far: the process's peak resident set (host) and the most bytes of device
   // buffers it held at once (0 on the reference engine).
   std::size_t peak_host_bytes = 0;

@@ -49,7 +49,13 @@ enum class Sampler {
 };
 
 struct TrainingConfig {
-  int steps = 24000;
+  // -1: the scan's (kSteps2d or kSteps3d, filled in by the Reconstructor). 3D has its own
+  // because a step there draws its rays over ~100x the detector elements of a slice: the paper's
+  // 3D protocol reaches 37.4 dB at 12 000 steps in under 10 min on 2 cores (bench/RESULTS.md).
+  static constexpr int kScanSteps = -1;
+  static constexpr int kSteps2d = 24000;
+  static constexpr int kSteps3d = 12000;
+  int steps = kScanSteps;
   Sampler sampler = Sampler::kEven;
   int rays_per_step =
       0;  // uniform and even samplers; 0: the execution plan's (riner/execution_plan.hpp)
@@ -94,7 +100,13 @@ struct TrainingConfig {
   // [(l - 1) k, l k] with k = level_warmup_steps (its features are scaled by 0 .. 1), so the
   // image can hold fine structure, rings included, only after alpha has had time to explain
   // the per-element offsets.
-  int level_warmup_steps = 0;
+  // -1: by the noise evidence (model/noise_evidence.hpp): steps / 24 when the readings' noise
+  // is at least level_warmup_noise of their 99th percentile, else 0. On the noisy real scans
+  // (4e-3 to 7e-3) the finest levels draw the noise as sharp specks before the coarse ones
+  // hold the image; the paper's simulated scans (1e-4) keep their training as it was. Longer
+  // warm-ups (steps / 12) leave over- and undershoots at sharp edges (bench/RESULTS.md).
+  int level_warmup_steps = -1;
+  double level_warmup_noise = 0.001;
   // Stop on a plateau instead of at `steps`: in the last learning-rate phase, every
   // plateau_window steps (0: a quarter of the phase), training ends when the mean data loss of
   // the latest window is less than plateau_tolerance (relative) below the window's before.
@@ -116,6 +128,12 @@ struct TrainingConfig {
   double relative_beta_threshold = 0.0;
   std::uint64_t seed = 0;
 
+  // Steps for a scan of this dimension: `steps`, or the dimension's default when it is -1.
+  int steps_for(bool is_3d) const {
+    if (steps != kScanSteps) return steps;
+    return is_3d ? kSteps3d : kSteps2d;
+  }
+  // Needs `steps` resolved (steps_for); the Reconstructor's config always is.
   int decay_interval() const {
     return lr_decay_steps > 0 ? lr_decay_steps : std::max(1, steps / 4);
   }

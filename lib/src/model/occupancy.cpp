@@ -263,6 +263,26 @@ Occupancy carve_occupancy(const Scan& scan, const OccupancySettings& settings) {
   return o;
 }
 
+void fade_into_skipped_air(const Occupancy& occupancy, const std::vector<std::size_t>& shape,
+                           int taper_px, std::vector<float>& image) {
+  if (!occupancy.carved) return;
+  if (taper_px <= 0) {
+    for (std::size_t i = 0; i < image.size(); ++i) {
+      if (!occupancy.inside[i]) image[i] = 0.0f;
+    }
+    return;
+  }
+  // Depth of each voxel in the region: chessboard distance to the nearest voxel outside it
+  // (1 on its outline, 0 outside).
+  std::vector<std::uint8_t> outside(occupancy.inside.size());
+  for (std::size_t i = 0; i < outside.size(); ++i) outside[i] = occupancy.inside[i] ? 0 : 1;
+  const std::vector<std::uint16_t> depth = distance_to_inside(outside, shape);
+  const double ramp = 1.0 / (taper_px + 1.0);
+  for (std::size_t i = 0; i < image.size(); ++i) {
+    if (depth[i] <= taper_px) image[i] = static_cast<float>(image[i] * depth[i] * ramp);
+  }
+}
+
 double clip_segments(std::vector<RaySegment>& segments, const Geometry& g,
                      const Occupancy& occupancy, double spacing_voxels) {
   double samples = 0.0;

@@ -45,6 +45,16 @@ struct Occupancy {
 
 Occupancy carve_occupancy(const Scan& scan, const OccupancySettings& settings);
 
+// The image on the region as the output shows it: 0 in the air training skipped and, over the
+// region's outermost `taper_px` voxels (the margin's outer part, air the readings certified
+// too), a linear ramp down to that 0. A hard step at the margin's outline would leave its
+// corners as isolated pixels above the dark air (measured: the HTC disc's "specks").
+void fade_into_skipped_air(const Occupancy& occupancy, const std::vector<std::size_t>& shape,
+                           int taper_px, std::vector<float>& image);
+
+// The taper the margin leaves room for: half of it, at most 2 voxels.
+inline int air_taper_px(int margin_px) { return margin_px >= 4 ? 2 : margin_px / 2; }
+
 // Keeps each segment's samples from its first to its last inside the region (none when it
 // misses it: count 0). Returns the samples left, summed over all rays.
 double clip_segments(std::vector<RaySegment>& segments, const Geometry& g,

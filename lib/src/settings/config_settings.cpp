@@ -49,7 +49,8 @@ void add_network(Table& t) {
 
 // How a step samples rays along them.
 void add_training_sampling(Table& t) {
-  t.push_back(field<C>("training", "steps", closed(0, kMaxSteps), "training steps", &C::training,
+  t.push_back(field<C>("training", "steps", closed(-1, kMaxSteps),
+                       "training steps; -1: the scan's, 24000 in 2D, 12000 in 3D", &C::training,
                        &T::steps));
   t.push_back(enum_choice<C>(
       "training", "sampler",
@@ -115,9 +116,14 @@ void add_training_schedule(Table& t) {
                        "beta of elements with valid readings stays put for these steps; -1: the "
                        "first learning-rate phase",
                        &C::training, &T::beta_warmup_steps));
-  t.push_back(field<C>("training", "level_warmup_steps", closed(0, kMaxSteps),
-                       "coarse to fine: each finer level fades in over these steps; 0: off",
+  t.push_back(field<C>("training", "level_warmup_steps", closed(-1, kMaxSteps),
+                       "coarse to fine: each finer level fades in over these steps; 0: off; -1: "
+                       "steps / 24 when the readings are noisy (level_warmup_noise), else 0",
                        &C::training, &T::level_warmup_steps));
+  t.push_back(field<C>("training", "level_warmup_noise", closed(0, 1),
+                       "level_warmup_steps -1: coarse to fine when the readings' noise is at "
+                       "least this fraction of their 99th percentile",
+                       &C::training, &T::level_warmup_noise));
   t.push_back(field<C>("training", "stop_on_plateau", {},
                        "stop in the last learning-rate phase when the loss stops falling",
                        &C::training, &T::stop_on_plateau));

@@ -54,7 +54,8 @@ struct Reconstructor::Impl {
 
 namespace {
 
-// The settings left to the device (rays_per_step = 0) filled in from its execution plan.
+// The settings left to the device (rays_per_step = 0) filled in from its execution plan (those
+// left to the scan: TrainingSetup).
 RinerConfig resolved(RinerConfig config, const std::optional<ExecutionPlan>& plan) {
   if (config.training.rays_per_step == 0) {
     config.training.rays_per_step = plan ? plan->rays_per_step : ExecutionPlan::kCpuRaysPerStep;
@@ -143,7 +144,9 @@ Array Reconstructor::field_image() const {
   const Geometry& g = impl_->setup.scan.geometry;
   Array out(g.volume_shape);
   out.data = impl_->trainer->evaluate_grid();
-  impl_->zero_skipped_air(out);
+  model::fade_into_skipped_air(impl_->setup.occupancy, g.volume_shape,
+                               model::air_taper_px(impl_->setup.config.training.air_margin_px),
+                               out.data);
   return out;
 }
 
@@ -278,6 +281,8 @@ TrainingStats Reconstructor::stats() const {
   s.air_note = setup.occupancy.note;
   s.alpha_rate = setup.alpha_rate;
   s.stripe_rms = setup.stripe_rms;
+  s.level_warmup_steps = setup.config.training.level_warmup_steps;
+  s.relative_noise = setup.noise.relative;
   rusage usage{};
   if (getrusage(RUSAGE_SELF, &usage) == 0) {
     s.peak_host_bytes = static_cast<std::size_t>(usage.ru_maxrss) * 1024;  // kB on Linux

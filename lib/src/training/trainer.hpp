@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "model/batch_sampler.hpp"
+#include "model/noise_evidence.hpp"
 #include "model/occupancy.hpp"
 #include "model/parameter_layout.hpp"
 #include "model/ray_segments.hpp"
@@ -36,6 +37,7 @@ struct TrainingSetup {
   double samples_kept = 0.0;                    // of those, inside the occupied region
   double stripe_rms = 0.0;                      // model/stripe_evidence.hpp
   double alpha_rate = 1.0;  // alpha_lr_scale times the stripe evidence's factor
+  model::NoiseEvidence noise;  // model/noise_evidence.hpp; sets level_warmup_steps -1
 
   TrainingSetup(Scan scan, RinerConfig config);
   double learning_rate(int step) const;

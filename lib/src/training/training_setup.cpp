@@ -13,6 +13,7 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c) : scan(std::move(s)), config
   check_scan(scan);
   const Geometry& g = scan.geometry;
   elements_per_view = g.n_u * (g.is_3d() ? g.n_v : 1);
+  config.training.steps = config.training.steps_for(g.is_3d());
   if (config.encoding.finest_resolution == 0) {
     const std::size_t largest = *std::max_element(g.volume_shape.begin(), g.volume_shape.end());
     config.encoding.finest_resolution =
@@ -38,6 +39,11 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c) : scan(std::move(s)), config
   alpha_rate = config.training.alpha_lr_scale;
   if (config.training.alpha_stripe_scale > 0) {
     alpha_rate *= std::min(1.0, stripe_rms / config.training.alpha_stripe_scale);
+  }
+  noise = model::reading_noise(scan);
+  if (config.training.level_warmup_steps < 0) {
+    config.training.level_warmup_steps =
+        noise.relative >= config.training.level_warmup_noise ? config.training.steps / 24 : 0;
   }
   seed = static_cast<std::uint32_t>(config.training.seed ^ (config.training.seed >> 32));
   invalid_readings.assign(elements_per_view, 0);
