@@ -53,13 +53,15 @@ struct ReconstructionResult {
   std::optional<RingCorrection> response_rings;
 };
 
-// An element taken for dead, and why: its readings are all non-finite, or training switched it
-// off (beta below Reconstructor::kDeadBelowBeta).
+// An element taken for dead, and why: its readings are all non-finite, they stay steady while
+// its neighbours' vary (training.stuck_elements), or training switched it off (beta below
+// Reconstructor::kDeadBelowBeta).
 struct DeadElement {
   std::size_t element = 0;  // flat index ([n_u] in 2D, row-major [n_v, n_u] in 3D)
   double beta = 0.0;
   std::size_t invalid_readings = 0;  // non-finite readings, of one per view
-  std::string reason;                // "no finite reading" or "beta below 0.5"
+  std::string reason;  // "no finite reading", "stuck: steady while its neighbours vary" or
+                       // "beta below 0.5"
 };
 
 // How the training's rays covered the detector: an element's (pixel's, in 3D) alpha and beta

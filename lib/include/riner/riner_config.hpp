@@ -93,6 +93,10 @@ struct TrainingConfig {
   // gradient, so an alpha as fast as the field on a detector whose offsets are 0.002 learns
   // the object's edges instead (the halo of bench/RESULTS.md, issue 13). 0 turns it off.
   double alpha_stripe_scale = 0.05;
+  // Elements whose readings stay steady while their neighbours on both sides vary (a dead,
+  // hot or stuck pixel, row or column; model/stuck_elements.hpp) are taken for dead before
+  // training: their readings count as invalid, like non-finite ones.
+  bool stuck_elements = true;
   double beta_lr_scale = 3.0;
   int alpha_warmup_steps = 0;
   int beta_warmup_steps = -1;  // -1: the first learning-rate phase (decay_interval())

@@ -107,6 +107,10 @@ void add_training_schedule(Table& t) {
                        "alpha's rate is further scaled by min(1, the measurement's stripe RMS / "
                        "this); 0: off",
                        &C::training, &T::alpha_stripe_scale));
+  t.push_back(field<C>("training", "stuck_elements", {},
+                       "elements steady over the views while their neighbours vary are dead "
+                       "before training",
+                       &C::training, &T::stuck_elements));
   t.push_back(field<C>("training", "beta_lr_scale", closed_open(0, 1000),
                        "beta's learning rate over the field's", &C::training, &T::beta_lr_scale));
   t.push_back(field<C>("training", "alpha_warmup_steps", closed(0, kMaxSteps),

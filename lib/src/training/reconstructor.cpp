@@ -86,8 +86,14 @@ void Reconstructor::step(int n) {
   const auto start = std::chrono::steady_clock::now();
   for (int i = 0; i < n; ++i) {
     const int index = impl_->steps;
-    const model::Batch batch = impl_->sampler.batch(static_cast<std::uint32_t>(index));
+    model::Batch batch = impl_->sampler.batch(static_cast<std::uint32_t>(index));
     const std::size_t per_view = impl_->setup.elements_per_view;
+    // A stuck element's readings say nothing; read as 0 they would pull the field to 0.
+    if (impl_->setup.stuck_count > 0) {
+      for (std::size_t b = 0; b < batch.rays.size(); ++b) {
+        if (impl_->setup.stuck[batch.rays[b] % per_view]) batch.weights[b] = 0.0f;
+      }
+    }
     for (std::uint32_t r : batch.rays) {
       impl_->samples += impl_->setup.segments[r].count;
       ++impl_->element_rays[r % per_view];
@@ -224,10 +230,14 @@ std::vector<DeadElement> Reconstructor::dead_element_report() const {
   const std::vector<std::uint32_t>& invalid = impl_->setup.invalid_readings;
   const std::size_t views = impl_->setup.scan.geometry.n_views();
   std::vector<DeadElement> dead;
+  const std::vector<std::uint8_t>& stuck = impl_->setup.stuck;
   for (std::size_t e = 0; e < b.size(); ++e) {
     const bool no_reading = invalid[e] == views;
     if (!no_reading && !(b.data[e] < kDeadBelowBeta)) continue;
-    dead.push_back({e, b.data[e], invalid[e], no_reading ? "no finite reading" : "beta below 0.5"});
+    const char* reason = stuck[e]     ? "stuck: steady while its neighbours vary"
+                         : no_reading ? "no finite reading"
+                                      : "beta below 0.5";
+    dead.push_back({e, b.data[e], stuck[e] ? 0 : invalid[e], reason});
   }
   return dead;
 }

@@ -38,6 +38,8 @@ struct TrainingSetup {
   double stripe_rms = 0.0;                      // model/stripe_evidence.hpp
   double alpha_rate = 1.0;  // alpha_lr_scale times the stripe evidence's factor
   model::NoiseEvidence noise;  // model/noise_evidence.hpp; sets level_warmup_steps -1
+  std::vector<std::uint8_t> stuck;  // per element, model/stuck_elements.hpp (readings now NaN)
+  std::size_t stuck_count = 0;
 
   TrainingSetup(Scan scan, RinerConfig config);
   double learning_rate(int step) const;

@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include "model/stripe_evidence.hpp"
+#include "model/stuck_elements.hpp"
 #include "riner/error.hpp"
 #include "training/trainer.hpp"
 
@@ -29,6 +30,23 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c) : scan(std::move(s)), config
     throw InputError("no detector ray crosses the reconstruction grid: check the geometry");
   for (const model::RaySegment& segment : segments) samples_in_grid += segment.count;
   samples_kept = samples_in_grid;
+  noise = model::reading_noise(scan);
+  if (config.training.level_warmup_steps < 0) {
+    config.training.level_warmup_steps =
+        noise.relative >= config.training.level_warmup_noise ? config.training.steps / 24 : 0;
+  }
+  // Before carving: a pixel stuck at the flat reads air through the object.
+  if (config.training.stuck_elements) {
+    stuck = model::stuck_elements(scan, noise.sigma);
+    std::vector<float>& rho = scan.measurement.data;
+    for (std::size_t e = 0; e < elements_per_view; ++e) {
+      if (!stuck[e]) continue;
+      ++stuck_count;
+      for (std::size_t i = e; i < rho.size(); i += elements_per_view) rho[i] = NAN;
+    }
+  } else {
+    stuck.assign(elements_per_view, 0);
+  }
   occupancy.inside.assign(shape_size(g.volume_shape), 1);
   if (config.training.skip_air) {
     occupancy = model::carve_occupancy(
@@ -39,11 +57,6 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c) : scan(std::move(s)), config
   alpha_rate = config.training.alpha_lr_scale;
   if (config.training.alpha_stripe_scale > 0) {
     alpha_rate *= std::min(1.0, stripe_rms / config.training.alpha_stripe_scale);
-  }
-  noise = model::reading_noise(scan);
-  if (config.training.level_warmup_steps < 0) {
-    config.training.level_warmup_steps =
-        noise.relative >= config.training.level_warmup_noise ? config.training.steps / 24 : 0;
   }
   seed = static_cast<std::uint32_t>(config.training.seed ^ (config.training.seed >> 32));
   invalid_readings.assign(elements_per_view, 0);

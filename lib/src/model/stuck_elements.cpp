@@ -1,0 +1,66 @@
+#include "model/stuck_elements.hpp"
+
+#include <cmath>
+#include <limits>
+
+namespace riner::model {
+
+namespace {
+
+constexpr double kSteadyFraction = 0.05;
+constexpr double kJudgedNoiseSigmas = 10.0;
+constexpr long kFarthestNeighbour = 2;
+
+}  // namespace
+
+std::vector<std::uint8_t> stuck_elements(const Scan& scan, double noise_sigma) {
+  const Geometry& g = scan.geometry;
+  const std::size_t views = g.n_views();
+  const long columns = static_cast<long>(g.n_u);
+  const long rows = g.is_3d() ? static_cast<long>(g.n_v) : 1;
+  const std::size_t per_view = static_cast<std::size_t>(rows * columns);
+  std::vector<std::uint8_t> stuck(per_view, 0);
+  if (views < 2) return stuck;
+  // Variance over the views; NaN where any reading is not finite.
+  std::vector<double> sum(per_view, 0.0), squares(per_view, 0.0);
+  const std::vector<float>& rho = scan.measurement.data;
+  for (std::size_t v = 0; v < views; ++v) {
+    for (std::size_t e = 0; e < per_view; ++e) {
+      const double x = rho[v * per_view + e];
+      sum[e] += x;  // a non-finite reading makes the sum non-finite
+      squares[e] += x * x;
+    }
+  }
+  std::vector<double> variance(per_view);
+  const double n = static_cast<double>(views);
+  for (std::size_t e = 0; e < per_view; ++e) {
+    const double mean = sum[e] / n;
+    variance[e] = std::isfinite(mean) ? std::max(0.0, squares[e] / n - mean * mean)
+                                      : std::numeric_limits<double>::quiet_NaN();
+  }
+  const double judged = kJudgedNoiseSigmas * kJudgedNoiseSigmas * noise_sigma * noise_sigma;
+  auto at = [&](long r, long c) {
+    if (r < 0 || r >= rows || c < 0 || c >= columns) return std::numeric_limits<double>::quiet_NaN();
+    return variance[static_cast<std::size_t>(r * columns + c)];
+  };
+  for (long r = 0; r < rows; ++r) {
+    for (long c = 0; c < columns; ++c) {
+      const double own = at(r, c);
+      if (!std::isfinite(own)) continue;
+      bool found = false;
+      for (long d = 1; d <= kFarthestNeighbour && !found; ++d) {
+        const double pairs[2][2] = {{at(r, c - d), at(r, c + d)}, {at(r - d, c), at(r + d, c)}};
+        for (const auto& pair : pairs) {
+          const double weaker = std::fmin(pair[0], pair[1]);
+          // fmin ignores one NaN; both neighbours must be there.
+          if (!std::isfinite(pair[0]) || !std::isfinite(pair[1])) continue;
+          if (weaker > judged && own < kSteadyFraction * weaker) found = true;
+        }
+      }
+      stuck[static_cast<std::size_t>(r * columns + c)] = found;
+    }
+  }
+  return stuck;
+}
+
+}  // namespace riner::model
