@@ -152,7 +152,7 @@ TEST_SUITE("cli") {
     CHECK(clean(0, 249) == doctest::Approx(128 * 0.02).epsilon(0.02));
   }
 
-  TEST_CASE("3D: mismatched stacks exit 2; a detector row that reads NaN is dead, and said so") {
+  TEST_CASE("3D: mismatched stacks exit 2; rows that read NaN or stay steady are dead, and said so") {
     riner::test::TempDir dir;
     riner::test::write_bytes(dir / "g3.json", R"({"type": "cone3d",
       "detector": {"count": [30, 20], "pitch_mm": [2.0, 2.0]}, "source_origin_mm": 300,
@@ -171,10 +171,12 @@ TEST_SUITE("cli") {
                                "/geometry.json --out " + (dir / "b").string(),
                            dir),
                  2, sim2 + "/sino.npy has shape [360, 500] but the cone3d geometry expects");
-    // Detector row 5 reads NaN in every view: its 30 pixels are dead for that reason.
+    // Detector row 5 reads NaN in every view: its 30 pixels are dead for that reason. Row 10
+    // reads 0 (stuck at the flat) where the phantom's shadow crosses it.
     riner::Array stack = riner::read_array(sim3 + "/sino.npy").array;
     for (std::size_t v = 0; v < 36; ++v) {
       for (std::size_t c = 0; c < 30; ++c) stack.data[(v * 20 + 5) * 30 + c] = NAN;
+      for (std::size_t c = 0; c < 30; ++c) stack.data[(v * 20 + 10) * 30 + c] = 0.0f;
     }
     riner::write_array(dir / "nan_row.npy", stack);
     REQUIRE(riner_cli("reconstruct " + (dir / "nan_row.npy").string() + " --geometry " + sim3 +
@@ -182,12 +184,18 @@ TEST_SUITE("cli") {
                       dir)
                 .code == 0);
     const auto summary = nlohmann::json::parse(riner::test::read_bytes(dir / "c" / "summary.json"));
-    int row_five = 0;
+    int row_five = 0, row_ten = 0, stuck_elsewhere = 0;
     for (const auto& d : summary["dead_element_reasons"]) {
       const std::size_t e = d["element"];
       if (e / 30 == 5 && d["reason"] == "no finite reading") ++row_five;
+      if (d["reason"] == "stuck: steady while its neighbours vary") {
+        (e / 30 == 10 ? row_ten : stuck_elsewhere)++;
+      }
     }
     CHECK(row_five == 30);
+    MESSAGE("row 10: " << row_ten << " of 30 found stuck");
+    CHECK(row_ten >= 10);  // the columns the phantom's shadow sweeps
+    CHECK(stuck_elsewhere == 0);
     const riner::Array image = riner::read_array(dir / "c" / "image.nii").array;
     for (float v : image.data) REQUIRE(std::isfinite(v));
   }
