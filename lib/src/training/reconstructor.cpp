@@ -32,15 +32,6 @@ struct Reconstructor::Impl {
         sampler(setup.scan.geometry, setup.config.training),
         element_rays(setup.elements_per_view, 0) {}
 
-  // The air training skipped reads 0 (the measurements certified it).
-  void zero_skipped_air(Array& image) const {
-    const model::Occupancy& o = setup.occupancy;
-    if (!o.carved) return;
-    for (std::size_t i = 0; i < image.data.size(); ++i) {
-      if (!o.inside[i]) image.data[i] = 0.0f;
-    }
-  }
-
   void drain() {
     for (LossRecord& r : trainer->drain_losses()) {
       if (!std::isfinite(r.data_loss)) {
@@ -189,8 +180,9 @@ ReconstructionResult Reconstructor::evaluate_result() const {
     r.alpha = r.response_rings->alpha;
   }
   // Each correction subtracts its profile along whole circles; where a circle leaves the
-  // sampled region, that would paint the ring into the skipped air.
-  impl_->zero_skipped_air(r.image);
+  // sampled region, that would paint the ring into the skipped air. No second ramp: the field's
+  // already has one.
+  model::fade_into_skipped_air(impl_->setup.occupancy, g.volume_shape, 0, r.image.data);
   return r;
 }
 
