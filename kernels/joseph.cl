@@ -75,9 +75,12 @@ inline int joseph_setup(const ScanGeometry* g, float3 origin, float3 direction, 
     w->slope1 = 0.0f;
     w->base1 = 0.0f;
   }
+  // Compared as floats: a ray that misses the grid at a near-zero slope (a view at exactly 90
+  // degrees: cos is 6e-17) has bounds near 1e17, which no int holds.
+  if (!(m_lo <= m_hi)) return 0;
   w->m_lo = (int)m_lo;
   w->m_hi = (int)m_hi;
-  return w->m_lo <= w->m_hi;
+  return 1;
 }
 
 // Number of interpolation cells per plane: 2 in 2D, 4 in 3D.

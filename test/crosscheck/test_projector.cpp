@@ -1,6 +1,7 @@
 // kernels/project.cl and kernels/backproject.cl against the reference projector.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <random>
 
 #include "riner/error.hpp"
@@ -26,9 +27,21 @@ double inner(const riner::Array& a, const riner::Array& b) {
   return s;
 }
 
-const riner::Geometry kGeometries[] = {riner::test::small_fan2d(), riner::test::small_parallel2d(),
+// Views from exactly 0 over half a turn: view 15 lies at 90 degrees, where the rotation's cos
+// is 6e-17 and a ray that misses the grid has plane bounds near 1e17, which no int holds (the
+// kernels once looped over ~2^31 planes there).
+riner::Geometry axis_aligned(riner::Geometry g) {
+  g.uniform_angles = riner::UniformAngles{30, 0.0, M_PI};
+  g.angles = riner::uniform_angles(*g.uniform_angles);
+  return g;
+}
+
+const riner::Geometry kGeometries[] = {riner::test::small_fan2d(),
+                                       riner::test::small_parallel2d(),
                                        riner::test::small_cone3d(),
-                                       riner::test::small_parallel3d()};
+                                       riner::test::small_parallel3d(),
+                                       axis_aligned(riner::test::small_parallel2d()),
+                                       axis_aligned(riner::test::small_parallel3d())};
 
 }  // namespace
 
