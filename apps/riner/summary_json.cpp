@@ -27,6 +27,16 @@ nlohmann::json ring_summary(const std::optional<RingCorrection>& rings) {
   return out;
 }
 
+nlohmann::json volume_ring_summary(const std::optional<VolumeRingCorrection>& rings) {
+  if (!rings) return nullptr;
+  return {{"slices_corrected", rings->slices},
+          {"air_applied", rings->air_applied},
+          {"gradient_applied", rings->gradient_applied},
+          {"response_applied", rings->response_applied},
+          {"mean_response_change", rings->mean_response_change},
+          {"note", rings->note}};
+}
+
 nlohmann::json quality_summary(const QualityCheck& check) {
   const QualityReport& q = check.image;
   nlohmann::json out = {{"fbp_noise_per_mm", q.noise},
@@ -103,6 +113,7 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
       {"air_ring_correction", ring_summary(result.air_rings)},
       {"gradient_ring_correction", ring_summary(result.gradient_rings)},
       {"response_ring_correction", ring_summary(result.response_rings)},
+      {"slice_ring_corrections", volume_ring_summary(result.volume_rings)},
       {"final_loss", history.empty() ? 0.0 : history.back().data_loss}};
 }
 

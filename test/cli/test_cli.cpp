@@ -42,6 +42,21 @@ void expect_error(const Run& run, int code, const std::string& message) {
   CHECK(std::count(run.err.begin(), run.err.end(), '\n') == 1);
 }
 
+// A small parallel-beam stack (36 views, 30 x 20 detector, 20 x 24 x 24 volume) simulated into
+// dir/sim, its geometry in dir/g3.json; returns dir/sim.
+std::string simulate_small_parallel3d(const riner::test::TempDir& dir) {
+  riner::test::write_bytes(dir / "g3.json", R"({"type": "parallel3d",
+      "detector": {"count": [30, 20], "pitch_mm": [1.0, 1.0]},
+      "angles": {"count": 36, "range_rad": 3.141592653589793},
+      "volume": {"shape": [20, 24, 24], "voxel_mm": 1.0}})");
+  const std::string sim = (dir / "sim").string();
+  REQUIRE(riner_cli("simulate --quiet --seed 3 --geometry " + (dir / "g3.json").string() +
+                        " --out " + sim,
+                    dir)
+              .code == 0);
+  return sim;
+}
+
 }  // namespace
 
 TEST_SUITE("cli") {
@@ -200,17 +215,24 @@ TEST_SUITE("cli") {
     for (float v : image.data) REQUIRE(std::isfinite(v));
   }
 
+  TEST_CASE("3D: the ring corrections run slice by slice on a parallel scan only when asked") {
+    riner::test::TempDir dir;
+    const std::string sim = simulate_small_parallel3d(dir);
+    const std::string run = "reconstruct " + sim + "/sino.npy --steps 200 --json --out ";
+    const Run plain = riner_cli(run + (dir / "plain").string(), dir);
+    REQUIRE(plain.code == 0);
+    CHECK(nlohmann::json::parse(plain.out)["slice_ring_corrections"].is_null());
+    const Run sliced =
+        riner_cli(run + (dir / "sliced").string() + " --set rings.slice_by_slice=true", dir);
+    REQUIRE(sliced.code == 0);
+    const auto rings = nlohmann::json::parse(sliced.out)["slice_ring_corrections"];
+    CHECK(rings["slices_corrected"] == 20);  // every slice lies at a row's height
+    CHECK(rings["note"] == "");
+  }
+
   TEST_CASE("raw projections: a TIFF folder with flats and darks gives the measurement's image") {
     riner::test::TempDir dir;
-    riner::test::write_bytes(dir / "g3.json", R"({"type": "parallel3d",
-      "detector": {"count": [30, 20], "pitch_mm": [1.0, 1.0]},
-      "angles": {"count": 36, "range_rad": 3.141592653589793},
-      "volume": {"shape": [20, 24, 24], "voxel_mm": 1.0}})");
-    const std::string sim = (dir / "sim").string();
-    REQUIRE(riner_cli("simulate --quiet --seed 3 --geometry " + (dir / "g3.json").string() +
-                          " --out " + sim,
-                      dir)
-                .code == 0);
+    const std::string sim = simulate_small_parallel3d(dir);
     const riner::Array rho = riner::read_array(sim + "/sino_clean.npy").array;
     // The scanner's files: I = D + (F - D) exp(-rho), a flat that varies across the detector
     // (three frames, averaged), a dark of two frames, one reading at the dark.

@@ -264,6 +264,32 @@ TEST_SUITE("ring_correction") {
     check_left_alone(c, image, alpha);
   }
 
+  TEST_CASE("light material enclosed by a dense shell is not air, though below the air rule") {
+    // Light wood (0.0004/mm, under 3% of the shell's 0.02) inside its dense growth rings, with
+    // a knot: only air joined to the grid's edge counts, so the light core keeps its values.
+    // Taken for air, it would be "corrected" to the air's level of 0.
+    const riner::Geometry g = ring_geometry();
+    const riner::Array image =
+        discs(g, {{0, 0, 45, 0.02f}, {0, 0, 30, 0.0004f}, {12, 0, 4, 0.03f}});
+    riner::Array alpha({g.n_u}, 1.0f);
+    const auto core_drop = [&](const riner::RingCorrection& c) {
+      double largest = 0.0;
+      for (std::size_t p = 0; p < image.size(); ++p) {
+        if (image.data[p] == 0.0004f) {
+          largest = std::max(largest, double(image.data[p]) - c.image.data[p]);
+        }
+      }
+      return largest;
+    };
+    const riner::RingCorrection c = riner::correct_rings_from_air(image, alpha, g);
+    CHECK(core_drop(c) < 1e-7);
+    riner::AirRingSettings any_air;
+    any_air.reaches_edge = false;
+    const riner::RingCorrection old_rule = riner::correct_rings_from_air(image, alpha, g, any_air);
+    CHECK(old_rule.applied);
+    CHECK(core_drop(old_rule) > 2e-4);
+  }
+
   TEST_CASE("gradient: a narrow ring inside the object leaves the image for alpha") {
     const riner::Geometry g = ring_geometry();
     const riner::Array truth = phantom(g, false);

@@ -21,6 +21,7 @@
 #include "riner/riner_config.hpp"
 #include "riner/ring_correction.hpp"
 #include "riner/scan.hpp"
+#include "riner/volume_ring_correction.hpp"
 
 namespace riner {
 
@@ -51,6 +52,8 @@ struct ReconstructionResult {
   std::optional<RingCorrection> air_rings;
   std::optional<RingCorrection> gradient_rings;
   std::optional<RingCorrection> response_rings;
+  // 3D: the same corrections slice by slice (parallel beam; a cone beam gets a note).
+  std::optional<VolumeRingCorrection> volume_rings;
 };
 
 // An element taken for dead, and why: its readings are all non-finite, they stay steady while

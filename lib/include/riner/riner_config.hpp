@@ -158,6 +158,10 @@ struct RingCorrectionConfig {
   GradientRingSettings gradient;
   bool response_reference = true;
   ResponseRingSettings response;
+  // Parallel-beam volumes: the three above, slice by slice (riner/volume_ring_correction.hpp).
+  // Off by default: the 3D field holds few rings, and on the simulated parallel-beam head the
+  // chain cost 1.2 dB (the radial-gradient step 1.35 dB; bench/RESULTS.md, issue 14).
+  bool slice_by_slice = false;
 };
 
 struct RinerConfig {

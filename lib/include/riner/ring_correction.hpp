@@ -45,6 +45,12 @@ struct AirRingSettings {
   // ...and at least this many pixels (|dx| + |dy|) from anything that is not air, so the
   // partial-volume pixels at the object's edge stay out.
   int erosion_px = 3;
+  // ...and joined, through such pixels, to the grid's edge. Low-density material inside an
+  // object (light wood within its denser growth rings, foam) falls below the fraction when
+  // the object's densest parts set the percentile; taken for air it would be "corrected" to
+  // air's level (bench/RESULTS.md, issue 13). Air pockets enclosed by the object are lost to
+  // the measurement; the radial-gradient correction sees their rings.
+  bool reaches_edge = true;
   // A radius (bins of half a pixel) is measured only when it has this many air pixels.
   int min_pixels = 8;
   // Gaussian smoothing of the measured ring profile across radius bins (sigma in bins; 0 off).

@@ -42,6 +42,38 @@ std::vector<char> erode(std::vector<char> mask, std::size_t ny, std::size_t nx, 
   return mask;
 }
 
+// Pixels of `mask` joined to the grid's edge through mask pixels (4-neighbourhood): the air
+// around the object, which outside the grid continues.
+std::vector<char> joined_to_edge(const std::vector<char>& mask, std::size_t ny, std::size_t nx) {
+  std::vector<char> out(mask.size(), 0);
+  std::vector<std::size_t> stack;
+  const auto visit = [&](std::size_t p) {
+    if (mask[p] && !out[p]) {
+      out[p] = 1;
+      stack.push_back(p);
+    }
+  };
+  for (std::size_t k = 0; k < nx; ++k) {
+    visit(k);
+    visit((ny - 1) * nx + k);
+  }
+  for (std::size_t i = 0; i < ny; ++i) {
+    visit(i * nx);
+    visit(i * nx + nx - 1);
+  }
+  while (!stack.empty()) {
+    const std::size_t p = stack.back();
+    stack.pop_back();
+    const std::size_t i = p / nx;
+    const std::size_t k = p % nx;
+    if (i > 0) visit(p - nx);
+    if (i + 1 < ny) visit(p + nx);
+    if (k > 0) visit(p - 1);
+    if (k + 1 < nx) visit(p + 1);
+  }
+  return out;
+}
+
 }  // namespace
 
 RingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
@@ -70,6 +102,7 @@ RingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
   for (int pass = 0; pass < kPasses; ++pass) {
     std::vector<char> air(n);
     for (std::size_t p = 0; p < n; ++p) air[p] = image.data[p] - profile[bin[p]] < threshold;
+    if (settings.reaches_edge) air = joined_to_edge(air, ny, nx);
     air = erode(std::move(air), ny, nx, settings.erosion_px);
     air_values.clear();
     for (auto& values : air_by_bin) values.clear();

@@ -19,6 +19,10 @@ const std::vector<settings::Setting<AirRingSettings>>& air_settings() {
                &S::air_fraction),
       field<S>("rings", "air_erosion_px", closed(0, 64),
                "air pixels this far (|dx|+|dy|) from anything that is not air", &S::erosion_px),
+      field<S>("rings", "air_reaches_edge", {},
+               "air correction: only air joined to the grid's edge (not low-density material "
+               "inside the object)",
+               &S::reaches_edge),
       field<S>("rings", "min_air_pixels", closed(1, 1 << 20),
                "air pixels a radius bin needs to be measured", &S::min_pixels),
       field<S>("rings", "max_mean_response_change", open_closed(0, 10),

@@ -55,7 +55,10 @@ void add_training_sampling(Table& t) {
   t.push_back(enum_choice<C>(
       "training", "sampler",
       {Sampler::kUniform, Sampler::kViewsTimesElements, Sampler::kMixed, Sampler::kEven},
-      sampler_name, "how a step's rays are drawn; even: every detector element equally often, each at a random view", &C::training, &T::sampler));
+      sampler_name,
+      "how a step's rays are drawn; even: every detector element equally often, each at a random "
+      "view",
+      &C::training, &T::sampler));
   t.push_back(field<C>("training", "rays_per_step", closed(0, 1 << 20),
                        "uniform and even samplers' rays per step; 0: the execution plan's",
                        &C::training, &T::rays_per_step));
@@ -101,8 +104,7 @@ void add_training_schedule(Table& t) {
   t.push_back(field<C>("training", "lambda", closed_open(0, 1e6),
                        "weight of the -beta^2 term (dead-element mask)", &C::training, &T::lambda));
   t.push_back(field<C>("training", "alpha_lr_scale", closed_open(0, 1000),
-                       "alpha's learning rate over the field's", &C::training,
-                       &T::alpha_lr_scale));
+                       "alpha's learning rate over the field's", &C::training, &T::alpha_lr_scale));
   t.push_back(field<C>("training", "alpha_stripe_scale", closed(0, 10),
                        "alpha's rate is further scaled by min(1, the measurement's stripe RMS / "
                        "this); 0: off",
@@ -154,21 +156,27 @@ void add_training_schedule(Table& t) {
 }
 
 void add_rings(Table& t) {
-  t.push_back(field<C>("rings", "air_reference", {}, "2D: ring correction from the air", &C::rings,
+  t.push_back(field<C>("rings", "air_reference", {},
+                       "2D (3D: slice_by_slice): ring correction from the air", &C::rings,
                        &R::air_reference));
   for (const auto& s : rings::air_settings()) t.push_back(settings::lift<C>(s, &C::rings, &R::air));
   t.push_back(field<C>("rings", "gradient_reference", {},
-                       "2D: ring correction from the image's radial slopes", &C::rings,
-                       &R::gradient_reference));
+                       "2D (3D: slice_by_slice): ring correction from the image's radial slopes",
+                       &C::rings, &R::gradient_reference));
   for (const auto& s : rings::gradient_settings()) {
     t.push_back(settings::lift<C>(s, &C::rings, &R::gradient));
   }
-  t.push_back(field<C>("rings", "response_reference", {},
-                       "2D: broad rings back from alpha's structure across the detector", &C::rings,
-                       &R::response_reference));
+  t.push_back(field<C>(
+      "rings", "response_reference", {},
+      "2D (3D: slice_by_slice): broad rings back from alpha's structure across the detector",
+      &C::rings, &R::response_reference));
   for (const auto& s : rings::response_settings()) {
     t.push_back(settings::lift<C>(s, &C::rings, &R::response));
   }
+  t.push_back(field<C>("rings", "slice_by_slice", {},
+                       "parallel 3D: the corrections above, each slice with its detector row "
+                       "(off: measured to cost 1.2 dB on a simulated head)",
+                       &C::rings, &R::slice_by_slice));
 }
 
 void add_plan(Table& t) {

@@ -162,7 +162,16 @@ ReconstructionResult Reconstructor::evaluate_result() const {
   r.field_image = field_image();
   r.image = r.field_image;
   r.alpha = trained_alpha();
-  if (g.is_3d()) return r;
+  const bool corrected =
+      c.rings.air_reference || c.rings.gradient_reference || c.rings.response_reference;
+  if (g.is_3d()) {
+    if (!corrected || !c.rings.slice_by_slice) return r;
+    r.volume_rings = correct_rings_per_slice(r.image, r.alpha, g, dead_elements(), c.rings);
+    r.image = r.volume_rings->image;
+    r.alpha = r.volume_rings->alpha;
+    model::fade_into_skipped_air(impl_->setup.occupancy, g.volume_shape, 0, r.image.data);
+    return r;
+  }
   if (c.rings.air_reference) {
     r.air_rings = correct_rings_from_air(r.image, r.alpha, g, c.rings.air);
     r.image = r.air_rings->image;
@@ -193,7 +202,9 @@ Array Reconstructor::alpha() const {
   // Without the corrections, alpha needs no evaluation of the field.
   const bool corrected =
       c.rings.air_reference || c.rings.gradient_reference || c.rings.response_reference;
-  if (!corrected || impl_->setup.scan.geometry.is_3d()) return trained_alpha();
+  if (!corrected || (impl_->setup.scan.geometry.is_3d() && !c.rings.slice_by_slice)) {
+    return trained_alpha();
+  }
   return result().alpha;
 }
 
