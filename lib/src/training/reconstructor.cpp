@@ -114,6 +114,14 @@ bool on_plateau(const TrainingConfig& t, const std::vector<LossRecord>& history)
   return before - latest < t.plateau_tolerance * before;
 }
 
+// Whether the ring corrections change image and alpha: in 2D when any is on; in 3D only slice
+// by slice (rings.slice_by_slice).
+bool corrects_rings(const RinerConfig& c, const Geometry& g) {
+  const bool any =
+      c.rings.air_reference || c.rings.gradient_reference || c.rings.response_reference;
+  return any && (!g.is_3d() || c.rings.slice_by_slice);
+}
+
 }  // namespace
 
 void Reconstructor::run(const ProgressCallback& callback, int report_every) {
@@ -162,10 +170,8 @@ ReconstructionResult Reconstructor::evaluate_result() const {
   r.field_image = field_image();
   r.image = r.field_image;
   r.alpha = trained_alpha();
-  const bool corrected =
-      c.rings.air_reference || c.rings.gradient_reference || c.rings.response_reference;
+  if (!corrects_rings(c, g)) return r;
   if (g.is_3d()) {
-    if (!corrected || !c.rings.slice_by_slice) return r;
     r.volume_rings = correct_rings_per_slice(r.image, r.alpha, g, dead_elements(), c.rings);
     r.image = r.volume_rings->image;
     r.alpha = r.volume_rings->alpha;
@@ -200,11 +206,7 @@ Array Reconstructor::image() const { return result().image; }
 Array Reconstructor::alpha() const {
   const RinerConfig& c = impl_->setup.config;
   // Without the corrections, alpha needs no evaluation of the field.
-  const bool corrected =
-      c.rings.air_reference || c.rings.gradient_reference || c.rings.response_reference;
-  if (!corrected || (impl_->setup.scan.geometry.is_3d() && !c.rings.slice_by_slice)) {
-    return trained_alpha();
-  }
+  if (!corrects_rings(c, impl_->setup.scan.geometry)) return trained_alpha();
   return result().alpha;
 }
 
