@@ -5,12 +5,14 @@
 
 #include <cmath>
 #include <map>
+#include <vector>
 
 #include "model/batch_sampler.hpp"
 #include "model/counter_rng.hpp"
 #include "model/packed_batch.hpp"
 #include "model/parameter_layout.hpp"
 #include "model/ray_segments.hpp"
+#include "riner/error.hpp"
 #include "riner/rays.hpp"
 #include "support/geometries.hpp"
 
@@ -107,6 +109,21 @@ TEST_SUITE("model_layout") {
     for (std::size_t i = 0; i < b.rays.size(); ++i) per_element[b.rays[i] % g.n_u] += b.weights[i];
     for (const auto& [e, w] : per_element) CHECK(w == doctest::Approx(0.2));
     CHECK(per_element.size() == b.elements.size());
+
+    // Silent elements (stuck ones): the same rays, theirs at weight 0, the rest as they were.
+    std::vector<std::uint8_t> silent(g.n_u, 0);
+    for (std::size_t e = 0; e < g.n_u; e += 3) silent[e] = 1;
+    const auto quiet = riner::model::BatchSampler(g, t, silent).batch(3);
+    REQUIRE(quiet.rays == b.rays);
+    std::size_t zeroed = 0;
+    for (std::size_t i = 0; i < b.rays.size(); ++i) {
+      const bool is_silent = silent[b.rays[i] % g.n_u] != 0;
+      zeroed += is_silent;
+      CHECK(quiet.weights[i] == (is_silent ? 0.0f : b.weights[i]));
+    }
+    CHECK(zeroed > 0);
+    CHECK_THROWS_AS(riner::model::BatchSampler(g, t, std::vector<std::uint8_t>(g.n_u + 1, 0)),
+                    riner::Error);
   }
 
   TEST_CASE("shuffled_index is a permutation of 0..n-1 for every key, and keys differ") {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <unordered_map>
+#include <utility>
 
 #include "model/counter_rng.hpp"
 #include "riner/error.hpp"
@@ -18,8 +19,17 @@ std::uint32_t draw(std::uint32_t seed, std::uint32_t step, std::uint32_t i, std:
 
 }  // namespace
 
-BatchSampler::BatchSampler(const Geometry& g, const TrainingConfig& config)
-    : views_(g.n_views()), rows_(g.is_3d() ? g.n_v : 1), n_u_(g.n_u), config_(config) {
+BatchSampler::BatchSampler(const Geometry& g, const TrainingConfig& config,
+                           std::vector<std::uint8_t> silent)
+    : views_(g.n_views()),
+      rows_(g.is_3d() ? g.n_v : 1),
+      n_u_(g.n_u),
+      config_(config),
+      silent_(std::move(silent)) {
+  if (!silent_.empty() && silent_.size() != rows_ * n_u_) {
+    throw Error("BatchSampler: " + std::to_string(silent_.size()) + " silent flags for " +
+                std::to_string(rows_ * n_u_) + " detector elements");
+  }
   if (config.sampler != Sampler::kViewsTimesElements && config.rays_per_step < 1) {
     throw Error("BatchSampler: rays_per_step " + std::to_string(config.rays_per_step) +
                 " (0 is for the execution plan to resolve first)");
@@ -107,6 +117,11 @@ Batch BatchSampler::batch(std::uint32_t step) const {
     const double w =
         config_.data_term == DataTerm::kMean ? c / static_cast<double>(b.rays.size()) : c;
     b.weights.assign(b.rays.size(), static_cast<float>(w));
+  }
+  if (!silent_.empty()) {
+    for (std::size_t i = 0; i < b.rays.size(); ++i) {
+      if (silent_[b.rays[i] % per_view]) b.weights[i] = 0.0f;
+    }
   }
   return b;
 }

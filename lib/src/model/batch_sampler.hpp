@@ -23,7 +23,11 @@ struct Batch {
 
 class BatchSampler {
  public:
-  BatchSampler(const Geometry& g, const TrainingConfig& config);
+  // silent: per element (row-major [rows, columns]), 1 where the element's readings say nothing
+  // (stuck elements, model/stuck_elements.hpp): its rays are drawn as usual but weigh 0, since
+  // read as 0 they would pull the field to 0. Empty: none.
+  BatchSampler(const Geometry& g, const TrainingConfig& config,
+               std::vector<std::uint8_t> silent = {});
   Batch batch(std::uint32_t step) const;
   std::size_t rays_per_step() const;
 
@@ -32,6 +36,7 @@ class BatchSampler {
   std::size_t rows_;
   std::size_t n_u_;
   TrainingConfig config_;
+  std::vector<std::uint8_t> silent_;
 };
 
 }  // namespace riner::model

@@ -29,7 +29,8 @@ struct Reconstructor::Impl {
 
   Impl(Scan scan, RinerConfig config)
       : setup(std::move(scan), std::move(config)),
-        sampler(setup.scan.geometry, setup.config.training),
+        sampler(setup.scan.geometry, setup.config.training,
+                setup.stuck_count > 0 ? setup.stuck : std::vector<std::uint8_t>{}),
         element_rays(setup.elements_per_view, 0) {}
 
   void drain() {
@@ -77,14 +78,8 @@ void Reconstructor::step(int n) {
   const auto start = std::chrono::steady_clock::now();
   for (int i = 0; i < n; ++i) {
     const int index = impl_->steps;
-    model::Batch batch = impl_->sampler.batch(static_cast<std::uint32_t>(index));
+    const model::Batch batch = impl_->sampler.batch(static_cast<std::uint32_t>(index));
     const std::size_t per_view = impl_->setup.elements_per_view;
-    // A stuck element's readings say nothing; read as 0 they would pull the field to 0.
-    if (impl_->setup.stuck_count > 0) {
-      for (std::size_t b = 0; b < batch.rays.size(); ++b) {
-        if (impl_->setup.stuck[batch.rays[b] % per_view]) batch.weights[b] = 0.0f;
-      }
-    }
     for (std::uint32_t r : batch.rays) {
       impl_->samples += impl_->setup.segments[r].count;
       ++impl_->element_rays[r % per_view];
