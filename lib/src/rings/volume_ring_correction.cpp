@@ -5,7 +5,7 @@
 #include <string>
 
 #include "riner/error.hpp"
-#include "riner/ring_correction.hpp"
+#include "riner/ring_chain.hpp"
 
 namespace riner {
 
@@ -90,30 +90,19 @@ VolumeRingCorrection correct_rings_per_slice(const Array& volume, const Array& a
     Array response({g.n_u});
     std::copy_n(alpha.data.begin() + static_cast<std::ptrdiff_t>(row * g.n_u), g.n_u,
                 response.data.begin());
-    const Array before = response;
-    const auto take = [&](const RingCorrection& c, std::size_t& applied) {
-      applied += c.applied;
-      image = c.image;
-      response = c.alpha;
-    };
-    if (config.air_reference) {
-      take(correct_rings_from_air(image, response, slice_g, config.air), out.air_applied);
-    }
-    if (config.gradient_reference) {
-      take(correct_rings_from_gradient(image, response, slice_g, config.gradient),
-           out.gradient_applied);
-    }
-    if (config.response_reference) {
-      take(correct_rings_from_response(image, response, slice_g, dead_by_row[row], config.response),
-           out.response_applied);
-    }
-    std::copy(image.data.begin(), image.data.end(),
+    const RingChain chain =
+        correct_rings_in_order(image, response, slice_g, dead_by_row[row], config);
+    out.air_applied += chain.air && chain.air->applied;
+    out.gradient_applied += chain.gradient && chain.gradient->applied;
+    out.response_applied += chain.response && chain.response->applied;
+    std::copy(chain.image.data.begin(), chain.image.data.end(),
               out.image.data.begin() + static_cast<std::ptrdiff_t>(s * ny * nx));
-    std::copy(response.data.begin(), response.data.end(),
+    std::copy(chain.alpha.data.begin(), chain.alpha.data.end(),
               out.alpha.data.begin() + static_cast<std::ptrdiff_t>(row * g.n_u));
     for (std::size_t e = 0; e < g.n_u; ++e) {
-      if (before.data[e] > 0.0f && response.data[e] > 0.0f) {
-        change_sum += std::fabs(std::log(static_cast<double>(response.data[e]) / before.data[e]));
+      if (response.data[e] > 0.0f && chain.alpha.data[e] > 0.0f) {
+        change_sum +=
+            std::fabs(std::log(static_cast<double>(chain.alpha.data[e]) / response.data[e]));
       }
     }
   }

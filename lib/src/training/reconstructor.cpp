@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <utility>
 
 #include "cl/buffer.hpp"
 #include "riner/error.hpp"
+#include "riner/ring_chain.hpp"
 #include "training/trainer.hpp"
 
 namespace riner {
@@ -170,24 +172,13 @@ ReconstructionResult Reconstructor::evaluate_result() const {
     r.volume_rings = correct_rings_per_slice(r.image, r.alpha, g, dead_elements(), c.rings);
     r.image = r.volume_rings->image;
     r.alpha = r.volume_rings->alpha;
-    model::fade_into_skipped_air(impl_->setup.occupancy, g.volume_shape, 0, r.image.data);
-    return r;
-  }
-  if (c.rings.air_reference) {
-    r.air_rings = correct_rings_from_air(r.image, r.alpha, g, c.rings.air);
-    r.image = r.air_rings->image;
-    r.alpha = r.air_rings->alpha;
-  }
-  if (c.rings.gradient_reference) {
-    r.gradient_rings = correct_rings_from_gradient(r.image, r.alpha, g, c.rings.gradient);
-    r.image = r.gradient_rings->image;
-    r.alpha = r.gradient_rings->alpha;
-  }
-  if (c.rings.response_reference) {
-    r.response_rings =
-        correct_rings_from_response(r.image, r.alpha, g, dead_elements(), c.rings.response);
-    r.image = r.response_rings->image;
-    r.alpha = r.response_rings->alpha;
+  } else {
+    RingChain chain = correct_rings_in_order(r.image, r.alpha, g, dead_elements(), c.rings);
+    r.image = std::move(chain.image);
+    r.alpha = std::move(chain.alpha);
+    r.air_rings = std::move(chain.air);
+    r.gradient_rings = std::move(chain.gradient);
+    r.response_rings = std::move(chain.response);
   }
   // Each correction subtracts its profile along whole circles; where a circle leaves the
   // sampled region, that would paint the ring into the skipped air. No second ramp: the field's

@@ -1,0 +1,31 @@
+// The ring corrections of riner/ring_correction.hpp as a reconstruction runs them: air, radial
+// gradient, detector response, each that the settings turn on, each fed the image and alpha the
+// one before left. Used for a slice (Reconstructor) and for each slice of a parallel-beam volume
+// (riner/volume_ring_correction.hpp).
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include "riner/array.hpp"
+#include "riner/geometry.hpp"
+#include "riner/riner_config.hpp"
+#include "riner/ring_correction.hpp"
+
+namespace riner {
+
+struct RingChain {
+  Array image;  // after the last correction that ran
+  Array alpha;
+  std::optional<RingCorrection> air;  // each correction that ran, as it returned
+  std::optional<RingCorrection> gradient;
+  std::optional<RingCorrection> response;
+};
+
+// 2D geometry; `dead_elements` as correct_rings_from_response takes them.
+RingChain correct_rings_in_order(const Array& image, const Array& alpha, const Geometry& geometry,
+                                 const std::vector<std::size_t>& dead_elements,
+                                 const RingCorrectionConfig& config);
+
+}  // namespace riner

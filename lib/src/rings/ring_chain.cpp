@@ -1,0 +1,27 @@
+#include "riner/ring_chain.hpp"
+
+namespace riner {
+
+RingChain correct_rings_in_order(const Array& image, const Array& alpha, const Geometry& g,
+                                 const std::vector<std::size_t>& dead_elements,
+                                 const RingCorrectionConfig& config) {
+  RingChain out{image, alpha, std::nullopt, std::nullopt, std::nullopt};
+  const auto take = [&out](std::optional<RingCorrection>& slot, RingCorrection c) {
+    out.image = c.image;
+    out.alpha = c.alpha;
+    slot = std::move(c);
+  };
+  if (config.air_reference) {
+    take(out.air, correct_rings_from_air(out.image, out.alpha, g, config.air));
+  }
+  if (config.gradient_reference) {
+    take(out.gradient, correct_rings_from_gradient(out.image, out.alpha, g, config.gradient));
+  }
+  if (config.response_reference) {
+    take(out.response,
+         correct_rings_from_response(out.image, out.alpha, g, dead_elements, config.response));
+  }
+  return out;
+}
+
+}  // namespace riner
