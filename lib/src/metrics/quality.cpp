@@ -9,12 +9,12 @@
 #include "riner/error.hpp"
 #include "riner/metrics.hpp"
 #include "rings/radial.hpp"
+#include "util/robust_statistics.hpp"
 
 namespace riner {
 
 namespace {
 
-constexpr double kMadToSigma = 1.4826;
 constexpr double kSpeckSigmas = 6.0;
 
 void require_2d(const Array& a, const char* what) {
@@ -81,7 +81,7 @@ double residual_noise(const Array& image) {
   }
   if (r.empty()) return 0.0;
   std::nth_element(r.begin(), r.begin() + static_cast<long>(r.size() / 2), r.end());
-  return kMadToSigma * r[r.size() / 2];
+  return util::kMadToSigma * r[r.size() / 2];
 }
 
 double specks_per_10k(const Array& image, double noise) {

@@ -4,21 +4,16 @@
 #include <cmath>
 #include <vector>
 
+#include "util/robust_statistics.hpp"
+
 namespace riner::model {
 
 namespace {
 
-constexpr double kMadToSigma = 1.4826;
 // A second difference of independent readings has variance 6 sigma^2.
 const double kSecondDifferenceGain = std::sqrt(6.0);
 // Enough readings for stable quantiles; a 3D scan is thinned evenly to about this many.
 constexpr std::size_t kMostSamples = std::size_t{1} << 20;
-
-double quantile(std::vector<double>& values, double q) {
-  const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(values.size() - 1));
-  std::nth_element(values.begin(), values.begin() + k, values.end());
-  return values[static_cast<std::size_t>(k)];
-}
 
 }  // namespace
 
@@ -28,8 +23,7 @@ NoiseEvidence reading_noise(const Scan& scan) {
   const std::size_t per_view = g.n_u * (g.is_3d() ? g.n_v : 1);
   NoiseEvidence e;
   if (views < 3 || per_view == 0) return e;
-  const std::size_t stride =
-      std::max<std::size_t>(1, (views - 2) * per_view / kMostSamples);
+  const std::size_t stride = std::max<std::size_t>(1, (views - 2) * per_view / kMostSamples);
   const std::vector<float>& rho = scan.measurement.data;
   std::vector<double> differences, readings;
   for (std::size_t i = 0; i < (views - 2) * per_view; i += stride) {
@@ -41,8 +35,8 @@ NoiseEvidence reading_noise(const Scan& scan) {
       differences.push_back(std::fabs(static_cast<double>(a) - 2.0 * b + c));
   }
   if (differences.empty() || readings.empty()) return e;
-  e.sigma = kMadToSigma * quantile(differences, 0.5) / kSecondDifferenceGain;
-  e.level = quantile(readings, 0.99);
+  e.sigma = util::kMadToSigma * util::quantile(differences, 0.5) / kSecondDifferenceGain;
+  e.level = util::quantile(readings, 0.99);
   e.relative = e.level > 0.0 ? e.sigma / e.level : 0.0;
   return e;
 }
