@@ -84,9 +84,13 @@ ProgramCacheStats Context::program_cache_stats() const {
 void Context::launch(const Kernel& kernel, const Range& global, const Range& local) {
   std::size_t rounded[3];
   const cl_uint dims = global.dims;
+  // 1D launches that name no group get the kernel's default one (every such kernel returns
+  // past its count); in 2D and 3D the runtime chooses.
+  const Range group =
+      local.dims == 0 && dims == 1 ? Range(kernel.default_group(device_)) : local;
   for (cl_uint d = 0; d < dims; ++d) {
     const std::size_t g = global.size[d];
-    const std::size_t l = local.dims == 0 ? 1 : local.size[d];
+    const std::size_t l = group.dims == 0 ? 1 : group.size[d];
     rounded[d] = (g + l - 1) / l * l;
     // A zero-sized launch is an error in OpenCL; an empty batch is simply no work.
     if (rounded[d] == 0) return;
@@ -94,7 +98,7 @@ void Context::launch(const Kernel& kernel, const Range& global, const Range& loc
   const bool record = recording_ && profiling_;
   cl_event event = nullptr;
   RINER_CL_CALL(clEnqueueNDRangeKernel, queue_.get(), kernel.get(), dims, nullptr, rounded,
-                local.dims == 0 ? nullptr : local.size.data(), 0, nullptr,
+                group.dims == 0 ? nullptr : group.size.data(), 0, nullptr,
                 record ? &event : nullptr);
   if (record) {
     std::lock_guard<std::mutex> lock(mutex_);

@@ -64,8 +64,9 @@ class Context {
                                          const std::string& options = "");
   ProgramCacheStats program_cache_stats() const;
 
-  // Enqueues the kernel; global is rounded up to a multiple of local. Records the event when
-  // recording is on; finishes the queue when RINER_SYNC_LAUNCHES=1.
+  // Enqueues the kernel; global is rounded up to a multiple of local (1D without one: the
+  // kernel's default_group, so its work-items past the count must return). Records the event
+  // when recording is on; finishes the queue when RINER_SYNC_LAUNCHES=1.
   void launch(const Kernel& kernel, const Range& global, const Range& local = Range());
 
   void finish() const;

@@ -1,5 +1,6 @@
 #include "cl/program.hpp"
 
+#include <algorithm>
 #include <atomic>
 
 namespace riner::cl {
@@ -46,6 +47,13 @@ std::size_t Kernel::max_work_group_size(cl_device_id device) const {
   RINER_CL_CALL(clGetKernelWorkGroupInfo, kernel_.get(), device, CL_KERNEL_WORK_GROUP_SIZE,
                 sizeof(size), &size, nullptr);
   return size;
+}
+
+std::size_t Kernel::default_group(cl_device_id device) const {
+  if (default_group_ == 0) {
+    default_group_ = std::max<std::size_t>(1, std::min(kDefaultGroup, max_work_group_size(device)));
+  }
+  return default_group_;
 }
 
 }  // namespace riner::cl

@@ -67,12 +67,19 @@ class Kernel {
 
   // Largest work-group the kernel can use on its device.
   std::size_t max_work_group_size(cl_device_id device) const;
+  // The work-group size of launches that name none (Context::launch): kDefaultGroup, or the
+  // kernel's largest when smaller. Left to the runtime, the group must divide the global size,
+  // and a global size with no small factors (a prime count of parameters) ran in groups of one:
+  // twice the time of a whole training step on PoCL (bench/RESULTS.md, issue 14).
+  static constexpr std::size_t kDefaultGroup = 64;
+  std::size_t default_group(cl_device_id device) const;
 
  private:
   void set_raw(cl_uint index, std::size_t size, const void* value);
 
   Handle<cl_kernel> kernel_;
   std::string name_;
+  mutable std::size_t default_group_ = 0;  // 0: not asked yet
 };
 
 }  // namespace riner::cl
