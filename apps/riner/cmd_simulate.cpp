@@ -82,6 +82,12 @@ RingModel model_from(const Args& args) {
   m.dead_elements = static_cast<std::size_t>(dead);
   m.dead_rows = static_cast<std::size_t>(rows);
   m.dead_columns = static_cast<std::size_t>(columns);
+  const std::string pattern = args.get("response-pattern");
+  if (pattern == "rows-x-columns") {
+    m.pattern = ResponsePattern::kRowsTimesColumns;
+  } else if (pattern != "per-element") {
+    throw UsageError("--response-pattern must be per-element or rows-x-columns");
+  }
   m.validate();
   return m;
 }
@@ -111,6 +117,10 @@ int run_simulate(int argc, char** argv, int first) {
       .option("nonideal-fraction", "F", "fraction of elements with alpha ~ U[min, max]", "0.75")
       .option("alpha-min", "A", "smallest non-ideal response", "0.75")
       .option("alpha-max", "A", "largest non-ideal response", "1.25")
+      .option("response-pattern", "P",
+              "per-element, or rows-x-columns (3D: alpha = row factor x column factor, each "
+              "~ U[sqrt(min), sqrt(max)])",
+              "per-element")
       .option("dead", "N", "dead elements (alpha = 0)", "2")
       .option("dead-rows", "N", "3D: whole dead detector rows", "0")
       .option("dead-columns", "N", "3D: whole dead detector columns", "0")
@@ -174,6 +184,7 @@ int run_simulate(int argc, char** argv, int first) {
                             {"photons", model.photons},
                             {"nonideal_fraction", model.nonideal_fraction},
                             {"alpha_range", {model.alpha_min, model.alpha_max}},
+                            {"response_pattern", args.get("response-pattern")},
                             {"dead_elements", dead},
                             {"non_finite_measurements", stats.non_finite()},
                             {"max_line_integral", max_line},

@@ -98,6 +98,12 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
         {"noise_sigma", stats.noise},
         {"note", r.config().training.skip_air ? stats.air_note : "off (training.skip_air)"}}},
       {"alpha_rate", {{"scale", stats.alpha_rate}, {"stripe_rms", stats.stripe_rms}}},
+      {"alpha_model",
+       {{"model", alpha_model_name(stats.alpha_model)},
+        {"setting", alpha_model_name(r.config().training.alpha_model)},
+        {"factor_evidence", stats.alpha_factor_explained >= 0.0
+                                ? nlohmann::json(stats.alpha_factor_explained)
+                                : nlohmann::json()}}},
       {"level_warmup",
        {{"steps", stats.level_warmup_steps}, {"relative_noise", stats.relative_noise}}},
       {"coverage",

@@ -53,6 +53,23 @@ TEST_SUITE("model_layout") {
     CHECK(riner::model::initial_parameters(l, 43) != p);
   }
 
+  TEST_CASE("alpha as row x column factors: the block after alpha0, all factors start at 1") {
+    const riner::EncodingConfig enc{4, 2, 10, 4, 32};
+    const auto plain = riner::model::make_layout(3, enc, {16, 1}, 12);
+    CHECK_FALSE(plain.factored_alpha());
+    CHECK(plain.beta_offset == plain.alpha_offset + 12);
+    const auto l = riner::model::make_layout(3, enc, {16, 1}, 12, 3);
+    REQUIRE(l.factored_alpha());
+    CHECK(l.factor_rows == 3);
+    CHECK(l.factor_columns == 4);
+    CHECK(l.factor_offset == l.alpha_offset + 12);
+    CHECK(l.beta_offset == l.factor_offset + 7);
+    CHECK(l.total == plain.total + 7);
+    const auto p = riner::model::initial_parameters(l, 1);
+    for (std::size_t i = l.alpha_offset; i < l.total; ++i) CHECK(p[i] == 1.0f);
+    CHECK_THROWS_AS(riner::model::make_layout(3, enc, {16, 1}, 12, 5), riner::InputError);
+  }
+
   TEST_CASE("ray segments tile the clipped ray exactly, inside the unit square") {
     const riner::Geometry g = riner::test::small_fan2d();
     const auto segments = riner::model::ray_segments(g, 1.0, false);

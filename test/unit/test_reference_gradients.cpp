@@ -6,6 +6,7 @@
 #include <random>
 
 #include "model/batch_sampler.hpp"
+#include "reference/alpha_factors_ref.hpp"
 #include "reference/riner_step_ref.hpp"
 #include "support/fixture.hpp"
 #include "support/tiny_problem.hpp"
@@ -70,6 +71,58 @@ TEST_SUITE("reference_gradients") {
     MESSAGE("checked " << checked << " parameters; worst relative error " << worst << " at "
                        << worst_index);
     CHECK(checked > 300);
+    CHECK(worst < 1e-5);
+  }
+
+  TEST_CASE("alpha's row and column factors: their gradient matches central differences") {
+    // The tiny scan's 50 elements taken as 5 rows x 10 columns: the chain rule through the
+    // product does not depend on where the elements sit.
+    const riner::test::TinyProblem t = riner::test::tiny_problem(4);
+    const auto layout =
+        riner::model::make_layout(2, {3, 2, 6, 4, 16}, {16, 1}, t.geometry.n_u, 5);
+    REQUIRE(layout.factor_columns == 10);
+    const auto segments = riner::model::ray_segments(t.geometry, 1.0, false);
+    std::vector<double> params;
+    for (float v : riner::model::initial_parameters(layout, 6)) params.push_back(v);
+    std::mt19937 rng(static_cast<unsigned>(riner::test::seed()) + 3);
+    std::uniform_real_distribution<double> u(-0.5, 0.5);
+    for (std::size_t i = 0; i < layout.grid_params; ++i) params[i] = u(rng);
+    for (std::size_t f = layout.factor_offset; f < layout.beta_offset; ++f) {
+      params[f] = 1.0 + 0.3 * u(rng);
+    }
+    riner::ref::alpha_factors_expand(layout, params);
+    riner::TrainingConfig tc;
+    tc.rays_per_step = 40;
+    const riner::model::Batch batch = riner::model::BatchSampler(t.geometry, tc).batch(0);
+    riner::ref::StepInputs in;
+    in.layout = &layout;
+    in.segments = &segments;
+    in.measurement = &t.scan.measurement.data;
+    in.elements_per_view = t.geometry.n_u;
+    in.lambda = 0.01;
+    in.level_weights = {1.0f, 1.0f, 1.0f};
+    riner::ref::StepResult r = riner::ref::riner_step(in, batch, params);
+    riner::ref::alpha_factors_gradient(layout, params, r.grad);
+    auto loss = [&](std::vector<double> p) {
+      riner::ref::alpha_factors_expand(layout, p);
+      const riner::ref::StepResult s = riner::ref::riner_step(in, batch, p, false);
+      return s.data_loss + s.penalty;
+    };
+    double worst = 0.0;
+    int nonzero = 0;
+    for (std::size_t i = layout.factor_offset; i < layout.beta_offset; ++i) {
+      const double h = 1e-6;
+      std::vector<double> plus = params;
+      std::vector<double> minus = params;
+      plus[i] += h;
+      minus[i] -= h;
+      const double fd = (loss(plus) - loss(minus)) / (2.0 * h);
+      worst = std::max(worst, std::fabs(fd - r.grad[i]) /
+                                  std::max(1e-4, std::fabs(fd) + std::fabs(r.grad[i])));
+      nonzero += r.grad[i] != 0.0;
+    }
+    MESSAGE("worst relative error over the 15 factors " << worst);
+    CHECK(nonzero == 15);  // 40 rays reach every row and column
     CHECK(worst < 1e-5);
   }
 }

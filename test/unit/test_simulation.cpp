@@ -9,6 +9,40 @@
 #include "support/geometries.hpp"
 
 TEST_SUITE("simulation") {
+  TEST_CASE("responses by rows x columns: a product of row and column factors, in range") {
+    const riner::Geometry g = riner::test::small_cone3d();  // 37 rows x 61 columns
+    riner::RingModel model;
+    model.seed = 3;
+    model.pattern = riner::ResponsePattern::kRowsTimesColumns;
+    const riner::Array alpha = riner::draw_responses(g, model);
+    REQUIRE(alpha.shape == std::vector<std::size_t>{37, 61});
+    auto at = [&](std::size_t r, std::size_t c) { return double(alpha.data[r * 61 + c]); };
+    int dead = 0;
+    for (float a : alpha.data) {
+      dead += a == 0.0f;
+      if (a != 0.0f) {
+        CHECK(a >= 0.75f * (1 - 1e-6f));
+        CHECK(a <= 1.25f * (1 + 1e-6f));
+      }
+    }
+    CHECK(dead == 2);
+    // Rank one wherever all four corners are live: a(r, c) a(s, d) = a(r, d) a(s, c).
+    int checked = 0;
+    for (std::size_t r = 0; r + 5 < 37; r += 3) {
+      for (std::size_t c = 0; c + 7 < 61; c += 4) {
+        const double p = at(r, c) * at(r + 5, c + 7);
+        const double q = at(r, c + 7) * at(r + 5, c);
+        if (p == 0.0 || q == 0.0) continue;
+        CHECK(p == doctest::Approx(q).epsilon(1e-6));
+        ++checked;
+      }
+    }
+    CHECK(checked > 100);
+    riner::Geometry flat = riner::test::small_fan2d();
+    CHECK_THROWS_WITH(riner::draw_responses(flat, model),
+                      doctest::Contains("rows x columns need a 3D detector"));
+  }
+
   TEST_CASE("responses follow the protocol exactly: 375 non-ideal, 2 dead, 123 ideal of 500") {
     const riner::Geometry g = riner::preset_geometry("fan2d-paper");
     riner::RingModel model;

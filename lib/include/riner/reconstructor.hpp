@@ -99,6 +99,10 @@ struct TrainingStats {
   // measurement's stripe evidence, training.alpha_stripe_scale) and that evidence.
   double alpha_rate = 1.0;
   double stripe_rms = 0.0;
+  // What alpha was made of (training.alpha_model, never auto here) and, in 3D, the share of the
+  // stripe pattern row x column factors explain (model/factor_evidence.hpp; -1 in 2D).
+  AlphaModel alpha_model = AlphaModel::kPerElement;
+  double alpha_factor_explained = -1.0;
   // Coarse to fine as trained (training.level_warmup_steps) and the noise evidence that set it
   // when -1: the readings' noise sigma over their 99th percentile.
   int level_warmup_steps = 0;

@@ -48,6 +48,14 @@ enum class Sampler {
                         // random view; alpha and beta of every element learn from as many rays
 };
 
+// What alpha is made of in 3D. Per element: one response per detector pixel (the paper's).
+// Rows x columns: alpha(r, c) = row factor r times column factor c (kernels/alpha_factors.cl),
+// rows + columns numbers instead of rows x columns, for detectors whose gains vary by readout
+// line or column amplifier. Auto: rows x columns when the measurement's stripe pattern is
+// explained by row and column factors (model/factor_evidence.hpp), per element otherwise.
+// A 2D scan's detector is one row, where the two are the same: it keeps per element.
+enum class AlphaModel { kAuto, kPerElement, kRowsTimesColumns };
+
 struct TrainingConfig {
   // -1: the scan's (kSteps2d or kSteps3d, filled in by the Reconstructor). 3D has its own
   // because a step there draws its rays over ~100x the detector elements of a slice: the paper's
@@ -97,6 +105,10 @@ struct TrainingConfig {
   // hot or stuck pixel, row or column; model/stuck_elements.hpp) are taken for dead before
   // training: their readings count as invalid, like non-finite ones.
   bool stuck_elements = true;
+  AlphaModel alpha_model = AlphaModel::kAuto;
+  // Auto: rows x columns when the factors explain at least this fraction of the stripe
+  // pattern's energy (model/factor_evidence.hpp).
+  double alpha_factor_evidence = 0.9;
   double beta_lr_scale = 3.0;
   int alpha_warmup_steps = 0;
   int beta_warmup_steps = -1;  // -1: the first learning-rate phase (decay_interval())
@@ -205,5 +217,7 @@ constexpr bool draws_block(Sampler s) {
   return s == Sampler::kViewsTimesElements || s == Sampler::kMixed;
 }
 const char* data_term_name(DataTerm term);
+// "auto", "per-element", "rows-x-columns".
+const char* alpha_model_name(AlphaModel model);
 
 }  // namespace riner

@@ -14,7 +14,14 @@
 
 namespace riner {
 
+// How the non-ideal responses are laid out. Per element: each pixel its own (the paper's).
+// Rows x columns (3D): alpha(r, c) = a_r b_c, with round(nonideal_fraction * rows) row factors
+// and as many column factors ~ U[sqrt(alpha_min), sqrt(alpha_max)] (the rest 1): the gains of
+// a detector read out by line or by column amplifier.
+enum class ResponsePattern { kPerElement, kRowsTimesColumns };
+
 struct RingModel {
+  ResponsePattern pattern = ResponsePattern::kPerElement;
   double nonideal_fraction = 0.75;  // of all detector elements (pixels in 3D), exactly rounded
   double alpha_min = 0.75;          // non-ideal responses ~ U[alpha_min, alpha_max]
   double alpha_max = 1.25;

@@ -86,8 +86,7 @@ void Context::launch(const Kernel& kernel, const Range& global, const Range& loc
   const cl_uint dims = global.dims;
   // 1D launches that name no group get the kernel's default one (every such kernel returns
   // past its count); in 2D and 3D the runtime chooses.
-  const Range group =
-      local.dims == 0 && dims == 1 ? Range(kernel.default_group(device_)) : local;
+  const Range group = local.dims == 0 && dims == 1 ? Range(kernel.default_group(device_)) : local;
   for (cl_uint d = 0; d < dims; ++d) {
     const std::size_t g = global.size[d];
     const std::size_t l = group.dims == 0 ? 1 : group.size[d];

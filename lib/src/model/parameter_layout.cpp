@@ -15,7 +15,9 @@ std::size_t ParameterLayout::w_hidden(int layer) const {
 std::size_t ParameterLayout::w_out() const { return w_hidden(hidden_layers); }
 
 ParameterLayout make_layout(int dims, const EncodingConfig& encoding, const NetworkConfig& network,
-                            std::size_t elements) {
+                            std::size_t elements, std::size_t alpha_rows) {
+  if (alpha_rows > 0 && elements % alpha_rows != 0)
+    throw InputError("alpha's factors: the detector's elements are not rows x columns");
   ParameterLayout l;
   l.dims = dims;
   l.levels = encoding.levels;
@@ -52,7 +54,10 @@ ParameterLayout make_layout(int dims, const EncodingConfig& encoding, const Netw
                      (static_cast<std::size_t>(l.width) * l.width + l.width) +
                  l.width + 1;
   l.alpha_offset = l.mlp_offset + l.mlp_params;
-  l.beta_offset = l.alpha_offset + elements;
+  l.factor_offset = l.alpha_offset + elements;
+  l.factor_rows = alpha_rows;
+  l.factor_columns = alpha_rows > 0 ? elements / alpha_rows : 0;
+  l.beta_offset = l.factor_offset + l.factor_rows + l.factor_columns;
   l.elements = elements;
   l.total = l.beta_offset + elements;
   if (l.total >= (std::size_t{1} << 32))
@@ -84,6 +89,7 @@ std::vector<float> initial_parameters(const ParameterLayout& l, std::uint64_t se
     p[l.alpha_offset + e] = 1.0f;
     p[l.beta_offset + e] = 1.0f;
   }
+  for (std::size_t f = l.factor_offset; f < l.beta_offset; ++f) p[f] = 1.0f;
   return p;
 }
 

@@ -1,5 +1,9 @@
 // Where every trainable number lives in the one flat parameter buffer both engines share:
-//   [hash-grid tables | MLP | alpha0 per element | beta0 per element]
+//   [hash-grid tables | MLP | alpha0 per element | alpha's row and column factors | beta0 per
+//    element]
+// The factor block is there only for a rows-times-columns alpha (kernels/alpha_factors.cl):
+// alpha0 of element (r, c) is then row factor r times column factor c, the factors are what
+// Adam trains, and alpha0 per element is their product, kept where the step reads it.
 // Grid: level l holds entries(l) x features floats from levels[l].offset; entry e, feature f at
 // offset + e * features + f. MLP: W_in [inputs][width], b_in [width], then per extra hidden
 // layer W [width][width], b [width], then W_out [width], b_out [1] (row-major).
@@ -35,6 +39,9 @@ struct ParameterLayout {
   std::size_t mlp_offset = 0;
   std::size_t mlp_params = 0;
   std::size_t alpha_offset = 0;
+  std::size_t factor_offset = 0;  // row factors, then column factors (alpha_offset + elements)
+  std::size_t factor_rows = 0;     // 0: alpha0 per element is trained directly
+  std::size_t factor_columns = 0;
   std::size_t beta_offset = 0;
   std::size_t elements = 0;
   std::size_t total = 0;
@@ -48,13 +55,17 @@ struct ParameterLayout {
   }
   std::size_t w_out() const;
   std::size_t b_out() const { return w_out() + static_cast<std::size_t>(width); }
+  bool factored_alpha() const { return factor_rows > 0; }
 };
 
+// alpha_rows > 0: alpha as row x column factors over a detector of alpha_rows rows (elements
+// must be a multiple of it).
 ParameterLayout make_layout(int dims, const EncodingConfig& encoding, const NetworkConfig& network,
-                            std::size_t elements);
+                            std::size_t elements, std::size_t alpha_rows = 0);
 
 // Initial values: grid U(-1e-4, 1e-4) (instant-NGP), MLP weights and biases
-// U(-1/sqrt(fan_in), 1/sqrt(fan_in)) (PyTorch's nn.Linear), alpha0 = beta0 = 1 (the paper).
+// U(-1/sqrt(fan_in), 1/sqrt(fan_in)) (PyTorch's nn.Linear), alpha0 = beta0 = 1 (the paper),
+// alpha's factors 1.
 std::vector<float> initial_parameters(const ParameterLayout& layout, std::uint64_t seed);
 
 }  // namespace riner::model

@@ -113,6 +113,16 @@ void add_training_schedule(Table& t) {
                        "elements steady over the views while their neighbours vary are dead "
                        "before training",
                        &C::training, &T::stuck_elements));
+  t.push_back(enum_choice<C>(
+      "training", "alpha_model",
+      {AlphaModel::kAuto, AlphaModel::kPerElement, AlphaModel::kRowsTimesColumns},
+      alpha_model_name,
+      "3D: alpha per detector pixel, or row x column factors; auto: by the stripe evidence",
+      &C::training, &T::alpha_model));
+  t.push_back(field<C>("training", "alpha_factor_evidence", closed(0, 1),
+                       "alpha_model auto: row x column factors when they explain this fraction "
+                       "of the stripe pattern",
+                       &C::training, &T::alpha_factor_evidence));
   t.push_back(field<C>("training", "beta_lr_scale", closed_open(0, 1000),
                        "beta's learning rate over the field's", &C::training, &T::beta_lr_scale));
   t.push_back(field<C>("training", "alpha_warmup_steps", closed(0, kMaxSteps),

@@ -50,6 +50,18 @@ const char* data_term_name(DataTerm t) {
   return "unknown";
 }
 
+const char* alpha_model_name(AlphaModel m) {
+  switch (m) {
+    case AlphaModel::kAuto:
+      return "auto";
+    case AlphaModel::kPerElement:
+      return "per-element";
+    case AlphaModel::kRowsTimesColumns:
+      return "rows-x-columns";
+  }
+  return "unknown";
+}
+
 const char* sampler_name(Sampler s) {
   switch (s) {
     case Sampler::kUniform:
@@ -177,6 +189,7 @@ RinerConfig RinerConfig::paper() {
   c.training.beta_lr_scale = 1.0;
   c.training.level_warmup_steps = 0;
   c.training.stuck_elements = false;
+  c.training.alpha_model = AlphaModel::kPerElement;
   c.training.skip_air = false;  // riner's additions, not the paper's
   c.rings.air_reference = false;
   c.rings.gradient_reference = false;

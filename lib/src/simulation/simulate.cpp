@@ -54,6 +54,9 @@ Array draw_responses(const Geometry& g, const RingModel& model) {
   if (!g.is_3d() && (model.dead_rows > 0 || model.dead_columns > 0)) {
     throw InputError("dead rows and columns need a 3D detector");
   }
+  if (!g.is_3d() && model.pattern == ResponsePattern::kRowsTimesColumns) {
+    throw InputError("responses by rows x columns need a 3D detector");
+  }
   if (model.dead_rows > rows || model.dead_columns > g.n_u || model.dead_elements > n) {
     throw InputError("more dead rows, columns or elements than the detector has");
   }
@@ -78,6 +81,23 @@ Array draw_responses(const Geometry& g, const RingModel& model) {
               1.0f);
   for (std::size_t e = 0; e < n; ++e) {
     if (dead[e]) alpha.data[e] = 0.0f;
+  }
+  if (model.pattern == ResponsePattern::kRowsTimesColumns) {
+    const double low = std::sqrt(model.alpha_min);
+    const double high = std::sqrt(model.alpha_max);
+    auto factors = [&](std::size_t count) {
+      std::vector<double> f(count, 1.0);
+      const auto nonideal = static_cast<std::size_t>(std::llround(model.nonideal_fraction * count));
+      for (std::size_t i : choose(iota(count), nonideal, rng)) {
+        f[i] = low + (high - low) * rng.uniform();
+      }
+      return f;
+    };
+    const std::vector<double> row = factors(rows);
+    const std::vector<double> column = factors(g.n_u);
+    for (std::size_t e : live)
+      alpha.data[e] = static_cast<float>(row[e / g.n_u] * column[e % g.n_u]);
+    return alpha;
   }
   const auto nonideal = static_cast<std::size_t>(std::llround(model.nonideal_fraction * n));
   for (std::size_t e : choose(live, nonideal, rng)) {

@@ -9,6 +9,7 @@
 #include "cl/upload_ring.hpp"
 #include "model/packed_batch.hpp"
 #include "ops/adam.hpp"
+#include "ops/alpha_factors.hpp"
 #include "ops/riner_step.hpp"
 #include "riner/error.hpp"
 #include "training/trainer.hpp"
@@ -36,7 +37,9 @@ class OpenclTrainer final : public Trainer {
         uploads_(ctx_, kUploadsInFlight),
         step_op_(ctx_, setup.layout, plan_,
                  model::BatchSampler(setup.scan.geometry, setup.config.training).rays_per_step()),
-        adam_(ctx_, setup.layout.total) {}
+        adam_(ctx_, setup.layout.total) {
+    if (setup.layout.factored_alpha()) factors_.emplace(ctx_, setup.layout);
+  }
 
   void step(int index, const model::Batch& batch) override {
     const TrainingConfig& t = setup_.config.training;
@@ -59,12 +62,14 @@ class OpenclTrainer final : public Trainer {
     p.block_elements = batch.block_elements;
     const cl::Buffer<cl_uint>& words = uploads_.upload(packed_.words);
     step_op_.step(p, words, {&invalid_readings_}, params_, grad_, history_);
+    if (factors_) factors_->gradient(params_, grad_);
     const AdamRates rates = setup_.adam_rates(index);
     adam_.step({rates.field, setup_.layout.alpha_offset, rates.alpha, setup_.layout.beta_offset,
                 rates.beta, t.adam_beta1, t.adam_beta2, t.adam_epsilon},
                index + 1, params_, grad_,
                {&step_op_.mlp_partials(), setup_.layout.mlp_offset, setup_.layout.mlp_params,
                 step_op_.mlp_slices()});
+    if (factors_) factors_->expand(params_);
     pending_.push_back({index, 0.0, 0.0, rates.field});
     steps_ = index + 1;
     if (pending_.size() == kHistoryBlock) read_history();
@@ -124,6 +129,7 @@ class OpenclTrainer final : public Trainer {
   model::PackedBatch packed_;
   ops::RinerStepOp step_op_;
   ops::AdamOp adam_;
+  std::optional<ops::AlphaFactorsOp> factors_;  // alpha as row x column factors
   std::vector<LossRecord> pending_;
   std::vector<LossRecord> done_;
   int steps_ = 0;

@@ -282,6 +282,8 @@ TrainingStats Reconstructor::stats() const {
   s.air_note = setup.occupancy.note;
   s.alpha_rate = setup.alpha_rate;
   s.stripe_rms = setup.stripe_rms;
+  s.alpha_model = setup.alpha_model;
+  if (setup.factor_evidence.pixels > 0) s.alpha_factor_explained = setup.factor_evidence.explained;
   s.level_warmup_steps = setup.config.training.level_warmup_steps;
   s.relative_noise = setup.noise.relative;
   rusage usage{};

@@ -1,5 +1,6 @@
 // The reference engine: the whole step in double on the CPU (reference/riner_step_ref.cpp).
 #include "reference/adam_ref.hpp"
+#include "reference/alpha_factors_ref.hpp"
 #include "reference/riner_step_ref.hpp"
 #include "training/trainer.hpp"
 
@@ -32,12 +33,14 @@ class ReferenceTrainer final : public Trainer {
     inputs_.step = static_cast<std::uint32_t>(index);
     inputs_.level_weights = setup_.level_weights(index);
     inputs_.hold_valid_beta = setup_.hold_valid_beta(index);
-    const ref::StepResult r = ref::riner_step(inputs_, batch, params_);
+    ref::StepResult r = ref::riner_step(inputs_, batch, params_);
+    if (setup_.layout.factored_alpha()) ref::alpha_factors_gradient(setup_.layout, params_, r.grad);
     const TrainingConfig& t = setup_.config.training;
     const AdamRates rates = setup_.adam_rates(index);
     ref::adam_step({rates.field, setup_.layout.alpha_offset, rates.alpha, setup_.layout.beta_offset,
                     rates.beta, t.adam_beta1, t.adam_beta2, t.adam_epsilon},
                    index + 1, r.grad, params_, m_, v_);
+    if (setup_.layout.factored_alpha()) ref::alpha_factors_expand(setup_.layout, params_);
     losses_.push_back({index, r.data_loss, r.penalty, rates.field});
     steps_ = index + 1;
   }

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "model/batch_sampler.hpp"
+#include "model/factor_evidence.hpp"
 #include "model/noise_evidence.hpp"
 #include "model/occupancy.hpp"
 #include "model/parameter_layout.hpp"
@@ -40,6 +41,8 @@ struct TrainingSetup {
   model::NoiseEvidence noise;  // model/noise_evidence.hpp; sets level_warmup_steps -1
   std::vector<std::uint8_t> stuck;  // per element, model/stuck_elements.hpp (readings now NaN)
   std::size_t stuck_count = 0;
+  model::FactorEvidence factor_evidence;  // 3D, model/factor_evidence.hpp
+  AlphaModel alpha_model = AlphaModel::kPerElement;  // as trained (never auto)
 
   TrainingSetup(Scan scan, RinerConfig config);
   double learning_rate(int step) const;

@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "model/factor_evidence.hpp"
 #include "model/stripe_evidence.hpp"
 #include "model/stuck_elements.hpp"
 #include "riner/error.hpp"
@@ -20,8 +21,6 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c) : scan(std::move(s)), config
     config.encoding.finest_resolution =
         std::max(config.encoding.base_resolution, static_cast<int>(largest));
   }
-  layout =
-      model::make_layout(g.is_3d() ? 3 : 2, config.encoding, config.network, elements_per_view);
   segments = model::ray_segments(g, config.training.sample_spacing * g.voxel_mm,
                                  config.training.circle_region);
   std::size_t hit = 0;
@@ -47,6 +46,18 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c) : scan(std::move(s)), config
   } else {
     stuck.assign(elements_per_view, 0);
   }
+  // After the stuck elements: their steady readings are no detector gain.
+  if (g.is_3d()) {
+    factor_evidence = model::factor_evidence(scan);
+    const AlphaModel asked = config.training.alpha_model;
+    const bool by_evidence = factor_evidence.pixels > 0 &&
+                             factor_evidence.explained >= config.training.alpha_factor_evidence;
+    if (asked == AlphaModel::kRowsTimesColumns || (asked == AlphaModel::kAuto && by_evidence)) {
+      alpha_model = AlphaModel::kRowsTimesColumns;
+    }
+  }
+  layout = model::make_layout(g.is_3d() ? 3 : 2, config.encoding, config.network, elements_per_view,
+                              alpha_model == AlphaModel::kRowsTimesColumns ? g.n_v : 0);
   occupancy.inside.assign(shape_size(g.volume_shape), 1);
   if (config.training.skip_air) {
     occupancy = model::carve_occupancy(
