@@ -54,9 +54,17 @@ Ray detector_ray(const Geometry& g, std::size_t view, double u, double v) {
   return {target, {-s, c, 0.0}};
 }
 
+ViewRotation ViewRotation::of(const Geometry& g, std::size_t view) {
+  return {std::cos(g.angles[view]), std::sin(g.angles[view])};
+}
+
 DetectorPoint project_to_detector(const Geometry& g, std::size_t view, const Vec3& p) {
-  const double c = std::cos(g.angles[view]);
-  const double s = std::sin(g.angles[view]);
+  return project_to_detector(g, ViewRotation::of(g, view), p);
+}
+
+DetectorPoint project_to_detector(const Geometry& g, const ViewRotation& rotation, const Vec3& p) {
+  const double c = rotation.c;
+  const double s = rotation.s;
   // p in the view's frame: a across the detector, b towards it (R(-theta) p).
   const double a = p.x * c + p.y * s;
   const double b = -p.x * s + p.y * c;

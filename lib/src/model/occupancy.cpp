@@ -190,9 +190,9 @@ std::vector<std::uint8_t> certify_readings(const Scan& scan, const std::vector<E
 
 // Whether view v certifies every element of the shadow of a voxel centred at p (a sphere
 // circumscribing the voxel); false when the shadow leaves the detector.
-bool shadow_certified(const Geometry& g, std::size_t v, const Vec3& p, double radius,
-                      std::size_t rows, const std::vector<std::uint8_t>& certified) {
-  const DetectorPoint d = project_to_detector(g, v, p);
+bool shadow_certified(const Geometry& g, std::size_t v, const ViewRotation& rotation, const Vec3& p,
+                      double radius, std::size_t rows, const std::vector<std::uint8_t>& certified) {
+  const DetectorPoint d = project_to_detector(g, rotation, p);
   const double hu = radius * d.magnification / g.pitch_u;
   const double u0 = std::floor(d.u - hu), u1 = std::ceil(d.u + hu);
   if (!(u0 >= 0.0 && u1 <= static_cast<double>(g.n_u) - 1.0)) return false;
@@ -221,13 +221,15 @@ std::vector<std::uint8_t> carve(const Geometry& g, std::size_t rows,
   const std::size_t ny = g.volume_shape[rank - 2];
   const double radius = 0.5 * g.voxel_mm * std::sqrt(static_cast<double>(rank));
   std::vector<std::uint8_t> inside(voxels, 1);
+  std::vector<ViewRotation> rotations;
+  for (std::size_t v = 0; v < g.n_views(); ++v) rotations.push_back(ViewRotation::of(g, v));
   util::parallel_for(voxels, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       const Vec3 p =
           voxel_centre(g, static_cast<double>(i % nx), static_cast<double>((i / nx) % ny),
                        static_cast<double>(i / (nx * ny)));
       for (std::size_t v = 0; v < g.n_views(); ++v) {
-        if (shadow_certified(g, v, p, radius, rows, certified)) {
+        if (shadow_certified(g, v, rotations[v], p, radius, rows, certified)) {
           inside[i] = 0;
           break;
         }
