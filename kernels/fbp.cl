@@ -2,14 +2,15 @@
 //   fbp_filter(n_out, n_u, taps, in, out)
 //     one work-item per output sample; out[line][j] = sum_j' taps[j - j' + n_u - 1] *
 //     in[line][j'] (the ramp filter as a linear convolution; taps already hold the spacing).
-//   fbp_backproject(n_voxels, g, views, view_weights, filtered, volume)
-//     one work-item per voxel; sums over views the filtered value where the voxel projects
+//   fbp_backproject(n_voxels, first_slice, slice_step, g, views, view_weights, filtered, volume)
+//     one work-item per voxel of the selected axial slices first_slice + s * slice_step
+//     (volume[s] holds slice s of the selection; 2D: 0 and 1); sums over views the filtered value where the voxel projects
 //     (linear in u, bilinear in u and v in 3D), times the view weight and, for divergent beams,
 //     the distance weight (SOD / L)^2 with L the voxel's distance from the source along the
 //     central ray. Values off the detector count as 0.
 // Needs common.cl and ray_geometry.cl. No -D constants.
 // Buffers: taps float[2 n_u - 1]; in/out/filtered float[views][rows][n_u]; views float2 (cos,
-// sin); view_weights float[views]; volume float[nz][ny][nx].
+// sin); view_weights float[views]; volume float[selected slices][ny][nx].
 
 __kernel void fbp_filter(const uint n_out, const int n_u, __global const float* taps,
                          __global const float* in, __global float* out) {
@@ -42,14 +43,15 @@ inline float sample_detector(__global const float* view, int n_u, int n_v, float
   return value;
 }
 
-__kernel void fbp_backproject(const uint n_voxels, const ScanGeometry g,
+__kernel void fbp_backproject(const uint n_voxels, const uint first_slice, const uint slice_step,
+                              const ScanGeometry g,
                               __global const float2* views, __global const float* view_weights,
                               __global const float* filtered, __global float* volume) {
   const uint gid = get_global_id(0);
   if (gid >= n_voxels) return;
   const int k = gid % g.nx;
   const int i = (gid / g.nx) % g.ny;
-  const int l = gid / (g.nx * g.ny);
+  const int l = first_slice + gid / (g.nx * g.ny) * slice_step;
   const float x = ((float)k - 0.5f * (float)(g.nx - 1)) * g.voxel;
   const float y = (0.5f * (float)(g.ny - 1) - (float)i) * g.voxel;
   const float z = g.is_3d ? ((float)l - 0.5f * (float)(g.nz - 1)) * g.voxel : 0.0f;

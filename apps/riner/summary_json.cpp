@@ -10,6 +10,9 @@ namespace riner::app {
 
 namespace {
 
+// Axial slices of a volume the quality report measures, spread over it.
+constexpr std::size_t kQualitySlices = 16;
+
 nlohmann::json ring_summary(const std::optional<RingCorrection>& rings) {
   if (!rings) return {{"applied", false}};
   double largest = 0.0;
@@ -44,6 +47,8 @@ nlohmann::json quality_summary(const QualityCheck& check) {
                         {"fbp_ring_index", q.fbp_ring_index},
                         {"specks_per_10k_pixels", q.specks_per_10k},
                         {"fbp_specks_per_10k_pixels", q.fbp_specks_per_10k},
+                        {"slices_measured", check.slices},
+                        {"volume_slices", check.volume_slices},
                         {"centre", nullptr}};
   if (check.field) {
     out["centre"] = {{"radius_px", q.centre.radius_px},
@@ -63,10 +68,24 @@ QualityCheck check_quality(const Reconstructor& r, const ReconstructionResult& r
   FbpOptions options;
   options.engine = r.config().engine;
   options.device = device;
-  const Array fbp_image = fbp(r.scan(), options);
-  QualityCheck check{quality_against_fbp(result.image, fbp_image), {}};
-  if (fbp_image.rank() == 2) check.field = centre_deviation(result.field_image, fbp_image);
-  return check;
+  const Geometry& g = r.scan().geometry;
+  if (!g.is_3d()) {
+    const Array fbp_image = fbp(r.scan(), options);
+    QualityCheck check{quality_against_fbp(result.image, fbp_image), {}, {}, 0};
+    check.field = centre_deviation(result.field_image, fbp_image);
+    return check;
+  }
+  // The measures are per slice: a spread of them tells as much as the whole volume, and the
+  // FDK of all of it would cost more than the set-up of training (bench/RESULTS.md, issue 14).
+  options.slices = SliceSelection::spread(g.volume_shape[0], kQualitySlices);
+  const std::vector<std::size_t> slices = options.slices.slices(g.volume_shape[0]);
+  Array image({slices.size(), g.volume_shape[1], g.volume_shape[2]});
+  const std::size_t per_slice = g.volume_shape[1] * g.volume_shape[2];
+  for (std::size_t s = 0; s < slices.size(); ++s) {
+    std::copy_n(result.image.data.begin() + static_cast<std::ptrdiff_t>(slices[s] * per_slice),
+                per_slice, image.data.begin() + static_cast<std::ptrdiff_t>(s * per_slice));
+  }
+  return {quality_against_fbp(image, fbp(r.scan(), options)), {}, slices, g.volume_shape[0]};
 }
 
 nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& result,

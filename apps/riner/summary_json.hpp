@@ -24,6 +24,9 @@ nlohmann::json device_json(const DeviceInfo& device);
 struct QualityCheck {
   QualityReport image;
   std::optional<CentreDeviation> field;  // 2D only
+  // 3D: the axial slices measured (the FDK is reconstructed on those only) and of how many.
+  std::vector<std::size_t> slices;
+  std::size_t volume_slices = 0;
 };
 
 QualityCheck check_quality(const Reconstructor& r, const ReconstructionResult& result,

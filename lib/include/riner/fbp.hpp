@@ -6,6 +6,7 @@
 #include <cstddef>
 #include <optional>
 #include <string_view>
+#include <vector>
 
 #include "riner/array.hpp"
 #include "riner/device.hpp"
@@ -20,8 +21,23 @@ enum class FbpFilter { kRamLak, kSheppLogan, kHann };
 FbpFilter parse_fbp_filter(std::string_view name);
 const char* fbp_filter_name(FbpFilter filter);
 
+// Axial slices first, first + step, ... of a volume, count of them (0: all that fit).
+struct SliceSelection {
+  std::size_t first = 0;
+  std::size_t step = 1;
+  std::size_t count = 0;
+  // The selection's slices of a volume of nz; InputError when it names none or one past nz.
+  std::vector<std::size_t> slices(std::size_t nz) const;
+  // Up to `most` slices spread evenly over nz, centred.
+  static SliceSelection spread(std::size_t nz, std::size_t most);
+};
+
 struct FbpOptions {
   FbpFilter filter = FbpFilter::kRamLak;
+  // 3D: reconstruct only these axial slices (the result is [selected, ny, nx]); the
+  // backprojection's time and memory scale with them. Each slice's values are those of the
+  // whole volume's.
+  SliceSelection slices;
   Engine engine = Engine::kOpenCL;
   std::optional<Device> device;  // OpenCL engine; default Device::open()
 };

@@ -29,6 +29,27 @@ const char* fbp_filter_name(FbpFilter filter) {
   return "unknown";
 }
 
+std::vector<std::size_t> SliceSelection::slices(std::size_t nz) const {
+  if (step == 0) throw InputError("a slice selection's step must be at least 1");
+  if (first >= nz)
+    throw InputError("the slice selection starts past the volume's " + std::to_string(nz) +
+                     " slices");
+  const std::size_t fit = (nz - 1 - first) / step + 1;
+  if (count > fit)
+    throw InputError("the slice selection runs past the volume's " + std::to_string(nz) +
+                     " slices");
+  std::vector<std::size_t> out(count == 0 ? fit : count);
+  for (std::size_t s = 0; s < out.size(); ++s) out[s] = first + s * step;
+  return out;
+}
+
+SliceSelection SliceSelection::spread(std::size_t nz, std::size_t most) {
+  if (nz <= most || most == 0) return {};
+  const std::size_t step = (nz + most - 1) / most;
+  const std::size_t count = (nz - 1) / step + 1;
+  return {(nz - 1 - (count - 1) * step) / 2, step, count};
+}
+
 Array fbp(const Scan& scan, const FbpOptions& options, FbpReport* report) {
   const Geometry& g = scan.geometry;
   g.validate();
@@ -42,11 +63,20 @@ Array fbp(const Scan& scan, const FbpOptions& options, FbpReport* report) {
   const std::vector<double> view_weights = analytic::view_weights(g, &local.short_scan);
   if (report != nullptr) *report = local;
 
-  Array volume(g.volume_shape);
+  std::vector<std::size_t> shape = g.volume_shape;
+  std::size_t first = 0;
+  std::size_t step = 1;
+  if (g.is_3d()) {
+    const std::vector<std::size_t> slices = options.slices.slices(shape[0]);
+    shape[0] = slices.size();
+    first = slices.front();
+    step = options.slices.step;
+  }
+  Array volume(shape);
   if (options.engine == Engine::kReference) {
     const std::vector<double> in(weighted.data.begin(), weighted.data.end());
-    const std::vector<double> out =
-        ref::fbp_backproject(g, ref::fbp_filter(in, g.n_u, taps), view_weights);
+    const std::vector<double> out = ref::fbp_backproject(g, ref::fbp_filter(in, g.n_u, taps),
+                                                         view_weights, first, step, shape[0]);
     volume.data.assign(out.begin(), out.end());
     return volume;
   }
@@ -57,7 +87,7 @@ Array fbp(const Scan& scan, const FbpOptions& options, FbpReport* report) {
   cl::Buffer<float> d_filtered(ctx, weighted.size());
   cl::Buffer<float> d_volume(ctx, volume.size());
   op.filter(d_in, d_filtered);
-  op.backproject(d_filtered, d_volume);
+  op.backproject(d_filtered, d_volume, first, step);
   d_volume.read(std::span<float>(volume.data));
   return volume;
 }

@@ -17,7 +17,9 @@ FbpOp::FbpOp(cl::Context& context, const Geometry& geometry, const std::vector<d
       taps_(context, std::span<const float>(to_float(taps))),
       view_weights_(context, std::span<const float>(to_float(view_weights))),
       n_samples_(ray_count(geometry)),
-      n_voxels_(static_cast<cl_uint>(shape_size(geometry.volume_shape))),
+      slice_voxels_(static_cast<cl_uint>(geometry.volume_shape[geometry.volume_shape.size() - 1] *
+                                         geometry.volume_shape[geometry.volume_shape.size() - 2])),
+      n_slices_(static_cast<cl_uint>(geometry.is_3d() ? geometry.volume_shape[0] : 1)),
       program_(context.program({"common", "ray_geometry", "fbp"})),
       filter_(*program_, "fbp_filter"),
       backproject_(*program_, "fbp_backproject") {
@@ -32,12 +34,17 @@ void FbpOp::filter(const cl::Buffer<float>& in, cl::Buffer<float>& out) {
   context_.launch(filter_, n_samples_);
 }
 
-void FbpOp::backproject(const cl::Buffer<float>& filtered, cl::Buffer<float>& volume) {
-  if (filtered.size() != n_samples_ || volume.size() != n_voxels_) {
+void FbpOp::backproject(const cl::Buffer<float>& filtered, cl::Buffer<float>& volume,
+                        std::size_t first_slice, std::size_t slice_step) {
+  const std::size_t slices = volume.size() / slice_voxels_;
+  if (filtered.size() != n_samples_ || volume.size() % slice_voxels_ != 0 || slices == 0 ||
+      slice_step == 0 || first_slice + (slices - 1) * slice_step >= n_slices_) {
     throw Error("fbp_backproject: size mismatch");
   }
-  backproject_.set_args(n_voxels_, geometry_, views_, view_weights_, filtered, volume);
-  context_.launch(backproject_, n_voxels_);
+  const auto n = static_cast<cl_uint>(volume.size());
+  backproject_.set_args(n, static_cast<cl_uint>(first_slice), static_cast<cl_uint>(slice_step),
+                        geometry_, views_, view_weights_, filtered, volume);
+  context_.launch(backproject_, volume.size());
 }
 
 }  // namespace riner::ops

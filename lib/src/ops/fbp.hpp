@@ -18,8 +18,10 @@ class FbpOp {
 
   // out = in convolved with the taps along every detector row.
   void filter(const cl::Buffer<float>& in, cl::Buffer<float>& out);
-  // volume = weighted backprojection of the filtered measurement.
-  void backproject(const cl::Buffer<float>& filtered, cl::Buffer<float>& volume);
+  // volume = weighted backprojection of the filtered measurement onto the axial slices
+  // first_slice, first_slice + slice_step, ... (as many as volume holds; 2D: 0, 1).
+  void backproject(const cl::Buffer<float>& filtered, cl::Buffer<float>& volume,
+                   std::size_t first_slice = 0, std::size_t slice_step = 1);
 
  private:
   cl::Context& context_;
@@ -28,7 +30,8 @@ class FbpOp {
   cl::Buffer<float> taps_;
   cl::Buffer<float> view_weights_;
   cl_uint n_samples_;
-  cl_uint n_voxels_;
+  cl_uint slice_voxels_;  // nx * ny
+  cl_uint n_slices_;
   std::shared_ptr<const cl::Program> program_;
   cl::Kernel filter_;
   cl::Kernel backproject_;

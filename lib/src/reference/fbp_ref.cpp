@@ -43,11 +43,13 @@ std::vector<double> fbp_filter(const std::vector<double>& in, std::size_t n_u,
 }
 
 std::vector<double> fbp_backproject(const Geometry& g, const std::vector<double>& filtered,
-                                    const std::vector<double>& view_weights) {
+                                    const std::vector<double>& view_weights,
+                                    std::size_t first_slice, std::size_t slice_step,
+                                    std::size_t slices) {
   const std::size_t rank = g.volume_shape.size();
   const std::size_t nx = g.volume_shape[rank - 1];
   const std::size_t ny = g.volume_shape[rank - 2];
-  const std::size_t nz = g.is_3d() ? g.volume_shape[0] : 1;
+  const std::size_t nz = slices > 0 ? slices : (g.is_3d() ? g.volume_shape[0] : 1);
   const std::size_t rows = g.is_3d() ? g.n_v : 1;
   std::vector<double> cosines(g.n_views());
   std::vector<double> sines(g.n_views());
@@ -76,7 +78,7 @@ std::vector<double> fbp_backproject(const Geometry& g, const std::vector<double>
     for (std::size_t index = begin; index < end; ++index) {
       const std::size_t k = index % nx;
       const std::size_t i = (index / nx) % ny;
-      const std::size_t l = index / (nx * ny);
+      const std::size_t l = first_slice + index / (nx * ny) * slice_step;
       const Vec3 p =
           voxel_centre(g, static_cast<double>(k), static_cast<double>(i), static_cast<double>(l));
       double sum = 0.0;
