@@ -87,8 +87,11 @@ void joseph_walk(const GridIndexSpace& grid, const Ray& ray, Visit&& visit) {
       const double w = c - f;
       const long c0 = static_cast<long>(f);
       const int a = other[0];
-      if (c0 >= 0) visit(main_offset + c0 * stride[a], (1.0 - w) * step_length);
-      if (c0 + 1 < static_cast<long>(n[a]))
+      // Both ends checked: rounding can put c on n itself at a near-zero slope (a view at 90
+      // degrees), and the cell at n lies past the grid.
+      if (c0 >= 0 && c0 < static_cast<long>(n[a]))
+        visit(main_offset + c0 * stride[a], (1.0 - w) * step_length);
+      if (c0 + 1 >= 0 && c0 + 1 < static_cast<long>(n[a]))
         visit(main_offset + (c0 + 1) * stride[a], w * step_length);
       continue;
     }
