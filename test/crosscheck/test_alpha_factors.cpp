@@ -19,7 +19,7 @@ TEST_SUITE("alpha_factors") {
     std::mt19937 rng(static_cast<unsigned>(riner::test::seed()));
     std::uniform_real_distribution<double> u(-1.0, 1.0);
     const riner::EncodingConfig encoding{2, 2, 6, 4, 8};
-    for (const auto [rows, columns] : {std::pair{1, 1}, {1, 9}, {7, 1}, {13, 29}, {200, 300}}) {
+    for (const auto& [rows, columns] : {std::pair{1, 1}, {1, 9}, {7, 1}, {13, 29}, {200, 300}}) {
       CAPTURE(rows);
       CAPTURE(columns);
       const auto l =
