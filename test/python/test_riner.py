@@ -101,6 +101,25 @@ def test_arrays_come_out_as_float32_without_a_copy(tmp_path, fan_scan):
     assert np.array_equal(riner.fbp(np.asfortranarray(sim["sino"]), g), image)
 
 
+def test_a_rows_x_columns_detector_matches_the_cli_and_trains_as_factors(cli, tmp_path):
+    g = {"type": "cone3d", "detector": {"count": [40, 24], "pitch_mm": [2.0, 2.0]},
+         "source_origin_mm": 300, "origin_detector_mm": 300,
+         "angles": {"count": 36, "range_rad": 2 * np.pi},
+         "volume": {"shape": [12, 32, 32], "voxel_mm": 1.0}}
+    sim = riner.simulate(None, g, seed=2, response_pattern="rows-x-columns")
+    (tmp_path / "g.json").write_text(json.dumps(g))
+    subprocess.run([cli, "simulate", "--geometry", str(tmp_path / "g.json"), "--seed", "2",
+                    "--response-pattern", "rows-x-columns", "--out", str(tmp_path / "sim"),
+                    "--quiet"], check=True)
+    assert np.array_equal(sim["alpha"], riner.read_array(tmp_path / "sim" / "alpha.npy"))
+    r = riner.reconstruct(sim["sino"], g, steps=20, alpha_model="rows-x-columns", quality=False)
+    assert r.summary["alpha_model"]["model"] == "rows-x-columns"
+    a = r.alpha.astype(np.float64)
+    assert a[2, 3] * a[20, 37] == pytest.approx(a[2, 37] * a[20, 3], rel=1e-4)
+    with pytest.raises(riner.InputError, match="response_pattern must be"):
+        riner.simulate(None, g, response_pattern="diagonal")
+
+
 def test_reconstruct_returns_image_alpha_beta_summary(fan_scan):
     sim, g = fan_scan
     r = riner.reconstruct(sim["sino"], g, steps=300, seed=1)

@@ -172,11 +172,13 @@ def fbp(sino, geometry, flat=None, dark=None, center=None, filter="ram-lak", dev
 
 def simulate(image=None, geometry="fan2d-paper", seed=0, photons=1e7, nonideal_fraction=0.75,
              alpha_min=0.75, alpha_max=1.25, dead=2, dead_rows=0, dead_columns=0,
-             mu_unit="mm", mu_scale=0.1, projector="exact", device=None, engine="opencl"):
+             mu_unit="mm", mu_scale=0.1, projector="exact", device=None, engine="opencl",
+             response_pattern="per-element"):
     """A ring-corrupted scan by the paper's protocol (METHOD.md §4) of `image` (on the
     geometry's grid; mu_unit "cm" for DeepLesion's 1/cm) or, when None, of the built-in
-    Shepp-Logan phantom. Returns a dict: sino, clean, alpha (0 = dead), ground_truth,
-    geometry."""
+    Shepp-Logan phantom. response_pattern "rows-x-columns" (3D) draws alpha as row x column
+    factors, as `riner simulate --response-pattern` does. Returns a dict: sino, clean, alpha
+    (0 = dead), ground_truth, geometry."""
     if mu_unit not in ("mm", "cm"):
         raise InputError(f"mu_unit must be mm or cm (got {mu_unit!r})")
     if image is not None:
@@ -186,7 +188,7 @@ def simulate(image=None, geometry="fan2d-paper", seed=0, photons=1e7, nonideal_f
     geometry_json = _geometry_json(geometry)
     out = _riner.simulate(image, geometry_json, mu_scale, seed, photons, nonideal_fraction,
                           alpha_min, alpha_max, dead, dead_rows, dead_columns, projector,
-                          engine, _device(device))
+                          engine, _device(device), response_pattern)
     out["geometry"] = json.loads(geometry_json)
     return out
 

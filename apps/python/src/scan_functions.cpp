@@ -98,8 +98,14 @@ void bind_scan_functions(py::module_& m) {
                        double alpha_min, double alpha_max, std::size_t dead,
                        std::size_t dead_rows, std::size_t dead_columns,
                        const std::string& projector, const std::string& engine,
-                       const std::string& device) {
+                       const std::string& device, const std::string& response_pattern) {
     RingModel model;
+    if (response_pattern == "rows-x-columns") {
+      model.pattern = ResponsePattern::kRowsTimesColumns;
+    } else if (response_pattern != "per-element") {
+      throw InputError("response_pattern must be per-element or rows-x-columns (got \"" +
+                       response_pattern + "\")");
+    }
     model.seed = seed;
     model.photons = photons;
     model.nonideal_fraction = nonideal_fraction;
