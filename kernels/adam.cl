@@ -6,10 +6,11 @@
 //     (the split-K slices of the MLP's weight gradient, mlp_gradient.cl: deterministic).
 //     step_size = lr / (1 - beta1^t); inv_sqrt_bias2 = 1 / sqrt(1 - beta2^t); parameters from
 //     alpha_offset on (alpha0) use alpha_step_size, from beta_offset on (beta0)
-//     beta_step_size. Every parameter is updated every step (no skipping of zero gradients).
+//     beta_step_size. Parameters i < sparse_below with a zero gradient are skipped (their value
+//     and moments stay); all others are updated every step.
 // No -D constants. CPU twin: lib/src/reference/adam_ref.cpp.
 
-// Host mirror: ops::AdamParams (lib/src/ops/adam.hpp), 13 four-byte members.
+// Host mirror: ops::AdamParams (lib/src/ops/adam.hpp), 14 four-byte members.
 typedef struct {
   uint n;
   float step_size;
@@ -24,6 +25,7 @@ typedef struct {
   uint partial_offset;
   uint partial_count;
   uint n_partials;
+  uint sparse_below;
 } AdamParams;
 
 __kernel void adam_step(const AdamParams p, __global float* params, __global float* m,
@@ -31,11 +33,12 @@ __kernel void adam_step(const AdamParams p, __global float* params, __global flo
   const uint i = get_global_id(0);
   if (i >= p.n) return;
   float g = grad[i];
-  grad[i] = 0.0f;
   const uint k = i - p.partial_offset;  // wraps above partial_count when i < partial_offset
   if (k < p.partial_count) {
     for (uint q = 0; q < p.n_partials; ++q) g += partials[q * p.partial_count + k];
   }
+  if (i < p.sparse_below && g == 0.0f) return;  // grad[i] is 0 already
+  grad[i] = 0.0f;
   const float m_new = p.beta1 * m[i] + (1.0f - p.beta1) * g;
   const float v_new = p.beta2 * v[i] + (1.0f - p.beta2) * g * g;
   m[i] = m_new;

@@ -86,6 +86,9 @@ struct TrainingConfig {
   double adam_beta1 = 0.9;
   double adam_beta2 = 0.99;
   double adam_epsilon = 1e-15;
+  // Lazy Adam over the hash grid: entries the step's batch does not touch keep their value and
+  // moments instead of decaying and drifting (model/adam_settings.hpp).
+  bool sparse_adam = false;
   double lambda = 0.01;  // weight of the -beta^2 term
   // alpha0 and beta0 learn at learning_rate times these scales. alpha0 stays at its initial
   // value for alpha_warmup_steps (whichever of alpha and the field learns a ring first keeps

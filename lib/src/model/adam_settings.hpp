@@ -16,6 +16,9 @@ struct AdamSettings {
   double beta1 = 0.9;
   double beta2 = 0.999;
   double epsilon = 1e-8;
+  // Entries before this one whose gradient is exactly 0 this step are left as they are (value
+  // and moments): lazy Adam over the hash grid, whose entries a batch mostly does not touch.
+  std::size_t sparse_below = 0;
 };
 
 }  // namespace riner::model

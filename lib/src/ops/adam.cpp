@@ -46,6 +46,7 @@ void AdamOp::step(const AdamSettings& s, int step, cl::Buffer<float>& params,
   p.beta2 = static_cast<float>(s.beta2);
   p.inv_sqrt_bias2 = static_cast<float>(1.0 / std::sqrt(bias2));
   p.epsilon = static_cast<float>(s.epsilon);
+  p.sparse_below = static_cast<cl_uint>(std::min(s.sparse_below, n_params_));
   if (sliced) {
     p.partial_offset = static_cast<cl_uint>(slices.offset);
     p.partial_count = static_cast<cl_uint>(slices.count);

@@ -36,8 +36,9 @@ struct AdamParams {
   cl_uint partial_offset = 0;
   cl_uint partial_count = 0;
   cl_uint n_partials = 0;
+  cl_uint sparse_below = 0;
 };
-static_assert(sizeof(AdamParams) == 52, "must match AdamParams in adam.cl");
+static_assert(sizeof(AdamParams) == 56, "must match AdamParams in adam.cl");
 
 class AdamOp {
  public:

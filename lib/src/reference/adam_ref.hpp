@@ -1,6 +1,6 @@
 // CPU twin of kernels/adam.cl: Adam (Kingma & Ba) as PyTorch computes it, over the whole flat
 // parameter buffer; every parameter is updated every step (entries with a zero gradient decay
-// their moments too).
+// their moments too), except entries below sparse_below with a zero gradient (lazy Adam).
 #pragma once
 
 #include <cstddef>

@@ -101,6 +101,9 @@ void add_training_schedule(Table& t) {
                        &T::adam_beta2));
   t.push_back(field<C>("training", "adam_epsilon", open(0, 1), "Adam's epsilon", &C::training,
                        &T::adam_epsilon));
+  t.push_back(field<C>("training", "sparse_adam", {},
+                       "hash-grid entries the batch does not touch keep value and moments",
+                       &C::training, &T::sparse_adam));
   t.push_back(field<C>("training", "lambda", closed_open(0, 1e6),
                        "weight of the -beta^2 term (dead-element mask)", &C::training, &T::lambda));
   t.push_back(field<C>("training", "alpha_lr_scale", closed_open(0, 1000),

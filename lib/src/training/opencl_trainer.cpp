@@ -65,7 +65,8 @@ class OpenclTrainer final : public Trainer {
     if (factors_) factors_->gradient(params_, grad_);
     const AdamRates rates = setup_.adam_rates(index);
     adam_.step({rates.field, setup_.layout.alpha_offset, rates.alpha, setup_.layout.beta_offset,
-                rates.beta, t.adam_beta1, t.adam_beta2, t.adam_epsilon},
+                rates.beta, t.adam_beta1, t.adam_beta2, t.adam_epsilon,
+                t.sparse_adam ? setup_.layout.grid_params : 0},
                index + 1, params_, grad_,
                {&step_op_.mlp_partials(), setup_.layout.mlp_offset, setup_.layout.mlp_params,
                 step_op_.mlp_slices()});

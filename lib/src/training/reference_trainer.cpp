@@ -38,7 +38,8 @@ class ReferenceTrainer final : public Trainer {
     const TrainingConfig& t = setup_.config.training;
     const AdamRates rates = setup_.adam_rates(index);
     ref::adam_step({rates.field, setup_.layout.alpha_offset, rates.alpha, setup_.layout.beta_offset,
-                    rates.beta, t.adam_beta1, t.adam_beta2, t.adam_epsilon},
+                    rates.beta, t.adam_beta1, t.adam_beta2, t.adam_epsilon,
+                    t.sparse_adam ? setup_.layout.grid_params : 0},
                    index + 1, r.grad, params_, m_, v_);
     if (setup_.layout.factored_alpha()) ref::alpha_factors_expand(setup_.layout, params_);
     losses_.push_back({index, r.data_loss, r.penalty, rates.field});
