@@ -4,6 +4,8 @@
 #include <cmath>
 #include <vector>
 
+#include "model/stripe_evidence.hpp"
+
 namespace riner::model {
 
 namespace {
@@ -21,7 +23,8 @@ double median_times_count(std::vector<double> v) {
 }
 
 // mean[line][position] (transposed: mean[position][line]); NaN where a pixel had a
-// non-finite reading. The pattern at (line, p) is mean(p) - (mean(p - 1) + mean(p + 1)) / 2.
+// non-finite reading (element_means), which drops it out of the patterns. The pattern at (line, p)
+// is mean(p) - (mean(p - 1) + mean(p + 1)) / 2.
 Energies pattern_energies(const std::vector<double>& mean, std::size_t lines, std::size_t positions,
                           bool transposed) {
   auto at = [&](std::size_t line, std::size_t p) {
@@ -29,7 +32,6 @@ Energies pattern_energies(const std::vector<double>& mean, std::size_t lines, st
   };
   Energies e;
   if (positions < 3) return e;
-  std::vector<double> pattern(lines);
   std::vector<double> totals;
   std::vector<double> residuals;
   for (std::size_t p = 1; p + 1 < positions; ++p) {
@@ -38,7 +40,6 @@ Energies pattern_energies(const std::vector<double>& mean, std::size_t lines, st
     std::size_t n = 0;
     for (std::size_t line = 0; line < lines; ++line) {
       const double d = at(line, p) - 0.5 * (at(line, p - 1) + at(line, p + 1));
-      pattern[line] = d;
       if (!std::isfinite(d)) continue;
       sum += d;
       squares += d * d;
@@ -58,22 +59,16 @@ Energies pattern_energies(const std::vector<double>& mean, std::size_t lines, st
 }  // namespace
 
 FactorEvidence factor_evidence(const Scan& scan) {
-  const Geometry& g = scan.geometry;
+  return factor_evidence(element_means(scan), scan.geometry);
+}
+
+FactorEvidence factor_evidence(const std::vector<double>& means, const Geometry& g) {
   FactorEvidence out;
   if (!g.is_3d()) return out;
   const std::size_t rows = g.n_v;
   const std::size_t columns = g.n_u;
-  const std::size_t per_view = rows * columns;
-  const std::size_t views = g.n_views();
-  std::vector<double> mean(per_view, 0.0);
-  const std::vector<float>& rho = scan.measurement.data;
-  for (std::size_t v = 0; v < views; ++v) {
-    for (std::size_t e = 0; e < per_view; ++e) mean[e] += rho[v * per_view + e];
-  }
-  // A non-finite reading makes its pixel's mean non-finite: it drops out of the patterns.
-  for (double& m : mean) m /= static_cast<double>(views);
-  const Energies along_rows = pattern_energies(mean, rows, columns, false);
-  const Energies along_columns = pattern_energies(mean, columns, rows, true);
+  const Energies along_rows = pattern_energies(means, rows, columns, false);
+  const Energies along_columns = pattern_energies(means, columns, rows, true);
   const double total = along_rows.total + along_columns.total;
   out.pixels = along_rows.pixels + along_columns.pixels;
   if (total > 0.0) {

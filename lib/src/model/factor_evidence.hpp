@@ -11,6 +11,7 @@
 #pragma once
 
 #include <cstddef>
+#include <vector>
 
 #include "riner/scan.hpp"
 
@@ -21,7 +22,8 @@ struct FactorEvidence {
   std::size_t pixels = 0;  // pixels it was measured on (0: not measurable)
 };
 
-// 3D only (a 2D detector is one row: zero pixels).
+// 3D only (a 2D detector is one row: zero pixels). means: model::element_means of the scan.
 FactorEvidence factor_evidence(const Scan& scan);
+FactorEvidence factor_evidence(const std::vector<double>& means, const Geometry& g);
 
 }  // namespace riner::model

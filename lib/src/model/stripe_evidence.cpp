@@ -7,32 +7,32 @@
 
 namespace riner::model {
 
-double stripe_rms(const Scan& scan) {
+std::vector<double> element_means(const Scan& scan) {
   const Geometry& g = scan.geometry;
   const std::size_t views = g.n_views();
   const std::size_t per_view = g.n_u * (g.is_3d() ? g.n_v : 1);
-  std::vector<double> sum(per_view, 0.0);
-  std::vector<char> finite(per_view, 1);
+  std::vector<double> mean(per_view, 0.0);
   const std::vector<float>& rho = scan.measurement.data;
   for (std::size_t v = 0; v < views; ++v) {
-    for (std::size_t e = 0; e < per_view; ++e) {
-      const float r = rho[v * per_view + e];
-      if (std::isfinite(r)) {
-        sum[e] += r;
-      } else {
-        finite[e] = 0;
-      }
-    }
+    for (std::size_t e = 0; e < per_view; ++e) mean[e] += rho[v * per_view + e];
   }
+  // A non-finite reading leaves its element's sum non-finite.
+  for (double& m : mean) m = std::isfinite(m) ? m / static_cast<double>(views) : NAN;
+  return mean;
+}
+
+double stripe_rms(const Scan& scan) { return stripe_rms(element_means(scan), scan.geometry.n_u); }
+
+double stripe_rms(const std::vector<double>& means, std::size_t n_u) {
   constexpr std::size_t kWindow = 7;
   double squares = 0.0;
   std::size_t count = 0;
   std::vector<double> row;
-  for (std::size_t r = 0; r < per_view / g.n_u; ++r) {
+  for (std::size_t r = 0; r < means.size() / n_u; ++r) {
     row.clear();
-    for (std::size_t u = 0; u < g.n_u; ++u) {
-      const std::size_t e = r * g.n_u + u;
-      if (finite[e]) row.push_back(sum[e] / static_cast<double>(views));
+    for (std::size_t u = 0; u < n_u; ++u) {
+      const double m = means[r * n_u + u];
+      if (std::isfinite(m)) row.push_back(m);
     }
     if (row.size() < kWindow) continue;
     // Only where the window is centred: at a row's ends a sloping object would read as stripes.

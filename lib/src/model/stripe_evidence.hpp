@@ -6,11 +6,20 @@
 // the shared real scans 0.0015-0.0043 (bench/RESULTS.md, issue 13).
 #pragma once
 
+#include <cstddef>
+#include <vector>
+
 #include "riner/scan.hpp"
 
 namespace riner::model {
 
-// 0 when no row has seven elements with finite readings.
+// Each detector element's mean reading over the views ([rows][n_u] in 3D); NaN where any of
+// its readings is not finite. The one pass over the measurement this and
+// model/factor_evidence.hpp share.
+std::vector<double> element_means(const Scan& scan);
+
+// 0 when no row has seven elements with finite readings. means: element_means, rows of n_u.
+double stripe_rms(const std::vector<double>& means, std::size_t n_u);
 double stripe_rms(const Scan& scan);
 
 }  // namespace riner::model

@@ -47,8 +47,10 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c) : scan(std::move(s)), config
     stuck.assign(elements_per_view, 0);
   }
   // After the stuck elements: their steady readings are no detector gain.
+  const std::vector<double> means = model::element_means(scan);
+  stripe_rms = model::stripe_rms(means, g.n_u);
   if (g.is_3d()) {
-    factor_evidence = model::factor_evidence(scan);
+    factor_evidence = model::factor_evidence(means, g);
     const AlphaModel asked = config.training.alpha_model;
     const bool by_evidence = factor_evidence.pixels > 0 &&
                              factor_evidence.explained >= config.training.alpha_factor_evidence;
@@ -64,7 +66,6 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c) : scan(std::move(s)), config
         scan, {config.training.air_noise_sigmas, config.training.air_margin_px});
     samples_kept = model::clip_segments(segments, g, occupancy, config.training.sample_spacing);
   }
-  stripe_rms = model::stripe_rms(scan);
   alpha_rate = config.training.alpha_lr_scale;
   if (config.training.alpha_stripe_scale > 0) {
     alpha_rate *= std::min(1.0, stripe_rms / config.training.alpha_stripe_scale);
@@ -93,10 +94,18 @@ std::vector<float> TrainingSetup::level_weights(int step) const {
   return w;
 }
 
-AdamRates TrainingSetup::adam_rates(int step) const {
+model::AdamSettings TrainingSetup::adam_settings(int step) const {
   const TrainingConfig& t = config.training;
   const double lr = learning_rate(step);
-  return {lr, step < t.alpha_warmup_steps ? 0.0 : lr * alpha_rate, lr * t.beta_lr_scale};
+  return {lr,
+          layout.alpha_offset,
+          step < t.alpha_warmup_steps ? 0.0 : lr * alpha_rate,
+          layout.beta_offset,
+          lr * t.beta_lr_scale,
+          t.adam_beta1,
+          t.adam_beta2,
+          t.adam_epsilon,
+          t.sparse_adam ? layout.grid_params : 0};
 }
 
 }  // namespace riner::detail
