@@ -57,6 +57,7 @@ TEST_SUITE("stripe evidence") {
     config.training.alpha_stripe_scale = 0.0;  // off
     const riner::detail::TrainingSetup off(bump_scan(0.01f), config);
     CHECK(off.alpha_rate == doctest::Approx(0.5));
-    CHECK(off.adam_rates(0).alpha == doctest::Approx(0.5 * config.training.learning_rate));
+    CHECK(off.adam_settings(0).alpha_learning_rate ==
+          doctest::Approx(0.5 * config.training.learning_rate));
   }
 }

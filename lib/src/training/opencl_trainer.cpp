@@ -63,15 +63,12 @@ class OpenclTrainer final : public Trainer {
     const cl::Buffer<cl_uint>& words = uploads_.upload(packed_.words);
     step_op_.step(p, words, {&invalid_readings_}, params_, grad_, history_);
     if (factors_) factors_->gradient(params_, grad_);
-    const AdamRates rates = setup_.adam_rates(index);
-    adam_.step({rates.field, setup_.layout.alpha_offset, rates.alpha, setup_.layout.beta_offset,
-                rates.beta, t.adam_beta1, t.adam_beta2, t.adam_epsilon,
-                t.sparse_adam ? setup_.layout.grid_params : 0},
-               index + 1, params_, grad_,
+    const model::AdamSettings adam = setup_.adam_settings(index);
+    adam_.step(adam, index + 1, params_, grad_,
                {&step_op_.mlp_partials(), setup_.layout.mlp_offset, setup_.layout.mlp_params,
                 step_op_.mlp_slices()});
     if (factors_) factors_->expand(params_);
-    pending_.push_back({index, 0.0, 0.0, rates.field});
+    pending_.push_back({index, 0.0, 0.0, adam.learning_rate});
     steps_ = index + 1;
     if (pending_.size() == kHistoryBlock) read_history();
   }

@@ -35,14 +35,10 @@ class ReferenceTrainer final : public Trainer {
     inputs_.hold_valid_beta = setup_.hold_valid_beta(index);
     ref::StepResult r = ref::riner_step(inputs_, batch, params_);
     if (setup_.layout.factored_alpha()) ref::alpha_factors_gradient(setup_.layout, params_, r.grad);
-    const TrainingConfig& t = setup_.config.training;
-    const AdamRates rates = setup_.adam_rates(index);
-    ref::adam_step({rates.field, setup_.layout.alpha_offset, rates.alpha, setup_.layout.beta_offset,
-                    rates.beta, t.adam_beta1, t.adam_beta2, t.adam_epsilon,
-                    t.sparse_adam ? setup_.layout.grid_params : 0},
-                   index + 1, r.grad, params_, m_, v_);
+    const model::AdamSettings adam = setup_.adam_settings(index);
+    ref::adam_step(adam, index + 1, r.grad, params_, m_, v_);
     if (setup_.layout.factored_alpha()) ref::alpha_factors_expand(setup_.layout, params_);
-    losses_.push_back({index, r.data_loss, r.penalty, rates.field});
+    losses_.push_back({index, r.data_loss, r.penalty, adam.learning_rate});
     steps_ = index + 1;
   }
 

@@ -6,6 +6,7 @@
 #include <optional>
 #include <vector>
 
+#include "model/adam_settings.hpp"
 #include "model/batch_sampler.hpp"
 #include "model/factor_evidence.hpp"
 #include "model/noise_evidence.hpp"
@@ -17,12 +18,6 @@
 #include "riner/reconstructor.hpp"
 
 namespace riner::detail {
-
-struct AdamRates {
-  double field = 0.0;
-  double alpha = 0.0;
-  double beta = 0.0;
-};
 
 // What both engines share: layout, rays, batches, schedule.
 struct TrainingSetup {
@@ -46,8 +41,9 @@ struct TrainingSetup {
 
   TrainingSetup(Scan scan, RinerConfig config);
   double learning_rate(int step) const;
-  // Adam settings of a step: the schedule for the field, alpha0 and beta0.
-  AdamRates adam_rates(int step) const;
+  // Adam settings of a step, for both engines: the schedule for the field, alpha0 and beta0,
+  // and the lazy range (training.sparse_adam).
+  model::AdamSettings adam_settings(int step) const;
   // Whether beta0 of the elements without invalid readings is held at this step (warm-up).
   bool hold_valid_beta(int step) const { return step < config.training.beta_warmup(); }
   // Scale of each encoding level's features at a step (coarse to fine); all 1 when done.
