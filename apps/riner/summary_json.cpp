@@ -80,10 +80,10 @@ QualityCheck check_quality(const Reconstructor& r, const ReconstructionResult& r
   options.slices = SliceSelection::spread(g.volume_shape[0], kQualitySlices);
   const std::vector<std::size_t> slices = options.slices.slices(g.volume_shape[0]);
   Array image({slices.size(), g.volume_shape[1], g.volume_shape[2]});
-  const std::size_t per_slice = g.volume_shape[1] * g.volume_shape[2];
-  for (std::size_t s = 0; s < slices.size(); ++s) {
-    std::copy_n(result.image.data.begin() + static_cast<std::ptrdiff_t>(slices[s] * per_slice),
-                per_slice, image.data.begin() + static_cast<std::ptrdiff_t>(s * per_slice));
+  auto into = image.data.begin();
+  for (std::size_t z : slices) {
+    const Array slice = axial_slice(result.image, z);
+    into = std::copy(slice.data.begin(), slice.data.end(), into);
   }
   return {quality_against_fbp(image, fbp(r.scan(), options)), {}, slices, g.volume_shape[0]};
 }
