@@ -125,6 +125,8 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
                                 : nlohmann::json()}}},
       {"level_warmup",
        {{"steps", stats.level_warmup_steps}, {"relative_noise", stats.relative_noise}}},
+      {"tail_average",
+       {{"steps", stats.tail_average_steps}, {"snapshots", stats.tail_average_snapshots}}},
       {"coverage",
        {{"rays", stats.coverage.rays},
         {"rays_per_element_fewest", stats.coverage.fewest},

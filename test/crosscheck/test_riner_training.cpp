@@ -1,6 +1,10 @@
 // The OpenCL training against the reference engine, and tiny end-to-end reconstructions.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
 #include "riner/error.hpp"
 #include "riner/fbp.hpp"
 #include "riner/metrics.hpp"
@@ -74,6 +78,49 @@ TEST_SUITE("riner_training") {
       }
     }
     CHECK(dead == 1);
+  }
+
+  TEST_CASE("tail averaging: alpha is the mean of the snapshots' alphas; training unchanged") {
+    // 60 steps, a tail of 30: snapshots after steps 39, 49 and 59 (0-based). The run without
+    // averaging gives the snapshots; the run with it must give their mean, on both engines.
+    const riner::test::TinyProblem t = riner::test::tiny_problem(5);
+    for (riner::Engine engine : {riner::Engine::kOpenCL, riner::Engine::kReference}) {
+      CAPTURE(riner::engine_name(engine));
+      riner::RinerConfig c = riner::test::tiny_config();
+      c.engine = engine;
+      c.training.steps = 60;
+      c.rings.air_reference = c.rings.gradient_reference = c.rings.response_reference = false;
+      c.training.tail_average_steps = 0;
+      riner::Reconstructor last(t.scan, c, riner::test::device());
+      c.training.tail_average_steps = 30;
+      riner::Reconstructor averaged(t.scan, c, riner::test::device());
+      std::vector<double> mean(t.scan.geometry.n_u, 0.0);
+      for (int s = 0; s < 60; ++s) {
+        last.step(1);
+        if (s == 39 || s == 49 || s == 59) {
+          const riner::Array a = last.alpha();
+          for (std::size_t e = 0; e < mean.size(); ++e) mean[e] += a.data[e] / 3.0;
+        }
+      }
+      averaged.step(60);
+      CHECK(averaged.stats().tail_average_snapshots == 3);
+      CHECK(last.stats().tail_average_snapshots == 0);
+      const auto h_last = last.history();
+      const auto h_averaged = averaged.history();
+      REQUIRE(h_last.size() == h_averaged.size());
+      for (std::size_t i = 0; i < h_last.size(); ++i) {
+        CHECK(h_averaged[i].data_loss == h_last[i].data_loss);
+      }
+      const riner::Array a = averaged.alpha();
+      const riner::Array final_alpha = last.alpha();
+      double moved = 0.0;
+      for (std::size_t e = 0; e < mean.size(); ++e) {
+        CAPTURE(e);
+        CHECK(a.data[e] == doctest::Approx(mean[e]).epsilon(1e-6));
+        moved = std::max(moved, std::fabs(final_alpha.data[e] - mean[e]));
+      }
+      CHECK(moved > 1e-4);  // the mean differs from the last step's alpha
+    }
   }
 
   TEST_CASE("a tiny ring scan: the loss falls, the image beats FBP, the dead element is found") {
@@ -182,8 +229,7 @@ TEST_SUITE("riner_training") {
     riner::Array sino(g.measurement_shape());
     for (std::size_t i = 0; i < sino.size(); ++i) sino.data[i] = 0.1f + 0.01f * (i % 7);
     const riner::Scan volume{sino, g, 0};
-    CHECK(riner::Reconstructor(volume, c, riner::test::device()).config().training.steps ==
-          12000);
+    CHECK(riner::Reconstructor(volume, c, riner::test::device()).config().training.steps == 12000);
     c.training.steps = 77;  // an explicit count stays
     CHECK(riner::Reconstructor(volume, c, riner::test::device()).config().training.steps == 77);
   }

@@ -1,6 +1,7 @@
 // The noise evidence that turns coarse-to-fine training on (model/noise_evidence.hpp): known
 // Gaussian noise on a smooth sinogram reads back; per-element offsets do not count as noise;
-// level_warmup_steps -1 becomes steps / 24 on a noisy scan and 0 on a quiet one.
+// level_warmup_steps -1 becomes steps / 24 on a noisy scan and 0 on a quiet one, and
+// tail_average_steps -1 the last learning-rate phase on a noisy scan and 0 on a quiet one.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -28,8 +29,7 @@ riner::Scan disc_scan(double sigma) {
     for (std::size_t u = 0; u < 64; ++u) {
       const double x = (static_cast<double>(u) - 31.5 - centre) / 12.0;
       const double chord = std::fabs(x) < 1.0 ? 2.0 * std::sqrt(1.0 - x * x) : 0.0;
-      scan.measurement(v, u) =
-          static_cast<float>(chord + (u % 7 == 3 ? 0.05 : 0.0) + noise(rng));
+      scan.measurement(v, u) = static_cast<float>(chord + (u % 7 == 3 ? 0.05 : 0.0) + noise(rng));
     }
   }
   return scan;
@@ -63,17 +63,41 @@ TEST_SUITE("noise evidence") {
     riner::RinerConfig config;
     config.training.steps = 1200;
     // 0.02 / 2 = 1e-2 >= 0.001; 0.001 / 2 = 5e-4 below.
-    CHECK(riner::detail::TrainingSetup(disc_scan(0.02), config)
-              .config.training.level_warmup_steps == 50);
-    CHECK(riner::detail::TrainingSetup(disc_scan(0.001), config)
-              .config.training.level_warmup_steps == 0);
+    CHECK(
+        riner::detail::TrainingSetup(disc_scan(0.02), config).config.training.level_warmup_steps ==
+        50);
+    CHECK(
+        riner::detail::TrainingSetup(disc_scan(0.001), config).config.training.level_warmup_steps ==
+        0);
     config.training.level_warmup_steps = 7;  // an explicit value stays
-    CHECK(riner::detail::TrainingSetup(disc_scan(0.02), config)
-              .config.training.level_warmup_steps == 7);
+    CHECK(
+        riner::detail::TrainingSetup(disc_scan(0.02), config).config.training.level_warmup_steps ==
+        7);
     config.training.level_warmup_steps = -1;
     config.training.steps = -1;  // the scan's: 24 000 for a slice
     const riner::detail::TrainingSetup slice(disc_scan(0.02), config);
     CHECK(slice.config.training.steps == 24000);
     CHECK(slice.config.training.level_warmup_steps == 1000);
+  }
+
+  TEST_CASE(
+      "tail_average_steps -1: the last learning-rate phase on a noisy scan, 0 on a quiet one") {
+    riner::RinerConfig config;
+    config.training.steps = 1200;
+    const riner::detail::TrainingSetup noisy(disc_scan(0.02), config);
+    CHECK(noisy.config.training.tail_average_steps == 300);
+    CHECK(noisy.tail_average.steps == 300);
+    CHECK(noisy.tail_average.total == 1200);
+    CHECK(riner::detail::TrainingSetup(disc_scan(0.001), config).tail_average.steps == 0);
+    config.training.lr_decay_steps = 200;  // a shorter last phase
+    CHECK(riner::detail::TrainingSetup(disc_scan(0.02), config).tail_average.steps == 200);
+    config.training.lr_decay_steps = 5000;  // one phase only: still the last quarter at most
+    CHECK(riner::detail::TrainingSetup(disc_scan(0.02), config).tail_average.steps == 300);
+    config.training.tail_average_steps = 40;  // an explicit value stays, on a quiet scan too
+    CHECK(riner::detail::TrainingSetup(disc_scan(0.001), config).tail_average.steps == 40);
+    config.training.tail_average_steps = 5000;  // longer than the run: the whole run
+    CHECK(riner::detail::TrainingSetup(disc_scan(0.001), config).tail_average.steps == 1200);
+    config = riner::RinerConfig::paper();
+    CHECK(riner::detail::TrainingSetup(disc_scan(0.02), config).tail_average.steps == 0);
   }
 }

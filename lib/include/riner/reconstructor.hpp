@@ -107,6 +107,10 @@ struct TrainingStats {
   // when -1: the readings' noise sigma over their 99th percentile.
   int level_warmup_steps = 0;
   double relative_noise = 0.0;
+  // Tail averaging as trained (training.tail_average_steps, the same evidence when -1) and the
+  // snapshots the result is the mean of so far (0: the last step's parameters).
+  int tail_average_steps = 0;
+  int tail_average_snapshots = 0;
   // Memory, so far: the process's peak resident set (host) and the most bytes of device
   // buffers it held at once (0 on the reference engine).
   std::size_t peak_host_bytes = 0;

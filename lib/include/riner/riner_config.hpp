@@ -126,6 +126,13 @@ struct TrainingConfig {
   // warm-ups (steps / 12) leave over- and undershoots at sharp edges (bench/RESULTS.md).
   int level_warmup_steps = -1;
   double level_warmup_noise = 0.001;
+  // Tail averaging (model/tail_average.hpp): the image, alpha and beta come from the mean of the
+  // parameters over the last tail_average_steps steps (a snapshot every 10) instead of the last
+  // step's. -1: the last learning-rate phase (at most a quarter of the steps) when the readings
+  // are noisy (as for level_warmup_steps), else 0. On the noisy real scans the last iterate draws
+  // the last batches' noise as specks; on the paper's simulations the field still sharpens in the
+  // last phase and its mean lags (DeepLesion -0.3 dB), so they keep the last iterate.
+  int tail_average_steps = -1;
   // Stop on a plateau instead of at `steps`: in the last learning-rate phase, every
   // plateau_window steps (0: a quarter of the phase), training ends when the mean data loss of
   // the latest window is less than plateau_tolerance (relative) below the window's before.

@@ -118,8 +118,7 @@ void add_training_schedule(Table& t) {
                        &C::training, &T::stuck_elements));
   t.push_back(enum_choice<C>(
       "training", "alpha_model",
-      {AlphaModel::kAuto, AlphaModel::kPerElement, AlphaModel::kRowsTimesColumns},
-      alpha_model_name,
+      {AlphaModel::kAuto, AlphaModel::kPerElement, AlphaModel::kRowsTimesColumns}, alpha_model_name,
       "3D: alpha per detector pixel, or row x column factors; auto: by the stripe evidence",
       &C::training, &T::alpha_model));
   t.push_back(field<C>("training", "alpha_factor_evidence", closed(0, 1),
@@ -143,6 +142,11 @@ void add_training_schedule(Table& t) {
                        "level_warmup_steps -1: coarse to fine when the readings' noise is at "
                        "least this fraction of their 99th percentile",
                        &C::training, &T::level_warmup_noise));
+  t.push_back(field<C>("training", "tail_average_steps", closed(-1, kMaxSteps),
+                       "the result is the mean of the parameters over these last steps; 0: the "
+                       "last step's; -1: the last learning-rate phase when the readings are "
+                       "noisy (level_warmup_noise), else 0",
+                       &C::training, &T::tail_average_steps));
   t.push_back(field<C>("training", "stop_on_plateau", {},
                        "stop in the last learning-rate phase when the loss stops falling",
                        &C::training, &T::stop_on_plateau));

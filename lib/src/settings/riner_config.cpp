@@ -188,6 +188,7 @@ RinerConfig RinerConfig::paper() {
   c.training.alpha_stripe_scale = 0.0;  // the paper's alpha learns at the field's rate
   c.training.beta_lr_scale = 1.0;
   c.training.level_warmup_steps = 0;
+  c.training.tail_average_steps = 0;  // the paper's result is the last step's
   c.training.stuck_elements = false;
   c.training.alpha_model = AlphaModel::kPerElement;
   c.training.skip_air = false;  // riner's additions, not the paper's

@@ -11,6 +11,7 @@
 #include "ops/adam.hpp"
 #include "ops/alpha_factors.hpp"
 #include "ops/riner_step.hpp"
+#include "ops/vector_ops.hpp"
 #include "riner/error.hpp"
 #include "training/trainer.hpp"
 
@@ -39,6 +40,10 @@ class OpenclTrainer final : public Trainer {
                  model::BatchSampler(setup.scan.geometry, setup.config.training).rays_per_step()),
         adam_(ctx_, setup.layout.total) {
     if (setup.layout.factored_alpha()) factors_.emplace(ctx_, setup.layout);
+    if (setup.tail_average.steps > 0) {
+      vector_ops_.emplace(ctx_);
+      tail_sum_.emplace(ctx_, std::vector<float>(setup.layout.total, 0.0f));
+    }
   }
 
   void step(int index, const model::Batch& batch) override {
@@ -68,6 +73,10 @@ class OpenclTrainer final : public Trainer {
                {&step_op_.mlp_partials(), setup_.layout.mlp_offset, setup_.layout.mlp_params,
                 step_op_.mlp_slices()});
     if (factors_) factors_->expand(params_);
+    if (setup_.tail_average.takes(index)) {
+      vector_ops_->axpy(1.0f, params_, *tail_sum_);
+      ++snapshots_;
+    }
     pending_.push_back({index, 0.0, 0.0, adam.learning_rate});
     steps_ = index + 1;
     if (pending_.size() == kHistoryBlock) read_history();
@@ -80,7 +89,7 @@ class OpenclTrainer final : public Trainer {
     return out;
   }
 
-  std::vector<float> parameters() override { return params_.read(); }
+  std::vector<float> parameters() override { return result_parameters().read(); }
 
   std::vector<float> evaluate_grid() override {
     const Geometry& g = setup_.scan.geometry;
@@ -88,12 +97,13 @@ class OpenclTrainer final : public Trainer {
     cl::Buffer<float> out(ctx_, n);
     level_weights_.write(setup_.level_weights(steps_));
     const model::SamplingDomain domain = model::sampling_domain(g);
+    const cl::Buffer<float>& params = result_parameters();
     constexpr std::size_t kChunk = std::size_t{1} << 20;
     for (std::size_t first = 0; first < n; first += kChunk) {
       step_op_.evaluate(static_cast<cl_uint>(first),
                         static_cast<cl_uint>(std::min(kChunk, n - first)), g.volume_shape,
                         static_cast<float>(g.voxel_mm), static_cast<float>(domain.extent_mm),
-                        level_weights_, params_, out);
+                        level_weights_, params, out);
     }
     return out.read();
   }
@@ -102,6 +112,15 @@ class OpenclTrainer final : public Trainer {
   std::optional<ExecutionPlan> plan() const override { return plan_; }
 
  private:
+  // The parameters the result is made of: the snapshots' mean once the tail has begun.
+  const cl::Buffer<float>& result_parameters() {
+    if (snapshots_ == 0) return params_;
+    if (!tail_mean_) tail_mean_.emplace(ctx_, setup_.layout.total);
+    vector_ops_->fill(*tail_mean_, 0.0f);
+    vector_ops_->axpy(1.0f / static_cast<float>(snapshots_), *tail_sum_, *tail_mean_);
+    return *tail_mean_;
+  }
+
   void read_history() {
     if (pending_.empty()) return;
     const std::vector<float> values = history_.read();
@@ -128,6 +147,10 @@ class OpenclTrainer final : public Trainer {
   ops::RinerStepOp step_op_;
   ops::AdamOp adam_;
   std::optional<ops::AlphaFactorsOp> factors_;  // alpha as row x column factors
+  std::optional<ops::VectorOps> vector_ops_;    // tail averaging (model/tail_average.hpp)
+  std::optional<cl::Buffer<float>> tail_sum_;
+  std::optional<cl::Buffer<float>> tail_mean_;
+  int snapshots_ = 0;
   std::vector<LossRecord> pending_;
   std::vector<LossRecord> done_;
   int steps_ = 0;

@@ -286,6 +286,8 @@ TrainingStats Reconstructor::stats() const {
   if (setup.factor_evidence.pixels > 0) s.alpha_factor_explained = setup.factor_evidence.explained;
   s.level_warmup_steps = setup.config.training.level_warmup_steps;
   s.relative_noise = setup.noise.relative;
+  s.tail_average_steps = setup.tail_average.steps;
+  s.tail_average_snapshots = setup.tail_average.snapshots(impl_->steps);
   rusage usage{};
   if (getrusage(RUSAGE_SELF, &usage) == 0) {
     s.peak_host_bytes = static_cast<std::size_t>(usage.ru_maxrss) * 1024;  // kB on Linux

@@ -16,6 +16,7 @@ class ReferenceTrainer final : public Trainer {
     params_.assign(init.begin(), init.end());
     m_.assign(params_.size(), 0.0);
     v_.assign(params_.size(), 0.0);
+    if (setup.tail_average.steps > 0) tail_sum_.assign(params_.size(), 0.0);
     inputs_.layout = &setup_.layout;
     inputs_.segments = &setup_.segments;
     inputs_.measurement = &setup_.scan.measurement.data;
@@ -38,6 +39,10 @@ class ReferenceTrainer final : public Trainer {
     const model::AdamSettings adam = setup_.adam_settings(index);
     ref::adam_step(adam, index + 1, r.grad, params_, m_, v_);
     if (setup_.layout.factored_alpha()) ref::alpha_factors_expand(setup_.layout, params_);
+    if (setup_.tail_average.takes(index)) {
+      for (std::size_t i = 0; i < params_.size(); ++i) tail_sum_[i] += params_[i];
+      ++snapshots_;
+    }
     losses_.push_back({index, r.data_loss, r.penalty, adam.learning_rate});
     steps_ = index + 1;
   }
@@ -48,10 +53,13 @@ class ReferenceTrainer final : public Trainer {
     return out;
   }
 
-  std::vector<float> parameters() override { return {params_.begin(), params_.end()}; }
+  std::vector<float> parameters() override {
+    const std::vector<double> p = result_parameters();
+    return {p.begin(), p.end()};
+  }
 
   std::vector<float> evaluate_grid() override {
-    return ref::riner_step_field_evaluate(setup_.layout, params_,
+    return ref::riner_step_field_evaluate(setup_.layout, result_parameters(),
                                           model::voxel_positions(setup_.scan.geometry),
                                           setup_.level_weights(steps_));
   }
@@ -60,12 +68,22 @@ class ReferenceTrainer final : public Trainer {
   std::optional<ExecutionPlan> plan() const override { return std::nullopt; }
 
  private:
+  // The parameters the result is made of: the snapshots' mean once the tail has begun.
+  std::vector<double> result_parameters() const {
+    if (snapshots_ == 0) return params_;
+    std::vector<double> mean(tail_sum_.size());
+    for (std::size_t i = 0; i < mean.size(); ++i) mean[i] = tail_sum_[i] / snapshots_;
+    return mean;
+  }
+
   const TrainingSetup& setup_;
   ref::StepInputs inputs_;
   std::vector<double> params_;
   std::vector<double> m_;
   std::vector<double> v_;
   std::vector<LossRecord> losses_;
+  std::vector<double> tail_sum_;  // tail averaging (model/tail_average.hpp)
+  int snapshots_ = 0;
   int steps_ = 0;
 };
 

@@ -13,6 +13,7 @@
 #include "model/occupancy.hpp"
 #include "model/parameter_layout.hpp"
 #include "model/ray_segments.hpp"
+#include "model/tail_average.hpp"
 #include "riner/device.hpp"
 #include "riner/execution_plan.hpp"
 #include "riner/reconstructor.hpp"
@@ -32,11 +33,12 @@ struct TrainingSetup {
   double samples_in_grid = 0.0;                 // samples of every ray inside the grid
   double samples_kept = 0.0;                    // of those, inside the occupied region
   double stripe_rms = 0.0;                      // model/stripe_evidence.hpp
-  double alpha_rate = 1.0;  // alpha_lr_scale times the stripe evidence's factor
-  model::NoiseEvidence noise;  // model/noise_evidence.hpp; sets level_warmup_steps -1
+  double alpha_rate = 1.0;                      // alpha_lr_scale times the stripe evidence's factor
+  model::NoiseEvidence noise;       // model/noise_evidence.hpp; sets level_warmup_steps -1
+  model::TailAverage tail_average;  // which steps' parameters the result averages
   std::vector<std::uint8_t> stuck;  // per element, model/stuck_elements.hpp (readings now NaN)
   std::size_t stuck_count = 0;
-  model::FactorEvidence factor_evidence;  // 3D, model/factor_evidence.hpp
+  model::FactorEvidence factor_evidence;             // 3D, model/factor_evidence.hpp
   AlphaModel alpha_model = AlphaModel::kPerElement;  // as trained (never auto)
 
   TrainingSetup(Scan scan, RinerConfig config);

@@ -34,6 +34,14 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c) : scan(std::move(s)), config
     config.training.level_warmup_steps =
         noise.relative >= config.training.level_warmup_noise ? config.training.steps / 24 : 0;
   }
+  if (config.training.tail_average_steps < 0) {
+    // The last learning-rate phase, and never more than the last quarter of the run.
+    const int phase = std::min(config.training.decay_interval(), config.training.steps / 4);
+    config.training.tail_average_steps =
+        noise.relative >= config.training.level_warmup_noise ? phase : 0;
+  }
+  tail_average = {std::min(config.training.tail_average_steps, config.training.steps),
+                  config.training.steps};
   // Before carving: a pixel stuck at the flat reads air through the object.
   if (config.training.stuck_elements) {
     stuck = model::stuck_elements(scan, noise.sigma);
