@@ -8,6 +8,7 @@
 #include <iterator>
 
 #include "harness.hpp"
+#include "riner/error.hpp"
 #include "riner/fbp.hpp"
 #include "riner/io.hpp"
 #include "riner/metrics.hpp"
@@ -170,18 +171,11 @@ riner::Array beside(const riner::Array& left, const riner::Array& right) {
   return panel;
 }
 
-// A real scan (neutron360 by default): FBP and Riner side by side, ring index, specks and the
-// centre's deviation from FBP (riner/quality.hpp) of each; --png=PREFIX for the PNG pairs,
-// --npy=PREFIX for the images and responses as .npy.
-std::vector<Result> riner_real_scan(const Options& o) {
-  const std::string scan_path = o.get("scan", "../shared/data/neutron360/sino.npy");
-  const std::string png = o.get("png", "");
-  riner::Scan scan = riner::load_scan(scan_path);
-  riner::Device device = riner::Device::open(o.device);
-  riner::FbpOptions fbp_options;
-  fbp_options.device = device;
-  const riner::Array fbp_image = riner::fbp(scan, fbp_options);
-  const riner::RinerConfig config = riner::bench::config_from(o);
+// One seed's run of riner_real_scan: Riner against the scan's FBP; PNG pairs and .npy files
+// when `png` / `npy` name a prefix.
+nlohmann::json real_scan_run(const riner::Scan& scan, const riner::Array& fbp_image,
+                             const riner::RinerConfig& config, const riner::Device& device,
+                             const std::string& png, const std::string& npy) {
   riner::Reconstructor r(scan, config, device);
   r.run();
   const riner::ReconstructionResult result = r.result();
@@ -216,40 +210,81 @@ std::vector<Result> riner_real_scan(const Options& o) {
     riner::write_png(png + "_fbp_riner_centre.png", zoom, w);
   }
   const riner::QualityReport quality = riner::quality_against_fbp(image, fbp_image);
-  if (const std::string npy = o.get("npy", ""); !npy.empty()) {  // the images, for analysis
+  if (!npy.empty()) {  // the images, for analysis
     riner::write_array(npy + "_fbp.npy", fbp_image);
     riner::write_array(npy + "_field.npy", field);
     riner::write_array(npy + "_image.npy", image);
     riner::write_array(npy + "_alpha.npy", result.alpha);
     riner::write_array(npy + "_trained_alpha.npy", r.trained_alpha());
   }
-  return {
-      {"riner_real_scan",
-       {{"scan", scan_path},
-        {"fbp_ring_index", riner::ring_index(fbp_image)},
-        {"riner_ring_index", riner::ring_index(image)},
-        {"noise", quality.noise},
-        {"fbp_specks_per_10k", quality.fbp_specks_per_10k},
-        {"riner_specks_per_10k", quality.specks_per_10k},
-        {"field_specks_per_10k", riner::specks_per_10k(field, quality.noise)},
-        {"centre_deviation", quality.centre.deviation},
-        {"centre_deviation_at_px", quality.centre.at_px},
-        {"centre_deviation_sigmas", quality.centre.sigmas},
-        {"centre_fbp_profile_noise", quality.centre.fbp_noise},
-        {"field_centre_deviation_sigmas", riner::centre_deviation(field, fbp_image).sigmas},
-        {"samples_kept_fraction", r.stats().samples_kept_fraction},
-        {"field_ring_index", riner::ring_index(field)},
-        {"ring_correction_applied", rings && rings->applied},
-        {"ring_correction_response_change", rings ? rings->mean_response_change : 0.0},
-        {"gradient_correction_applied", gradient && gradient->applied},
-        {"gradient_correction_response_change", gradient ? gradient->mean_response_change : 0.0},
-        {"response_correction_applied", response && response->applied},
-        {"response_correction_response_change", response ? response->mean_response_change : 0.0},
-        {"response_correction_even_to_odd",
-         response && std::isfinite(response->even_to_odd) ? response->even_to_odd : 1e9},
-        {"elements_switched_off", off},
-        {"seconds", r.stats().seconds},
-        {"steps", r.stats().steps}}}};
+  return {{"seed", config.training.seed},
+          {"fbp_ring_index", riner::ring_index(fbp_image)},
+          {"riner_ring_index", riner::ring_index(image)},
+          {"noise", quality.noise},
+          {"fbp_specks_per_10k", quality.fbp_specks_per_10k},
+          {"riner_specks_per_10k", quality.specks_per_10k},
+          {"field_specks_per_10k", riner::specks_per_10k(field, quality.noise)},
+          {"centre_deviation", quality.centre.deviation},
+          {"centre_deviation_at_px", quality.centre.at_px},
+          {"centre_deviation_sigmas", quality.centre.sigmas},
+          {"centre_fbp_profile_noise", quality.centre.fbp_noise},
+          {"field_centre_deviation_sigmas", riner::centre_deviation(field, fbp_image).sigmas},
+          {"samples_kept_fraction", r.stats().samples_kept_fraction},
+          {"field_ring_index", riner::ring_index(field)},
+          {"ring_correction_applied", rings && rings->applied},
+          {"ring_correction_response_change", rings ? rings->mean_response_change : 0.0},
+          {"gradient_correction_applied", gradient && gradient->applied},
+          {"gradient_correction_response_change", gradient ? gradient->mean_response_change : 0.0},
+          {"response_correction_applied", response && response->applied},
+          {"response_correction_response_change", response ? response->mean_response_change : 0.0},
+          {"response_correction_even_to_odd",
+           response && std::isfinite(response->even_to_odd) ? response->even_to_odd : 1e9},
+          {"elements_switched_off", off},
+          {"seconds", r.stats().seconds},
+          {"steps", r.stats().steps}};
+}
+
+// A real scan (neutron360 by default): FBP and Riner side by side, ring index, specks and the
+// centre's deviation from FBP (riner/quality.hpp) of each; --png=PREFIX for the PNG pairs,
+// --npy=PREFIX for the images and responses as .npy (both of the first seed). --seeds=N runs
+// seeds s .. s + N - 1 (s: the config's, 0 by default), one row each, and a row counting how
+// many pass each of issue 13's bars: ring index <= FBP's / 3, specks <= FBP's, centre <= 1 sigma
+// (one seed's numbers can pass a bar another's fails: bench/RESULTS.md).
+std::vector<Result> riner_real_scan(const Options& o) {
+  const std::string scan_path = o.get("scan", "../shared/data/neutron360/sino.npy");
+  const int seeds = o.get_int("seeds", 1);
+  if (seeds < 1) throw riner::InputError("--seeds must be at least 1");
+  riner::Scan scan = riner::load_scan(scan_path);
+  riner::Device device = riner::Device::open(o.device);
+  riner::FbpOptions fbp_options;
+  fbp_options.device = device;
+  const riner::Array fbp_image = riner::fbp(scan, fbp_options);
+  riner::RinerConfig config = riner::bench::config_from(o);
+  const std::uint64_t first_seed = config.training.seed;
+  std::vector<Result> rows;
+  int ring_pass = 0, speck_pass = 0, centre_pass = 0;
+  for (int i = 0; i < seeds; ++i) {
+    config.training.seed = first_seed + static_cast<std::uint64_t>(i);
+    nlohmann::json run =
+        real_scan_run(scan, fbp_image, config, device, i == 0 ? o.get("png", "") : "",
+                      i == 0 ? o.get("npy", "") : "");
+    ring_pass += run["riner_ring_index"].get<double>() <= run["fbp_ring_index"].get<double>() / 3.0;
+    speck_pass +=
+        run["riner_specks_per_10k"].get<double>() <= run["fbp_specks_per_10k"].get<double>();
+    centre_pass += run["centre_deviation_sigmas"].get<double>() <= 1.0;
+    run["scan"] = scan_path;
+    rows.push_back({"riner_real_scan", std::move(run)});
+  }
+  if (seeds > 1) {
+    rows.push_back({"riner_real_scan_bars",
+                    {{"scan", scan_path},
+                     {"seeds", seeds},
+                     {"first_seed", first_seed},
+                     {"ring_index_at_most_fbp_third", ring_pass},
+                     {"specks_at_most_fbp", speck_pass},
+                     {"centre_within_1_sigma", centre_pass}}});
+  }
+  return rows;
 }
 
 }  // namespace
