@@ -120,6 +120,12 @@ TEST_SUITE("riner_training") {
         moved = std::max(moved, std::fabs(final_alpha.data[e] - mean[e]));
       }
       CHECK(moved > 1e-4);  // the mean differs from the last step's alpha
+      // Past the planned steps the result follows training again: the last step's alpha.
+      last.step(1);
+      averaged.step(1);
+      const riner::Array a_after = averaged.alpha();
+      const riner::Array last_after = last.alpha();
+      for (std::size_t e = 0; e < mean.size(); ++e) CHECK(a_after.data[e] == last_after.data[e]);
     }
   }
 

@@ -112,9 +112,10 @@ class OpenclTrainer final : public Trainer {
   std::optional<ExecutionPlan> plan() const override { return plan_; }
 
  private:
-  // The parameters the result is made of: the snapshots' mean once the tail has begun.
+  // The parameters the result is made of: the snapshots' mean once the tail has begun, the
+  // last step's again once training goes past the planned steps.
   const cl::Buffer<float>& result_parameters() {
-    if (snapshots_ == 0) return params_;
+    if (snapshots_ == 0 || steps_ > setup_.tail_average.total) return params_;
     if (!tail_mean_) tail_mean_.emplace(ctx_, setup_.layout.total);
     vector_ops_->fill(*tail_mean_, 0.0f);
     vector_ops_->axpy(1.0f / static_cast<float>(snapshots_), *tail_sum_, *tail_mean_);

@@ -68,9 +68,10 @@ class ReferenceTrainer final : public Trainer {
   std::optional<ExecutionPlan> plan() const override { return std::nullopt; }
 
  private:
-  // The parameters the result is made of: the snapshots' mean once the tail has begun.
+  // The parameters the result is made of: the snapshots' mean once the tail has begun, the
+  // last step's again once training goes past the planned steps.
   std::vector<double> result_parameters() const {
-    if (snapshots_ == 0) return params_;
+    if (snapshots_ == 0 || steps_ > setup_.tail_average.total) return params_;
     std::vector<double> mean(tail_sum_.size());
     for (std::size_t i = 0; i < mean.size(); ++i) mean[i] = tail_sum_[i] / snapshots_;
     return mean;
