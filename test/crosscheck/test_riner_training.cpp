@@ -123,6 +123,7 @@ TEST_SUITE("riner_training") {
       // Past the planned steps the result follows training again: the last step's alpha.
       last.step(1);
       averaged.step(1);
+      CHECK(averaged.stats().tail_average_snapshots == 0);
       const riner::Array a_after = averaged.alpha();
       const riner::Array last_after = last.alpha();
       for (std::size_t e = 0; e < mean.size(); ++e) CHECK(a_after.data[e] == last_after.data[e]);

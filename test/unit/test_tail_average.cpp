@@ -18,6 +18,7 @@ TEST_SUITE("tail average") {
     CHECK(tail.snapshots(79) == 0);
     CHECK(tail.snapshots(80) == 1);
     CHECK(tail.snapshots(100) == 3);
+    CHECK(tail.snapshots(101) == 0);  // past the plan: the last step's parameters
   }
 
   TEST_CASE("no tail takes nothing; a tail of the whole run starts at its first snapshot") {

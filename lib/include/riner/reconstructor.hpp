@@ -108,7 +108,8 @@ struct TrainingStats {
   int level_warmup_steps = 0;
   double relative_noise = 0.0;
   // Tail averaging as trained (training.tail_average_steps, the same evidence when -1) and the
-  // snapshots the result is the mean of so far (0: the last step's parameters).
+  // snapshots the result is the mean of so far (0: the last step's parameters, also once
+  // training has gone past the planned steps).
   int tail_average_steps = 0;
   int tail_average_snapshots = 0;
   // Memory, so far: the process's peak resident set (host) and the most bytes of device

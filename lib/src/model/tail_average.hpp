@@ -21,8 +21,10 @@ struct TailAverage {
     return steps > 0 && step < total && step >= total - steps && (total - 1 - step) % kEvery == 0;
   }
 
-  // Snapshots taken by the time `done` steps have run.
+  // The snapshots the result is the mean of once `done` steps have run: those taken so far, and
+  // none (the last step's parameters) once training has gone past the planned steps.
   int snapshots(int done) const {
+    if (done > total) return 0;
     int n = 0;
     for (int s = total - steps; s < done; ++s) n += s >= 0 && takes(s);
     return n;

@@ -73,10 +73,7 @@ class OpenclTrainer final : public Trainer {
                {&step_op_.mlp_partials(), setup_.layout.mlp_offset, setup_.layout.mlp_params,
                 step_op_.mlp_slices()});
     if (factors_) factors_->expand(params_);
-    if (setup_.tail_average.takes(index)) {
-      vector_ops_->axpy(1.0f, params_, *tail_sum_);
-      ++snapshots_;
-    }
+    if (setup_.tail_average.takes(index)) vector_ops_->axpy(1.0f, params_, *tail_sum_);
     pending_.push_back({index, 0.0, 0.0, adam.learning_rate});
     steps_ = index + 1;
     if (pending_.size() == kHistoryBlock) read_history();
@@ -112,13 +109,14 @@ class OpenclTrainer final : public Trainer {
   std::optional<ExecutionPlan> plan() const override { return plan_; }
 
  private:
-  // The parameters the result is made of: the snapshots' mean once the tail has begun, the
-  // last step's again once training goes past the planned steps.
+  // The parameters the result is made of (model::TailAverage::snapshots): the snapshots' mean,
+  // or the last step's.
   const cl::Buffer<float>& result_parameters() {
-    if (snapshots_ == 0 || steps_ > setup_.tail_average.total) return params_;
+    const int snapshots = setup_.tail_average.snapshots(steps_);
+    if (snapshots == 0) return params_;
     if (!tail_mean_) tail_mean_.emplace(ctx_, setup_.layout.total);
     vector_ops_->fill(*tail_mean_, 0.0f);
-    vector_ops_->axpy(1.0f / static_cast<float>(snapshots_), *tail_sum_, *tail_mean_);
+    vector_ops_->axpy(1.0f / static_cast<float>(snapshots), *tail_sum_, *tail_mean_);
     return *tail_mean_;
   }
 
@@ -151,7 +149,6 @@ class OpenclTrainer final : public Trainer {
   std::optional<ops::VectorOps> vector_ops_;    // tail averaging (model/tail_average.hpp)
   std::optional<cl::Buffer<float>> tail_sum_;
   std::optional<cl::Buffer<float>> tail_mean_;
-  int snapshots_ = 0;
   std::vector<LossRecord> pending_;
   std::vector<LossRecord> done_;
   int steps_ = 0;

@@ -41,7 +41,6 @@ class ReferenceTrainer final : public Trainer {
     if (setup_.layout.factored_alpha()) ref::alpha_factors_expand(setup_.layout, params_);
     if (setup_.tail_average.takes(index)) {
       for (std::size_t i = 0; i < params_.size(); ++i) tail_sum_[i] += params_[i];
-      ++snapshots_;
     }
     losses_.push_back({index, r.data_loss, r.penalty, adam.learning_rate});
     steps_ = index + 1;
@@ -68,12 +67,13 @@ class ReferenceTrainer final : public Trainer {
   std::optional<ExecutionPlan> plan() const override { return std::nullopt; }
 
  private:
-  // The parameters the result is made of: the snapshots' mean once the tail has begun, the
-  // last step's again once training goes past the planned steps.
+  // The parameters the result is made of (model::TailAverage::snapshots): the snapshots' mean,
+  // or the last step's.
   std::vector<double> result_parameters() const {
-    if (snapshots_ == 0 || steps_ > setup_.tail_average.total) return params_;
+    const int snapshots = setup_.tail_average.snapshots(steps_);
+    if (snapshots == 0) return params_;
     std::vector<double> mean(tail_sum_.size());
-    for (std::size_t i = 0; i < mean.size(); ++i) mean[i] = tail_sum_[i] / snapshots_;
+    for (std::size_t i = 0; i < mean.size(); ++i) mean[i] = tail_sum_[i] / snapshots;
     return mean;
   }
 
@@ -84,7 +84,6 @@ class ReferenceTrainer final : public Trainer {
   std::vector<double> v_;
   std::vector<LossRecord> losses_;
   std::vector<double> tail_sum_;  // tail averaging (model/tail_average.hpp)
-  int snapshots_ = 0;
   int steps_ = 0;
 };
 
