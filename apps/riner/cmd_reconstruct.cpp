@@ -38,6 +38,13 @@ void print_doubts(Console& console, const QualityReport& q) {
                   q.fbp_specks_per_10k);
     console.line(line);
   }
+  if (q.edge_strength < kSoftEdgeRatio * q.fbp_edge_strength) {
+    std::snprintf(line, sizeof(line),
+                  "note: edges at %.0f%% of FBP's strength (99th percentile of the gradient): "
+                  "the image may be blurred",
+                  100.0 * q.edge_strength / q.fbp_edge_strength);
+    console.line(line);
+  }
 }
 
 RinerConfig config_from(const Args& args) {

@@ -47,6 +47,8 @@ nlohmann::json quality_summary(const QualityCheck& check) {
                         {"fbp_ring_index", q.fbp_ring_index},
                         {"specks_per_10k_pixels", q.specks_per_10k},
                         {"fbp_specks_per_10k_pixels", q.fbp_specks_per_10k},
+                        {"edge_strength_per_mm", q.edge_strength},
+                        {"fbp_edge_strength_per_mm", q.fbp_edge_strength},
                         {"slices_measured", check.slices},
                         {"volume_slices", check.volume_slices},
                         {"centre", nullptr}};

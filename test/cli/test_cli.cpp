@@ -566,6 +566,8 @@ TEST_SUITE("cli") {
     CHECK(q_with["fbp_ring_index"] == q_without["fbp_ring_index"]);
     CHECK(q_with["fbp_specks_per_10k_pixels"] == q_without["fbp_specks_per_10k_pixels"]);
     CHECK(std::isfinite(q_with["centre"]["fbp_noise_sigmas"].get<double>()));
+    CHECK(q_with["fbp_edge_strength_per_mm"] == q_without["fbp_edge_strength_per_mm"]);
+    CHECK(q_with["edge_strength_per_mm"].get<double>() > 0.0);
     // Training is deterministic, so the images differ by the subtracted rings alone: no pixel
     // by more than their largest values, and pixels at the same radius by the same amount.
     const riner::Array a = riner::read_array(dir / "a" / "image.npy").array;

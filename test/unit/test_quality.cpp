@@ -75,4 +75,38 @@ TEST_SUITE("quality") {
     CHECK(q.noise == noise);
     CHECK(q.specks_per_10k < q.fbp_specks_per_10k + 1.0);
   }
+
+  TEST_CASE("edge strength: a blurred disc reads weaker than a sharp one; noise barely counts") {
+    const std::size_t n = 160;
+    const double c = 0.5 * (n - 1.0);
+    // A disc of 0.02/mm over a ramp, its edge sharp, or blurred by averaging 7 x 7 pixels.
+    riner::Array sharp = noisy(n, 0.0, 5);
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t k = 0; k < n; ++k)
+        if (std::hypot(i - c, k - c) < 40.0) sharp(i, k) += 0.02f;
+    riner::Array blurred = sharp;
+    for (std::size_t i = 3; i + 3 < n; ++i) {
+      for (std::size_t k = 3; k + 3 < n; ++k) {
+        double sum = 0.0;
+        for (int di = -3; di <= 3; ++di)
+          for (int dk = -3; dk <= 3; ++dk) sum += sharp(i + di, k + dk);
+        blurred(i, k) = static_cast<float>(sum / 49.0);
+      }
+    }
+    const double e_sharp = riner::edge_strength(sharp);
+    // A step of h after a Gaussian of 1 px has its steepest slope h / sqrt(2 pi) per pixel; the
+    // edge covers ~3% of the disc's pixels, so the 99th percentile lies on it.
+    CHECK(e_sharp > 0.4 * 0.02 / std::sqrt(2.0 * M_PI));
+    CHECK(e_sharp < 1.1 * 0.02 / std::sqrt(2.0 * M_PI));
+    CHECK(riner::edge_strength(blurred) < 0.6 * e_sharp);
+    // White noise of 1/20 of the step moves it by less than 10%.
+    const riner::Array ramp = noisy(n, 0.0, 6);
+    riner::Array noisy_sharp = noisy(n, 1e-3, 6);  // the same ramp with noise
+    for (std::size_t p = 0; p < noisy_sharp.size(); ++p)
+      noisy_sharp.data[p] += sharp.data[p] - ramp.data[p];
+    CHECK(riner::edge_strength(noisy_sharp) == doctest::Approx(e_sharp).epsilon(0.1));
+    const riner::QualityReport q = riner::quality_against_fbp(blurred, sharp);
+    CHECK(q.edge_strength / q.fbp_edge_strength < riner::kSoftEdgeRatio);
+    CHECK_THROWS_AS(riner::edge_strength(riner::Array({8, 8})), riner::InputError);
+  }
 }

@@ -11,6 +11,10 @@
 //                FBP, against the FBP profile's own noise there (the rms of its angular means
 //                about their smoothed version): a disc or dip at the centre that FBP does not
 //                show stands out as more than one such sigma
+//   edges        the 99th percentile of the gradient magnitude inside the disc (Sobel after a
+//                Gaussian of 1 px, so that pixel noise does not pass for edges), of the image and
+//                of the FBP: well below the FBP's, the image is blurred. Fewer specks and rings
+//                can come from blur alone (bench/RESULTS.md), so these read beside it
 #pragma once
 
 #include "riner/array.hpp"
@@ -31,6 +35,14 @@ struct CentreDeviation {
   double sigmas = 0.0;     // deviation / fbp_noise
 };
 
+// The 99th percentile of |gradient| (1/mm per pixel) inside the inscribed disc, of each axial
+// slice of a volume together.
+double edge_strength(const Array& image);
+
+// Below this fraction of the FBP's edge strength an image reads as blurred: the shared real scans
+// give 0.92-1.02 at the defaults and 0.40-0.73 after 2000 steps (bench/RESULTS.md).
+constexpr double kSoftEdgeRatio = 0.8;
+
 CentreDeviation centre_deviation(const Array& image, const Array& fbp, int radius_px = 20,
                                  double smoothing_px = 3.0);
 
@@ -40,6 +52,8 @@ struct QualityReport {
   double fbp_ring_index = 0.0;
   double specks_per_10k = 0.0;
   double fbp_specks_per_10k = 0.0;
+  double edge_strength = 0.0;
+  double fbp_edge_strength = 0.0;
   CentreDeviation centre;
 };
 

@@ -16,6 +16,8 @@ namespace riner {
 namespace {
 
 constexpr double kSpeckSigmas = 6.0;
+constexpr double kEdgeSmoothingPx = 1.0;
+constexpr double kEdgePercentile = 0.99;
 
 void require_2d(const Array& a, const char* what) {
   if (a.rank() != 2 || a.shape[0] < 16 || a.shape[1] < 16)
@@ -71,7 +73,71 @@ std::vector<double> slice_median_residuals(const Array& a) {
   return out;
 }
 
+// Gaussian of kEdgeSmoothingPx along both axes (edge pixels repeated beyond the border).
+Array smoothed(const Array& a) {
+  const int reach = static_cast<int>(std::ceil(3.0 * kEdgeSmoothingPx));
+  std::vector<double> w(static_cast<std::size_t>(2 * reach + 1));
+  double total = 0.0;
+  for (int d = -reach; d <= reach; ++d) {
+    w[static_cast<std::size_t>(d + reach)] =
+        std::exp(-0.5 * d * d / (kEdgeSmoothingPx * kEdgeSmoothingPx));
+    total += w[static_cast<std::size_t>(d + reach)];
+  }
+  for (double& v : w) v /= total;
+  const long ny = static_cast<long>(a.shape[0]), nx = static_cast<long>(a.shape[1]);
+  Array rows({a.shape[0], a.shape[1]}), out({a.shape[0], a.shape[1]});
+  for (long i = 0; i < ny; ++i) {
+    for (long k = 0; k < nx; ++k) {
+      double sum = 0.0;
+      for (int d = -reach; d <= reach; ++d)
+        sum += w[static_cast<std::size_t>(d + reach)] * a(i, std::clamp(k + d, 0L, nx - 1));
+      rows(i, k) = static_cast<float>(sum);
+    }
+  }
+  for (long i = 0; i < ny; ++i) {
+    for (long k = 0; k < nx; ++k) {
+      double sum = 0.0;
+      for (int d = -reach; d <= reach; ++d)
+        sum += w[static_cast<std::size_t>(d + reach)] * rows(std::clamp(i + d, 0L, ny - 1), k);
+      out(i, k) = static_cast<float>(sum);
+    }
+  }
+  return out;
+}
+
+// |Sobel gradient| / 8 (a central difference per pixel) at every interior pixel of the disc.
+void append_gradients(const Array& image, std::vector<double>& out) {
+  const Array a = smoothed(image);
+  const std::size_t ny = a.shape[0], nx = a.shape[1];
+  const double r_max = disc_radius(a);
+  for (std::size_t i = 1; i + 1 < ny; ++i) {
+    for (std::size_t k = 1; k + 1 < nx; ++k) {
+      if (radius_of(a, i, k) > r_max) continue;
+      const double gx = (a(i - 1, k + 1) + 2.0 * a(i, k + 1) + a(i + 1, k + 1)) -
+                        (a(i - 1, k - 1) + 2.0 * a(i, k - 1) + a(i + 1, k - 1));
+      const double gy = (a(i + 1, k - 1) + 2.0 * a(i + 1, k) + a(i + 1, k + 1)) -
+                        (a(i - 1, k - 1) + 2.0 * a(i - 1, k) + a(i - 1, k + 1));
+      const double g = std::hypot(gx, gy) / 8.0;
+      if (std::isfinite(g)) out.push_back(g);
+    }
+  }
+}
+
 }  // namespace
+
+double edge_strength(const Array& image) {
+  require_2d_or_slices(image, "the image");
+  std::vector<double> g;
+  if (image.rank() == 2) {
+    append_gradients(image, g);
+  } else {
+    for (std::size_t z = 0; z < image.shape[0]; ++z) append_gradients(axial_slice(image, z), g);
+  }
+  if (g.empty()) return 0.0;
+  const auto at = static_cast<long>(kEdgePercentile * static_cast<double>(g.size() - 1));
+  std::nth_element(g.begin(), g.begin() + at, g.end());
+  return g[static_cast<std::size_t>(at)];
+}
 
 double residual_noise(const Array& image) {
   require_2d_or_slices(image, "the image");
@@ -142,6 +208,8 @@ QualityReport quality_against_fbp(const Array& image, const Array& fbp) {
   q.fbp_ring_index = ring_index(fbp);
   q.specks_per_10k = specks_per_10k(image, q.noise);
   q.fbp_specks_per_10k = specks_per_10k(fbp, q.noise);
+  q.edge_strength = edge_strength(image);
+  q.fbp_edge_strength = edge_strength(fbp);
   if (image.rank() == 2) q.centre = centre_deviation(image, fbp);
   return q;
 }
