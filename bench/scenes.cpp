@@ -70,6 +70,9 @@ RinerConfig config_from(const Options& o) {
   }
   if (o.size == "tiny") config.training.steps = 300;
   config.training.steps = o.get_int("steps", config.training.steps);
+  // The training seed (the scenes' own seeds come from --seed-offset).
+  config.training.seed =
+      static_cast<std::uint64_t>(o.get_int("seed", static_cast<int>(config.training.seed)));
   config.engine = parse_engine(o.get("engine", "opencl"));
   config.validate();
   return config;

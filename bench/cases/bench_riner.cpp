@@ -250,10 +250,10 @@ nlohmann::json real_scan_run(const riner::Scan& scan, const riner::Array& fbp_im
 // A real scan (neutron360 by default): FBP and Riner side by side, ring index, specks and the
 // centre's deviation from FBP (riner/quality.hpp) of each; --png=PREFIX for the PNG pairs,
 // --npy=PREFIX for the images and responses as .npy (both of the first seed). --seeds=N runs
-// seeds s .. s + N - 1 (s: the config's, 0 by default), one row each, and a row counting how
-// many pass each of issue 13's bars: ring index <= FBP's / 3, specks <= FBP's, centre <= 1 sigma
-// (one seed's numbers can pass a bar another's fails: bench/RESULTS.md), and how many keep
-// their edges (edge strength >= 0.8 of FBP's: a blur passes the other bars).
+// seeds s .. s + N - 1 (s: --seed=N or the config's, 0 by default), one row each, and a row
+// counting how many pass each of issue 13's bars: ring index <= FBP's / 3, specks <= FBP's, centre
+// <= 1 sigma (one seed's numbers can pass a bar another's fails: bench/RESULTS.md), and how many
+// keep their edges (edge strength >= 0.8 of FBP's: a blur passes the other bars).
 std::vector<Result> riner_real_scan(const Options& o) {
   const std::string scan_path = o.get("scan", "../shared/data/neutron360/sino.npy");
   const int seeds = o.get_int("seeds", 1);
