@@ -40,7 +40,7 @@ struct CentreDeviation {
 double edge_strength(const Array& image);
 
 // Below this fraction of the FBP's edge strength an image reads as blurred: the shared real scans
-// give 0.92-1.02 at the defaults and 0.40-0.73 after 2000 steps (bench/RESULTS.md).
+// give 0.92-1.01 at the defaults and 0.40-0.76 after 2000 steps (bench/RESULTS.md).
 constexpr double kSoftEdgeRatio = 0.8;
 
 CentreDeviation centre_deviation(const Array& image, const Array& fbp, int radius_px = 20,

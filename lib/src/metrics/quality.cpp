@@ -61,13 +61,14 @@ std::vector<double> median_residuals(const Array& a) {
   return out;
 }
 
-// median_residuals of every axial slice, one after the other.
-std::vector<double> slice_median_residuals(const Array& a) {
-  if (a.rank() == 2) return median_residuals(a);
+// per_image of a 2D image, or of every axial slice of a volume, one after the other.
+template <typename PerImage>
+std::vector<double> over_slices(const Array& a, PerImage per_image) {
+  if (a.rank() == 2) return per_image(a);
   std::vector<double> out;
   out.reserve(a.size());
   for (std::size_t z = 0; z < a.shape[0]; ++z) {
-    const std::vector<double> r = median_residuals(axial_slice(a, z));
+    const std::vector<double> r = per_image(axial_slice(a, z));
     out.insert(out.end(), r.begin(), r.end());
   }
   return out;
@@ -106,8 +107,9 @@ Array smoothed(const Array& a) {
 }
 
 // |Sobel gradient| / 8 (a central difference per pixel) at every interior pixel of the disc.
-void append_gradients(const Array& image, std::vector<double>& out) {
+std::vector<double> gradients(const Array& image) {
   const Array a = smoothed(image);
+  std::vector<double> out;
   const std::size_t ny = a.shape[0], nx = a.shape[1];
   const double r_max = disc_radius(a);
   for (std::size_t i = 1; i + 1 < ny; ++i) {
@@ -121,18 +123,14 @@ void append_gradients(const Array& image, std::vector<double>& out) {
       if (std::isfinite(g)) out.push_back(g);
     }
   }
+  return out;
 }
 
 }  // namespace
 
 double edge_strength(const Array& image) {
   require_2d_or_slices(image, "the image");
-  std::vector<double> g;
-  if (image.rank() == 2) {
-    append_gradients(image, g);
-  } else {
-    for (std::size_t z = 0; z < image.shape[0]; ++z) append_gradients(axial_slice(image, z), g);
-  }
+  std::vector<double> g = over_slices(image, gradients);
   if (g.empty()) return 0.0;
   const auto at = static_cast<long>(kEdgePercentile * static_cast<double>(g.size() - 1));
   std::nth_element(g.begin(), g.begin() + at, g.end());
@@ -142,7 +140,7 @@ double edge_strength(const Array& image) {
 double residual_noise(const Array& image) {
   require_2d_or_slices(image, "the image");
   std::vector<double> r;
-  for (double v : slice_median_residuals(image)) {
+  for (double v : over_slices(image, median_residuals)) {
     if (v >= 0.0) r.push_back(v);
   }
   if (r.empty()) return 0.0;
@@ -153,7 +151,7 @@ double residual_noise(const Array& image) {
 double specks_per_10k(const Array& image, double noise) {
   require_2d_or_slices(image, "the image");
   std::size_t specks = 0, pixels = 0;
-  for (double v : slice_median_residuals(image)) {
+  for (double v : over_slices(image, median_residuals)) {
     if (v < 0.0) continue;
     ++pixels;
     specks += v > kSpeckSigmas * noise;
