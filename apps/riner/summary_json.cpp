@@ -36,6 +36,7 @@ nlohmann::json volume_ring_summary(const std::optional<VolumeRingCorrection>& ri
           {"air_applied", rings->air_applied},
           {"gradient_applied", rings->gradient_applied},
           {"response_applied", rings->response_applied},
+          {"gradient_after_response_applied", rings->gradient_after_response_applied},
           {"mean_response_change", rings->mean_response_change},
           {"note", rings->note}};
 }
@@ -97,6 +98,7 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
   std::vector<std::size_t> dead;
   for (const DeadElement& d : dead_report) dead.push_back(d.element);
   const std::vector<LossRecord> history = r.history();
+  const nlohmann::json gradient_again = ring_summary(result.gradient_after_response_rings);
   return {
       {"shape", result.image.shape},
       {"steps", stats.steps},
@@ -142,6 +144,7 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
       {"air_ring_correction", ring_summary(result.air_rings)},
       {"gradient_ring_correction", ring_summary(result.gradient_rings)},
       {"response_ring_correction", ring_summary(result.response_rings)},
+      {"gradient_after_response_ring_correction", gradient_again},
       {"slice_ring_corrections", volume_ring_summary(result.volume_rings)},
       {"final_loss", history.empty() ? 0.0 : history.back().data_loss}};
 }

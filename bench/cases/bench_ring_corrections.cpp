@@ -1,8 +1,8 @@
 // Compares the ring corrections on the same trained fields: each DeepLesion slice (paper
 // protocol) is trained once at the current settings, then the field goes through the air
 // reference alone, the air reference plus the radial-gradient correction, and those plus the
-// detector-response correction at several scales (and without the gradient step), so the
-// differences are the corrections' only.
+// detector-response correction at several scales (and the gradient correction once more after
+// it, as reconstructions run it), so the differences are the corrections' only.
 //
 //   riner_bench --case=ring_corrections [--first=0] [--last=9] [--seed-offset=0] [--config=JSON]
 //               [--json=FILE]
@@ -26,6 +26,7 @@ struct Variant {
   double gradient_scale_px = 0.0;  // 0: no gradient correction
   double response_scale_px = 0.0;  // 0: no detector-response correction
   double min_even_to_odd = riner::ResponseRingSettings{}.min_even_to_odd;
+  bool gradient_after_response = false;
 };
 
 constexpr const char* kReconstruct = "reconstruct";
@@ -48,6 +49,8 @@ std::vector<Result> ring_corrections(const Options& o) {
       {"air + gradient", true, 12.0, 0.0},
       {"air + gradient + response 24 px", true, 12.0, 24.0},
       {"air + gradient + response 24 px, ungated", true, 12.0, 24.0, 0.0},
+      {"air + gradient + response 24 px + gradient", true, 12.0, 24.0,
+       riner::ResponseRingSettings{}.min_even_to_odd, true},
       {"air + gradient + response 16 px", true, 12.0, 16.0},
       {"air + gradient + response 32 px", true, 12.0, 32.0}};
   std::vector<Totals> totals(variants.size() + 1);  // the last: kReconstruct
@@ -79,15 +82,17 @@ std::vector<Result> ring_corrections(const Options& o) {
       double change = 0.0;
       double response_change = 0.0;
       double even_to_odd = 0.0;
-      if (variants[v].gradient_scale_px > 0.0) {
+      // The radial-gradient step on the current image and alpha; its response change.
+      const auto gradient_step = [&] {
         riner::GradientRingSettings settings = config.rings.gradient;
         settings.scale_px = variants[v].gradient_scale_px;
         const riner::RingCorrection c =
             riner::correct_rings_from_gradient(image, response, g, settings);
         image = c.image;
         response = c.alpha;
-        change = c.applied ? c.mean_response_change : -1.0;
-      }
+        return c.applied ? c.mean_response_change : -1.0;
+      };
+      if (variants[v].gradient_scale_px > 0.0) change = gradient_step();
       if (variants[v].response_scale_px > 0.0) {
         riner::ResponseRingSettings settings = config.rings.response;
         settings.scale_px = variants[v].response_scale_px;
@@ -99,6 +104,7 @@ std::vector<Result> ring_corrections(const Options& o) {
         response_change = c.applied ? c.mean_response_change : -1.0;
         even_to_odd = std::isfinite(c.even_to_odd) ? c.even_to_odd : 1e9;
       }
+      if (variants[v].gradient_after_response) gradient_step();
       const riner::ImageMetrics m = riner::compare_images(image, scene.sim.ground_truth);
       const double alpha_error =
           riner::bench::detector_accuracy(response, beta, scene.sim)["alpha_mae_live"]

@@ -4,6 +4,7 @@
 // without rings, without air, or with a centred round object are left alone.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <initializer_list>
@@ -302,13 +303,12 @@ TEST_SUITE("ring_correction") {
     CHECK(c.applied);
     CHECK(c.measured_radii > 60);
     CHECK(c.mean_response_change < 0.01);
-    // Measured: the ring's rms over the image falls from 6.1e-5 to 2.2e-5/mm; what stays is its
-    // broad part, which the high-pass leaves by design (an exact slope estimate would leave
-    // 2.1e-5).
+    // Measured: the ring's rms over the image falls from 6.1e-5 to 6.9e-6/mm (a Gaussian
+    // high-pass of the same scale left 2.2e-5: its broad part).
     const double before = rms_difference(trained, truth);
     const double after = rms_difference(c.image, truth);
     MESSAGE("ring rms " << before << " -> " << after);
-    CHECK(after < 0.4 * before);
+    CHECK(after < 0.2 * before);
     // The data fit is unchanged: view-averaged predictions within 5% of the ring's largest
     // projection (measured 3.6%: the projector sees the profile as pixels, the correction
     // integrates it continuously).
@@ -329,14 +329,40 @@ TEST_SUITE("ring_correction") {
 
   TEST_CASE("gradient: a round object centred on the axis is an object, not a ring") {
     // A cylinder of 0.02/mm, 30 mm in radius, with an insert: its edge is a step on every
-    // circle, which only a response change of several percent could explain.
+    // circle, and the running median keeps steps.
     const riner::Geometry g = ring_geometry();
     const riner::Array image = discs(g, {{0, 0, 30, 0.02f}, {10, 5, 6, 0.03f}});
     riner::Array alpha({g.n_u}, 1.0f);
     const riner::RingCorrection c = riner::correct_rings_from_gradient(image, alpha, g);
-    MESSAGE("mean response change " << c.mean_response_change);
-    CHECK(c.mean_response_change > riner::GradientRingSettings{}.max_mean_response_change);
-    check_left_alone(c, image, alpha);
+    double largest = 0.0;
+    for (double v : c.profile) largest = std::max(largest, std::fabs(v));
+    MESSAGE("largest profile value " << largest << ", response change " << c.mean_response_change);
+    CHECK(largest < 2e-4);  // 1% of the step
+    CHECK(c.mean_response_change < 1e-3);
+  }
+
+  TEST_CASE("gradient: a soft disc about the axis keeps its edge, a narrow ring beside it goes") {
+    // The wood's case (bench/RESULTS.md, issue 13): training left a soft disc at the axis, and a
+    // Gaussian high-pass of its edge put rings on both sides of it. Disc: +0.0005/mm inside 30 mm,
+    // falling to 0 at 34 mm; the ring at 12 mm as above, inside the ellipse.
+    const riner::Geometry g = ring_geometry();
+    const riner::Array truth =
+        sum_of(phantom(g, false), painted(g, [](const riner::Vec3& c) {
+                 const double r = std::hypot(c.x, c.y);
+                 return static_cast<float>(0.0005 * std::clamp((34.0 - r) / 4.0, 0.0, 1.0));
+               }));
+    const riner::Array trained = sum_of(truth, narrow_inner_ring(g));
+    riner::Array alpha({g.n_u}, 1.0f);
+    const riner::RingCorrection c = riner::correct_rings_from_gradient(trained, alpha, g);
+    CHECK(c.applied);
+    // Measured: the rms error falls from 6.1e-5 to 6.9e-6/mm; the Gaussian high-pass made it
+    // 8.9e-5, rings on both sides of the disc's edge. A ring within half a window of the edge
+    // biases the median (edge at 24-28 mm: 4.2e-5, Gaussian 8.1e-5); in a reconstruction the
+    // second pass, after the response correction took the broad structure, sees it.
+    const double before = rms_difference(trained, truth);
+    const double after = rms_difference(c.image, truth);
+    MESSAGE("rms error " << before << " -> " << after);
+    CHECK(after < 0.25 * before);
   }
 
   TEST_CASE("response: a broad dip the responses carry goes back into the image") {

@@ -52,6 +52,7 @@ struct ReconstructionResult {
   std::optional<RingCorrection> air_rings;
   std::optional<RingCorrection> gradient_rings;
   std::optional<RingCorrection> response_rings;
+  std::optional<RingCorrection> gradient_after_response_rings;
   // 3D: the same corrections slice by slice (parallel beam; a cone beam gets a note).
   std::optional<VolumeRingCorrection> volume_rings;
 };

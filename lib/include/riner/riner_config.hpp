@@ -172,7 +172,8 @@ struct TrainingConfig {
 // After training, 2D: the ring corrections (riner/ring_correction.hpp) move the rings the data
 // cannot tell from detector offsets out of the image: first wherever air shows them, then the
 // narrow ones inside the object, from the image's radial slopes; then the broad ones back from
-// alpha, whose broad structure across the detector is not a detector's.
+// alpha, whose broad structure across the detector is not a detector's; then the narrow ones
+// again, which the broad structure hid.
 struct RingCorrectionConfig {
   bool air_reference = true;
   AirRingSettings air;
@@ -180,6 +181,10 @@ struct RingCorrectionConfig {
   GradientRingSettings gradient;
   bool response_reference = true;
   ResponseRingSettings response;
+  // The gradient correction once more after the response correction (when both are on): the
+  // first pass keeps the edges of broad structure, so the narrow rings beside them wait until
+  // the response correction has taken it (bench/RESULTS.md, issue 13).
+  bool gradient_after_response = true;
   // Parallel-beam volumes: the three above, slice by slice (riner/volume_ring_correction.hpp).
   // Off by default: the 3D field holds few rings, and on the simulated parallel-beam head the
   // chain cost 1.2 dB (the radial-gradient step 1.35 dB; bench/RESULTS.md, issue 14).

@@ -1,7 +1,7 @@
 // The ring corrections of riner/ring_correction.hpp as a reconstruction runs them: air, radial
-// gradient, detector response, each that the settings turn on, each fed the image and alpha the
-// one before left. Used for a slice (Reconstructor) and for each slice of a parallel-beam volume
-// (riner/volume_ring_correction.hpp).
+// gradient, detector response, radial gradient again, each that the settings turn on, each fed
+// the image and alpha the one before left. Used for a slice (Reconstructor) and for each slice of a
+// parallel-beam volume (riner/volume_ring_correction.hpp).
 #pragma once
 
 #include <cstddef>
@@ -21,6 +21,7 @@ struct RingChain {
   std::optional<RingCorrection> air;  // each correction that ran, as it returned
   std::optional<RingCorrection> gradient;
   std::optional<RingCorrection> response;
+  std::optional<RingCorrection> gradient_after_response;
 };
 
 // 2D geometry; `dead_elements` as correct_rings_from_response takes them.

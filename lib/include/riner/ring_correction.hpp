@@ -13,9 +13,9 @@
 // - Radial gradient: inside the object, a ring changes the image by the same amount along its
 //   whole circle, while anatomy's edges cross a circle at a few places. So the ring's slope at
 //   radius r is the median, over the circle's flattest points (least change along the circle),
-//   of the image's change from r to r + 1 pixel; summed outwards and high-passed at
-//   scale_px, it gives the narrow rings everywhere. Broader rings (and the image's mean radial
-//   trend) are left alone: the median cannot tell them apart.
+//   of the image's change from r to r + 1 pixel; summed outwards, minus its running median over
+//   2 scale_px + 1 radii, it gives the narrow rings everywhere. Broader rings, the image's mean
+//   radial trend and steps (a disc's edge) are left alone: the median cannot tell them apart.
 // - Detector response: a detector's responses differ element by element; they do not drift
 //   together over dozens of neighbouring elements. So -ln(alpha)'s structure across the detector
 //   broader than scale_px, beyond its mean, is taken for broad rings the training put into
@@ -23,6 +23,10 @@
 //   it (least squares, kept out of air) goes back into the image. This is the broad band the
 //   radial gradient leaves. Rings can only make structure that is even about the axis, so the
 //   correction needs the even part to stand out over the odd one (the responses' own level).
+//
+// The chain runs air, gradient, response, then the gradient again (RingCorrectionConfig): the
+// first gradient pass keeps the steps of broad structure, the response step takes the broad
+// structure away, and the second pass sees the narrow rings that sat beside it.
 //
 // What neither can see: an object that is itself rotationally symmetric about the axis (a
 // sample holder, a container, a cylindrical sample's edge) looks exactly like a ring. Such an
@@ -85,8 +89,8 @@ RingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
                                       const AirRingSettings& settings = {});
 
 struct GradientRingSettings {
-  // Rings narrower than this (sigma of the Gaussian high-pass, in pixels) are measured; broader
-  // ones stay, as the image's own radial trends do.
+  // Rings narrower than this (the running median's half width, in pixels) are measured;
+  // broader ones stay, as the image's own radial trends and steps do.
   double scale_px = 12.0;
   // The fraction of each circle's points whose slopes enter the median: those with the least
   // change along the circle, where anatomy's edges are not.
@@ -96,7 +100,8 @@ struct GradientRingSettings {
 };
 
 // Same inputs and guarantees as correct_rings_from_air; the profile has one node per pixel of
-// radius. Run it after the air reference: the air fixes broad rings where it can see them.
+// radius. Run it after the air reference (the air fixes broad rings where it can see them), and
+// again after the response correction.
 RingCorrection correct_rings_from_gradient(const Array& image, const Array& alpha,
                                            const Geometry& geometry,
                                            const GradientRingSettings& settings = {});
@@ -119,7 +124,8 @@ struct ResponseRingSettings {
 
 // Same inputs and guarantees as correct_rings_from_air; `dead_elements` (flat indices) do not
 // count: their alpha is not a response. The profile has one node per pixel of radius and is
-// negative where the image gains. Run it after the other two: it is the broad band they leave.
+// negative where the image gains. Run it after the other two (it is the broad band they leave),
+// then the gradient correction again.
 RingCorrection correct_rings_from_response(const Array& image, const Array& alpha,
                                            const Geometry& geometry,
                                            const std::vector<std::size_t>& dead_elements,

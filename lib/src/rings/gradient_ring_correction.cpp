@@ -3,7 +3,6 @@
 
 #include "riner/error.hpp"
 #include "riner/ring_correction.hpp"
-#include "rings/radial.hpp"
 #include "rings/ring_profile.hpp"
 #include "rings/ring_settings.hpp"
 
@@ -84,10 +83,31 @@ bool ring_slope(const PolarSamples& s, std::size_t r, double flat_fraction, doub
   return true;
 }
 
-// values minus their Gaussian smoothing (sigma in nodes), mirrored at both ends.
-std::vector<double> high_pass(const std::vector<double>& values, double sigma) {
-  std::vector<double> out = rings::gaussian_smooth(values, sigma, rings::Ends::kMirror);
-  for (std::size_t i = 0; i < out.size(); ++i) out[i] = values[i] - out[i];
+// values minus their running median over 2 half_width + 1 nodes, mirrored at both ends. A
+// feature narrower than half_width goes; a step (the edge of a disc about the axis) stays, where
+// a Gaussian high-pass would leave rings on both sides of it (bench/RESULTS.md, issue 13).
+std::vector<double> high_pass(const std::vector<double>& values, std::size_t half_width) {
+  const std::size_t n = values.size();
+  const auto mirrored = [n](std::ptrdiff_t i) {
+    const auto last = static_cast<std::ptrdiff_t>(n) - 1;
+    if (last == 0) return std::size_t{0};
+    const std::ptrdiff_t period = 2 * last;
+    i %= period;
+    if (i < 0) i += period;
+    return static_cast<std::size_t>(i <= last ? i : period - i);
+  };
+  std::vector<double> out(n);
+  std::vector<double> window(2 * half_width + 1);
+  const auto h = static_cast<std::ptrdiff_t>(half_width);
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::ptrdiff_t k = -h; k <= h; ++k) {
+      window[static_cast<std::size_t>(k + h)] =
+          values[mirrored(static_cast<std::ptrdiff_t>(i) + k)];
+    }
+    const auto mid = window.begin() + h;
+    std::nth_element(window.begin(), mid, window.end());
+    out[i] = values[i] - *mid;
+  }
   return out;
 }
 
@@ -112,7 +132,7 @@ RingCorrection correct_rings_from_gradient(const Array& image, const Array& alph
     ring[r + 1] = ring[r] + slope;
   }
   if (out.measured_radii == 0) return out;
-  out.profile = high_pass(ring, settings.scale_px);
+  out.profile = high_pass(ring, static_cast<std::size_t>(std::lround(settings.scale_px)));
   out.profile.push_back(out.profile.back());  // a spare node for the interpolation
   if (rings::fold_into_alpha(out,
                              rings::ring_projections(out.profile, out.radius_step_mm, geometry),

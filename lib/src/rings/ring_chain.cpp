@@ -5,7 +5,7 @@ namespace riner {
 RingChain correct_rings_in_order(const Array& image, const Array& alpha, const Geometry& g,
                                  const std::vector<std::size_t>& dead_elements,
                                  const RingCorrectionConfig& config) {
-  RingChain out{image, alpha, std::nullopt, std::nullopt, std::nullopt};
+  RingChain out{image, alpha, std::nullopt, std::nullopt, std::nullopt, std::nullopt};
   const auto take = [&out](std::optional<RingCorrection>& slot, RingCorrection c) {
     out.image = c.image;
     out.alpha = c.alpha;
@@ -20,6 +20,10 @@ RingChain correct_rings_in_order(const Array& image, const Array& alpha, const G
   if (config.response_reference) {
     take(out.response,
          correct_rings_from_response(out.image, out.alpha, g, dead_elements, config.response));
+    if (config.gradient_reference && config.gradient_after_response) {
+      take(out.gradient_after_response,
+           correct_rings_from_gradient(out.image, out.alpha, g, config.gradient));
+    }
   }
   return out;
 }

@@ -38,8 +38,11 @@ const std::vector<settings::Setting<AirRingSettings>>& air_settings() {
 const std::vector<settings::Setting<GradientRingSettings>>& gradient_settings() {
   using S = GradientRingSettings;
   static const std::vector<settings::Setting<S>> table = {
-      field<S>("rings", "gradient_scale_px", open_closed(0, 1000),
-               "gradient correction: rings narrower than this (pixels) are measured", &S::scale_px),
+      field<S>(
+          "rings", "gradient_scale_px", open_closed(0, 1000),
+          "gradient correction: rings narrower than this (pixels; half the running median) are "
+          "measured",
+          &S::scale_px),
       field<S>("rings", "gradient_flat_fraction", open_closed(0, 1),
                "gradient correction: fraction of each circle's flattest points in the median",
                &S::flat_fraction),

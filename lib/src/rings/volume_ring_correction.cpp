@@ -95,6 +95,8 @@ VolumeRingCorrection correct_rings_per_slice(const Array& volume, const Array& a
     out.air_applied += chain.air && chain.air->applied;
     out.gradient_applied += chain.gradient && chain.gradient->applied;
     out.response_applied += chain.response && chain.response->applied;
+    out.gradient_after_response_applied +=
+        chain.gradient_after_response && chain.gradient_after_response->applied;
     std::copy(chain.image.data.begin(), chain.image.data.end(),
               out.image.data.begin() + static_cast<std::ptrdiff_t>(s * ny * nx));
     std::copy(chain.alpha.data.begin(), chain.alpha.data.end(),

@@ -190,6 +190,9 @@ void add_rings(Table& t) {
   for (const auto& s : rings::response_settings()) {
     t.push_back(settings::lift<C>(s, &C::rings, &R::response));
   }
+  t.push_back(field<C>("rings", "gradient_after_response", {},
+                       "the gradient correction again after the response correction (both on)",
+                       &C::rings, &R::gradient_after_response));
   t.push_back(field<C>("rings", "slice_by_slice", {},
                        "parallel 3D: the corrections above, each slice with its detector row "
                        "(off: measured to cost 1.2 dB on a simulated head)",

@@ -179,6 +179,7 @@ ReconstructionResult Reconstructor::evaluate_result() const {
     r.air_rings = std::move(chain.air);
     r.gradient_rings = std::move(chain.gradient);
     r.response_rings = std::move(chain.response);
+    r.gradient_after_response_rings = std::move(chain.gradient_after_response);
   }
   // Each correction subtracts its profile along whole circles; where a circle leaves the
   // sampled region, that would paint the ring into the skipped air. No second ramp: the field's

@@ -1,0 +1,202 @@
+// Ring-correction chains replayed on saved training results: train once, then try orders and
+// settings of the corrections in seconds instead of retraining (bench/RESULTS.md, issue 13).
+//
+//   riner_bench --case=ring_chain_replay --save=DIR [--first=0] [--last=9] [--seed-offset=0]
+//   riner_bench --case=ring_chain_replay --save=DIR --scan=SINO.npy --tag=NAME [--seed=N]
+//       train at the config and save, per scan, DIR/NAME/: the field, the trained alpha, the
+//       dead elements, the geometry, the reference (DeepLesion: the ground truth; a real scan:
+//       its FBP) and which pixels the reconstruction zeroed as skipped air
+//   riner_bench --case=ring_chain_replay --replay=DIR [--order=agrg] [--config=JSON] [--json=F]
+//       run the corrections in `order` (a = air, g = radial gradient, r = detector response;
+//       the default is the reconstruction's chain) on every saved scan; DeepLesion: PSNR / SSIM
+//       against the truth, real scans: the quality report against FBP
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include "harness.hpp"
+#include "riner/error.hpp"
+#include "riner/fbp.hpp"
+#include "riner/io.hpp"
+#include "riner/metrics.hpp"
+#include "riner/quality.hpp"
+#include "riner/reconstructor.hpp"
+#include "riner/ring_correction.hpp"
+#include "riner/scan.hpp"
+#include "scenes.hpp"
+
+namespace {
+
+using riner::bench::Options;
+using riner::bench::Result;
+namespace fs = std::filesystem;
+
+constexpr const char* kChain = "agrg";  // as riner::correct_rings_in_order runs them
+
+struct Saved {
+  riner::Geometry geometry;
+  riner::Array field, alpha, reference, keep;
+  std::vector<std::size_t> dead;
+  bool simulated = false;  // reference: ground truth (else the scan's FBP)
+};
+
+riner::Array replay(const std::string& order, const Saved& s,
+                    const riner::RingCorrectionConfig& c) {
+  riner::Array image = s.field;
+  riner::Array alpha = s.alpha;
+  for (char step : order) {
+    riner::RingCorrection r;
+    if (step == 'a') {
+      r = riner::correct_rings_from_air(image, alpha, s.geometry, c.air);
+    } else if (step == 'g') {
+      r = riner::correct_rings_from_gradient(image, alpha, s.geometry, c.gradient);
+    } else if (step == 'r') {
+      r = riner::correct_rings_from_response(image, alpha, s.geometry, s.dead, c.response);
+    } else {
+      throw riner::InputError(std::string("--order: unknown step '") + step + "' (a, g or r)");
+    }
+    image = std::move(r.image);
+    alpha = std::move(r.alpha);
+  }
+  for (std::size_t p = 0; p < image.size(); ++p) image.data[p] *= s.keep.data[p];
+  return image;
+}
+
+void save(const fs::path& dir, riner::Reconstructor& r, const riner::Geometry& g,
+          const riner::Array& reference, bool simulated, const riner::RingCorrectionConfig& c) {
+  fs::create_directories(dir);
+  const riner::ReconstructionResult result = r.result();
+  Saved s{g, result.field_image, r.trained_alpha(), reference, {}, r.dead_elements(), simulated};
+  // The pixels the reconstruction zeroed after its corrections (air that training skipped).
+  s.keep = riner::Array(result.image.shape, 1.0f);
+  const riner::Array chain = replay(kChain, s, c);
+  for (std::size_t p = 0; p < s.keep.size(); ++p) {
+    if (result.image.data[p] == 0.0f && chain.data[p] != 0.0f) s.keep.data[p] = 0.0f;
+  }
+  riner::write_array(dir / "field.npy", s.field);
+  riner::write_array(dir / "alpha.npy", s.alpha);
+  riner::write_array(dir / "reference.npy", s.reference);
+  riner::write_array(dir / "keep.npy", s.keep);
+  riner::Array dead({s.dead.size() + 1});  // a leading -1 keeps the array non-empty
+  dead.data[0] = -1.0f;
+  for (std::size_t i = 0; i < s.dead.size(); ++i) dead.data[i + 1] = static_cast<float>(s.dead[i]);
+  riner::write_array(dir / "dead.npy", dead);
+  std::ofstream(dir / "geometry.json") << g.to_json();
+  std::ofstream(dir / "kind") << (simulated ? "simulated" : "real");
+}
+
+Saved load(const fs::path& dir) {
+  Saved s;
+  std::ifstream geometry(dir / "geometry.json");
+  s.geometry =
+      riner::Geometry::from_json(std::string(std::istreambuf_iterator<char>(geometry), {}));
+  s.field = riner::read_array(dir / "field.npy").array;
+  s.alpha = riner::read_array(dir / "alpha.npy").array;
+  s.reference = riner::read_array(dir / "reference.npy").array;
+  s.keep = riner::read_array(dir / "keep.npy").array;
+  const riner::Array dead = riner::read_array(dir / "dead.npy").array;
+  for (std::size_t i = 1; i < dead.size(); ++i)
+    s.dead.push_back(static_cast<std::size_t>(dead.data[i]));
+  std::string kind;
+  std::ifstream(dir / "kind") >> kind;
+  s.simulated = kind == "simulated";
+  return s;
+}
+
+std::vector<Result> ring_chain_replay(const Options& o) {
+  riner::RinerConfig config = riner::bench::config_from(o);
+  if (o.size == "tiny") config.training.steps = std::min(config.training.steps_for(false), 200);
+  const std::string save_dir = o.get("save", "");
+  const std::string replay_dir = o.get("replay", "");
+  if (save_dir.empty() == replay_dir.empty()) {
+    throw riner::InputError("ring_chain_replay: give --save=DIR or --replay=DIR");
+  }
+  std::vector<Result> results;
+  if (!save_dir.empty()) {
+    riner::Device device = riner::Device::open(o.device);
+    const std::string scan_path = o.get("scan", "");
+    if (scan_path.empty()) {
+      const riner::Projector projector(riner::preset_geometry("fan2d-paper"),
+                                       riner::Engine::kOpenCL, device);
+      for (int i = o.get_int("first", 0); i <= o.get_int("last", 9); ++i) {
+        const riner::bench::RingScene scene = riner::bench::paper_scene(o, i, projector);
+        riner::Reconstructor r(scene.sim.scan, config, device);
+        r.run();
+        const std::string name = "slice_" + std::to_string(i + o.get_int("seed-offset", 0));
+        save(fs::path(save_dir) / name, r, scene.sim.scan.geometry, scene.sim.ground_truth, true,
+             config.rings);
+        std::fprintf(stderr, "%s: saved after %.1f s of training\n", name.c_str(),
+                     r.stats().seconds);
+      }
+    } else {
+      const riner::Scan scan = riner::load_scan(scan_path);
+      riner::FbpOptions fbp_options;
+      fbp_options.device = device;
+      const riner::Array fbp_image = riner::fbp(scan, fbp_options);
+      riner::Reconstructor r(scan, config, device);
+      r.run();
+      save(fs::path(save_dir) / o.get("tag", "scan"), r, scan.geometry, fbp_image, false,
+           config.rings);
+    }
+    return results;
+  }
+  const std::string order = o.get("order", kChain);
+  std::vector<fs::path> dirs;
+  for (const auto& entry : fs::directory_iterator(replay_dir)) {
+    if (entry.is_directory()) dirs.push_back(entry.path());
+  }
+  std::sort(dirs.begin(), dirs.end());
+  double psnr = 0.0, ssim = 0.0;
+  int simulated = 0;
+  for (const fs::path& dir : dirs) {
+    const Saved s = load(dir);
+    const riner::Array image = replay(order, s, config.rings);
+    const std::string name = dir.filename().string();
+    nlohmann::json row{{"scan", name}, {"order", order}};
+    std::string line;
+    if (s.simulated) {
+      const riner::ImageMetrics m = riner::compare_images(image, s.reference);
+      psnr += m.psnr;
+      ssim += m.ssim;
+      ++simulated;
+      row["psnr"] = m.psnr;
+      row["ssim"] = m.ssim;
+      line = riner::bench::format("%-12s %s  %.3f dB / %.4f", name.c_str(), order.c_str(), m.psnr,
+                                  m.ssim);
+    } else {
+      const riner::QualityReport q = riner::quality_against_fbp(image, s.reference);
+      row.update({{"ring_index", q.ring_index},
+                  {"fbp_ring_index", q.fbp_ring_index},
+                  {"specks_per_10k", q.specks_per_10k},
+                  {"fbp_specks_per_10k", q.fbp_specks_per_10k},
+                  {"centre_sigmas", q.centre.sigmas},
+                  {"edge_ratio", q.edge_strength / q.fbp_edge_strength}});
+      line = riner::bench::format(
+          "%-12s %s  ring %.5f (FBP/3 %.5f)  specks %.3f (FBP %.3f)  centre %.2f sigma  edges "
+          "%.3f of FBP's",
+          name.c_str(), order.c_str(), q.ring_index, q.fbp_ring_index / 3, q.specks_per_10k,
+          q.fbp_specks_per_10k, q.centre.sigmas, q.edge_strength / q.fbp_edge_strength);
+    }
+    std::fprintf(stderr, "%s\n", line.c_str());
+    results.push_back({"ring_chain_replay", row, line});
+  }
+  if (simulated > 0) {
+    const nlohmann::json mean{{"scan", "simulated mean"},
+                              {"order", order},
+                              {"scans", simulated},
+                              {"psnr", psnr / simulated},
+                              {"ssim", ssim / simulated}};
+    results.push_back({"ring_chain_replay", mean,
+                       riner::bench::format("mean of %d simulated: %.3f dB / %.4f", simulated,
+                                            psnr / simulated, ssim / simulated)});
+  }
+  return results;
+}
+
+}  // namespace
+
+RINER_BENCH_CASE(ring_chain_replay,
+                 "ring-correction chains replayed on saved training results (--save, --replay)",
+                 ring_chain_replay);
