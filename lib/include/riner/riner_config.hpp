@@ -186,8 +186,8 @@ struct RingCorrectionConfig {
   // the response correction has taken it (bench/RESULTS.md, issue 13).
   bool gradient_after_response = true;
   // Parallel-beam volumes: the three above, slice by slice (riner/volume_ring_correction.hpp).
-  // Off by default: the 3D field holds few rings, and on the simulated parallel-beam head the
-  // chain cost 1.2 dB (the radial-gradient step 1.35 dB; bench/RESULTS.md, issue 14).
+  // Off by default: the 3D field holds few rings; on the simulated parallel-beam head the chain
+  // costs 0.13 dB, and on the real savu_proj3d it raises the ring index (bench/RESULTS.md).
   bool slice_by_slice = false;
 };
 
