@@ -79,5 +79,14 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "riner_bench: no case named '%s' (see --help)\n", which.c_str());
     return 2;
   }
-  return 0;
+  // Checked after the run (cases read their options as they go): the results stand, the exit
+  // status says that an option did nothing.
+  int ignored = 0;
+  for (const auto& [key, value] : options.extra) {
+    if (options.read.count(key) != 0) continue;
+    std::fprintf(stderr, "riner_bench: --%s=%s was not read by case %s (a typo?)\n", key.c_str(),
+                 value.c_str(), which.c_str());
+    ++ignored;
+  }
+  return ignored > 0 ? 2 : 0;
 }

@@ -55,16 +55,19 @@ std::string Options::output_dir(const std::string& key, const std::string& fallb
 }
 
 std::string Options::get(const std::string& key, const std::string& fallback) const {
+  read.insert(key);
   const auto it = extra.find(key);
   return it == extra.end() ? fallback : it->second;
 }
 
 int Options::get_int(const std::string& key, int fallback) const {
+  read.insert(key);
   const auto it = extra.find(key);
   return it == extra.end() ? fallback : std::stoi(it->second);
 }
 
 double Options::get_double(const std::string& key, double fallback) const {
+  read.insert(key);
   const auto it = extra.find(key);
   return it == extra.end() ? fallback : std::stod(it->second);
 }

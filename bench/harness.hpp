@@ -5,6 +5,7 @@
 #include <functional>
 #include <map>
 #include <nlohmann/json.hpp>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,8 @@ struct Options {
   std::string json_path;                     // JSON lines appended here when set
   std::string self;                          // argv[0], for cases that time fresh processes
   std::map<std::string, std::string> extra;  // --key=value options a case understands
+  // The keys of `extra` a case asked for: any other was ignored (a typo reads as the defaults).
+  mutable std::set<std::string> read;
 
   // A case's own option (--key=value), or the fallback.
   std::string get(const std::string& key, const std::string& fallback) const;
