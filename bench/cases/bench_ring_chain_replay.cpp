@@ -23,6 +23,7 @@
 #include "riner/metrics.hpp"
 #include "riner/quality.hpp"
 #include "riner/reconstructor.hpp"
+#include "riner/ring_chain.hpp"
 #include "riner/ring_correction.hpp"
 #include "riner/scan.hpp"
 #include "scenes.hpp"
@@ -33,7 +34,7 @@ using riner::bench::Options;
 using riner::bench::Result;
 namespace fs = std::filesystem;
 
-constexpr const char* kChain = "agrg";  // as riner::correct_rings_in_order runs them
+constexpr const char* kChain = "agrg";  // --order's default: riner::correct_rings_in_order's
 
 struct Saved {
   riner::Geometry geometry;
@@ -71,7 +72,7 @@ void save(const fs::path& dir, riner::Reconstructor& r, const riner::Geometry& g
   Saved s{g, result.field_image, r.trained_alpha(), reference, {}, r.dead_elements(), simulated};
   // The pixels the reconstruction zeroed after its corrections (air that training skipped).
   s.keep = riner::Array(result.image.shape, 1.0f);
-  const riner::Array chain = replay(kChain, s, c);
+  const riner::Array chain = riner::correct_rings_in_order(s.field, s.alpha, g, s.dead, c).image;
   for (std::size_t p = 0; p < s.keep.size(); ++p) {
     if (result.image.data[p] == 0.0f && chain.data[p] != 0.0f) s.keep.data[p] = 0.0f;
   }

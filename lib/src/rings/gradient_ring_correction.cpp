@@ -3,6 +3,7 @@
 
 #include "riner/error.hpp"
 #include "riner/ring_correction.hpp"
+#include "rings/radial.hpp"
 #include "rings/ring_profile.hpp"
 #include "rings/ring_settings.hpp"
 
@@ -87,26 +88,19 @@ bool ring_slope(const PolarSamples& s, std::size_t r, double flat_fraction, doub
 // feature narrower than half_width goes; a step (the edge of a disc about the axis) stays, where
 // a Gaussian high-pass would leave rings on both sides of it (bench/RESULTS.md, issue 13).
 std::vector<double> high_pass(const std::vector<double>& values, std::size_t half_width) {
-  const std::size_t n = values.size();
-  const auto mirrored = [n](std::ptrdiff_t i) {
-    const auto last = static_cast<std::ptrdiff_t>(n) - 1;
-    if (last == 0) return std::size_t{0};
-    const std::ptrdiff_t period = 2 * last;
-    i %= period;
-    if (i < 0) i += period;
-    return static_cast<std::size_t>(i <= last ? i : period - i);
-  };
-  std::vector<double> out(n);
+  const auto n = static_cast<std::ptrdiff_t>(values.size());
+  std::vector<double> out(values.size());
   std::vector<double> window(2 * half_width + 1);
   const auto h = static_cast<std::ptrdiff_t>(half_width);
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::ptrdiff_t i = 0; i < n; ++i) {
     for (std::ptrdiff_t k = -h; k <= h; ++k) {
       window[static_cast<std::size_t>(k + h)] =
-          values[mirrored(static_cast<std::ptrdiff_t>(i) + k)];
+          values[static_cast<std::size_t>(rings::mirrored(i + k, n))];
     }
     const auto mid = window.begin() + h;
     std::nth_element(window.begin(), mid, window.end());
-    out[i] = values[i] - *mid;
+    const auto at = static_cast<std::size_t>(i);
+    out[at] = values[at] - *mid;
   }
   return out;
 }

@@ -33,9 +33,6 @@ std::size_t PixelRadii::nearest_nodes() const {
   return nodes;
 }
 
-namespace {
-
-// Index j mirrored into 0..n-1 about the first and last nodes.
 std::ptrdiff_t mirrored(std::ptrdiff_t j, std::ptrdiff_t n) {
   if (n == 1) return 0;
   const std::ptrdiff_t period = 2 * (n - 1);
@@ -43,8 +40,6 @@ std::ptrdiff_t mirrored(std::ptrdiff_t j, std::ptrdiff_t n) {
   if (j < 0) j += period;
   return j < n ? j : period - j;
 }
-
-}  // namespace
 
 std::vector<double> gaussian_smooth(const std::vector<double>& values, double sigma, Ends ends,
                                     const std::vector<char>* use) {

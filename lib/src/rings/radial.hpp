@@ -41,6 +41,9 @@ enum class Ends {
   kMirror,  // the values mirrored about the end nodes (a radial profile is even about r = 0)
 };
 
+// Index j mirrored into 0..n-1 about the first and last nodes (Ends::kMirror).
+std::ptrdiff_t mirrored(std::ptrdiff_t j, std::ptrdiff_t n);
+
 // Gaussian smoothing (sigma in nodes) of regularly spaced values. With `use`, only the values
 // it marks enter, renormalised, and the others come out 0.
 std::vector<double> gaussian_smooth(const std::vector<double>& values, double sigma, Ends ends,
