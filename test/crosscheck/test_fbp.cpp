@@ -40,6 +40,9 @@ TEST_SUITE("fbp") {
         const riner::Array device = riner::fbp(scan, options);
         options.engine = riner::Engine::kReference;
         const riner::Array reference = riner::fbp(scan, options);
+        // The reference once returned n_y images for a 2D scan (its rows taken for slices).
+        REQUIRE(reference.shape == device.shape);
+        REQUIRE(reference.data.size() == device.data.size());
         // fp32 convolution over n_u taps and sums over views: ~1e-6; 1e-4 is the bar.
         const auto stats = riner::test::compare(device.data, reference.data);
         CHECK_MESSAGE(stats.rms_rel < riner::test::tolerance::kChained, stats.describe());

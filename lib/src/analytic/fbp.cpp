@@ -75,8 +75,9 @@ Array fbp(const Scan& scan, const FbpOptions& options, FbpReport* report) {
   Array volume(shape);
   if (options.engine == Engine::kReference) {
     const std::vector<double> in(weighted.data.begin(), weighted.data.end());
-    const std::vector<double> out = ref::fbp_backproject(g, ref::fbp_filter(in, g.n_u, taps),
-                                                         view_weights, first, step, shape[0]);
+    // Slices only in 3D: a 2D image is one slice (passing its row count gave ny images).
+    const std::vector<double> out = ref::fbp_backproject(
+        g, ref::fbp_filter(in, g.n_u, taps), view_weights, first, step, g.is_3d() ? shape[0] : 1);
     volume.data.assign(out.begin(), out.end());
     return volume;
   }
