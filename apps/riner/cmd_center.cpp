@@ -1,16 +1,18 @@
 // riner center SCAN: the centre-of-rotation offset the scan's own views point to.
 #include "cli_common.hpp"
 #include "commands.hpp"
-#include "summary_json.hpp"
 #include "scan_options.hpp"
+#include "summary_json.hpp"
 
 namespace riner::app {
 
 int run_center(int argc, char** argv, int first) {
   Args args("center",
             "Estimates where the rotation axis projects on the detector (the geometry's "
-            "detector.offset_px) from views half a turn apart, which a parallel beam sees as "
-            "mirror images. Use the result with --offset-px, or pass --offset-px auto to "
+            "detector.offset_px) from the whole sinogram: the first half-turn and its mirror "
+            "image make one unbroken full-turn sinogram only about the axis (Vo et al. 2014); "
+            "views half a turn apart, which a parallel beam sees as mirror images, are the "
+            "cross-check. Use the result with --offset-px, or pass --offset-px auto to "
             "reconstruct and fbp.");
   add_scan_options(args);
   args.output_flags();

@@ -6,8 +6,8 @@
 #include "riner/fbp.hpp"
 #include "riner/io.hpp"
 #include "riner/scan.hpp"
-#include "summary_json.hpp"
 #include "scan_options.hpp"
+#include "summary_json.hpp"
 
 namespace riner::app {
 
@@ -25,6 +25,7 @@ int run_fbp(int argc, char** argv, int first) {
   if (!args.parse(argc, argv, first)) return 0;
   Console console(args);
   const LoadedScan loaded = scan_from(args, console);
+  check_centre(loaded, console);
   const Scan& scan = loaded.scan;
   const std::filesystem::path out = args.get("out");
   format_from_path(out);  // reject an unknown extension before the work

@@ -15,8 +15,8 @@
 #include "riner/quality.hpp"
 #include "riner/reconstructor.hpp"
 #include "riner/scan.hpp"
-#include "summary_json.hpp"
 #include "scan_options.hpp"
+#include "summary_json.hpp"
 
 namespace riner::app {
 
@@ -36,6 +36,13 @@ void print_doubts(Console& console, const QualityReport& q) {
     std::snprintf(line, sizeof(line),
                   "note: %.1f isolated specks per 10^4 pixels against FBP's %.1f", q.specks_per_10k,
                   q.fbp_specks_per_10k);
+    console.line(line);
+  }
+  if (q.lost.share > kLostObjectShare) {
+    std::snprintf(line, sizeof(line),
+                  "note: %.2f%% of the field (%zu pixels) shows air where FBP clearly sees "
+                  "object: look there before trusting the image",
+                  100.0 * q.lost.share, q.lost.pixels);
     console.line(line);
   }
   if (q.edge_strength < kSoftEdgeRatio * q.fbp_edge_strength) {
@@ -132,6 +139,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   const auto started = std::chrono::steady_clock::now();
   Console console(args);
   LoadedScan loaded = scan_from(args, console);
+  const std::optional<CentreEstimate> centre_check = check_centre(loaded, console);
   Scan& scan = loaded.scan;
   const RinerConfig config = config_from(args);
   const std::string format = args.get("format");
@@ -151,11 +159,23 @@ int run_reconstruct(int argc, char** argv, int first) {
     const TrainingStats setup = reconstructor.stats();
     if (setup.plan) console.line(setup.plan->describe());
     if (setup.air_skipped) {
-      char line[160];
+      char line[240];
       std::snprintf(line, sizeof(line),
                     "skipping the air: %.0f%% of the grid sampled, %.0f%% of the samples kept",
                     100.0 * setup.inside_fraction, 100.0 * setup.samples_kept_fraction);
       console.line(line);
+      if (setup.air_outlier_views > 0) {
+        console.line("  " + std::to_string(setup.air_outlier_views) +
+                     " view(s) read their air off the others' level or noise: they carve nothing");
+      }
+      if (setup.skipped_rays_unresolved > 0) {
+        std::snprintf(line, sizeof(line),
+                      "note: %zu ray(s) through only skipped air next to the object read more "
+                      "than air, up to %.1f noise sigmas (training.skip_air false samples "
+                      "everything)",
+                      setup.skipped_rays_unresolved, setup.skipped_ray_sigmas);
+        console.line(line);
+      }
     } else if (config.training.skip_air && !setup.air_note.empty()) {
       console.line("not skipping the air: " + setup.air_note);
     }
@@ -194,14 +214,16 @@ int run_reconstruct(int argc, char** argv, int first) {
   summary["flat_field"] =
       loaded.flat_field ? flat_field_json(*loaded.flat_field) : nlohmann::json(nullptr);
   summary["centre"] = loaded.centre ? centre_json(*loaded.centre) : nlohmann::json(nullptr);
+  // The scan's own estimate of the axis beside the offset it was given (null: not checked).
+  summary["centre_check"] = centre_check ? centre_json(*centre_check) : nlohmann::json(nullptr);
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   summary["wall_seconds"] = wall;  // "seconds" is the training's
   write_text(out / "summary.json", summary.dump(1) + "\n");
   console.line("reconstructed " + shape_string(image.shape) + " in " + format_duration(wall) +
-               " (training " + format_duration(stats.seconds) + "; " +
-               std::to_string(stats.steps) + " steps, " +
-               std::to_string(dead.size()) + " elements flagged dead) -> " + out.string());
+               " (training " + format_duration(stats.seconds) + "; " + std::to_string(stats.steps) +
+               " steps, " + std::to_string(dead.size()) + " elements flagged dead) -> " +
+               out.string());
   print_doubts(console, quality.image);
   console.summary(summary);
   return 0;

@@ -101,7 +101,9 @@ int run_simulate(int argc, char** argv, int first) {
             "Writes sino.npy (corrupted), sino_clean.npy (exact, noise-free), "
             "ground_truth.nii, alpha.npy (0 = dead), geometry.json, PNG previews and "
             "simulation.json into the output folder.");
-  args.option("phantom", "NAME|FILE", "shepp-logan, or an image/volume file on the grid",
+  args.option("phantom", "NAME|FILE",
+              "shepp-logan, faint-square (a faint square with sharp corners and a dense line), "
+              "or an image/volume file on the grid",
               "shepp-logan")
       .option("geometry", "PRESET|FILE",
               "fan2d-paper, cone3d-paper, parallel3d, or a geometry JSON", "fan2d-paper")
@@ -124,8 +126,8 @@ int run_simulate(int argc, char** argv, int first) {
       .option("dead", "N", "dead elements (alpha = 0)", "2")
       .option("dead-rows", "N", "3D: whole dead detector rows", "0")
       .option("dead-columns", "N", "3D: whole dead detector columns", "0")
-      .option("supersample", "S", "Shepp-Logan raster: S^d points averaged per voxel", "4")
-      .option("projector", "NAME", "exact (analytic, Shepp-Logan only) or joseph", "exact");
+      .option("supersample", "S", "built-in phantoms' raster: S^d points averaged per voxel", "4")
+      .option("projector", "NAME", "exact (analytic, built-in phantoms only) or joseph", "exact");
   add_engine_flags(args);
   args.output_flags();
   if (!args.parse(argc, argv, first)) return 0;
@@ -134,7 +136,8 @@ int run_simulate(int argc, char** argv, int first) {
   const RingModel model = model_from(args);
   const Engine engine = engine_from(args);
   const std::filesystem::path out = make_output_dir(args.get("out"));
-  const bool phantom = args.get("phantom") == "shepp-logan";
+  const std::string phantom_name = args.get("phantom");
+  const bool phantom = phantom_name == "shepp-logan" || phantom_name == "faint-square";
   std::string projector_name = args.get("projector");
   if (projector_name != "exact" && projector_name != "joseph") {
     throw UsageError("--projector must be exact or joseph");
@@ -144,7 +147,8 @@ int run_simulate(int argc, char** argv, int first) {
   SimulatedScan sim;
   sim.scan.geometry = g;
   if (phantom) {
-    const Phantom p = shepp_logan(g, args.number("mu-scale"));
+    const Phantom p =
+        phantom_name == "shepp-logan" ? shepp_logan(g, args.number("mu-scale")) : faint_square(g);
     sim.ground_truth = rasterize(p, g, static_cast<int>(args.integer("supersample")));
     if (projector_name == "exact") sim.clean = exact_projections(p, g);
   } else {

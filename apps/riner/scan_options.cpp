@@ -1,5 +1,6 @@
 #include "scan_options.hpp"
 
+#include <cmath>
 #include <cstdio>
 
 #include "riner/error.hpp"
@@ -27,13 +28,14 @@ void add_scan_options(Args& args) {
               "reconstruct detector row N of a projection stack with a 2D geometry (one slice)", "")
       .option("offset-px", "PX|auto",
               "the detector's centre-of-rotation offset instead of the geometry's; auto: "
-              "estimated from views half a turn apart (parallel beam, `riner center`)",
+              "estimated from the scan's own sinogram (parallel beam, `riner center`)",
               "");
 }
 
 LoadedScan scan_from(const Args& args, const Console& console) {
-  ScanSource source{args.get("SCAN"), args.get("geometry"), args.get("flat"), args.get("dark"),
-                    std::nullopt, args.has("offset-px") ? args.get("offset-px") : ""};
+  ScanSource source{args.get("SCAN"), args.get("geometry"),
+                    args.get("flat"), args.get("dark"),
+                    std::nullopt,     args.has("offset-px") ? args.get("offset-px") : ""};
   if (const std::string r = args.get("row"); !r.empty()) {
     const long n = args.integer("row");
     if (n < 0) throw UsageError("--row must be 0 or more");
@@ -41,8 +43,9 @@ LoadedScan scan_from(const Args& args, const Console& console) {
   }
   const bool scan_json = std::filesystem::path(source.path).extension() == ".json";
   if (scan_json && !(source.flat.empty() && source.dark.empty() && source.geometry.empty())) {
-    throw UsageError("a scan JSON names its own data and geometry: drop --flat, --dark and "
-                     "--geometry");
+    throw UsageError(
+        "a scan JSON names its own data and geometry: drop --flat, --dark and "
+        "--geometry");
   }
   if (!scan_json && !source.dark.empty() && source.flat.empty()) {
     throw UsageError("--dark needs --flat (and SCAN holding raw projections)");
@@ -51,6 +54,27 @@ LoadedScan scan_from(const Args& args, const Console& console) {
   LoadedScan loaded = load_scan_source(std::move(source));
   for (const std::string& note : loaded.notes) console.line(note);
   return loaded;
+}
+
+std::optional<CentreEstimate> check_centre(const LoadedScan& loaded, const Console& console) {
+  if (loaded.centre || loaded.scan.geometry.is_divergent()) return std::nullopt;
+  std::optional<CentreEstimate> e;
+  try {
+    e = estimate_centre(loaded.scan);
+  } catch (const InputError&) {
+    return std::nullopt;  // no half-turn, no view pair: nothing to check against
+  }
+  const double given = loaded.scan.geometry.offset_u;
+  if (std::fabs(e->offset_px - given) > kCentreDoubtPx) {
+    char line[300];
+    std::snprintf(line, sizeof(line),
+                  "note: the scan's own sinogram puts the rotation axis at offset %.2f px, the "
+                  "geometry at %.2f: a wrong axis doubles edges and leaves arcs (pass "
+                  "--offset-px auto, or check the geometry)",
+                  e->offset_px, given);
+    console.line(line);
+  }
+  return e;
 }
 
 }  // namespace riner::app

@@ -17,4 +17,13 @@ void add_scan_options(Args& args);
 // Console lines say what was done.
 LoadedScan scan_from(const Args& args, const Console& console);
 
+// Further from the scan's own estimate of its axis (`riner center`) than this, the geometry's
+// offset is doubted aloud: half a pixel blurs little, a few pixels double edges.
+constexpr double kCentreDoubtPx = 1.0;
+
+// A parallel-beam scan whose offset was given (not auto): the scan's own estimate, and a console
+// note when the two differ by more than kCentreDoubtPx. nullopt for divergent beams, auto
+// offsets and scans without a half-turn or a view pair.
+std::optional<CentreEstimate> check_centre(const LoadedScan& loaded, const Console& console);
+
 }  // namespace riner::app

@@ -24,8 +24,9 @@ void resolve_scan_json(ScanSource& source) {
                      "file as the geometry, or name the data in \"files\"");
   }
   if (!source.flat.empty() || !source.dark.empty() || !source.geometry.empty()) {
-    throw InputError("a scan JSON names its own data and geometry: give no flat, dark or "
-                     "geometry with it");
+    throw InputError(
+        "a scan JSON names its own data and geometry: give no flat, dark or "
+        "geometry with it");
   }
   source.geometry = source.path;
   source.path = (files->measurement.empty() ? files->projections : files->measurement).string();
@@ -64,16 +65,16 @@ LoadedScan load_scan_source(ScanSource source) {
       throw InputError(source.path + ": the file holds no flat field (" + file.layout +
                        "); pass one with --flat");
     }
-    loaded.scan = raw_scan(Geometry::load(find_geometry(source.path, source.geometry)),
-                           file.projections, file.flats, file.darks, source.row, source.path,
-                           &report);
+    loaded.scan =
+        raw_scan(Geometry::load(find_geometry(source.path, source.geometry)), file.projections,
+                 file.flats, file.darks, source.row, source.path, &report);
     loaded.flat_field = report;
     loaded.notes.push_back(file.layout + " file: " + flat_field_line(report));
   } else if (source.flat.empty()) {
     loaded.scan = load_scan(source.path, source.geometry, source.row);
   } else {
-    loaded.scan = load_raw_scan(source.path, source.flat, source.dark, source.geometry, &report,
-                                source.row);
+    loaded.scan =
+        load_raw_scan(source.path, source.flat, source.dark, source.geometry, &report, source.row);
     loaded.flat_field = report;
     loaded.notes.push_back(flat_field_line(report));
   }
@@ -97,7 +98,20 @@ std::string flat_field_line(const FlatFieldReport& r) {
 }
 
 std::string centre_line(const CentreEstimate& e) {
-  char line[200];
+  char line[320];
+  if (e.method == "sinogram") {
+    std::snprintf(line, sizeof(line),
+                  "centre of rotation: offset %.2f px (axis at column %.2f) from the whole "
+                  "sinogram over %zu row(s)",
+                  e.offset_px, e.axis_column, e.rows);
+    std::string out = line;
+    if (e.pairs > 0) {
+      std::snprintf(line, sizeof(line), "; view pairs say %.2f px (spread %.2f over %zu pairs)",
+                    e.pairs_offset_px, e.spread_px, e.pairs);
+      out += line;
+    }
+    return out;
+  }
   std::snprintf(line, sizeof(line),
                 "centre of rotation: offset %.2f px (axis at column %.2f), spread %.2f px over "
                 "%zu view pair(s) x %zu row(s)",

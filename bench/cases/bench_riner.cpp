@@ -228,12 +228,15 @@ nlohmann::json real_scan_run(const riner::Scan& scan, const riner::Array& fbp_im
           {"fbp_edge_strength", quality.fbp_edge_strength},
           {"riner_edge_strength", quality.edge_strength},
           {"edge_ratio", quality.edge_strength / quality.fbp_edge_strength},
+          {"lost_object_pixels", quality.lost.pixels},
+          {"lost_object_share", quality.lost.share},
           {"centre_deviation", quality.centre.deviation},
           {"centre_deviation_at_px", quality.centre.at_px},
           {"centre_deviation_sigmas", quality.centre.sigmas},
           {"centre_fbp_profile_noise", quality.centre.fbp_noise},
           {"field_centre_deviation_sigmas", riner::centre_deviation(field, fbp_image).sigmas},
           {"samples_kept_fraction", r.stats().samples_kept_fraction},
+          {"grid_fraction_sampled", r.stats().inside_fraction},
           {"field_ring_index", riner::ring_index(field)},
           {"ring_correction_applied", rings && rings->applied},
           {"ring_correction_response_change", rings ? rings->mean_response_change : 0.0},
@@ -254,8 +257,9 @@ nlohmann::json real_scan_run(const riner::Scan& scan, const riner::Array& fbp_im
 // --npy=PREFIX for the images and responses as .npy (both of the first seed). --seeds=N runs
 // seeds s .. s + N - 1 (s: --seed=N or the config's, 0 by default), one row each, and a row
 // counting how many pass each of issue 13's bars: ring index <= FBP's / 3, specks <= FBP's, centre
-// <= 1 sigma (one seed's numbers can pass a bar another's fails: bench/RESULTS.md), and how many
-// keep their edges (edge strength >= 0.8 of FBP's: a blur passes the other bars).
+// <= 1 sigma (one seed's numbers can pass a bar another's fails: bench/RESULTS.md), how many
+// keep their edges (edge strength >= 0.8 of FBP's: a blur passes the other bars) and how many
+// lose no object (issue 29: quality.lost_object 0).
 std::vector<Result> riner_real_scan(const Options& o) {
   const std::string scan_path = o.get("scan", "../shared/data/neutron360/sino.npy");
   const int seeds = o.get_int("seeds", 1);
@@ -268,7 +272,7 @@ std::vector<Result> riner_real_scan(const Options& o) {
   riner::RinerConfig config = riner::bench::config_from(o);
   const std::uint64_t first_seed = config.training.seed;
   std::vector<Result> rows;
-  int ring_pass = 0, speck_pass = 0, centre_pass = 0, edge_pass = 0;
+  int ring_pass = 0, speck_pass = 0, centre_pass = 0, edge_pass = 0, kept_pass = 0;
   for (int i = 0; i < seeds; ++i) {
     config.training.seed = first_seed + static_cast<std::uint64_t>(i);
     nlohmann::json run =
@@ -279,6 +283,7 @@ std::vector<Result> riner_real_scan(const Options& o) {
         run["riner_specks_per_10k"].get<double>() <= run["fbp_specks_per_10k"].get<double>();
     centre_pass += run["centre_deviation_sigmas"].get<double>() <= 1.0;
     edge_pass += run["edge_ratio"].get<double>() >= riner::kSoftEdgeRatio;
+    kept_pass += run["lost_object_pixels"].get<std::size_t>() == 0;
     run["scan"] = scan_path;
     rows.push_back({"riner_real_scan", std::move(run)});
   }
@@ -290,7 +295,8 @@ std::vector<Result> riner_real_scan(const Options& o) {
                      {"ring_index_at_most_fbp_third", ring_pass},
                      {"specks_at_most_fbp", speck_pass},
                      {"centre_within_1_sigma", centre_pass},
-                     {"edges_at_least_0_8_of_fbp", edge_pass}}});
+                     {"edges_at_least_0_8_of_fbp", edge_pass},
+                     {"no_lost_object", kept_pass}}});
   }
   return rows;
 }

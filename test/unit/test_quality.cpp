@@ -21,7 +21,48 @@ riner::Array noisy(std::size_t n, double sigma, unsigned seed) {
   return a;
 }
 
+// A square sample of mu in air, plus white noise, on an n x n grid; `cut` zeroes its top-left
+// corner triangle of that many pixels per side.
+riner::Array square_sample(std::size_t n, double mu, double sigma, unsigned seed, std::size_t cut) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> g(0.0, sigma);
+  riner::Array a({n, n});
+  const std::size_t lo = n / 4, hi = 3 * n / 4;
+  for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t k = 0; k < n; ++k) {
+      const bool inside = i >= lo && i < hi && k >= lo && k < hi && (i - lo) + (k - lo) >= cut;
+      a(i, k) = static_cast<float>((inside ? mu : 0.0) + g(rng));
+    }
+  }
+  return a;
+}
+
 }  // namespace
+
+TEST_SUITE("quality: lost object") {
+  TEST_CASE(
+      "object the FBP sees and the image sets to air is counted; noise and agreement are not") {
+    const std::size_t n = 200;
+    // Per pixel the sample is 2 noise sigmas, blurred by the measure 14.
+    const riner::Array fbp = square_sample(n, 2e-3, 1e-3, 5, 0);
+    // The same sample, clean: nothing lost.
+    CHECK(riner::lost_object(square_sample(n, 2e-3, 0.0, 6, 0), fbp).pixels == 0);
+    // Its corner set to air over a triangle of 20 pixels a side (210 pixels; the blur of the
+    // measure takes a pixel or so off the edges).
+    const riner::LostObject lost = riner::lost_object(square_sample(n, 2e-3, 0.0, 6, 20), fbp);
+    CHECK(lost.pixels > 120);
+    CHECK(lost.pixels < 260);
+    const double disc = M_PI * 99.0 * 99.0;
+    CHECK(lost.share == doctest::Approx(static_cast<double>(lost.pixels) / disc).epsilon(0.05));
+    // The blurred FBP's noise: white noise of 1e-3 blurred by 2 px is 1e-3 / (2 sqrt(pi) 2).
+    CHECK(lost.fbp_noise == doctest::Approx(1e-3 / (4.0 * std::sqrt(M_PI))).epsilon(0.2));
+    // A faint sample (below 5 sigma of the blurred noise) is not claimed either way.
+    CHECK(riner::lost_object(square_sample(n, 0.0, 0.0, 7, 0), square_sample(n, 2e-5, 1e-3, 8, 0))
+              .pixels == 0);
+    // An image at half the FBP's level still shows the object.
+    CHECK(riner::lost_object(square_sample(n, 1e-3, 0.0, 9, 0), fbp).pixels == 0);
+  }
+}
 
 TEST_SUITE("quality") {
   TEST_CASE("the noise estimate scales with the noise, specks count isolated outliers") {

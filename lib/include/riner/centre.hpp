@@ -1,9 +1,15 @@
 // Where the rotation axis projects on the detector, from the scan itself: a parallel-beam view
-// and the view half a turn later are mirror images of each other about the axis, so the axis
-// is where the mirrored pair matches best.
+// and the view half a turn later are mirror images of each other about the axis. Two ways to
+// read it: the whole sinogram (the first half-turn and its mirror image make one unbroken
+// full-turn sinogram only about the axis: Vo et al. 2014, lib/src/preprocessing/
+// centre_sinogram.hpp), and view pairs (the axis where each view and its opposite match best).
+// The sinogram uses every view, so one noisy or dim view moves it little, and it needs no exact
+// pair (a 179.5-degree scan); the pairs are its cross-check, and the answer when the views do
+// not cover an evenly spaced half-turn.
 #pragma once
 
 #include <cstddef>
+#include <string>
 
 #include "riner/scan.hpp"
 
@@ -17,12 +23,17 @@ struct CentreEstimate {
   double spread_px = 0.0;
   std::size_t pairs = 0;  // view pairs half a turn apart that were compared
   std::size_t rows = 0;   // detector rows compared (1 in 2D)
+  std::string method;     // "sinogram" or "view pairs": which gave offset_px
+  // Each method's own answer (NaN where it has none): the cross-check.
+  double sinogram_offset_px = 0.0;
+  double pairs_offset_px = 0.0;
 };
 
-// Parallel beam (2D or 3D) with views half a turn after others: exactly (within a quarter of
-// the mean angular step) or between two views (interpolated in angle; a 360-degree scan with an
-// odd number of views). A 180-degree scan needs its endpoint view. Non-finite readings are left
-// out. InputError for a divergent beam or a scan with no such views.
+// Parallel beam (2D or 3D). The sinogram where the views cover an evenly spaced half-turn less
+// 1.5 steps; else view pairs half a turn apart: exactly (within a quarter of the mean angular
+// step) or between two views (interpolated in angle; a 360-degree scan with an odd number of
+// views). Non-finite readings are left out (pairs) or interpolated along the row (sinogram).
+// InputError for a divergent beam or a scan where neither works.
 CentreEstimate estimate_centre(const Scan& scan);
 
 }  // namespace riner

@@ -1,5 +1,6 @@
-// Analytic phantoms made of ellipses/ellipsoids: exact values anywhere, exact line integrals
-// along any ray (the oracle the projector is tested against), and supersampled rasters.
+// Analytic phantoms made of ellipses/ellipsoids and rectangles/cuboids: exact values anywhere,
+// exact line integrals along any ray (the oracle the projector is tested against), and
+// supersampled rasters.
 #pragma once
 
 #include <array>
@@ -18,8 +19,16 @@ struct Ellipsoid {
   double value = 0.0;                                         // added inside (1/mm)
 };
 
+struct Cuboid {
+  Vec3 centre;                                                // mm
+  Vec3 half_sizes;                                            // mm; z ignored for 2D use
+  std::array<double, 9> rotation{1, 0, 0, 0, 1, 0, 0, 0, 1};  // world -> local, row-major
+  double value = 0.0;                                         // added inside (1/mm)
+};
+
 struct Phantom {
   std::vector<Ellipsoid> ellipsoids;
+  std::vector<Cuboid> cuboids;
 
   double value_at(const Vec3& p) const;
   // Exact integral of the phantom along the whole line (mm x 1/mm).
@@ -31,6 +40,13 @@ struct Phantom {
 // values in "head units" (skull 1.0, brain 0.2) times mu_scale (1/mm). The default scale 0.1
 // makes the brain water-like, 0.02 / mm.
 Phantom shepp_logan(const Geometry& g, double mu_scale = 0.1);
+
+// A faint square sample with sharp corners (issue 29: what the air carving cut off a real
+// neutron scan): a square of 0.6 x the grid's smaller width, turned by 20 degrees, whose
+// thickest projection is about 0.4 (neutron-like contrast), a dense line inside it (13 x the
+// square's mu), a denser disc, a fainter one and a hole. In 3D a square prism of 0.6 x the
+// grid's height.
+Phantom faint_square(const Geometry& g);
 
 // Voxel averages over supersample^d points per voxel, on the geometry's grid.
 Array rasterize(const Phantom& phantom, const Geometry& g, int supersample = 4);

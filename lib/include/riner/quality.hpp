@@ -15,6 +15,11 @@
 //                Gaussian of 1 px, so that pixel noise does not pass for edges), of the image and
 //                of the FBP: well below the FBP's, the image is blurred. Fewer specks and rings
 //                can come from blur alone (bench/RESULTS.md), so these read beside it
+//   lost object  the share of the disc where the FBP clearly sees object and the image shows air
+//                (issue 29): both blurred by a Gaussian of 2 px; the FBP's air level and noise
+//                are the median and MAD of its blurred values where the image reads air (below
+//                a tenth of its 99.5th percentile); object is over 5 of those sigmas, and air
+//                in the image is less than a quarter of what the FBP shows there
 #pragma once
 
 #include "riner/array.hpp"
@@ -46,6 +51,19 @@ constexpr double kSoftEdgeRatio = 0.8;
 CentreDeviation centre_deviation(const Array& image, const Array& fbp, int radius_px = 20,
                                  double smoothing_px = 3.0);
 
+// Above this share of the disc, lost object is worth a look (a user trusts that what the image
+// does not show was not there).
+constexpr double kLostObjectShare = 1e-3;
+
+struct LostObject {
+  std::size_t pixels = 0;  // where the FBP sees object and the image air
+  double share = 0.0;      // of the disc's pixels
+  double fbp_noise = 0.0;  // the blurred FBP's noise sigma in the image's air (1/mm)
+};
+
+// Of a volume, over its axial slices together.
+LostObject lost_object(const Array& image, const Array& fbp);
+
 struct QualityReport {
   double noise = 0.0;  // the FBP's pixel noise
   double ring_index = 0.0;
@@ -54,6 +72,7 @@ struct QualityReport {
   double fbp_specks_per_10k = 0.0;
   double edge_strength = 0.0;
   double fbp_edge_strength = 0.0;
+  LostObject lost;
   CentreDeviation centre;
 };
 

@@ -56,6 +56,10 @@ enum class Sampler {
 // A 2D scan's detector is one row, where the two are the same: it keeps per element.
 enum class AlphaModel { kAuto, kPerElement, kRowsTimesColumns };
 
+// training.air_fbp_check: auto is on in 2D and off in 3D, where the FDK's ring and cone-beam
+// artifacts in the air read as object (the paper's 3D head: 0.32 -> 0.55 of the grid sampled).
+enum class AirFbpCheck { kAuto, kOn, kOff };
+
 struct TrainingConfig {
   // -1: the scan's (kSteps2d or kSteps3d, filled in by the Reconstructor). 3D has its own
   // because a step there draws its rays over ~100x the detector elements of a slice: the paper's
@@ -72,12 +76,17 @@ struct TrainingConfig {
   double sample_spacing = 1.5;  // along each ray, in voxels (the paper uses a fixed interval)
   bool jitter = false;          // stratified random offsets while training (midpoints if off)
   bool circle_region = false;   // sample the inscribed circle instead of the whole grid
-  // Skip the air around the object (model/occupancy.hpp): voxels that some ray certifies as
-  // air (its reading within air_noise_sigmas noise sigmas of its element's offset) are not
-  // sampled and read 0 in the image; air_margin_px voxels around the rest stay.
+  // Skip the air around the object (model/occupancy.hpp): voxels that air_min_views views
+  // certify as air (the mean of three neighbouring readings within air_noise_sigmas noise
+  // sigmas of their offsets, over the voxel's shadow widened by air_centre_tolerance_px), that the
+  // FBP does not see as object (air_fbp_check) and that no ray through the skipped air contradicts
+  // are not sampled and read 0 in the image; air_margin_px voxels around the rest stay.
   bool skip_air = true;
   double air_noise_sigmas = 4.0;
   int air_margin_px = 4;
+  int air_min_views = 3;
+  double air_centre_tolerance_px = 0.0;
+  AirFbpCheck air_fbp_check = AirFbpCheck::kAuto;
   double learning_rate = 1e-3;
   // The rate is multiplied by lr_decay every lr_decay_steps steps; 0: every steps / 4, so the
   // schedule stretches with the budget (--steps 12000 halves every 3000).
@@ -234,5 +243,6 @@ constexpr bool draws_block(Sampler s) {
 const char* data_term_name(DataTerm term);
 // "auto", "per-element", "rows-x-columns".
 const char* alpha_model_name(AlphaModel model);
+const char* air_fbp_check_name(AirFbpCheck check);
 
 }  // namespace riner

@@ -9,6 +9,7 @@
 #include "riner/error.hpp"
 #include "riner/metrics.hpp"
 #include "rings/radial.hpp"
+#include "util/gaussian_blur.hpp"
 #include "util/robust_statistics.hpp"
 
 namespace riner {
@@ -18,6 +19,11 @@ namespace {
 constexpr double kSpeckSigmas = 6.0;
 constexpr double kEdgeSmoothingPx = 1.0;
 constexpr double kEdgePercentile = 0.99;
+constexpr double kLostBlurPx = 2.0;
+constexpr double kLostAirShareOfHigh = 0.1;  // of the image's 99.5th percentile
+constexpr double kLostObjectSigmas = 5.0;
+constexpr double kLostShownShare = 0.25;  // of what the FBP shows
+constexpr std::size_t kLostMinAirPixels = 100;
 
 void require_2d(const Array& a, const char* what) {
   if (a.rank() != 2 || a.shape[0] < 16 || a.shape[1] < 16)
@@ -76,34 +82,7 @@ std::vector<double> over_slices(const Array& a, PerImage per_image) {
 
 // Gaussian of kEdgeSmoothingPx along both axes (edge pixels repeated beyond the border).
 Array smoothed(const Array& a) {
-  const int reach = static_cast<int>(std::ceil(3.0 * kEdgeSmoothingPx));
-  std::vector<double> w(static_cast<std::size_t>(2 * reach + 1));
-  double total = 0.0;
-  for (int d = -reach; d <= reach; ++d) {
-    w[static_cast<std::size_t>(d + reach)] =
-        std::exp(-0.5 * d * d / (kEdgeSmoothingPx * kEdgeSmoothingPx));
-    total += w[static_cast<std::size_t>(d + reach)];
-  }
-  for (double& v : w) v /= total;
-  const long ny = static_cast<long>(a.shape[0]), nx = static_cast<long>(a.shape[1]);
-  Array rows({a.shape[0], a.shape[1]}), out({a.shape[0], a.shape[1]});
-  for (long i = 0; i < ny; ++i) {
-    for (long k = 0; k < nx; ++k) {
-      double sum = 0.0;
-      for (int d = -reach; d <= reach; ++d)
-        sum += w[static_cast<std::size_t>(d + reach)] * a(i, std::clamp(k + d, 0L, nx - 1));
-      rows(i, k) = static_cast<float>(sum);
-    }
-  }
-  for (long i = 0; i < ny; ++i) {
-    for (long k = 0; k < nx; ++k) {
-      double sum = 0.0;
-      for (int d = -reach; d <= reach; ++d)
-        sum += w[static_cast<std::size_t>(d + reach)] * rows(std::clamp(i + d, 0L, ny - 1), k);
-      out(i, k) = static_cast<float>(sum);
-    }
-  }
-  return out;
+  return Array(a.shape, util::gaussian_blur(a.data, a.shape, kEdgeSmoothingPx));
 }
 
 // |Sobel gradient| / 8 (a central difference per pixel) at every interior pixel of the disc.
@@ -126,7 +105,76 @@ std::vector<double> gradients(const Array& image) {
   return out;
 }
 
+// Where the FBP sees object and the image air, per pixel of one 2D image (-1 outside the disc,
+// 1 lost, 0 not); the noise it measured into `noise`.
+std::vector<double> lost_pixels(const Array& image, const Array& fbp, double* noise) {
+  const Array shown = Array(image.shape, util::gaussian_blur(image.data, image.shape, kLostBlurPx));
+  const Array seen = Array(fbp.shape, util::gaussian_blur(fbp.data, fbp.shape, kLostBlurPx));
+  const double r_max = disc_radius(image);
+  std::vector<std::size_t> disc;
+  std::vector<double> values;
+  for (std::size_t i = 0; i < image.shape[0]; ++i) {
+    for (std::size_t k = 0; k < image.shape[1]; ++k) {
+      if (radius_of(image, i, k) > r_max) continue;
+      const std::size_t p = i * image.shape[1] + k;
+      if (!std::isfinite(shown.data[p]) || !std::isfinite(seen.data[p])) continue;
+      disc.push_back(p);
+      values.push_back(shown.data[p]);
+    }
+  }
+  std::vector<double> out(image.size(), -1.0);
+  if (disc.empty()) return out;
+  const double high = util::quantile(values, 0.995);
+  std::vector<double> air_shown, air_seen;
+  for (std::size_t p : disc) {
+    out[p] = 0.0;
+    if (shown.data[p] > kLostAirShareOfHigh * high) continue;
+    air_shown.push_back(shown.data[p]);
+    air_seen.push_back(seen.data[p]);
+  }
+  if (air_seen.size() < kLostMinAirPixels) return out;
+  const double level_shown = util::quantile(air_shown, 0.5);
+  const double level_seen = util::quantile(air_seen, 0.5);
+  for (double& v : air_seen) v = std::fabs(v - level_seen);
+  const double sigma = util::kMadToSigma * util::quantile(air_seen, 0.5);
+  *noise = sigma;
+  for (std::size_t p : disc) {
+    const double object = seen.data[p] - level_seen;
+    out[p] = object > kLostObjectSigmas * sigma &&
+             shown.data[p] - level_shown < kLostShownShare * object;
+  }
+  return out;
+}
+
 }  // namespace
+
+LostObject lost_object(const Array& image, const Array& fbp) {
+  require_2d_or_slices(image, "the image");
+  require_2d_or_slices(fbp, "the FBP");
+  if (image.shape != fbp.shape) throw InputError("the image and the FBP differ in shape");
+  LostObject lost;
+  double noise_sum = 0.0;
+  std::size_t images = 0, disc = 0;
+  auto per_image = [&](const Array& a, const Array& f) {
+    double noise = 0.0;
+    for (double v : lost_pixels(a, f, &noise)) {
+      if (v < 0.0) continue;
+      ++disc;
+      lost.pixels += v > 0.0;
+    }
+    noise_sum += noise;
+    ++images;
+  };
+  if (image.rank() == 2) {
+    per_image(image, fbp);
+  } else {
+    for (std::size_t z = 0; z < image.shape[0]; ++z)
+      per_image(axial_slice(image, z), axial_slice(fbp, z));
+  }
+  lost.share = disc > 0 ? static_cast<double>(lost.pixels) / static_cast<double>(disc) : 0.0;
+  lost.fbp_noise = images > 0 ? noise_sum / static_cast<double>(images) : 0.0;
+  return lost;
+}
 
 double edge_strength(const Array& image) {
   require_2d_or_slices(image, "the image");
@@ -208,6 +256,7 @@ QualityReport quality_against_fbp(const Array& image, const Array& fbp) {
   q.fbp_specks_per_10k = specks_per_10k(fbp, q.noise);
   q.edge_strength = edge_strength(image);
   q.fbp_edge_strength = edge_strength(fbp);
+  q.lost = lost_object(image, fbp);
   if (image.rank() == 2) q.centre = centre_deviation(image, fbp);
   return q;
 }

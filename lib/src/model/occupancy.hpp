@@ -1,36 +1,53 @@
 // Where the object can be, from the measurements alone, so that training skips the samples in
 // the air around it (METHOD.md §2: "skip what a scene doesn't need"), and the image is zero
-// there. A ray that measured no more than the noise above its element's offset (-ln alpha)
-// crossed nothing: every voxel it passes through is air (the visual hull of space carving).
+// there. Skipping object is the worst thing the tool can do (the image says "nothing here"), so
+// a voxel is skipped only on evidence that holds against the noise, an outlier view and a
+// centre of rotation a few pixels off (issue 29; bench/RESULTS.md):
 //
-// - An element's offset is the low end of its readings over the views (its minimum plus one
-//   noise sigma). Only elements whose readings look like pure air in every view (tight spread,
-//   the scan's edges) set the noise and the range of plausible offsets; an element whose
-//   lowest reading is outside that range (it never sees past the object) certifies nothing.
-//   No such elements (a truncated scan, the object wider than the detector): no carving. An
-//   air reading must also be a plausible -ln alpha (|offset| <= 0.5), and air must read 0 on
-//   average (flat-field normalised, |median| <= 0.1): readings that are steady over the views
-//   but larger come from an object centred on the axis (it projects alike in every view).
-// - A voxel is air when, in some view, every element its footprint covers (the voxel's
-//   shadow, interpolation included) reads certified air at that view.
-// - The region is dilated by a margin; rays keep the samples from their first to their last
-//   inside it (the same sample points, fewer of them).
-// Wrongly carved object can only be object whose whole ray attenuation is below the noise
-// threshold: a sliver at a convex surface, which the margin covers.
+// 1. Readings that certify air (model/air_readings.hpp): within the noise of their element's
+//    offset, as the mean of three neighbouring rays; outlier views certify nothing.
+// 2. Rays: a voxel is air when, in at least `min_views` views, every element its footprint
+//    covers (the voxel's shadow, interpolation included, widened along the row by
+//    `centre_tolerance_px` elements) reads certified air (space carving's visual hull). A centre
+//    of rotation off by d pixels shrinks the hull by d on every side: the FBP check (it sees the
+//    object a few pixels off as well), the margin and the ray check hold it up to 5 pixels on
+//    the shared scans; the widening holds it by construction, for more samples (0 by default).
+// 3. The FBP (model/object_seen_by_fbp.hpp): every voxel the scan's binned FBP clearly sees as
+//    object is kept, whatever the rays said. A ray grazing a faint corner reads like air; the
+//    FBP sums every view there and sees the corner.
+// 4. Rays through the skipped air: a ray that crosses the grid but misses the kept region
+//    (grown by the margin) must read air. One that reads more than `ray_check_sigmas` (more
+//    for scans with so many rays that noise alone would cross it once in ten scans) near the
+//    region has found object the carving took (a wrong centre of rotation shrinks the hull on
+//    every side): the skipped voxels along it near the region are kept, and the check runs
+//    again. One far from the region is a detector's spike, or a separate object the FBP sees.
+// 5. The region is grown by a margin; rays keep the samples from their first to their last
+//    inside it (the same sample points, fewer of them).
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "model/ray_segments.hpp"
+#include "riner/device.hpp"
+#include "riner/engine.hpp"
 #include "riner/scan.hpp"
 
 namespace riner::model {
 
 struct OccupancySettings {
-  double noise_sigmas = 4.0;  // a reading within this many noise sigmas of its offset is air
-  int margin_px = 4;          // voxels of dilation around what the rays did not carve
+  double noise_sigmas = 4.0;         // a reading (mean of three) within this many sigmas is air
+  int margin_px = 4;                 // voxels of dilation around what the rays did not carve
+  int min_views = 3;                 // views that must certify a voxel's shadow
+  double centre_tolerance_px = 0.0;  // each shadow widened by this many elements either side
+  bool fbp_check = true;             // keep what the FBP sees (3.)
+  double fbp_sigmas = 5.0;           // object in the FBP: this many of its noise sigmas above air
+  double ray_check_sigmas = 5.0;     // a skipped ray reading more than this has found object (4.);
+                                     // more where so many rays are checked that noise would
+  Engine engine = Engine::kOpenCL;   // of the FBP check
+  std::optional<Device> device;      // OpenCL: default Device::open()
 };
 
 struct Occupancy {
@@ -41,8 +58,29 @@ struct Occupancy {
   std::size_t air_elements = 0;    // elements that read air in every view
   double air_offset_median = 0.0;  // their readings' typical level (-ln alpha; 0 when flat)
   std::string note;                // why no carving, when carved is false
+  std::size_t outlier_views = 0;   // views that certified nothing (dim, noisy)
+  std::size_t fbp_bin = 0;         // the FBP check's binning (0: no check)
+  double fbp_noise = 0.0;          // its blurred FBP's noise sigma in the carved air (1/mm)
+  std::size_t kept_by_fbp = 0;     // voxels the rays carved and the FBP kept
+  std::size_t kept_by_rays = 0;    // voxels kept because a ray through the skipped air read more
+  int ray_check_rounds = 0;
+  // After the last round: rays (checked: not from outlier views) that cross the grid but not the
+  // region, and the largest mean excess over their offsets (of three neighbours) among them, in
+  // rho and in noise sigmas of such a mean.
+  std::size_t skipped_rays = 0;
+  double skipped_ray_excess = 0.0;
+  double skipped_ray_sigmas = 0.0;
+  double ray_check_threshold = 0.0;         // noise sigmas (ray_check_sigmas or more)
+  std::size_t skipped_rays_above = 0;       // reading more than that
+  std::size_t skipped_rays_unresolved = 0;  // of those, near the region (the rounds ran out)
 };
 
+// `segments`: the scan's rays as training samples them (ray_segments), spacing in voxels: a
+// ray that misses the region is one whose samples all do.
+Occupancy carve_occupancy(const Scan& scan, const std::vector<RaySegment>& segments,
+                          double spacing_voxels, const OccupancySettings& settings);
+
+// The same with the rays sampled every 1.5 voxels across the whole grid.
 Occupancy carve_occupancy(const Scan& scan, const OccupancySettings& settings);
 
 // The image on the region as the output shows it: 0 in the air training skipped and, over the

@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <span>
 #include <vector>
 
+#include "preprocessing/centre_sinogram.hpp"
 #include "riner/error.hpp"
 
 namespace riner {
@@ -162,19 +164,13 @@ double best_axis(std::span<const LinePair> lines, std::size_t n_u, double* width
 
 }  // namespace
 
-CentreEstimate estimate_centre(const Scan& scan) {
+namespace {
+
+// The view-pair estimate (offset, axis, spread, pairs, rows); nullopt without a pair.
+std::optional<CentreEstimate> from_view_pairs(const Scan& scan) {
   const Geometry& g = scan.geometry;
-  if (g.is_divergent()) {
-    throw InputError(std::string("centre finding needs a parallel beam (this scan is ") +
-                     geometry_type_name(g.type) + "); pass the offset with --offset-px");
-  }
-  if (g.n_u < 8) throw InputError("centre finding needs a detector of at least 8 elements");
   std::vector<ViewPair> all = opposite_views(g.angles);
-  if (all.empty()) {
-    throw InputError(
-        "no two views are half a turn apart, or either side of it (a 180-degree scan needs its "
-        "endpoint view); pass the offset with --offset-px");
-  }
+  if (all.empty()) return std::nullopt;
   std::vector<ViewPair> pairs;
   for (std::size_t i : evenly(all.size(), kMostPairs)) pairs.push_back(all[i]);
   const std::vector<std::size_t> rows = evenly(g.is_3d() ? g.n_v : 1, kMostRows);
@@ -196,6 +192,37 @@ CentreEstimate estimate_centre(const Scan& scan) {
       sum2 += (a - e.axis_column) * (a - e.axis_column);
     }
     e.spread_px = std::sqrt(sum2 / static_cast<double>(pairs.size()));
+  }
+  return e;
+}
+
+}  // namespace
+
+CentreEstimate estimate_centre(const Scan& scan) {
+  const Geometry& g = scan.geometry;
+  if (g.is_divergent()) {
+    throw InputError(std::string("centre finding needs a parallel beam (this scan is ") +
+                     geometry_type_name(g.type) + "); pass the offset with --offset-px");
+  }
+  if (g.n_u < 8) throw InputError("centre finding needs a detector of at least 8 elements");
+  const std::optional<CentreEstimate> pairs = from_view_pairs(scan);
+  const std::optional<preprocessing::SinogramAxis> sinogram = preprocessing::sinogram_axis(scan);
+  if (!pairs && !sinogram) {
+    throw InputError(
+        "the views cover no evenly spaced half-turn and no two are half a turn apart (or either "
+        "side of it); pass the offset with --offset-px");
+  }
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  CentreEstimate e = pairs ? *pairs : CentreEstimate{};
+  e.pairs_offset_px = pairs ? pairs->offset_px : kNaN;
+  e.method = "view pairs";
+  e.sinogram_offset_px = kNaN;
+  if (sinogram) {
+    e.method = "sinogram";
+    e.axis_column = sinogram->axis_column;
+    e.offset_px = 0.5 * (static_cast<double>(g.n_u) - 1.0) - e.axis_column;
+    e.sinogram_offset_px = e.offset_px;
+    e.rows = sinogram->rows;
   }
   return e;
 }

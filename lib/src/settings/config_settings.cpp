@@ -84,6 +84,20 @@ void add_training_sampling(Table& t) {
   t.push_back(field<C>("training", "air_margin_px", closed(0, 64),
                        "skip_air: voxels kept around what is not air", &C::training,
                        &T::air_margin_px));
+  t.push_back(field<C>("training", "air_min_views", closed(1, 100000),
+                       "skip_air: views that must certify a voxel as air", &C::training,
+                       &T::air_min_views));
+  t.push_back(
+      field<C>("training", "air_centre_tolerance_px", closed(0, 64),
+               "skip_air: each view's shadow of a voxel widened by this many pixels (a centre of "
+               "rotation off by as many shrinks the carved region's outline)",
+               &C::training, &T::air_centre_tolerance_px));
+  t.push_back(enum_choice<C>(
+      "training", "air_fbp_check", {AirFbpCheck::kAuto, AirFbpCheck::kOn, AirFbpCheck::kOff},
+      air_fbp_check_name,
+      "skip_air: keep every voxel the scan's FBP clearly sees as object; auto: in 2D (in 3D the "
+      "FDK's artifacts read as object)",
+      &C::training, &T::air_fbp_check));
 }
 
 // The optimiser, the schedule and the loss.

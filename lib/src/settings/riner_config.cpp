@@ -62,6 +62,18 @@ const char* alpha_model_name(AlphaModel m) {
   return "unknown";
 }
 
+const char* air_fbp_check_name(AirFbpCheck c) {
+  switch (c) {
+    case AirFbpCheck::kAuto:
+      return "auto";
+    case AirFbpCheck::kOn:
+      return "on";
+    case AirFbpCheck::kOff:
+      return "off";
+  }
+  return "unknown";
+}
+
 const char* sampler_name(Sampler s) {
   switch (s) {
     case Sampler::kUniform:

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <utility>
 
 #include "riner/error.hpp"
 #include "util/parallel.hpp"
@@ -40,6 +42,20 @@ Vec3 to_local(const Ellipsoid& e, const Vec3& p, bool is_point) {
 
 double dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
 
+// Local, size-normalised coordinates of a cuboid: it is [-1, 1]^3 there.
+Vec3 to_local(const Cuboid& c, const Vec3& p, bool is_point) {
+  const Vec3 q = is_point ? Vec3{p.x - c.centre.x, p.y - c.centre.y, p.z - c.centre.z} : p;
+  const auto& r = c.rotation;
+  return {(r[0] * q.x + r[1] * q.y + r[2] * q.z) / c.half_sizes.x,
+          (r[3] * q.x + r[4] * q.y + r[5] * q.z) / c.half_sizes.y,
+          (r[6] * q.x + r[7] * q.y + r[8] * q.z) / c.half_sizes.z};
+}
+
+// World -> local rotation of axes turned by phi about z.
+std::array<double, 9> turned_about_z(double phi) {
+  return {std::cos(phi), std::sin(phi), 0, -std::sin(phi), std::cos(phi), 0, 0, 0, 1};
+}
+
 }  // namespace
 
 double Phantom::value_at(const Vec3& p) const {
@@ -47,6 +63,10 @@ double Phantom::value_at(const Vec3& p) const {
   for (const Ellipsoid& e : ellipsoids) {
     const Vec3 q = to_local(e, p, true);
     if (dot(q, q) <= 1.0) v += e.value;
+  }
+  for (const Cuboid& c : cuboids) {
+    const Vec3 q = to_local(c, p, true);
+    if (std::fabs(q.x) <= 1.0 && std::fabs(q.y) <= 1.0 && std::fabs(q.z) <= 1.0) v += c.value;
   }
   return v;
 }
@@ -61,6 +81,23 @@ double Phantom::line_integral(const Ray& ray) const {
     const double b = dot(o, d);
     const double disc = b * b - a * (dot(o, o) - 1.0);
     if (disc > 0.0) sum += e.value * 2.0 * std::sqrt(disc) / a;
+  }
+  for (const Cuboid& c : cuboids) {
+    // Slabs: |o + t d| <= 1 on each local axis; t is in mm as above.
+    const Vec3 o = to_local(c, ray.origin, true);
+    const Vec3 d = to_local(c, ray.direction, false);
+    double enter = -std::numeric_limits<double>::infinity();
+    double exit = std::numeric_limits<double>::infinity();
+    for (const auto& [oa, da] : {std::pair{o.x, d.x}, std::pair{o.y, d.y}, std::pair{o.z, d.z}}) {
+      if (da == 0.0) {
+        if (std::fabs(oa) > 1.0) exit = enter;  // parallel to the slab, outside it
+        continue;
+      }
+      const double t0 = (-1.0 - oa) / da, t1 = (1.0 - oa) / da;
+      enter = std::max(enter, std::min(t0, t1));
+      exit = std::min(exit, std::max(t0, t1));
+    }
+    if (exit > enter) sum += c.value * (exit - enter);
   }
   return sum;
 }
@@ -80,12 +117,40 @@ Phantom shepp_logan(const Geometry& g, double mu_scale) {
     e.centre = {row.x * radius, row.y * radius, g.is_3d() ? row.z * half_height : 0.0};
     // 2D: an infinitely tall cylinder section; only x, y matter since rays lie in z = 0.
     e.semi_axes = {row.a * radius, row.b * radius, g.is_3d() ? row.c * half_height : 1.0};
-    const double phi = row.phi * M_PI / 180.0;
     // Local axes rotated by phi: world -> local is the rotation by -phi.
-    e.rotation = {std::cos(phi), std::sin(phi), 0, -std::sin(phi), std::cos(phi), 0, 0, 0, 1};
+    e.rotation = turned_about_z(row.phi * M_PI / 180.0);
     phantom.ellipsoids.push_back(e);
   }
   return phantom;
+}
+
+Phantom faint_square(const Geometry& g) {
+  g.validate();
+  const std::size_t rank = g.volume_shape.size();
+  const double width = g.voxel_mm * static_cast<double>(std::min(g.volume_shape[rank - 1],
+                                                                 g.volume_shape[rank - 2]));
+  const double height = g.is_3d() ? g.voxel_mm * static_cast<double>(g.volume_shape[0]) : 1.0;
+  const double side = 0.6 * width;
+  const double mu = 0.4 / side;
+  const double phi = 20.0 * M_PI / 180.0;
+  const std::array<double, 9> turn = turned_about_z(phi);
+  // A point given in the square's own axes (fractions of the width), in the world.
+  auto at = [&](double a, double b) {
+    return Vec3{width * (a * std::cos(phi) - b * std::sin(phi)),
+                width * (a * std::sin(phi) + b * std::cos(phi)), 0.0};
+  };
+  const double z = g.is_3d() ? 0.3 * height : 1.0;
+  Phantom p;
+  p.cuboids.push_back({{0, 0, 0}, {0.5 * side, 0.5 * side, z}, turn, mu});
+  p.cuboids.push_back({at(0.1, 0.0), {0.006 * width, 0.2 * width, 0.8 * z}, turn, 12.0 * mu});
+  auto disc = [&](double a, double b, double r, double value) {
+    const Vec3 c = at(a, b);
+    p.ellipsoids.push_back({c, {r * width, r * width, g.is_3d() ? 0.5 * z : 1.0}, turn, value});
+  };
+  disc(-0.12, 0.1, 0.05, mu);
+  disc(0.0, -0.15, 0.04, -0.5 * mu);
+  disc(-0.1, -0.05, 0.02, -mu);
+  return p;
 }
 
 Array rasterize(const Phantom& phantom, const Geometry& g, int supersample) {

@@ -29,8 +29,8 @@ struct Reconstructor::Impl {
   std::optional<ReconstructionResult> result;
   int result_steps = -1;
 
-  Impl(Scan scan, RinerConfig config)
-      : setup(std::move(scan), std::move(config)),
+  Impl(Scan scan, RinerConfig config, std::optional<Device> device = std::nullopt)
+      : setup(std::move(scan), std::move(config), std::move(device)),
         sampler(setup.scan.geometry, setup.config.training,
                 setup.stuck_count > 0 ? setup.stuck : std::vector<std::uint8_t>{}),
         element_rays(setup.elements_per_view, 0) {}
@@ -68,7 +68,7 @@ Reconstructor::Reconstructor(Scan scan, RinerConfig config, std::optional<Device
   }
   Device d = device ? *device : Device::open();
   const ExecutionPlan plan = choose_execution_plan(d.info(), config.plan);
-  impl_ = std::make_unique<Impl>(std::move(scan), resolved(std::move(config), plan));
+  impl_ = std::make_unique<Impl>(std::move(scan), resolved(std::move(config), plan), d);
   impl_->trainer = detail::make_opencl_trainer(impl_->setup, std::move(d), plan);
 }
 
@@ -281,6 +281,17 @@ TrainingStats Reconstructor::stats() const {
       setup.samples_in_grid > 0.0 ? setup.samples_kept / setup.samples_in_grid : 1.0;
   s.noise = setup.occupancy.noise;
   s.air_note = setup.occupancy.note;
+  s.air_outlier_views = setup.occupancy.outlier_views;
+  s.air_fbp_bin = setup.occupancy.fbp_bin;
+  s.air_fbp_noise = setup.occupancy.fbp_noise;
+  s.air_kept_by_fbp = setup.occupancy.kept_by_fbp;
+  s.air_kept_by_rays = setup.occupancy.kept_by_rays;
+  s.skipped_rays = setup.occupancy.skipped_rays;
+  s.skipped_ray_excess = setup.occupancy.skipped_ray_excess;
+  s.skipped_ray_sigmas = setup.occupancy.skipped_ray_sigmas;
+  s.skipped_ray_threshold = setup.occupancy.ray_check_threshold;
+  s.skipped_rays_above = setup.occupancy.skipped_rays_above;
+  s.skipped_rays_unresolved = setup.occupancy.skipped_rays_unresolved;
   s.alpha_rate = setup.alpha_rate;
   s.stripe_rms = setup.stripe_rms;
   s.alpha_model = setup.alpha_model;

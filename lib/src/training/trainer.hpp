@@ -41,7 +41,8 @@ struct TrainingSetup {
   model::FactorEvidence factor_evidence;             // 3D, model/factor_evidence.hpp
   AlphaModel alpha_model = AlphaModel::kPerElement;  // as trained (never auto)
 
-  TrainingSetup(Scan scan, RinerConfig config);
+  // device: where the air carving's FBP check runs (the OpenCL engine; default Device::open()).
+  TrainingSetup(Scan scan, RinerConfig config, std::optional<Device> device = std::nullopt);
   double learning_rate(int step) const;
   // Adam settings of a step, for both engines: the schedule for the field, alpha0 and beta0,
   // and the lazy range (training.sparse_adam).

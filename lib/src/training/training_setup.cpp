@@ -9,7 +9,8 @@
 
 namespace riner::detail {
 
-TrainingSetup::TrainingSetup(Scan s, RinerConfig c) : scan(std::move(s)), config(std::move(c)) {
+TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device)
+    : scan(std::move(s)), config(std::move(c)) {
   config.validate();
   scan.geometry.validate();
   check_scan(scan);
@@ -70,8 +71,16 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c) : scan(std::move(s)), config
                               alpha_model == AlphaModel::kRowsTimesColumns ? g.n_v : 0);
   occupancy.inside.assign(shape_size(g.volume_shape), 1);
   if (config.training.skip_air) {
-    occupancy = model::carve_occupancy(
-        scan, {config.training.air_noise_sigmas, config.training.air_margin_px});
+    model::OccupancySettings air;
+    air.noise_sigmas = config.training.air_noise_sigmas;
+    air.margin_px = config.training.air_margin_px;
+    air.min_views = config.training.air_min_views;
+    air.centre_tolerance_px = config.training.air_centre_tolerance_px;
+    const AirFbpCheck check = config.training.air_fbp_check;
+    air.fbp_check = check == AirFbpCheck::kOn || (check == AirFbpCheck::kAuto && !g.is_3d());
+    air.engine = config.engine;
+    air.device = std::move(device);
+    occupancy = model::carve_occupancy(scan, segments, config.training.sample_spacing, air);
     samples_kept = model::clip_segments(segments, g, occupancy, config.training.sample_spacing);
   }
   alpha_rate = config.training.alpha_lr_scale;

@@ -1,0 +1,240 @@
+#include "preprocessing/centre_sinogram.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <unsupported/Eigen/FFT>
+#include <vector>
+
+#include "analytic/fbp_setup.hpp"
+#include "util/parallel.hpp"
+#include "util/robust_statistics.hpp"
+
+namespace riner::preprocessing {
+
+namespace {
+
+// The coarse search's sinogram: at most this many columns and views (binned).
+constexpr std::size_t kCoarseColumns = 256;
+constexpr std::size_t kMostViews = 256;
+// The fine search at full width: this step (px) within one coarse column of the coarse minimum.
+constexpr double kFineStepPx = 0.25;
+constexpr std::size_t kMostRows = 8;
+// Angles evenly spaced within this share of the step.
+constexpr double kEvenSpacing = 0.1;
+
+using Row = std::vector<double>;
+
+// The next length >= n whose only prime factors are 2, 3 and 5 (fast FFTs).
+std::size_t smooth_length(std::size_t n) {
+  for (std::size_t m = n;; ++m) {
+    std::size_t r = m;
+    for (std::size_t p : {2, 3, 5}) {
+      while (r % p == 0) r /= p;
+    }
+    if (r == 1) return m;
+  }
+}
+
+// A half-turn sinogram [views][columns] binned by `by_views` and `by_columns` (means), then
+// resampled in angle (linearly, over the half-turn) to a view count whose FFT is fast: the
+// column transforms run over twice the views, and 229 (neutron360's half-turn) is prime.
+std::vector<Row> binned(const std::vector<Row>& s, std::size_t by_views, std::size_t by_columns) {
+  const std::size_t views = s.size() / by_views, columns = s[0].size() / by_columns;
+  std::vector<Row> bins(views, Row(columns, 0.0));
+  for (std::size_t v = 0; v < views * by_views; ++v) {
+    for (std::size_t u = 0; u < columns * by_columns; ++u) {
+      bins[v / by_views][u / by_columns] += s[v][u];
+    }
+  }
+  const double n = static_cast<double>(by_views * by_columns);
+  for (Row& r : bins) {
+    for (double& x : r) x /= n;
+  }
+  const std::size_t count = smooth_length(views);
+  if (count == views) return bins;
+  std::vector<Row> out(count, Row(columns));
+  for (std::size_t i = 0; i < count; ++i) {
+    const double x =
+        static_cast<double>(i) * static_cast<double>(views - 1) / static_cast<double>(count - 1);
+    const auto k = std::min(static_cast<std::size_t>(x), views - 2);
+    const double t = x - static_cast<double>(k);
+    for (std::size_t u = 0; u < columns; ++u)
+      out[i][u] = (1.0 - t) * bins[k][u] + t * bins[k + 1][u];
+  }
+  return out;
+}
+
+// Mean magnitude of the stacked sinogram's spectrum outside the double wedge: the first half's
+// rows as they are, the second half's mirrored about `axis`. The mirror is taken in the rows'
+// spectra (r(2a - u) has the spectrum exp(-4 pi i k a / P) conj(R(k)) for a row of period P):
+// exact at any fractional axis, where linear interpolation would damp the high frequencies
+// more at some fractions than at others and pull the minimum towards them.
+class WedgeEnergy {
+ public:
+  explicit WedgeEnergy(const std::vector<Row>& s)
+      : n_(s[0].size()), padded_(smooth_length(2 * s[0].size())), views_(s.size()) {
+    for (const Row& r : s) first_.push_back(spectrum(r));
+  }
+
+  double operator()(double axis) const {
+    // Harmonic m of a point at radius r (px): |m| <= 2 pi r k / padded at detector frequency k;
+    // r reaches half the detector.
+    const std::size_t turn = 2 * views_;
+    const double slope = M_PI * static_cast<double>(n_) / static_cast<double>(padded_);
+    Eigen::FFT<double> fft;
+    std::vector<std::complex<double>> column(turn), harmonics;
+    double sum = 0.0, count = 0.0;
+    for (std::size_t k = 1; k <= padded_ / 2; ++k) {
+      const double wedge = slope * static_cast<double>(k) + 1.0;
+      if (wedge >= 0.5 * static_cast<double>(turn)) break;
+      const std::complex<double> shift = std::polar(
+          1.0, -4.0 * M_PI * static_cast<double>(k) * axis / static_cast<double>(padded_));
+      for (std::size_t v = 0; v < views_; ++v) {
+        column[v] = first_[v][k];
+        column[views_ + v] = shift * std::conj(first_[v][k]);
+      }
+      fft.fwd(harmonics, column);
+      for (std::size_t m = 0; m < turn; ++m) {
+        const double signed_m = m <= turn / 2 ? static_cast<double>(m)
+                                              : static_cast<double>(m) - static_cast<double>(turn);
+        if (std::fabs(signed_m) <= wedge) continue;
+        sum += std::abs(harmonics[m]);
+        count += 1.0;
+      }
+    }
+    return count > 0.0 ? sum / count : 0.0;
+  }
+
+ private:
+  // A row's spectrum, padded to `padded_` by a straight line from its last value back to its
+  // first (no step at the wrap).
+  std::vector<std::complex<double>> spectrum(const Row& r) const {
+    Row line(padded_);
+    std::copy(r.begin(), r.end(), line.begin());
+    const std::size_t gap = padded_ - n_;
+    for (std::size_t i = 0; i < gap; ++i) {
+      const double t = static_cast<double>(i + 1) / static_cast<double>(gap + 1);
+      line[n_ + i] = (1.0 - t) * r.back() + t * r.front();
+    }
+    Eigen::FFT<double> fft;
+    std::vector<std::complex<double>> out;
+    fft.fwd(out, line);
+    return out;
+  }
+
+  std::size_t n_ = 0;
+  std::size_t padded_ = 0;
+  std::size_t views_ = 0;
+  std::vector<std::vector<std::complex<double>>> first_;
+};
+
+// The best of `candidates` (evaluated in parallel; the costs of every half-turn added) and its
+// neighbours' costs.
+struct Minimum {
+  std::size_t index = 0;
+  std::vector<double> costs;
+};
+Minimum minimise(const std::vector<WedgeEnergy>& costs, const std::vector<double>& candidates) {
+  Minimum m;
+  m.costs.resize(candidates.size());
+  util::parallel_for(candidates.size(), [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) {
+      m.costs[i] = 0.0;
+      for (const WedgeEnergy& cost : costs) m.costs[i] += cost(candidates[i]);
+    }
+  });
+  m.index =
+      static_cast<std::size_t>(std::min_element(m.costs.begin(), m.costs.end()) - m.costs.begin());
+  return m;
+}
+
+// The axis of one detector row from its half-turn sinograms (one per half-turn the scan holds;
+// finite values).
+double row_axis(const std::vector<std::vector<Row>>& turns) {
+  const std::size_t n = turns[0][0].size();
+  const std::size_t by_views = std::max<std::size_t>(1, turns[0].size() / kMostViews);
+  const std::size_t by_columns = std::max<std::size_t>(1, n / kCoarseColumns);
+  std::vector<WedgeEnergy> coarse, wide;
+  for (const std::vector<Row>& s : turns) {
+    coarse.emplace_back(binned(s, by_views, by_columns));
+    wide.emplace_back(binned(s, by_views, 1));
+  }
+  const double nb = static_cast<double>(n / by_columns);
+  std::vector<double> candidates;
+  for (double a = 0.25 * (nb - 1.0); a <= 0.75 * (nb - 1.0) + 1e-9; a += 0.5) {
+    candidates.push_back(a);
+  }
+  const Minimum c = minimise(coarse, candidates);
+  // Binned column a covers columns by_columns a .. by_columns (a + 1) - 1.
+  const double f = static_cast<double>(by_columns);
+  const double centre = f * candidates[c.index] + 0.5 * (f - 1.0);
+  std::vector<double> fine;
+  for (double a = centre - f; a <= centre + f + 1e-9; a += kFineStepPx) fine.push_back(a);
+  const Minimum m = minimise(wide, fine);
+  if (m.index == 0 || m.index + 1 == fine.size()) return fine[m.index];
+  // A parabola through the best and its neighbours.
+  const double y0 = m.costs[m.index - 1], y1 = m.costs[m.index], y2 = m.costs[m.index + 1];
+  const double curvature = y0 - 2.0 * y1 + y2;
+  const double step = curvature > 0.0 ? 0.5 * (y0 - y2) / curvature : 0.0;
+  return fine[m.index] + std::clamp(step, -0.5, 0.5) * kFineStepPx;
+}
+
+// The scan's half-turns of evenly spaced views: the first view of each (the second starts at
+// the first view half a turn after the first's); empty when not even the first fits.
+std::vector<std::size_t> half_turns(const std::vector<double>& angles, std::size_t* views) {
+  const double step = std::fabs(angles[1] - angles[0]);
+  if (!(step > 0.0)) return {};
+  std::vector<std::size_t> starts;
+  std::size_t start = 0;
+  while (start + 2 < angles.size()) {
+    std::size_t end = start + 1;
+    while (end < angles.size() && std::fabs(angles[end] - angles[start]) < M_PI - 0.5 * step) {
+      if (std::fabs(std::fabs(angles[end] - angles[end - 1]) - step) > kEvenSpacing * step) {
+        return starts;
+      }
+      ++end;
+    }
+    if (std::fabs(angles[end - 1] - angles[start]) < M_PI - 1.5 * step) return starts;
+    if (starts.empty()) *views = end - start;
+    if (end - start != *views) return starts;
+    starts.push_back(start);
+    start = end;
+  }
+  return starts;
+}
+
+}  // namespace
+
+std::optional<SinogramAxis> sinogram_axis(const Scan& scan) {
+  const Geometry& g = scan.geometry;
+  if (g.is_divergent() || g.n_views() < 8 || g.n_u < 8) return std::nullopt;
+  std::size_t views = 0;
+  const std::vector<std::size_t> starts = half_turns(g.angles, &views);
+  if (starts.empty()) return std::nullopt;
+  // Rows evenly spread (all of a 2D scan's one).
+  const std::size_t rows = g.is_3d() ? g.n_v : 1;
+  const std::size_t used = std::min(rows, kMostRows);
+  Array half({views, g.n_u});
+  std::vector<double> axes;
+  for (std::size_t i = 0; i < used; ++i) {
+    const std::size_t row = (2 * i + 1) * rows / (2 * used);
+    std::vector<std::vector<Row>> turns;
+    for (std::size_t start : starts) {
+      for (std::size_t v = 0; v < views; ++v) {
+        const float* line = scan.measurement.ptr() + ((start + v) * rows + row) * g.n_u;
+        std::copy(line, line + g.n_u, half.data.begin() + static_cast<long>(v * g.n_u));
+      }
+      analytic::repair_non_finite(half, g.n_u);
+      std::vector<Row>& s = turns.emplace_back(views, Row(g.n_u));
+      for (std::size_t v = 0; v < views; ++v) {
+        std::copy_n(half.data.begin() + static_cast<long>(v * g.n_u), g.n_u, s[v].begin());
+      }
+    }
+    axes.push_back(row_axis(turns));
+  }
+  return SinogramAxis{util::quantile(axes, 0.5), views * starts.size(), axes.size()};
+}
+
+}  // namespace riner::preprocessing
