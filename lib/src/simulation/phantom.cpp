@@ -31,25 +31,25 @@ constexpr Row kSheppLogan[] = {
     {0.1, 0.0230, 0.046, 0.020, 0.06, -0.6050, 0.00, 0},
 };
 
-// Local, axis-normalised coordinates: the ellipsoid is the unit ball there.
+// A shape's local coordinates, scaled by its sizes: the unit ball of an ellipsoid, [-1, 1]^3 of
+// a cuboid. A direction (is_point false) is rotated and scaled, not moved.
+template <typename Shape>
+Vec3 to_local(const Shape& shape, const Vec3& sizes, const Vec3& p, bool is_point) {
+  const Vec3& c = shape.centre;
+  const Vec3 q = is_point ? Vec3{p.x - c.x, p.y - c.y, p.z - c.z} : p;
+  const auto& r = shape.rotation;
+  return {(r[0] * q.x + r[1] * q.y + r[2] * q.z) / sizes.x,
+          (r[3] * q.x + r[4] * q.y + r[5] * q.z) / sizes.y,
+          (r[6] * q.x + r[7] * q.y + r[8] * q.z) / sizes.z};
+}
 Vec3 to_local(const Ellipsoid& e, const Vec3& p, bool is_point) {
-  const Vec3 q = is_point ? Vec3{p.x - e.centre.x, p.y - e.centre.y, p.z - e.centre.z} : p;
-  const auto& r = e.rotation;
-  return {(r[0] * q.x + r[1] * q.y + r[2] * q.z) / e.semi_axes.x,
-          (r[3] * q.x + r[4] * q.y + r[5] * q.z) / e.semi_axes.y,
-          (r[6] * q.x + r[7] * q.y + r[8] * q.z) / e.semi_axes.z};
+  return to_local(e, e.semi_axes, p, is_point);
+}
+Vec3 to_local(const Cuboid& c, const Vec3& p, bool is_point) {
+  return to_local(c, c.half_sizes, p, is_point);
 }
 
 double dot(const Vec3& a, const Vec3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-
-// Local, size-normalised coordinates of a cuboid: it is [-1, 1]^3 there.
-Vec3 to_local(const Cuboid& c, const Vec3& p, bool is_point) {
-  const Vec3 q = is_point ? Vec3{p.x - c.centre.x, p.y - c.centre.y, p.z - c.centre.z} : p;
-  const auto& r = c.rotation;
-  return {(r[0] * q.x + r[1] * q.y + r[2] * q.z) / c.half_sizes.x,
-          (r[3] * q.x + r[4] * q.y + r[5] * q.z) / c.half_sizes.y,
-          (r[6] * q.x + r[7] * q.y + r[8] * q.z) / c.half_sizes.z};
-}
 
 // World -> local rotation of axes turned by phi about z.
 std::array<double, 9> turned_about_z(double phi) {
