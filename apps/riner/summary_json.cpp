@@ -78,7 +78,7 @@ QualityCheck check_quality(const Reconstructor& r, const ReconstructionResult& r
   const Geometry& g = r.scan().geometry;
   if (!g.is_3d()) {
     const Array fbp_image = fbp(r.scan(), options);
-    QualityCheck check{quality_against_fbp(result.image, fbp_image), {}, {}, 0};
+    QualityCheck check{quality_against_fbp(result.image, fbp_image, field_radius_px(g)), {}, {}, 0};
     check.field = centre_deviation(result.field_image, fbp_image);
     return check;
   }
@@ -92,7 +92,10 @@ QualityCheck check_quality(const Reconstructor& r, const ReconstructionResult& r
     const Array slice = axial_slice(result.image, z);
     into = std::copy(slice.data.begin(), slice.data.end(), into);
   }
-  return {quality_against_fbp(image, fbp(r.scan(), options)), {}, slices, g.volume_shape[0]};
+  return {quality_against_fbp(image, fbp(r.scan(), options), field_radius_px(g)),
+          {},
+          slices,
+          g.volume_shape[0]};
 }
 
 nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& result,
@@ -128,13 +131,12 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
              {{"bin", stats.air_fbp_bin},
               {"noise_per_mm", stats.air_fbp_noise},
               {"voxels_kept", stats.air_kept_by_fbp}}},
-            {"voxels_kept_by_skipped_rays", stats.air_kept_by_rays},
             {"skipped_rays", stats.skipped_rays},
             {"skipped_ray_largest_excess", stats.skipped_ray_excess},
             {"skipped_ray_largest_sigmas", stats.skipped_ray_sigmas},
             {"skipped_ray_threshold_sigmas", stats.skipped_ray_threshold},
             {"skipped_rays_above_threshold", stats.skipped_rays_above},
-            {"skipped_rays_unresolved", stats.skipped_rays_unresolved},
+            {"skipped_rays_above_threshold_near_object", stats.skipped_rays_near},
             {"note", r.config().training.skip_air ? stats.air_note : "off (training.skip_air)"}}},
           {"alpha_rate", {{"scale", stats.alpha_rate}, {"stripe_rms", stats.stripe_rms}}},
           {"alpha_model",

@@ -77,18 +77,17 @@ std::vector<Result> air_carving(const Options& o) {
                              {"grid_fraction_kept", occupancy.inside_fraction},
                              {"outlier_views", occupancy.outlier_views},
                              {"kept_by_fbp", occupancy.kept_by_fbp},
-                             {"kept_by_rays", occupancy.kept_by_rays},
                              {"skipped_rays", occupancy.skipped_rays},
                              {"skipped_ray_largest_sigmas", occupancy.skipped_ray_sigmas},
-                             {"skipped_rays_unresolved", occupancy.skipped_rays_unresolved},
+                             {"skipped_rays_near", occupancy.skipped_rays_near},
                              {"object_voxels_skipped", lost},
                              {"seconds", seconds},
                              {"note", occupancy.note}};
     rows.push_back({"air_carving", fields,
-                    riner::bench::format("shift %+5.1f px  kept %.4f  fbp %zu  rays %zu  "
+                    riner::bench::format("shift %+5.1f px  kept %.4f  fbp %zu  rays near %zu  "
                                          "object skipped %ld  %.2f s",
                                          shift, occupancy.inside_fraction, occupancy.kept_by_fbp,
-                                         occupancy.kept_by_rays, lost, seconds)});
+                                         occupancy.skipped_rays_near, lost, seconds)});
   }
   return rows;
 }

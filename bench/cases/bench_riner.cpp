@@ -210,7 +210,8 @@ nlohmann::json real_scan_run(const riner::Scan& scan, const riner::Array& fbp_im
     }
     riner::write_png(png + "_fbp_riner_centre.png", zoom, w);
   }
-  const riner::QualityReport quality = riner::quality_against_fbp(image, fbp_image);
+  const riner::QualityReport quality =
+      riner::quality_against_fbp(image, fbp_image, riner::field_radius_px(scan.geometry));
   if (!npy.empty()) {  // the images, for analysis
     riner::write_array(npy + "_fbp.npy", fbp_image);
     riner::write_array(npy + "_field.npy", field);

@@ -167,7 +167,8 @@ std::vector<Result> ring_chain_replay(const Options& o) {
       line = riner::bench::format("%-12s %s  %.3f dB / %.4f", name.c_str(), order.c_str(), m.psnr,
                                   m.ssim);
     } else {
-      const riner::QualityReport q = riner::quality_against_fbp(image, s.reference);
+      const riner::QualityReport q =
+          riner::quality_against_fbp(image, s.reference, riner::field_radius_px(s.geometry));
       row.update({{"ring_index", q.ring_index},
                   {"fbp_ring_index", q.fbp_ring_index},
                   {"specks_per_10k", q.specks_per_10k},

@@ -114,13 +114,18 @@ TEST_SUITE("occupancy") {
   TEST_CASE("clipped rays keep every sample inside the region, at the same positions") {
     const riner::Geometry g = riner::test::small_fan2d();
     const riner::Phantom p = discs(g);
-    const riner::model::Occupancy o = riner::model::carve_occupancy(ring_scan(g, p, 1e6), on_cpu());
-    REQUIRE(o.carved);
+    const riner::Scan scan = ring_scan(g, p, 1e6);
     const double spacing = 1.5;
     const std::vector<riner::model::RaySegment> full =
         riner::model::ray_segments(g, spacing, false);
     std::vector<riner::model::RaySegment> clipped = full;
-    const double kept = riner::model::clip_segments(clipped, g, o, spacing);
+    const riner::model::Occupancy o =
+        riner::model::carve_occupancy(scan, clipped, spacing / g.voxel_mm, on_cpu());
+    REQUIRE(o.carved);
+    const double kept = o.samples_kept;
+    // clip_segments clips as the carving did.
+    std::vector<riner::model::RaySegment> again = full;
+    CHECK(riner::model::clip_segments(again, scan, o, spacing / g.voxel_mm) == kept);
     double total = 0.0, inside_samples = 0.0;
     const long n = static_cast<long>(g.volume_shape[1]);
     for (std::size_t r = 0; r < full.size(); ++r) {
@@ -236,9 +241,17 @@ TEST_SUITE("occupancy: issue 29") {
       lost += sim.ground_truth.data[i] > 0.0f && !o.inside[i];
     }
     CHECK(lost > 100);
+    // The rays through the skipped air see it: beside the cut corners they read above air.
+    CHECK(o.skipped_rays > 0);
+    CHECK(o.skipped_ray_sigmas > o.ray_check_threshold);
+    CHECK(o.skipped_rays_near > 0);
     const riner::model::Occupancy checked = riner::model::carve_occupancy(sim.scan, on_cpu());
     CHECK(checked.kept_by_fbp > 0);
     check_object_kept(checked, sim.ground_truth);
+    // With the FBP's voxels kept, no ray through the skipped air reads more than air.
+    CHECK(checked.ray_check_threshold >= 5.0);
+    CHECK(checked.skipped_ray_sigmas < checked.ray_check_threshold);
+    CHECK(checked.skipped_rays_near == 0);
   }
 
   TEST_CASE("air readings: outlier views, correlated noise, elements that never see air") {

@@ -62,6 +62,29 @@ TEST_SUITE("quality: lost object") {
     // An image at half the FBP's level still shows the object.
     CHECK(riner::lost_object(square_sample(n, 1e-3, 0.0, 9, 0), fbp).pixels == 0);
   }
+
+  TEST_CASE("the FBP's bright rim at the field's edge is not object") {
+    const std::size_t n = 200;
+    riner::Array fbp = square_sample(n, 2e-3, 1e-3, 5, 0);
+    // A rim 3 px wide just outside the field (radius 92 px), as FBP draws it there.
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t k = 0; k < n; ++k) {
+        const double r = std::hypot(i - 0.5 * (n - 1.0), k - 0.5 * (n - 1.0));
+        if (std::fabs(r - 93.5) < 1.5) fbp(i, k) += 5e-3f;
+      }
+    }
+    const riner::Array image = square_sample(n, 2e-3, 0.0, 6, 0);
+    CHECK(riner::lost_object(image, fbp).pixels > 500);
+    CHECK(riner::lost_object(image, fbp, 92.0).pixels == 0);
+    // The field comes from the geometry: the detector's nearer end (the axis 1 element left of
+    // its middle: 91.5 elements of 0.5 mm), in voxels of 0.5 mm.
+    riner::Geometry g;
+    g.n_u = 185;
+    g.pitch_u = 0.5;
+    g.offset_u = -1.0;
+    g.voxel_mm = 0.5;
+    CHECK(riner::field_radius_px(g) == doctest::Approx(91.5));
+  }
 }
 
 TEST_SUITE("quality") {

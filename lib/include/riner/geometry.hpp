@@ -69,6 +69,15 @@ struct Geometry {
   void save(const std::filesystem::path& path) const;
 };
 
+// The cylinder (disc in 2D) around the axis that every view's detector sees whole: its radius
+// from the detector's nearer end, its half height (3D) from the rows at the largest
+// magnification. Zero when the axis is off the detector.
+struct FieldOfView {
+  double radius_mm = 0.0;
+  double half_height_mm = 0.0;
+};
+FieldOfView field_of_view(const Geometry& g);
+
 // Uniform angles start + range * i / count, i = 0..count-1.
 std::vector<double> uniform_angles(const UniformAngles& spec);
 

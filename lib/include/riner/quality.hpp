@@ -19,10 +19,16 @@
 //                (issue 29): both blurred by a Gaussian of 2 px; the FBP's air level and noise
 //                are the median and MAD of its blurred values where the image reads air (below
 //                a tenth of its 99.5th percentile); object is over 5 of those sigmas, and air
-//                in the image is less than a quarter of what the FBP shows there
+//                in the image is less than a quarter of what the FBP shows there; only inside
+//                the field every view sees, when it is given (FBP's bright rim at its edge is
+//                not object). A ring in the FBP that the image has not counts as lost: read
+//                the pixels with the PNG pair
 #pragma once
 
+#include <limits>
+
 #include "riner/array.hpp"
+#include "riner/geometry.hpp"
 
 namespace riner {
 
@@ -61,8 +67,13 @@ struct LostObject {
   double fbp_noise = 0.0;  // the blurred FBP's noise sigma in the image's air (1/mm)
 };
 
-// Of a volume, over its axial slices together.
-LostObject lost_object(const Array& image, const Array& fbp);
+constexpr double kWholeDisc = std::numeric_limits<double>::infinity();
+
+// Of a volume, over its axial slices together. `field_radius_px`: the radius, in pixels from the
+// grid centre, of the field every view sees (riner::field_of_view); the lost object is looked
+// for kFieldRimPx inside it.
+LostObject lost_object(const Array& image, const Array& fbp, double field_radius_px = kWholeDisc);
+constexpr double kFieldRimPx = 4.0;
 
 struct QualityReport {
   double noise = 0.0;  // the FBP's pixel noise
@@ -78,6 +89,10 @@ struct QualityReport {
 
 // InputError unless both are 2D images or volumes of the same shape, slices at least 16 x 16.
 // Of a volume, `centre` stays zero.
-QualityReport quality_against_fbp(const Array& image, const Array& fbp);
+QualityReport quality_against_fbp(const Array& image, const Array& fbp,
+                                  double field_radius_px = kWholeDisc);
+
+// The field's radius in pixels of the reconstruction grid, for the above.
+double field_radius_px(const Geometry& g);
 
 }  // namespace riner

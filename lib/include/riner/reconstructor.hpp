@@ -97,23 +97,21 @@ struct TrainingStats {
   double noise = 0.0;  // the readings' noise sigma the carving used
   std::string air_note;
   // How the carving was checked (model/occupancy.hpp): views that certified nothing (dim or
-  // noisy), voxels the rays carved but the binned FBP kept (its binning and noise), voxels kept
-  // because a ray through the skipped air read more than air, and after that the rays that
-  // cross the grid but only skipped voxels with the largest mean excess over their offsets
+  // noisy), voxels the rays carved but the binned FBP kept (its binning and noise), and the rays
+  // that cross the grid but only skipped voxels with the largest mean excess over their offsets
   // among them (rho, and noise sigmas of such a mean), the check's threshold (5 sigma, more
   // where noise alone would cross it once in ten scans), how many read more, and how many of
-  // those pass near the region (unresolved: the check gave up there).
+  // those pass within the margin's width of the region (something skipped beside the object).
   std::size_t air_outlier_views = 0;
   std::size_t air_fbp_bin = 0;
   double air_fbp_noise = 0.0;
   std::size_t air_kept_by_fbp = 0;
-  std::size_t air_kept_by_rays = 0;
   std::size_t skipped_rays = 0;
   double skipped_ray_excess = 0.0;
   double skipped_ray_sigmas = 0.0;
   double skipped_ray_threshold = 0.0;
   std::size_t skipped_rays_above = 0;
-  std::size_t skipped_rays_unresolved = 0;
+  std::size_t skipped_rays_near = 0;
   // alpha's learning rate over the field's as trained (training.alpha_lr_scale and the
   // measurement's stripe evidence, training.alpha_stripe_scale) and that evidence.
   double alpha_rate = 1.0;

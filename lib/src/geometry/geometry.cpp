@@ -1,5 +1,6 @@
 #include "riner/geometry.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "riner/array.hpp"
@@ -65,6 +66,23 @@ void Geometry::check_measurement_shape(const std::vector<std::size_t>& shape,
                std::to_string(expected[0]) + " angles";
   }
   throw InputError(message);
+}
+
+FieldOfView field_of_view(const Geometry& g) {
+  auto nearer_end = [](std::size_t n, double offset, double pitch) {
+    const double lo = (-0.5 - 0.5 * (static_cast<double>(n) - 1.0) + offset) * pitch;
+    const double hi =
+        (static_cast<double>(n) - 0.5 - 0.5 * (static_cast<double>(n) - 1.0) + offset) * pitch;
+    return lo < 0.0 && hi > 0.0 ? std::min(-lo, hi) : 0.0;
+  };
+  const double u = nearer_end(g.n_u, g.offset_u, g.pitch_u);
+  const double v = g.is_3d() ? nearer_end(g.n_v, g.offset_v, g.pitch_v) : 0.0;
+  if (!g.is_divergent()) return {u, v};
+  const double sdd = g.source_origin_mm + g.origin_detector_mm;
+  FieldOfView f;
+  f.radius_mm = g.source_origin_mm * u / std::hypot(u, sdd);
+  f.half_height_mm = v * std::max(0.0, g.source_origin_mm - f.radius_mm) / sdd;
+  return f;
 }
 
 }  // namespace riner

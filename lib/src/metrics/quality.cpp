@@ -107,10 +107,11 @@ std::vector<double> gradients(const Array& image) {
 
 // Where the FBP sees object and the image air, per pixel of one 2D image (-1 outside the disc,
 // 1 lost, 0 not); the noise it measured into `noise`.
-std::vector<double> lost_pixels(const Array& image, const Array& fbp, double* noise) {
+std::vector<double> lost_pixels(const Array& image, const Array& fbp, double field_radius_px,
+                                double* noise) {
   const Array shown = Array(image.shape, util::gaussian_blur(image.data, image.shape, kLostBlurPx));
   const Array seen = Array(fbp.shape, util::gaussian_blur(fbp.data, fbp.shape, kLostBlurPx));
-  const double r_max = disc_radius(image);
+  const double r_max = std::min(disc_radius(image), field_radius_px - kFieldRimPx);
   std::vector<std::size_t> disc;
   std::vector<double> values;
   for (std::size_t i = 0; i < image.shape[0]; ++i) {
@@ -148,7 +149,7 @@ std::vector<double> lost_pixels(const Array& image, const Array& fbp, double* no
 
 }  // namespace
 
-LostObject lost_object(const Array& image, const Array& fbp) {
+LostObject lost_object(const Array& image, const Array& fbp, double field_radius_px) {
   require_2d_or_slices(image, "the image");
   require_2d_or_slices(fbp, "the FBP");
   if (image.shape != fbp.shape) throw InputError("the image and the FBP differ in shape");
@@ -157,7 +158,7 @@ LostObject lost_object(const Array& image, const Array& fbp) {
   std::size_t images = 0, disc = 0;
   auto per_image = [&](const Array& a, const Array& f) {
     double noise = 0.0;
-    for (double v : lost_pixels(a, f, &noise)) {
+    for (double v : lost_pixels(a, f, field_radius_px, &noise)) {
       if (v < 0.0) continue;
       ++disc;
       lost.pixels += v > 0.0;
@@ -244,7 +245,9 @@ CentreDeviation centre_deviation(const Array& image, const Array& fbp, int radiu
   return c;
 }
 
-QualityReport quality_against_fbp(const Array& image, const Array& fbp) {
+double field_radius_px(const Geometry& g) { return field_of_view(g).radius_mm / g.voxel_mm; }
+
+QualityReport quality_against_fbp(const Array& image, const Array& fbp, double field_radius_px) {
   require_2d_or_slices(image, "the image");
   require_2d_or_slices(fbp, "the FBP");
   if (image.shape != fbp.shape) throw InputError("the image and the FBP differ in shape");
@@ -256,7 +259,7 @@ QualityReport quality_against_fbp(const Array& image, const Array& fbp) {
   q.fbp_specks_per_10k = specks_per_10k(fbp, q.noise);
   q.edge_strength = edge_strength(image);
   q.fbp_edge_strength = edge_strength(fbp);
-  q.lost = lost_object(image, fbp);
+  q.lost = lost_object(image, fbp, field_radius_px);
   if (image.rank() == 2) q.centre = centre_deviation(image, fbp);
   return q;
 }

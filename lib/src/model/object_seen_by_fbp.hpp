@@ -16,9 +16,11 @@
 //   the rays and their check decide there), above the median by `sigmas` of that noise and by
 //   1.5 times the deepest dip below it within 12 binned voxels (artifacts swing both ways: a
 //   bright edge's ringing, rings, streaks; an object only up) and over 0.3 of the brightest
-//   within 3 binned voxels (a bright edge's blur spills into the air beside it), grown by 4 voxels
-//   of the scan's grid (a centre of rotation 5 pixels off blurs a faint corner below the threshold
-//   at its tip).
+//   within 3 binned voxels (a bright edge's blur spills into the air beside it), and joined to
+//   what the rays kept: an island out in the air is a streak's or a ring's bright spot far more
+//   often than a separate faint object (which this check then leaves to the rays).
+// - `object`: the voxels of that which the rays carved, grown by 4 voxels of the scan's grid (a
+//   centre of rotation 5 pixels off blurs a faint corner below the threshold at its tip).
 #pragma once
 
 #include <cstdint>
@@ -39,7 +41,7 @@ struct FbpCheckSettings {
 
 struct ObjectSeenByFbp {
   bool usable = false;               // false: too little carved air to measure the FBP's noise
-  std::vector<std::uint8_t> object;  // per voxel of the scan's grid
+  std::vector<std::uint8_t> object;  // per voxel of the scan's grid: carved object, grown
   std::size_t bin = 1;               // the binning factor
   double noise = 0.0;                // the blurred FBP's noise sigma in the carved air (1/mm)
   double level = 0.0;                // its median there

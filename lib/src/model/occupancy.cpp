@@ -17,8 +17,6 @@ namespace riner::model {
 
 namespace {
 
-// Rounds of the check of the rays through the skipped air (each keeps more; few are needed).
-constexpr int kMostRayCheckRounds = 6;
 // The check's threshold grows with the rays it looks at so that noise alone crosses it on one
 // ray in ten scans (5 sigma for 3e5 rays, 5.7 for the 1.2e7 of a 3D scan).
 constexpr double kFalseAlarmsPerScan = 0.1;
@@ -151,78 +149,79 @@ class RegionWalk {
 };
 
 struct RayCheck {
-  std::vector<std::size_t> missing;  // rays that miss the region (and are checked)
-  double threshold = 0.0;            // noise sigmas
+  double threshold = 0.0;  // noise sigmas
   std::size_t rays = 0;
   double excess = 0.0;
   double sigmas = 0.0;
-  std::size_t above = 0;          // rays reading more than air
-  std::size_t near = 0;           // of those, rays passing within reach of the region
-  std::vector<std::size_t> keep;  // skipped voxels to keep
+  std::size_t above = 0;  // rays reading more than air
+  std::size_t near = 0;   // of those, rays passing within `reach` voxels of the region
+  double samples = 0.0;   // kept, over all rays
 };
 
-// Step 4: every ray that crosses the grid but misses the region must read air. Those that do
-// not name the skipped voxels along them within `reach` of the region. One that passes nowhere
-// near it is a spike of the detector or a separate object; the FBP check sees the latter (it
-// sums every view where one ray is one reading), and real detectors have spikes: restoring
-// whole rays for them kept strips across the wood scan's air.
-// `candidates`: the rays to look at (those that missed a smaller region before; the region only
-// grows), or all when empty.
-RayCheck check_skipped_rays(const Scan& scan, const AirReadings& air,
-                            const std::vector<RaySegment>& segments, double spacing_voxels,
-                            const std::vector<std::uint8_t>& region, double sigmas, int reach,
-                            const std::vector<std::size_t>& candidates) {
+// Clips every ray to the region (its samples from the first to the last inside it; none when
+// it misses) and, with `air`, runs step 4 on the rays that miss it: each must read air. One that
+// reads more near the region says the carving took object; one far from it is a detector's
+// spike or a separate faint object. One walk along each ray serves both.
+RayCheck clip_and_check(std::vector<RaySegment>& segments, const Scan& scan,
+                        const std::vector<std::uint8_t>& region, double spacing_voxels,
+                        const AirReadings* air, double sigmas, int reach) {
   const RegionWalk walk(scan.geometry, region);
-  const bool every = candidates.empty();
-  const double tested = static_cast<double>(every ? segments.size() : candidates.size());
-  const double threshold =
-      std::max(sigmas, upper_quantile(kFalseAlarmsPerScan / std::max(tested, 1.0)));
-  std::vector<RayCheck> parts = util::parallel_map_chunks(
-      every ? segments.size() : candidates.size(), [&](std::size_t begin, std::size_t end) {
+  RayCheck all;
+  all.threshold = std::max(
+      sigmas,
+      upper_quantile(kFalseAlarmsPerScan / std::max(1.0, static_cast<double>(segments.size()))));
+  std::vector<RayCheck> parts =
+      util::parallel_map_chunks(segments.size(), [&](std::size_t begin, std::size_t end) {
         RayCheck part;
-        for (std::size_t i = begin; i < end; ++i) {
-          const std::size_t r = every ? i : candidates[i];
-          const RaySegment& s = segments[r];
-          if (s.count == 0 || walk.kept_range(s, spacing_voxels)) continue;
-          const std::size_t view = r / air.per_view, element = r % air.per_view;
-          const double z = air.excess_sigmas(scan, view, element);
-          if (std::isnan(z)) continue;
-          part.missing.push_back(r);
-          ++part.rays;
-          if (z > part.sigmas) {
-            part.sigmas = z;
-            part.excess = air.excess(scan, view, element);
+        for (std::size_t r = begin; r < end; ++r) {
+          RaySegment& s = segments[r];
+          if (s.count == 0) continue;
+          const auto range = walk.kept_range(s, spacing_voxels);
+          if (range) {
+            const auto [first, last] = *range;
+            for (int a = 0; a < 3; ++a) s.start[a] += static_cast<float>(first) * s.step[a];
+            s.count = static_cast<std::uint32_t>(last - first + 1);
+            part.samples += s.count;
+            continue;
           }
-          if (!(z > threshold)) continue;
-          ++part.above;
-          const std::size_t before = part.keep.size();
-          for (std::uint32_t k = 0; k < s.count; ++k) {
-            const std::size_t voxel = walk.voxel_of(s, k);
-            if (walk.distance(voxel) <= reach) part.keep.push_back(voxel);
+          const double z =
+              air ? air->excess_sigmas(scan, r / air->per_view, r % air->per_view) : NAN;
+          if (!std::isnan(z)) {
+            ++part.rays;
+            if (z > part.sigmas) {
+              part.sigmas = z;
+              part.excess = air->excess(scan, r / air->per_view, r % air->per_view);
+            }
+            if (z > all.threshold) {
+              ++part.above;
+              for (std::uint32_t k = 0; k < s.count; ++k) {
+                if (walk.distance(walk.voxel_of(s, k)) <= reach) {
+                  ++part.near;
+                  break;
+                }
+              }
+            }
           }
-          part.near += part.keep.size() > before;
+          s.count = 0;
         }
         return part;
       });
-  RayCheck all;
-  all.threshold = threshold;
-  for (RayCheck& p : parts) {
-    all.missing.insert(all.missing.end(), p.missing.begin(), p.missing.end());
+  for (const RayCheck& p : parts) {
     all.rays += p.rays;
     all.above += p.above;
     all.near += p.near;
+    all.samples += p.samples;
     if (p.sigmas > all.sigmas) {
       all.sigmas = p.sigmas;
       all.excess = p.excess;
     }
-    all.keep.insert(all.keep.end(), p.keep.begin(), p.keep.end());
   }
   return all;
 }
 
 }  // namespace
 
-Occupancy carve_occupancy(const Scan& scan, const std::vector<RaySegment>& segments,
+Occupancy carve_occupancy(const Scan& scan, std::vector<RaySegment>& segments,
                           double spacing_voxels, const OccupancySettings& settings) {
   const Geometry& g = scan.geometry;
   const std::size_t voxels = shape_size(g.volume_shape);
@@ -257,25 +256,15 @@ Occupancy carve_occupancy(const Scan& scan, const std::vector<RaySegment>& segme
   }
   const int margin = std::max(0, settings.margin_px);
   std::vector<std::uint8_t> region = dilated(kept, g.volume_shape, margin);
-  std::vector<std::size_t> candidates;  // all rays at first
-  for (o.ray_check_rounds = 1; o.ray_check_rounds <= kMostRayCheckRounds; ++o.ray_check_rounds) {
-    RayCheck check = check_skipped_rays(scan, air, segments, spacing_voxels, region,
-                                        settings.ray_check_sigmas, 2 * margin + 2, candidates);
-    candidates = std::move(check.missing);
-    o.skipped_rays = check.rays;
-    o.skipped_ray_excess = check.excess;
-    o.skipped_ray_sigmas = check.sigmas;
-    o.skipped_rays_above = check.above;
-    o.ray_check_threshold = check.threshold;
-    o.skipped_rays_unresolved = check.near;
-    if (check.keep.empty() || candidates.empty() || o.ray_check_rounds == kMostRayCheckRounds)
-      break;
-    for (std::size_t voxel : check.keep) {
-      o.kept_by_rays += !kept[voxel];
-      kept[voxel] = 1;
-    }
-    region = dilated(kept, g.volume_shape, margin);
-  }
+  const RayCheck check = clip_and_check(segments, scan, region, spacing_voxels, &air,
+                                        settings.ray_check_sigmas, std::max(1, margin));
+  o.samples_kept = check.samples;
+  o.skipped_rays = check.rays;
+  o.skipped_ray_excess = check.excess;
+  o.skipped_ray_sigmas = check.sigmas;
+  o.ray_check_threshold = check.threshold;
+  o.skipped_rays_above = check.above;
+  o.skipped_rays_near = check.near;
   std::size_t count = 0;
   for (std::uint8_t v : region) count += v;
   o.inside = std::move(region);
@@ -287,8 +276,8 @@ Occupancy carve_occupancy(const Scan& scan, const std::vector<RaySegment>& segme
 Occupancy carve_occupancy(const Scan& scan, const OccupancySettings& settings) {
   constexpr double kSpacingVoxels = 1.5;
   const Geometry& g = scan.geometry;
-  return carve_occupancy(scan, ray_segments(g, kSpacingVoxels * g.voxel_mm, false), kSpacingVoxels,
-                         settings);
+  std::vector<RaySegment> segments = ray_segments(g, kSpacingVoxels * g.voxel_mm, false);
+  return carve_occupancy(scan, segments, kSpacingVoxels, settings);
 }
 
 void fade_into_skipped_air(const Occupancy& occupancy, const std::vector<std::size_t>& shape,
@@ -311,34 +300,14 @@ void fade_into_skipped_air(const Occupancy& occupancy, const std::vector<std::si
   }
 }
 
-double clip_segments(std::vector<RaySegment>& segments, const Geometry& g,
+double clip_segments(std::vector<RaySegment>& segments, const Scan& scan,
                      const Occupancy& occupancy, double spacing_voxels) {
-  double samples = 0.0;
   if (!occupancy.carved) {
+    double samples = 0.0;
     for (const RaySegment& s : segments) samples += s.count;
     return samples;
   }
-  const RegionWalk walk(g, occupancy.inside);
-  const std::vector<double> kept =
-      util::parallel_map_chunks(segments.size(), [&](std::size_t begin, std::size_t end) {
-        double sum = 0.0;
-        for (std::size_t r = begin; r < end; ++r) {
-          RaySegment& s = segments[r];
-          if (s.count == 0) continue;
-          const auto range = walk.kept_range(s, spacing_voxels);
-          if (!range) {
-            s.count = 0;
-            continue;
-          }
-          const auto [first, last] = *range;
-          for (int a = 0; a < 3; ++a) s.start[a] += static_cast<float>(first) * s.step[a];
-          s.count = static_cast<std::uint32_t>(last - first + 1);
-          sum += s.count;
-        }
-        return sum;
-      });
-  for (double k : kept) samples += k;
-  return samples;
+  return clip_and_check(segments, scan, occupancy.inside, spacing_voxels, nullptr, 0.0, 0).samples;
 }
 
 }  // namespace riner::model

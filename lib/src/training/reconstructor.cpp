@@ -285,13 +285,12 @@ TrainingStats Reconstructor::stats() const {
   s.air_fbp_bin = setup.occupancy.fbp_bin;
   s.air_fbp_noise = setup.occupancy.fbp_noise;
   s.air_kept_by_fbp = setup.occupancy.kept_by_fbp;
-  s.air_kept_by_rays = setup.occupancy.kept_by_rays;
   s.skipped_rays = setup.occupancy.skipped_rays;
   s.skipped_ray_excess = setup.occupancy.skipped_ray_excess;
   s.skipped_ray_sigmas = setup.occupancy.skipped_ray_sigmas;
   s.skipped_ray_threshold = setup.occupancy.ray_check_threshold;
   s.skipped_rays_above = setup.occupancy.skipped_rays_above;
-  s.skipped_rays_unresolved = setup.occupancy.skipped_rays_unresolved;
+  s.skipped_rays_near = setup.occupancy.skipped_rays_near;
   s.alpha_rate = setup.alpha_rate;
   s.stripe_rms = setup.stripe_rms;
   s.alpha_model = setup.alpha_model;

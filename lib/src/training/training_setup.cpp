@@ -81,7 +81,7 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
     air.engine = config.engine;
     air.device = std::move(device);
     occupancy = model::carve_occupancy(scan, segments, config.training.sample_spacing, air);
-    samples_kept = model::clip_segments(segments, g, occupancy, config.training.sample_spacing);
+    if (occupancy.carved) samples_kept = occupancy.samples_kept;
   }
   alpha_rate = config.training.alpha_lr_scale;
   if (config.training.alpha_stripe_scale > 0) {
