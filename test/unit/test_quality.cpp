@@ -84,6 +84,13 @@ TEST_SUITE("quality: lost object") {
     g.offset_u = -1.0;
     g.voxel_mm = 0.5;
     CHECK(riner::field_radius_px(g) == doctest::Approx(91.5));
+    // Fan beam: the ray to the detector's nearer end passes the axis at SOD sin(atan(u / SDD)).
+    g.type = riner::GeometryType::kFan2d;
+    g.source_origin_mm = 370.0;
+    g.origin_detector_mm = 370.0;
+    const double u = 91.5 * 0.5;
+    CHECK(riner::field_of_view(g).radius_mm ==
+          doctest::Approx(370.0 * std::sin(std::atan(u / 740.0))));
   }
 }
 
