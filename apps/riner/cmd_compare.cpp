@@ -1,4 +1,4 @@
-// riner compare: image quality against a reference (PSNR, SSIM, MAE, RMSE).
+// riner compare: image quality against a reference (PSNR, SSIM, MAE, RMSE, edge ratio).
 #include <cstdio>
 
 #include "cli_common.hpp"
@@ -12,7 +12,9 @@ namespace riner::app {
 int run_compare(int argc, char** argv, int first) {
   Args args("compare",
             "Compares an image or volume with a reference: PSNR and SSIM as scikit-image "
-            "computes them (data range = max - min of the reference), MAE and RMSE.");
+            "computes them (data range = max - min of the reference), MAE, RMSE, and the "
+            "edges' sharpness against the reference's (edge_ratio: 1 as sharp, below 1 "
+            "blurred).");
   args.positional("IMAGE", "the image to judge")
       .positional("REFERENCE", "the ground truth, same shape")
       .option("mask", "KIND", "none, or circle (the inscribed disk/cylinder)", "none")
@@ -30,11 +32,13 @@ int run_compare(int argc, char** argv, int first) {
                                         args.number("data-range"));
   char line[256];
   std::snprintf(line, sizeof(line),
-                "PSNR %.4f dB  SSIM %.5f  MAE %.6g  RMSE %.6g  (range %.6g, %zu pixels%s)", m.psnr,
-                m.ssim, m.mae, m.rmse, m.data_range, m.pixels,
+                "PSNR %.4f dB  SSIM %.5f  MAE %.6g  RMSE %.6g  edges %.3f  (range %.6g, %zu "
+                "pixels%s)",
+                m.psnr, m.ssim, m.mae, m.rmse, m.edge_ratio, m.data_range, m.pixels,
                 mask_kind == "circle" ? ", circle mask" : "");
   console.line(line);
   nlohmann::json summary = metrics_json(m.psnr, m.ssim, m.mae, m.rmse, m.data_range);
+  summary["edge_ratio"] = m.edge_ratio;
   summary["pixels"] = m.pixels;
   summary["mask"] = mask_kind;
   console.summary(summary);

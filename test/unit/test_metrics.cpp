@@ -2,6 +2,9 @@
 // (test/fixtures/make_metrics_fixtures.py), plus properties.
 #include <doctest/doctest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include <nlohmann/json.hpp>
 
 #include "riner/error.hpp"
@@ -37,6 +40,36 @@ TEST_SUITE("metrics") {
     CHECK(std::isinf(m.psnr));
     CHECK(m.ssim == doctest::Approx(1.0));
     CHECK(m.mae == 0.0);
+  }
+
+  TEST_CASE("edge ratio: 1 for the reference itself, about half for an edge spread over 6 px") {
+    // A disc of radius 20 px; the image's edge ramps linearly over `width` px.
+    auto disc = [](double width) {
+      riner::Array a({64, 64});
+      for (std::size_t i = 0; i < 64; ++i) {
+        for (std::size_t k = 0; k < 64; ++k) {
+          const double r = std::hypot(i - 31.5, k - 31.5);
+          a(i, k) = static_cast<float>(std::clamp((20.0 - r) / width + 0.5, 0.0, 1.0));
+        }
+      }
+      return a;
+    };
+    const riner::Array reference = disc(1.0);
+    CHECK(riner::compare_images(reference, reference).edge_ratio == doctest::Approx(1.0));
+    // Gaussian of 1 px on a step: 0.40 at the edge; a 6-px ramp: 1/6 over the edge pixels.
+    const double soft = riner::compare_images(disc(6.0), reference).edge_ratio;
+    CHECK(soft > 0.35);
+    CHECK(soft < 0.7);
+    // Of a volume, per axial slice: eight slices of each, the same ratio.
+    riner::Array volume({8, 64, 64}), reference_volume({8, 64, 64});
+    const riner::Array soft_disc = disc(6.0);
+    for (std::size_t z = 0; z < 8; ++z) {
+      std::copy(soft_disc.data.begin(), soft_disc.data.end(), volume.data.begin() + z * 4096);
+      std::copy(reference.data.begin(), reference.data.end(),
+                reference_volume.data.begin() + z * 4096);
+    }
+    CHECK(riner::compare_images(volume, reference_volume).edge_ratio ==
+          doctest::Approx(soft).epsilon(1e-9));
   }
 
   TEST_CASE("masks restrict every metric") {

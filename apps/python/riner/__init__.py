@@ -283,8 +283,10 @@ def write_array(path, array, voxel_size=None):
 
 
 def compare(image, reference, mask=None):
-    """PSNR, SSIM (scikit-image's definition), MAE, RMSE of image against reference;
-    mask="circle" restricts them to the inscribed circle."""
+    """PSNR, SSIM (scikit-image's definition), MAE, RMSE of image against reference, and
+    edge_ratio (the image's gradient over the reference's strongest edges against the
+    reference's: 1 as sharp, below 1 blurred); mask="circle" restricts them to the inscribed
+    circle."""
     if mask not in (None, "circle"):
         raise InputError(f"mask must be None or 'circle' (got {mask!r})")
     return _riner.compare(_array(image), _array(reference), mask == "circle")

@@ -27,8 +27,7 @@ Scan scan_from(const py::handle& measurement, const std::string& geometry_json) 
 namespace {
 
 py::array fbp_of(const py::handle& measurement, const std::string& geometry_json,
-                 const std::string& filter, const std::string& engine,
-                 const std::string& device) {
+                 const std::string& filter, const std::string& engine, const std::string& device) {
   const Scan scan = scan_from(measurement, geometry_json);
   FbpOptions options;
   options.filter = parse_fbp_filter(filter);
@@ -45,9 +44,9 @@ py::array fbp_of(const py::handle& measurement, const std::string& geometry_json
 // The protocol of METHOD.md §4 on `image` (mu in 1/mm on the geometry's grid), or on the
 // built-in Shepp-Logan phantom when image is None (then with exact projections unless
 // projector is "joseph").
-py::dict simulate_scan(const py::object& image, const std::string& geometry_json,
-                       double mu_scale, const RingModel& model, std::string projector,
-                       const std::string& engine, const std::string& device) {
+py::dict simulate_scan(const py::object& image, const std::string& geometry_json, double mu_scale,
+                       const RingModel& model, std::string projector, const std::string& engine,
+                       const std::string& device) {
   const Geometry g = Geometry::from_json(geometry_json, "geometry");
   model.validate();
   if (projector != "exact" && projector != "joseph") {
@@ -93,29 +92,29 @@ py::dict simulate_scan(const py::object& image, const std::string& geometry_json
 
 void bind_scan_functions(py::module_& m) {
   m.def("fbp", &fbp_of);
-  m.def("simulate", [](const py::object& image, const std::string& geometry_json, double mu_scale,
-                       std::uint64_t seed, double photons, double nonideal_fraction,
-                       double alpha_min, double alpha_max, std::size_t dead,
-                       std::size_t dead_rows, std::size_t dead_columns,
-                       const std::string& projector, const std::string& engine,
-                       const std::string& device, const std::string& response_pattern) {
-    RingModel model;
-    if (response_pattern == "rows-x-columns") {
-      model.pattern = ResponsePattern::kRowsTimesColumns;
-    } else if (response_pattern != "per-element") {
-      throw InputError("response_pattern must be per-element or rows-x-columns (got \"" +
-                       response_pattern + "\")");
-    }
-    model.seed = seed;
-    model.photons = photons;
-    model.nonideal_fraction = nonideal_fraction;
-    model.alpha_min = alpha_min;
-    model.alpha_max = alpha_max;
-    model.dead_elements = dead;
-    model.dead_rows = dead_rows;
-    model.dead_columns = dead_columns;
-    return simulate_scan(image, geometry_json, mu_scale, model, projector, engine, device);
-  });
+  m.def("simulate",
+        [](const py::object& image, const std::string& geometry_json, double mu_scale,
+           std::uint64_t seed, double photons, double nonideal_fraction, double alpha_min,
+           double alpha_max, std::size_t dead, std::size_t dead_rows, std::size_t dead_columns,
+           const std::string& projector, const std::string& engine, const std::string& device,
+           const std::string& response_pattern) {
+          RingModel model;
+          if (response_pattern == "rows-x-columns") {
+            model.pattern = ResponsePattern::kRowsTimesColumns;
+          } else if (response_pattern != "per-element") {
+            throw InputError("response_pattern must be per-element or rows-x-columns (got \"" +
+                             response_pattern + "\")");
+          }
+          model.seed = seed;
+          model.photons = photons;
+          model.nonideal_fraction = nonideal_fraction;
+          model.alpha_min = alpha_min;
+          model.alpha_max = alpha_max;
+          model.dead_elements = dead;
+          model.dead_rows = dead_rows;
+          model.dead_columns = dead_columns;
+          return simulate_scan(image, geometry_json, mu_scale, model, projector, engine, device);
+        });
   m.def("center", [](const py::handle& measurement, const std::string& geometry_json) {
     const Scan scan = scan_from(measurement, geometry_json);
     CentreEstimate estimate;
@@ -148,8 +147,8 @@ void bind_scan_functions(py::module_& m) {
       loaded = app::load_scan_source({path, geometry, flat, dark, row, offset_px});
     }
     const nlohmann::json notes = {
-        {"flat_field", loaded.flat_field ? app::flat_field_json(*loaded.flat_field)
-                                         : nlohmann::json(nullptr)},
+        {"flat_field",
+         loaded.flat_field ? app::flat_field_json(*loaded.flat_field) : nlohmann::json(nullptr)},
         {"centre", loaded.centre ? app::centre_json(*loaded.centre) : nlohmann::json(nullptr)}};
     return py::make_tuple(to_numpy(std::move(loaded.scan.measurement)),
                           loaded.scan.geometry.to_json(), notes.dump());
@@ -179,6 +178,7 @@ void bind_scan_functions(py::module_& m) {
     out["mae"] = metrics.mae;
     out["rmse"] = metrics.rmse;
     out["data_range"] = metrics.data_range;
+    out["edge_ratio"] = metrics.edge_ratio;
     out["pixels"] = metrics.pixels;
     return out;
   });

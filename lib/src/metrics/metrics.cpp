@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
+#include "metrics/gradient_magnitude.hpp"
 #include "metrics/radial_profile.hpp"
 #include "riner/error.hpp"
 #include "riner/io.hpp"
@@ -142,6 +144,48 @@ Array circle_mask(const std::vector<std::size_t>& shape, double fraction) {
   return mask;
 }
 
+namespace {
+
+constexpr double kEdgeSmoothingPx = 1.0;
+constexpr double kEdgeQuantile = 0.999;
+constexpr double kEdgeShareOfQuantile = 0.5;
+
+// ImageMetrics::edge_ratio.
+double edge_ratio(const Array& image, const Array& reference, const Array* mask) {
+  const std::size_t rank = image.rank();
+  if (rank != 2 && rank != 3) return 0.0;
+  const std::size_t slices = rank == 3 ? image.shape[0] : 1;
+  const std::size_t per_slice = image.size() / std::max<std::size_t>(1, slices);
+  if (image.shape[rank - 2] < 3 || image.shape[rank - 1] < 3) return 0.0;
+  std::vector<double> shown, truth;
+  for (std::size_t z = 0; z < slices; ++z) {
+    const std::vector<double> a =
+        metrics::gradient_magnitude(rank == 3 ? axial_slice(image, z) : image, kEdgeSmoothingPx);
+    const std::vector<double> r = metrics::gradient_magnitude(
+        rank == 3 ? axial_slice(reference, z) : reference, kEdgeSmoothingPx);
+    for (std::size_t p = 0; p < per_slice; ++p) {
+      if (mask != nullptr && mask->data[z * per_slice + p] == 0.0f) continue;
+      if (!std::isfinite(a[p]) || !std::isfinite(r[p]) || r[p] <= 0.0) continue;
+      shown.push_back(a[p]);
+      truth.push_back(r[p]);
+    }
+  }
+  if (truth.empty()) return 0.0;
+  std::vector<double> sorted = truth;
+  const auto at = static_cast<long>(kEdgeQuantile * static_cast<double>(sorted.size() - 1));
+  std::nth_element(sorted.begin(), sorted.begin() + at, sorted.end());
+  const double threshold = kEdgeShareOfQuantile * sorted[static_cast<std::size_t>(at)];
+  double sum_shown = 0.0, sum_truth = 0.0;
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    if (truth[i] < threshold) continue;
+    sum_shown += shown[i];
+    sum_truth += truth[i];
+  }
+  return sum_truth > 0.0 ? sum_shown / sum_truth : 0.0;
+}
+
+}  // namespace
+
 ImageMetrics compare_images(const Array& image, const Array& reference, const Array* mask,
                             double data_range) {
   check_pair(image, reference);
@@ -167,6 +211,7 @@ ImageMetrics compare_images(const Array& image, const Array& reference, const Ar
   m.psnr = mse > 0.0 ? 10.0 * std::log10(m.data_range * m.data_range / mse)
                      : std::numeric_limits<double>::infinity();
   m.ssim = ssim_mean(image, reference, mask, m.data_range);
+  m.edge_ratio = edge_ratio(image, reference, mask);
   return m;
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <vector>
 
+#include "metrics/gradient_magnitude.hpp"
 #include "metrics/radial_profile.hpp"
 #include "riner/error.hpp"
 #include "riner/metrics.hpp"
@@ -80,26 +81,15 @@ std::vector<double> over_slices(const Array& a, PerImage per_image) {
   return out;
 }
 
-// Gaussian of kEdgeSmoothingPx along both axes (edge pixels repeated beyond the border).
-Array smoothed(const Array& a) {
-  return Array(a.shape, util::gaussian_blur(a.data, a.shape, kEdgeSmoothingPx));
-}
-
-// |Sobel gradient| / 8 (a central difference per pixel) at every interior pixel of the disc.
+// The gradient magnitude at every interior pixel of the disc.
 std::vector<double> gradients(const Array& image) {
-  const Array a = smoothed(image);
+  const std::vector<double> g = metrics::gradient_magnitude(image, kEdgeSmoothingPx);
   std::vector<double> out;
-  const std::size_t ny = a.shape[0], nx = a.shape[1];
-  const double r_max = disc_radius(a);
-  for (std::size_t i = 1; i + 1 < ny; ++i) {
-    for (std::size_t k = 1; k + 1 < nx; ++k) {
-      if (radius_of(a, i, k) > r_max) continue;
-      const double gx = (a(i - 1, k + 1) + 2.0 * a(i, k + 1) + a(i + 1, k + 1)) -
-                        (a(i - 1, k - 1) + 2.0 * a(i, k - 1) + a(i + 1, k - 1));
-      const double gy = (a(i + 1, k - 1) + 2.0 * a(i + 1, k) + a(i + 1, k + 1)) -
-                        (a(i - 1, k - 1) + 2.0 * a(i - 1, k) + a(i - 1, k + 1));
-      const double g = std::hypot(gx, gy) / 8.0;
-      if (std::isfinite(g)) out.push_back(g);
+  const double r_max = disc_radius(image);
+  for (std::size_t i = 0; i < image.shape[0]; ++i) {
+    for (std::size_t k = 0; k < image.shape[1]; ++k) {
+      const double v = g[i * image.shape[1] + k];
+      if (radius_of(image, i, k) <= r_max && std::isfinite(v)) out.push_back(v);
     }
   }
   return out;
