@@ -1,0 +1,152 @@
+// riner at the sizes users scan (issue 29 item 2): the paper's fan-beam protocol with the
+// detector resampled to each of --columns (the paper's 1 m detector at C elements, 360 C / 512
+// views over 360 degrees, the grid C/2 square over the same 256 mm), riner at the settings
+// against the truth beside the FBP of the same scan and of its twin with a perfect detector
+// (the oracle): PSNR, SSIM, the edges' sharpness against the truth (ImageMetrics::edge_ratio),
+// the training time and how often each ray is drawn.
+//
+//   riner_bench --case=size_scaling [--columns=512,1024,2048] [--scene=deeplesion|shepp-logan]
+//               [--first=3 --last=3] [--seed-offset=N] [--config=JSON] [--json=FILE]
+// deeplesion: the shared slices (1 mm pixels) resampled bilinearly: no detail finer than 1 mm at
+// any size. shepp-logan: rasterised on each grid (4x supersampled): sharp at every size.
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+#include "harness.hpp"
+#include "riner/error.hpp"
+#include "riner/fbp.hpp"
+#include "riner/io.hpp"
+#include "riner/metrics.hpp"
+#include "riner/phantom.hpp"
+#include "riner/projector.hpp"
+#include "riner/reconstructor.hpp"
+#include "riner/resample.hpp"
+#include "riner/simulate.hpp"
+#include "scenes.hpp"
+
+namespace {
+
+using riner::bench::Options;
+using riner::bench::Result;
+
+constexpr double kDetectorMm = 1000.0;
+constexpr double kFieldMm = 256.0;
+constexpr std::size_t kPaperColumns = 512;
+constexpr std::size_t kPaperViews = 360;
+
+std::vector<std::size_t> columns_from(const std::string& text) {
+  std::vector<std::size_t> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    char* end = nullptr;
+    const long c = std::strtol(item.c_str(), &end, 10);
+    if (end == item.c_str() || *end != '\0' || c < 64 || c % 2 != 0)
+      throw riner::InputError(
+          "--columns takes even counts of at least 64, separated by commas "
+          "(got '" +
+          item + "')");
+    out.push_back(static_cast<std::size_t>(c));
+  }
+  return out;
+}
+
+riner::Geometry sized_geometry(std::size_t columns) {
+  riner::Geometry g;
+  g.type = riner::GeometryType::kFan2d;
+  g.n_u = columns;
+  g.pitch_u = kDetectorMm / static_cast<double>(columns);
+  g.source_origin_mm = 370.0;
+  g.origin_detector_mm = 370.0;
+  const riner::UniformAngles angles{kPaperViews * columns / kPaperColumns, 0.0, 2.0 * M_PI};
+  g.uniform_angles = angles;
+  g.angles = riner::uniform_angles(angles);
+  g.volume_shape = {columns / 2, columns / 2};
+  g.voxel_mm = kFieldMm / static_cast<double>(columns / 2);
+  g.validate();
+  return g;
+}
+
+riner::Array truth_on(const riner::Geometry& g, const std::string& scene, int index,
+                      const Options& o) {
+  if (scene == "shepp-logan") return riner::rasterize(riner::shepp_logan(g, 0.02), g, 4);
+  if (scene != "deeplesion")
+    throw riner::InputError("--scene is deeplesion or shepp-logan (got '" + scene + "')");
+  const std::string path =
+      o.get("data", "../shared/data/deeplesion") + "/slice_" + std::to_string(index) + ".nii";
+  riner::Array slice = riner::read_array(path).array;
+  for (float& v : slice.data) v *= 0.1f;  // 1/cm -> 1/mm (METHOD.md section 4)
+  return riner::resample_to_grid(slice, {1.0, 1.0}, g);
+}
+
+std::vector<Result> size_scaling(const Options& o) {
+  const std::vector<std::size_t> columns = columns_from(o.get("columns", "512,1024,2048"));
+  const std::string scene = o.get("scene", "deeplesion");
+  const int first = o.get_int("first", 3);
+  const int last = o.get_int("last", first);
+  const riner::RinerConfig config = riner::bench::config_from(o);
+  riner::Device device = riner::Device::open(o.device);
+  riner::FbpOptions fbp_options;
+  fbp_options.device = device;
+  std::vector<Result> rows;
+  for (int index = first; index <= last; ++index) {
+    for (std::size_t c : columns) {
+      const riner::Geometry g = sized_geometry(c);
+      const riner::Projector projector(g, riner::Engine::kOpenCL, device);
+      const riner::Array truth = truth_on(g, scene, index, o);
+      riner::RingModel model;
+      model.seed = static_cast<std::uint64_t>(index + o.get_int("seed-offset", 0));
+      const riner::SimulatedScan sim = riner::simulate(truth, projector, model);
+      riner::RingModel perfect = model;
+      perfect.nonideal_fraction = 0.0;
+      perfect.dead_elements = 0;
+      const riner::SimulatedScan twin = riner::simulate(truth, projector, perfect);
+      const riner::ImageMetrics fbp =
+          riner::compare_images(riner::fbp(sim.scan, fbp_options), truth);
+      const riner::ImageMetrics oracle =
+          riner::compare_images(riner::fbp(twin.scan, fbp_options), truth);
+
+      riner::Reconstructor r(sim.scan, config, device);
+      r.run();
+      const riner::ImageMetrics m = riner::compare_images(r.result().image, truth);
+      const riner::TrainingStats st = r.stats();
+      const int rays_per_step = config.training.rays_per_step > 0 ? config.training.rays_per_step
+                                : st.plan                         ? st.plan->rays_per_step
+                                                                  : 0;
+      const double draws_per_ray =
+          static_cast<double>(st.steps) * rays_per_step / static_cast<double>(g.n_views() * g.n_u);
+      const std::string name = scene + "/" + std::to_string(index);
+      rows.push_back(
+          {"size_scaling",
+           {{"scene", name},
+            {"columns", c},
+            {"grid", g.volume_shape[0]},
+            {"views", g.n_views()},
+            {"psnr", m.psnr},
+            {"ssim", m.ssim},
+            {"edge_ratio", m.edge_ratio},
+            {"oracle_psnr", oracle.psnr},
+            {"oracle_ssim", oracle.ssim},
+            {"oracle_edge_ratio", oracle.edge_ratio},
+            {"fbp_psnr", fbp.psnr},
+            {"seconds", st.seconds},
+            {"steps", st.steps},
+            {"rays_per_step", rays_per_step},
+            {"draws_per_ray", draws_per_ray},
+            {"config", nlohmann::json::parse(config.to_json())}},
+           riner::bench::format("%s %5zu columns (%4zu^2, %4zu views): riner %.2f dB / %.3f, "
+                                "edges %.3f | oracle %.2f / %.3f, edges %.3f | FBP %.2f | "
+                                "%.1f s, %.1f draws per ray",
+                                name.c_str(), c, g.volume_shape[0], g.n_views(), m.psnr, m.ssim,
+                                m.edge_ratio, oracle.psnr, oracle.ssim, oracle.edge_ratio, fbp.psnr,
+                                st.seconds, draws_per_ray)});
+    }
+  }
+  return rows;
+}
+
+}  // namespace
+
+RINER_BENCH_CASE(size_scaling, "riner at 512-2048 columns against the oracle FBP and the truth",
+                 size_scaling);
