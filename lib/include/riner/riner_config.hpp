@@ -57,7 +57,7 @@ enum class Sampler {
 enum class AlphaModel { kAuto, kPerElement, kRowsTimesColumns };
 
 // training.air_fbp_check: auto is on in 2D and off in 3D, where the FDK's ring and cone-beam
-// artifacts in the air read as object (the paper's 3D head: 0.32 -> 0.55 of the grid sampled).
+// artifacts in the air read as object (the paper's 3D head: 0.32 -> 0.41 of the grid sampled).
 enum class AirFbpCheck { kAuto, kOn, kOff };
 
 struct TrainingConfig {
@@ -78,9 +78,10 @@ struct TrainingConfig {
   bool circle_region = false;   // sample the inscribed circle instead of the whole grid
   // Skip the air around the object (model/occupancy.hpp): voxels that air_min_views views
   // certify as air (the mean of three neighbouring readings within air_noise_sigmas noise
-  // sigmas of their offsets, over the voxel's shadow widened by air_centre_tolerance_px), that the
-  // FBP does not see as object (air_fbp_check) and that no ray through the skipped air contradicts
-  // are not sampled and read 0 in the image; air_margin_px voxels around the rest stay.
+  // sigmas of their offsets, over the voxel's shadow widened by air_centre_tolerance_px) and that
+  // the FBP does not see as object (air_fbp_check) are not sampled and read 0 in the image;
+  // air_margin_px voxels around the rest stay. summary.json reports the rays through the skipped
+  // air that read above it.
   bool skip_air = true;
   double air_noise_sigmas = 4.0;
   int air_margin_px = 4;
