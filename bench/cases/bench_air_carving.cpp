@@ -45,16 +45,10 @@ std::vector<Result> air_carving(const Options& o) {
   const riner::Array truth =
       truth_path.empty() ? riner::Array() : riner::read_array(truth_path).array;
   const riner::RinerConfig config = riner::bench::config_from(o);
-  const riner::TrainingConfig& t = config.training;
-  riner::model::OccupancySettings settings;
-  settings.noise_sigmas = t.air_noise_sigmas;
-  settings.margin_px = t.air_margin_px;
-  settings.min_views = t.air_min_views;
-  settings.centre_tolerance_px = t.air_centre_tolerance_px;
-  settings.fbp_check = t.air_fbp_check == riner::AirFbpCheck::kOn ||
-                       (t.air_fbp_check == riner::AirFbpCheck::kAuto && !scan.geometry.is_3d());
-  settings.engine = config.engine;
-  if (config.engine == riner::Engine::kOpenCL) settings.device = riner::Device::open(o.device);
+  const riner::model::OccupancySettings settings = riner::model::occupancy_settings(
+      config.training, scan.geometry, config.engine,
+      config.engine == riner::Engine::kOpenCL ? std::optional(riner::Device::open(o.device))
+                                              : std::nullopt);
   std::vector<Result> rows;
   for (double shift : shifts_from(o.get("shifts", "0"))) {
     riner::Scan shifted = scan;

@@ -221,6 +221,20 @@ RayCheck clip_and_check(std::vector<RaySegment>& segments, const Scan& scan,
 
 }  // namespace
 
+OccupancySettings occupancy_settings(const TrainingConfig& training, const Geometry& g,
+                                     Engine engine, std::optional<Device> device) {
+  OccupancySettings s;
+  s.noise_sigmas = training.air_noise_sigmas;
+  s.margin_px = training.air_margin_px;
+  s.min_views = training.air_min_views;
+  s.centre_tolerance_px = training.air_centre_tolerance_px;
+  s.fbp_check = training.air_fbp_check == AirFbpCheck::kOn ||
+                (training.air_fbp_check == AirFbpCheck::kAuto && !g.is_3d());
+  s.engine = engine;
+  s.device = std::move(device);
+  return s;
+}
+
 Occupancy carve_occupancy(const Scan& scan, std::vector<RaySegment>& segments,
                           double spacing_voxels, const OccupancySettings& settings) {
   const Geometry& g = scan.geometry;

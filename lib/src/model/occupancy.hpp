@@ -33,6 +33,7 @@
 #include "model/ray_segments.hpp"
 #include "riner/device.hpp"
 #include "riner/engine.hpp"
+#include "riner/riner_config.hpp"
 #include "riner/scan.hpp"
 
 namespace riner::model {
@@ -49,6 +50,11 @@ struct OccupancySettings {
   Engine engine = Engine::kOpenCL;   // of the FBP check
   std::optional<Device> device;      // OpenCL: default Device::open()
 };
+
+// A run's settings: its training.air_* (air_fbp_check auto: on in 2D), the FBP check on `engine`
+// (OpenCL: on `device`, default Device::open()).
+OccupancySettings occupancy_settings(const TrainingConfig& training, const Geometry& g,
+                                     Engine engine, std::optional<Device> device);
 
 struct Occupancy {
   bool carved = false;               // false: everything counts as inside (no evidence)

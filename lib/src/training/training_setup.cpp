@@ -71,16 +71,9 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
                               alpha_model == AlphaModel::kRowsTimesColumns ? g.n_v : 0);
   occupancy.inside.assign(shape_size(g.volume_shape), 1);
   if (config.training.skip_air) {
-    model::OccupancySettings air;
-    air.noise_sigmas = config.training.air_noise_sigmas;
-    air.margin_px = config.training.air_margin_px;
-    air.min_views = config.training.air_min_views;
-    air.centre_tolerance_px = config.training.air_centre_tolerance_px;
-    const AirFbpCheck check = config.training.air_fbp_check;
-    air.fbp_check = check == AirFbpCheck::kOn || (check == AirFbpCheck::kAuto && !g.is_3d());
-    air.engine = config.engine;
-    air.device = std::move(device);
-    occupancy = model::carve_occupancy(scan, segments, config.training.sample_spacing, air);
+    occupancy = model::carve_occupancy(
+        scan, segments, config.training.sample_spacing,
+        model::occupancy_settings(config.training, g, config.engine, std::move(device)));
     if (occupancy.carved) samples_kept = occupancy.samples_kept;
   }
   alpha_rate = config.training.alpha_lr_scale;
