@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "preprocessing/stripes.hpp"
 #include "util/parallel.hpp"
 #include "util/robust_statistics.hpp"
 
@@ -177,21 +178,12 @@ std::vector<double> stripe_offsets(const Scan& scan, const AirReadings& a, doubl
     }
   }
   for (std::size_t e = 0; e < a.per_view; ++e) mean[e] = count[e] > 0.0 ? mean[e] / count[e] : NAN;
+  const std::vector<double> low =
+      preprocessing::row_quantile(mean, n_u, kStripeReach, kStripeQuantile);
   std::vector<double> out(a.per_view, std::numeric_limits<double>::quiet_NaN());
-  util::parallel_for(a.per_view, [&](std::size_t begin, std::size_t end) {
-    std::vector<double> near;
-    for (std::size_t e = begin; e < end; ++e) {
-      if (!std::isfinite(mean[e])) continue;
-      const std::size_t column = e % n_u;
-      near.clear();
-      for (std::size_t c = column >= kStripeReach ? column - kStripeReach : 0;
-           c <= std::min(n_u - 1, column + kStripeReach); ++c) {
-        const double m = mean[e - column + c];
-        if (std::isfinite(m)) near.push_back(m);
-      }
-      out[e] = a.air_offset_median + mean[e] - (util::quantile(near, kStripeQuantile) + rise);
-    }
-  });
+  for (std::size_t e = 0; e < a.per_view; ++e) {
+    if (std::isfinite(mean[e])) out[e] = a.air_offset_median + mean[e] - (low[e] + rise);
+  }
   return out;
 }
 
@@ -274,14 +266,15 @@ void read_offsets(const Scan& scan, const std::vector<ElementStats>& stats,
 
 }  // namespace
 
-double AirReadings::excess(const Scan& scan, std::size_t view, std::size_t element) const {
+double AirReadings::mean_excess(const Scan& scan, std::size_t view, std::size_t element,
+                                int& used) const {
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  used = 0;
   if (!usable || outlier_view[view] || !std::isfinite(offset[element])) return kNaN;
   const std::size_t n_u = scan.geometry.n_u;
   const std::size_t column = element % n_u;
   const float* line = scan.measurement.ptr() + view * per_view;
   double sum = 0.0;
-  int n = 0;
   for (std::size_t c = column > 0 ? column - 1 : 0; c <= std::min(column + 1, n_u - 1); ++c) {
     const std::size_t e = element - column + c;
     const float x = line[e];
@@ -290,22 +283,22 @@ double AirReadings::excess(const Scan& scan, std::size_t view, std::size_t eleme
       continue;
     }
     sum += x - view_level[view] - offset[e];
-    ++n;
+    ++used;
   }
-  return sum / n;
+  return sum / used;
+}
+
+double AirReadings::excess(const Scan& scan, std::size_t view, std::size_t element) const {
+  int used = 0;
+  return mean_excess(scan, view, element, used);
 }
 
 double AirReadings::excess_sigmas(const Scan& scan, std::size_t view, std::size_t element) const {
-  const std::size_t n_u = scan.geometry.n_u;
-  const std::size_t column = element % n_u;
-  const float* line = scan.measurement.ptr() + view * per_view;
-  int n = 0;
-  for (std::size_t c = column > 0 ? column - 1 : 0; c <= std::min(column + 1, n_u - 1); ++c) {
-    const std::size_t e = element - column + c;
-    n += std::isfinite(line[e]) && std::isfinite(offset[e]);
-  }
+  int used = 0;
+  const double mean = mean_excess(scan, view, element, used);
+  if (used == 0) return mean;  // NaN (view_noise3 is empty when nothing is usable)
   // Fewer than three (the row's ends, a dead neighbour): as if the noise were independent.
-  return excess(scan, view, element) / (view_noise3[view] * std::sqrt(3.0 / std::max(n, 1)));
+  return mean / (view_noise3[view] * std::sqrt(3.0 / used));
 }
 
 std::vector<std::uint8_t> AirReadings::certified(const Scan& scan, double sigmas) const {

@@ -60,6 +60,11 @@ struct AirReadings {
   double excess(const Scan& scan, std::size_t view, std::size_t element) const;
   // Per reading [views][elements]: excess_sigmas < sigmas.
   std::vector<std::uint8_t> certified(const Scan& scan, double sigmas) const;
+
+ private:
+  // excess(), and into `used` how many readings it averaged (3, fewer at a row's end or beside
+  // a reading without an offset).
+  double mean_excess(const Scan& scan, std::size_t view, std::size_t element, int& used) const;
 };
 
 AirReadings read_air(const Scan& scan, double noise_sigmas);

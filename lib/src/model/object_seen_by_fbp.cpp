@@ -9,6 +9,8 @@
 #include "riner/fbp.hpp"
 #include "riner/geometry.hpp"
 #include "riner/rays.hpp"
+#include "rings/radial.hpp"
+#include "util/along_each_axis.hpp"
 #include "util/gaussian_blur.hpp"
 #include "util/parallel.hpp"
 #include "util/robust_statistics.hpp"
@@ -22,7 +24,7 @@ constexpr std::size_t kLargestSide3d = 128;
 // Binned elements a detector row keeps at least (and rows in 3D).
 constexpr std::size_t kFewestColumns = 32;
 constexpr std::size_t kFewestRows = 8;
-constexpr long kStripeReach = 25;
+constexpr std::size_t kStripeReach = 25;
 constexpr double kBlurVoxels = 1.0;
 constexpr std::uint16_t kAirDistance = 3;
 constexpr std::size_t kMinAirVoxels = 64;
@@ -124,12 +126,8 @@ void remove_air_rings(std::vector<float>& image, const std::vector<std::size_t>&
   const std::size_t rank = shape.size();
   const std::size_t nx = shape[rank - 1], ny = shape[rank - 2];
   const std::size_t slices = image.size() / (nx * ny);
-  auto radius = [&](std::size_t i) {
-    const double x = static_cast<double>(i % nx) - 0.5 * (static_cast<double>(nx) - 1.0);
-    const double y = static_cast<double>((i / nx) % ny) - 0.5 * (static_cast<double>(ny) - 1.0);
-    return static_cast<std::size_t>(std::lround(std::hypot(x, y)));
-  };
-  const std::size_t bins = radius(0) + 1;
+  const rings::PixelRadii radii(ny, nx, 1.0);
+  const std::size_t bins = radii.nearest_nodes();
   util::parallel_for(slices, [&](std::size_t begin, std::size_t end) {
     std::vector<std::vector<double>> air(bins);
     std::vector<double> ring(bins);
@@ -137,13 +135,13 @@ void remove_air_rings(std::vector<float>& image, const std::vector<std::size_t>&
       for (auto& a : air) a.clear();
       const std::size_t first = z * nx * ny, last = first + nx * ny;
       for (std::size_t i = first; i < last; ++i) {
-        if (is_air[i]) air[radius(i - first)].push_back(image[i]);
+        if (is_air[i]) air[radii.nearest(i - first)].push_back(image[i]);
       }
       for (std::size_t r = 0; r < bins; ++r) {
         ring[r] = air[r].size() >= kMinRingAir ? util::quantile(air[r], 0.5) : 0.0;
       }
       for (std::size_t i = first; i < last; ++i) {
-        image[i] -= static_cast<float>(ring[radius(i - first)]);
+        image[i] -= static_cast<float>(ring[radii.nearest(i - first)]);
       }
     }
   });
@@ -192,27 +190,18 @@ std::vector<std::uint8_t> touching(const std::vector<std::uint8_t>& object,
 // voxel: over a box, one axis at a time.
 std::vector<float> box_extreme(const std::vector<float>& data,
                                const std::vector<std::size_t>& shape, long reach, bool largest) {
-  std::vector<float> in = data, out(data.size());
-  std::size_t stride = 1;
-  for (std::size_t axis = shape.size(); axis-- > 0;) {
-    const long n = static_cast<long>(shape[axis]);
-    const std::size_t lines = data.size() / static_cast<std::size_t>(n);
-    for (std::size_t line = 0; line < lines; ++line) {
-      const std::size_t base =
-          (line / stride) * stride * static_cast<std::size_t>(n) + line % stride;
-      for (long i = 0; i < n; ++i) {
-        float m = in[base + static_cast<std::size_t>(i) * stride];
-        for (long j = std::max(0L, i - reach); j <= std::min(n - 1, i + reach); ++j) {
-          const float x = in[base + static_cast<std::size_t>(j) * stride];
-          m = largest ? std::max(m, x) : std::min(m, x);
+  return util::along_each_axis(
+      data, shape, [&](const float* in, float* out, std::size_t size, std::size_t stride) {
+        const long n = static_cast<long>(size);
+        for (long i = 0; i < n; ++i) {
+          float m = in[static_cast<std::size_t>(i) * stride];
+          for (long j = std::max(0L, i - reach); j <= std::min(n - 1, i + reach); ++j) {
+            const float x = in[static_cast<std::size_t>(j) * stride];
+            m = largest ? std::max(m, x) : std::min(m, x);
+          }
+          out[static_cast<std::size_t>(i) * stride] = m;
         }
-        out[base + static_cast<std::size_t>(i) * stride] = m;
-      }
-    }
-    std::swap(in, out);
-    stride *= static_cast<std::size_t>(n);
-  }
-  return in;
+      });
 }
 
 }  // namespace

@@ -40,7 +40,7 @@ struct ParameterLayout {
   std::size_t mlp_params = 0;
   std::size_t alpha_offset = 0;
   std::size_t factor_offset = 0;  // row factors, then column factors (alpha_offset + elements)
-  std::size_t factor_rows = 0;     // 0: alpha0 per element is trained directly
+  std::size_t factor_rows = 0;    // 0: alpha0 per element is trained directly
   std::size_t factor_columns = 0;
   std::size_t beta_offset = 0;
   std::size_t elements = 0;

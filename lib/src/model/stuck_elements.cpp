@@ -40,7 +40,8 @@ std::vector<std::uint8_t> stuck_elements(const Scan& scan, double noise_sigma) {
   }
   const double judged = kJudgedNoiseSigmas * kJudgedNoiseSigmas * noise_sigma * noise_sigma;
   auto at = [&](long r, long c) {
-    if (r < 0 || r >= rows || c < 0 || c >= columns) return std::numeric_limits<double>::quiet_NaN();
+    if (r < 0 || r >= rows || c < 0 || c >= columns)
+      return std::numeric_limits<double>::quiet_NaN();
     return variance[static_cast<std::size_t>(r * columns + c)];
   };
   for (long r = 0; r < rows; ++r) {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "util/parallel.hpp"
+#include "util/along_each_axis.hpp"
 
 namespace riner::util {
 
@@ -18,31 +18,19 @@ std::vector<float> gaussian_blur(const std::vector<float>& data,
     total += w[static_cast<std::size_t>(d + reach)];
   }
   for (double& v : w) v /= total;
-  std::vector<float> in = data, out(data.size());
-  std::size_t stride = 1;
-  for (std::size_t axis = shape.size(); axis-- > 0;) {
-    const long n = static_cast<long>(shape[axis]);
-    const std::size_t lines = data.size() / static_cast<std::size_t>(n);
-    parallel_for(lines, [&](std::size_t begin, std::size_t end) {
-      for (std::size_t line = begin; line < end; ++line) {
-        // The line's first voxel: `line` counts the other axes, this one's stride left out.
-        const std::size_t base =
-            (line / stride) * stride * static_cast<std::size_t>(n) + line % stride;
+  return along_each_axis(
+      data, shape, [&](const float* in, float* out, std::size_t size, std::size_t stride) {
+        const long n = static_cast<long>(size);
         for (long i = 0; i < n; ++i) {
           double sum = 0.0;
           for (long d = -reach; d <= reach; ++d) {
             const long j = std::clamp(i + d, 0L, n - 1);
-            sum += w[static_cast<std::size_t>(d + reach)] *
-                   in[base + static_cast<std::size_t>(j) * stride];
+            sum +=
+                w[static_cast<std::size_t>(d + reach)] * in[static_cast<std::size_t>(j) * stride];
           }
-          out[base + static_cast<std::size_t>(i) * stride] = static_cast<float>(sum);
+          out[static_cast<std::size_t>(i) * stride] = static_cast<float>(sum);
         }
-      }
-    });
-    std::swap(in, out);
-    stride *= static_cast<std::size_t>(n);
-  }
-  return in;
+      });
 }
 
 }  // namespace riner::util
