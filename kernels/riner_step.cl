@@ -17,8 +17,9 @@
 //     of the batch's distinct elements: their rays' gradients in ascending ray order plus the
 //     -lambda beta^2 term into grad (each element's entries are written by one work-item:
 //     deterministic, no atomics). history[2 * slot] = data term, [2 * slot + 1] = penalties,
-//     summed by a fixed tree. When relative_beta_threshold > 0, lambda is replaced by
-//     data_weight relative_beta_threshold max(m, 1e-3) / 2, m the batch's median ray mismatch
+//     summed by a fixed tree. When relative_beta_threshold > 0, lambda is raised to
+//     data_weight relative_beta_threshold max(m, 1e-3) / 2 where that is larger, m the batch's
+//     median ray mismatch
 //     (scratch float[n_batch]). When hold_valid_beta != 0, beta0 of every element without
 //     invalid readings gets no gradient (the beta warm-up).
 //   riner_step_backward(p, batch, levels, params, d_sums, cache, grad)
@@ -167,7 +168,8 @@ __kernel void riner_step_loss(const StepParams p, __global const uint* batch,
       reduce[0] = select_kth(scratch, p.n_batch, (p.n_batch - 1) / 2);
     }
     barrier(CLK_LOCAL_MEM_FENCE);
-    penalty_weight = 0.5f * p.data_weight * p.relative_beta_threshold * fmax(reduce[0], 1e-3f);
+    penalty_weight = fmax(p.lambda, 0.5f * p.data_weight * p.relative_beta_threshold *
+                                        fmax(reduce[0], 1e-3f));
     barrier(CLK_LOCAL_MEM_FENCE);
   }
   float data = 0.0f;

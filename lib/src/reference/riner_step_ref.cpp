@@ -59,7 +59,7 @@ std::vector<double> ray_sums(const StepInputs& in, const model::Batch& batch,
 }
 
 // lambda, or with a relative threshold, data_weight * threshold * the batch's median ray
-// mismatch / 2 (riner_step.cl, riner_step_loss).
+// mismatch / 2 where that is larger (riner_step.cl, riner_step_loss).
 double penalty_weight(const StepInputs& in, const model::Batch& batch,
                       const std::vector<double>& params, const std::vector<double>& sums) {
   const model::ParameterLayout& l = *in.layout;
@@ -74,7 +74,8 @@ double penalty_weight(const StepInputs& in, const model::Batch& batch,
   std::nth_element(mismatch.begin(), mismatch.begin() + static_cast<long>((n - 1) / 2),
                    mismatch.end());
   const double median = mismatch[(n - 1) / 2];
-  return 0.5 * in.data_weight * in.relative_beta_threshold * std::max(median, 1e-3);
+  return std::max(in.lambda,
+                  0.5 * in.data_weight * in.relative_beta_threshold * std::max(median, 1e-3));
 }
 
 // The losses in batch order like the kernel: result's losses, d_sums and (with a gradient) the

@@ -180,7 +180,8 @@ void add_training_schedule(Table& t) {
   t.push_back(field<C>("training", "data_weight", open(0, 1e6), "multiplies the data term",
                        &C::training, &T::data_weight));
   t.push_back(field<C>("training", "relative_beta_threshold", closed_open(0, 1e6),
-                       "> 0: an element goes off past this many times the median ray mismatch",
+                       "> 0: an element stays on up to this many times the batch's median ray "
+                       "mismatch, when that is above the absolute threshold",
                        &C::training, &T::relative_beta_threshold));
   t.push_back(field<C>("training", "seed", closed(0, 18446744073709551615.0),
                        "seed of the initial weights and the sampler", &C::training, &T::seed));
