@@ -124,7 +124,8 @@ int run_reconstruct(int argc, char** argv, int first) {
               "")
       .option("steps", "N",
               "training steps (default " + std::to_string(TrainingConfig::kSteps2d) +
-                  " for a slice, " + std::to_string(TrainingConfig::kSteps3d) +
+                  " for a slice, more for a large one so that each ray is drawn 10 times, " +
+                  std::to_string(TrainingConfig::kSteps3d) +
                   " for a volume; the learning rate halves every quarter of them)",
               "")
       .option("seed", "N", "random seed", "")
@@ -164,6 +165,16 @@ int run_reconstruct(int argc, char** argv, int first) {
   {
     const TrainingStats setup = reconstructor.stats();
     if (setup.plan) console.line(setup.plan->describe());
+    if (config.training.steps == TrainingConfig::kScanSteps &&
+        setup.steps_planned >
+            config.training.steps_for(reconstructor.scan().geometry.is_3d())) {
+      char line[240];
+      std::snprintf(line, sizeof(line),
+                    "%d steps of %d rays, so that each of the slice's rays is drawn %.0f "
+                    "times (training.min_draws_per_ray; --steps N sets the count)",
+                    setup.steps_planned, setup.rays_per_step, setup.draws_per_ray_planned);
+      console.line(line);
+    }
     if (setup.air_skipped) {
       char line[240];
       std::snprintf(line, sizeof(line),

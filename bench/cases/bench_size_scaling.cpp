@@ -3,7 +3,7 @@
 // views over 360 degrees, the grid C/2 square over the same 256 mm), riner at the settings
 // against the truth beside the FBP of the same scan and of its twin with a perfect detector
 // (the oracle): PSNR, SSIM, the edges' sharpness against the truth (ImageMetrics::edge_ratio),
-// the training time and how often each ray is drawn.
+// the training time, how often each ray is drawn and the elements beta switched off.
 //
 //   riner_bench --case=size_scaling [--columns=512,1024,2048] [--scene=deeplesion|shepp-logan]
 //               [--first=3 --last=3] [--seed-offset=N] [--config=JSON] [--json=FILE]
@@ -111,11 +111,18 @@ std::vector<Result> size_scaling(const Options& o) {
       r.run();
       const riner::ImageMetrics m = riner::compare_images(r.result().image, truth);
       const riner::TrainingStats st = r.stats();
-      const int rays_per_step = config.training.rays_per_step > 0 ? config.training.rays_per_step
-                                : st.plan                         ? st.plan->rays_per_step
-                                                                  : 0;
+      const int rays_per_step = st.rays_per_step;
       const double draws_per_ray =
           static_cast<double>(st.steps) * rays_per_step / static_cast<double>(g.n_views() * g.n_u);
+      // beta below 0.5 on a live element takes its rays out of training: at size it was the
+      // first sign of a loose fit (bench/RESULTS.md, issue 29).
+      const riner::Array beta = r.beta();
+      int live_off = 0, dead_found = 0, dead = 0;
+      for (std::size_t e = 0; e < beta.size(); ++e) {
+        const bool is_dead = sim.alpha.data[e] == 0.0f;
+        dead += is_dead;
+        if (beta.data[e] < 0.5f) (is_dead ? dead_found : live_off) += 1;
+      }
       const std::string name = scene + "/" + std::to_string(index);
       rows.push_back(
           {"size_scaling",
@@ -134,13 +141,16 @@ std::vector<Result> size_scaling(const Options& o) {
             {"steps", st.steps},
             {"rays_per_step", rays_per_step},
             {"draws_per_ray", draws_per_ray},
+            {"live_elements_off", live_off},
+            {"dead_elements_found", dead_found},
+            {"dead_elements", dead},
             {"config", nlohmann::json::parse(config.to_json())}},
            riner::bench::format("%s %5zu columns (%4zu^2, %4zu views): riner %.2f dB / %.3f, "
                                 "edges %.3f | oracle %.2f / %.3f, edges %.3f | FBP %.2f | "
-                                "%.1f s, %.1f draws per ray",
+                                "%.1f s, %.1f draws per ray, %d live off, %d/%d dead found",
                                 name.c_str(), c, g.volume_shape[0], g.n_views(), m.psnr, m.ssim,
                                 m.edge_ratio, oracle.psnr, oracle.ssim, oracle.edge_ratio, fbp.psnr,
-                                st.seconds, draws_per_ray)});
+                                st.seconds, draws_per_ray, live_off, dead_found, dead)});
     }
   }
   return rows;

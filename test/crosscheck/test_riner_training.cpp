@@ -241,6 +241,29 @@ TEST_SUITE("riner_training") {
     CHECK(riner::Reconstructor(volume, c, riner::test::device()).config().training.steps == 77);
   }
 
+  TEST_CASE("a slice's steps left to the scan grow until each ray is drawn min_draws_per_ray times") {
+    // 50 x 90 = 4500 rays, one ray per step: 10 draws need 45 000 steps, more than 24 000.
+    const riner::Scan scan = riner::test::tiny_problem(3).scan;
+    riner::RinerConfig c = riner::test::tiny_config();
+    c.training.steps = riner::TrainingConfig::kScanSteps;
+    c.training.rays_per_step = 1;
+    const riner::Reconstructor raised(scan, c, riner::test::device());
+    CHECK(raised.config().training.steps == 45000);
+    CHECK(raised.stats().steps_planned == 45000);
+    CHECK(raised.stats().rays_per_step == 1);
+    CHECK(raised.stats().draws_per_ray_planned == doctest::Approx(10.0));
+    c.training.min_draws_per_ray = 2.5;  // fewer than the default's draws: the default stays
+    CHECK(riner::Reconstructor(scan, c, riner::test::device()).config().training.steps == 24000);
+    c.training.min_draws_per_ray = 0.0;  // off
+    CHECK(riner::Reconstructor(scan, c, riner::test::device()).config().training.steps == 24000);
+    c.training.min_draws_per_ray = 10.0;
+    c.training.steps = 500;  // an explicit count stays
+    CHECK(riner::Reconstructor(scan, c, riner::test::device()).config().training.steps == 500);
+    c.training.steps = riner::TrainingConfig::kScanSteps;
+    c.training.sampler = riner::Sampler::kViewsTimesElements;  // its batch is views x elements
+    CHECK(riner::Reconstructor(scan, c, riner::test::device()).config().training.steps == 24000);
+  }
+
   TEST_CASE("zero steps leave the initial field; alpha and beta start at 1 and sigmoid(1)") {
     const riner::test::TinyProblem t = riner::test::tiny_problem(7);
     riner::RinerConfig c = riner::test::tiny_config();

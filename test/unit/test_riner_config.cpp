@@ -86,8 +86,8 @@ TEST_SUITE("riner_config") {
     expect(R"({"plan": {"lanes": 4}})", "c.json: config: unknown setting plan.lanes");
     expect(R"({"plan": 4})", "c.json: config: plan must be an object");
     expect(R"({"training": {"rays_per_step": -3}})",
-           "c.json: config: training.rays_per_step must be in 0..1048576 (uniform and even "
-           "samplers' rays per step; 0: the execution plan's)");
+           "c.json: config: training.rays_per_step must be in 0..1048576 (uniform, even and "
+           "mixed samplers' rays per step; 0: the execution plan's)");
     // A value beyond an int's range is refused, not wrapped.
     expect(R"({"training": {"steps": 5000000000}})",
            "c.json: config: training.steps must be in -1..10000000 (training steps; -1: the scan's, 24000 in 2D, 12000 in 3D)");

@@ -81,6 +81,8 @@ struct RayCoverage {
 struct TrainingStats {
   int steps = 0;
   int steps_planned = 0;            // training.steps
+  int rays_per_step = 0;            // training.rays_per_step as resolved
+  double draws_per_ray_planned = 0.0;  // steps_planned x rays_per_step / the scan's rays
   bool stopped_on_plateau = false;  // training.stop_on_plateau ended the run early
   double seconds = 0.0;             // wall time inside step()/run()
   double samples = 0.0;             // field evaluations trained on (forward + backward)

@@ -69,8 +69,14 @@ struct TrainingConfig {
   static constexpr int kSteps3d = 12000;
   int steps = kScanSteps;
   Sampler sampler = Sampler::kEven;
-  int rays_per_step =
-      0;  // uniform and even samplers; 0: the execution plan's (riner/execution_plan.hpp)
+  // Uniform, even and mixed samplers; 0: the execution plan's (riner/execution_plan.hpp).
+  int rays_per_step = 0;
+  // A slice's steps, when left to the scan (steps -1), grow past kSteps2d until each ray is
+  // drawn this often over the run. 10: half the paper-size slice's 21 (24 000 x 160 rays over
+  // 360 x 500 rays). A 2048-column Shepp-Logan slice: 31.76 dB and edges 0.84 of the truth's
+  // at 1.3 draws, 38.44 and 0.97 at 10 (bench/RESULTS.md, issue 29 item 2); the 2D scans in
+  // ../shared (9.5-33 draws on a CPU) change by at most 5%. 0: off. 2D only.
+  double min_draws_per_ray = 10.0;
   int views_per_step = 40;      // views x elements sampler
   int elements_per_step = 2;    // views x elements sampler: adjacent elements
   double sample_spacing = 1.5;  // along each ray, in voxels (the paper uses a fixed interval)

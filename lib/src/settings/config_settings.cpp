@@ -60,8 +60,13 @@ void add_training_sampling(Table& t) {
       "view",
       &C::training, &T::sampler));
   t.push_back(field<C>("training", "rays_per_step", closed(0, 1 << 20),
-                       "uniform and even samplers' rays per step; 0: the execution plan's",
+                       "uniform, even and mixed samplers' rays per step; 0: the execution "
+                       "plan's",
                        &C::training, &T::rays_per_step));
+  t.push_back(field<C>("training", "min_draws_per_ray", closed_open(0, 1e6),
+                       "2D, steps -1: the steps grow until each ray is drawn this often; 0: "
+                       "off",
+                       &C::training, &T::min_draws_per_ray));
   t.push_back(field<C>("training", "views_per_step", closed(1, 65536),
                        "views x elements sampler: views", &C::training, &T::views_per_step));
   t.push_back(field<C>("training", "elements_per_step", closed(1, 65536),
