@@ -124,7 +124,9 @@ int run_reconstruct(int argc, char** argv, int first) {
               "")
       .option("steps", "N",
               "training steps (default " + std::to_string(TrainingConfig::kSteps2d) +
-                  " for a slice, more for a large one so that each ray is drawn 10 times, " +
+                  " for a slice, more for a large one so that each ray is drawn " +
+                  std::to_string(static_cast<int>(TrainingConfig{}.min_draws_per_ray)) +
+                  " times, " +
                   std::to_string(TrainingConfig::kSteps3d) +
                   " for a volume; the learning rate halves every quarter of them)",
               "")

@@ -121,7 +121,7 @@ std::vector<Result> size_scaling(const Options& o) {
       for (std::size_t e = 0; e < beta.size(); ++e) {
         const bool is_dead = sim.alpha.data[e] == 0.0f;
         dead += is_dead;
-        if (beta.data[e] < 0.5f) (is_dead ? dead_found : live_off) += 1;
+        if (beta.data[e] < riner::Reconstructor::kDeadBelowBeta) (is_dead ? dead_found : live_off) += 1;
       }
       const std::string name = scene + "/" + std::to_string(index);
       rows.push_back(

@@ -48,30 +48,11 @@ struct Reconstructor::Impl {
 
 namespace {
 
-// A slice's steps when the config leaves them to the scan: the default, raised so that each of
-// the scan's rays is drawn training.min_draws_per_ray times over the run. Scans larger than the
-// paper's draw each ray fewer times at a fixed budget (24 000 steps of 160 rays: a 1024-column
-// ray 5 times, a 2048-column one 1.3) and their images blur; more steps buy more than a bigger
-// batch at the same draws (bench/RESULTS.md, issue 29). Volumes keep their budget: a 3D field
-// is held by far fewer draws per ray.
-void raise_steps_for_draws(TrainingConfig& t, double scan_rays) {
-  if (!(t.min_draws_per_ray > 0.0) || t.sampler == Sampler::kViewsTimesElements) return;
-  const double wanted = std::ceil(t.min_draws_per_ray * scan_rays / t.rays_per_step);
-  if (wanted > t.steps) t.steps = static_cast<int>(std::min<double>(wanted, 1 << 30));
-}
-
-// The settings left to the device (rays_per_step = 0) filled in from its execution plan, and
-// the steps left to the scan from its size (those left to the scan's readings: TrainingSetup).
-RinerConfig resolved(RinerConfig config, const std::optional<ExecutionPlan>& plan,
-                     const Geometry& g) {
-  TrainingConfig& t = config.training;
-  if (t.rays_per_step == 0) {
-    t.rays_per_step = plan ? plan->rays_per_step : ExecutionPlan::kCpuRaysPerStep;
-  }
-  const bool steps_left_to_scan = t.steps == TrainingConfig::kScanSteps;
-  t.steps = t.steps_for(g.is_3d());
-  if (steps_left_to_scan && !g.is_3d()) {
-    raise_steps_for_draws(t, static_cast<double>(g.n_views()) * static_cast<double>(g.n_u));
+// The settings left to the device (rays_per_step = 0) filled in from its execution plan (those
+// left to the scan: TrainingSetup).
+RinerConfig resolved(RinerConfig config, const std::optional<ExecutionPlan>& plan) {
+  if (config.training.rays_per_step == 0) {
+    config.training.rays_per_step = plan ? plan->rays_per_step : ExecutionPlan::kCpuRaysPerStep;
   }
   return config;
 }
@@ -81,15 +62,13 @@ RinerConfig resolved(RinerConfig config, const std::optional<ExecutionPlan>& pla
 Reconstructor::Reconstructor(Scan scan, RinerConfig config, std::optional<Device> device) {
   config.validate();
   if (config.engine == Engine::kReference) {
-    RinerConfig c = resolved(std::move(config), std::nullopt, scan.geometry);
-    impl_ = std::make_unique<Impl>(std::move(scan), std::move(c));
+    impl_ = std::make_unique<Impl>(std::move(scan), resolved(std::move(config), std::nullopt));
     impl_->trainer = detail::make_reference_trainer(impl_->setup);
     return;
   }
   Device d = device ? *device : Device::open();
   const ExecutionPlan plan = choose_execution_plan(d.info(), config.plan);
-  RinerConfig c = resolved(std::move(config), plan, scan.geometry);
-  impl_ = std::make_unique<Impl>(std::move(scan), std::move(c), d);
+  impl_ = std::make_unique<Impl>(std::move(scan), resolved(std::move(config), plan), d);
   impl_->trainer = detail::make_opencl_trainer(impl_->setup, std::move(d), plan);
 }
 

@@ -9,6 +9,28 @@
 
 namespace riner::detail {
 
+namespace {
+
+// The steps when the config leaves them to the scan (-1): the dimension's default, and for a
+// slice raised so that each of its rays is drawn training.min_draws_per_ray times over the run.
+// Scans larger than the paper's draw each ray fewer times at a fixed budget (24 000 steps of
+// 160 rays: a 1024-column ray 5 times, a 2048-column one 1.3) and their images blur; more
+// steps buy more than a bigger batch at the same draws (bench/RESULTS.md, issue 29). Volumes
+// keep their budget: a 3D field is held by far fewer draws per ray. Needs rays_per_step
+// resolved (the Reconstructor's execution plan); left at 0, the default stays.
+void resolve_steps(TrainingConfig& t, const Geometry& g) {
+  const bool left_to_scan = t.steps == TrainingConfig::kScanSteps;
+  t.steps = t.steps_for(g.is_3d());
+  if (!left_to_scan || g.is_3d() || !(t.min_draws_per_ray > 0.0) || t.rays_per_step <= 0 ||
+      t.sampler == Sampler::kViewsTimesElements)
+    return;
+  const double rays = static_cast<double>(g.n_views()) * static_cast<double>(g.n_u);
+  const double wanted = std::ceil(t.min_draws_per_ray * rays / t.rays_per_step);
+  if (wanted > t.steps) t.steps = static_cast<int>(std::min<double>(wanted, 1 << 30));
+}
+
+}  // namespace
+
 TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device)
     : scan(std::move(s)), config(std::move(c)) {
   config.validate();
@@ -16,7 +38,7 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
   check_scan(scan);
   const Geometry& g = scan.geometry;
   elements_per_view = g.n_u * (g.is_3d() ? g.n_v : 1);
-  config.training.steps = config.training.steps_for(g.is_3d());
+  resolve_steps(config.training, g);
   if (config.encoding.finest_resolution == 0) {
     const std::size_t largest = *std::max_element(g.volume_shape.begin(), g.volume_shape.end());
     config.encoding.finest_resolution =
