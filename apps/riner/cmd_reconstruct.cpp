@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "detector_outputs.hpp"
 #include "progress.hpp"
+#include "reconstruct_slabs.hpp"
 #include "riner/error.hpp"
 #include "riner/fbp.hpp"
 #include "riner/io.hpp"
@@ -140,6 +141,7 @@ int run_reconstruct(int argc, char** argv, int first) {
       .flag("paper", "use the paper's settings (L=10, T=2^10, F=8, width 128, 4000 steps, ...)")
       .flag("no-ring-correction",
             "write the trained field and alpha as they are (no ring corrections)");
+  add_slab_options(args);
   add_engine_flags(args);
   args.output_flags();
   if (!args.parse(argc, argv, first)) return 0;
@@ -147,6 +149,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   // set-up and evaluation take longer than the training.
   const auto started = std::chrono::steady_clock::now();
   Console console(args);
+  if (wants_slabs(args)) return reconstruct_by_slabs(args, console, config_from(args), started);
   LoadedScan loaded = scan_from(args, console);
   const std::optional<CentreEstimate> centre_check = check_centre(loaded, console);
   Scan& scan = loaded.scan;

@@ -32,7 +32,7 @@ void add_scan_options(Args& args) {
               "");
 }
 
-LoadedScan scan_from(const Args& args, const Console& console) {
+ScanSource source_from(const Args& args) {
   ScanSource source{args.get("SCAN"), args.get("geometry"),
                     args.get("flat"), args.get("dark"),
                     std::nullopt,     args.has("offset-px") ? args.get("offset-px") : ""};
@@ -51,7 +51,11 @@ LoadedScan scan_from(const Args& args, const Console& console) {
     throw UsageError("--dark needs --flat (and SCAN holding raw projections)");
   }
   if (source.offset_px != "auto" && !source.offset_px.empty()) args.number("offset-px");
-  LoadedScan loaded = load_scan_source(std::move(source));
+  return source;
+}
+
+LoadedScan scan_from(const Args& args, const Console& console) {
+  LoadedScan loaded = load_scan_source(source_from(args));
   for (const std::string& note : loaded.notes) console.line(note);
   return loaded;
 }

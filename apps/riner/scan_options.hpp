@@ -6,11 +6,14 @@
 
 #include "cli_args.hpp"
 #include "cli_common.hpp"
-#include "scan_source.hpp"
+#include "riner/scan_source.hpp"
 
 namespace riner::app {
 
 void add_scan_options(Args& args);
+
+// The scan as the options name it (UsageError for a combination that cannot work).
+ScanSource source_from(const Args& args);
 
 // The measurement SCAN names, or, with --flat, raw projections normalised by their flat and
 // dark fields; its detector offset from --offset-px (a number, or auto: estimated).

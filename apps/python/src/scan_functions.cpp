@@ -12,7 +12,7 @@
 #include "riner/metrics.hpp"
 #include "riner/phantom.hpp"
 #include "riner/simulate.hpp"
-#include "scan_source.hpp"
+#include "riner/scan_source.hpp"
 #include "summary_json.hpp"
 
 namespace riner::python {
@@ -141,10 +141,10 @@ void bind_scan_functions(py::module_& m) {
   m.def("load_scan", [](const std::string& path, const std::string& geometry,
                         const std::string& flat, const std::string& dark,
                         std::optional<std::size_t> row, const std::string& offset_px) {
-    app::LoadedScan loaded;
+    LoadedScan loaded;
     {
       py::gil_scoped_release release;
-      loaded = app::load_scan_source({path, geometry, flat, dark, row, offset_px});
+      loaded = load_scan_source({path, geometry, flat, dark, row, offset_px});
     }
     const nlohmann::json notes = {
         {"flat_field",

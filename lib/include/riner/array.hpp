@@ -42,6 +42,17 @@ Array axial_slice(const Array& volume, std::size_t z);
 // InputError when there is no such row.
 Array detector_row(const Array& stack, std::size_t row);
 
+// Detector rows [first, first + count) of a stack: what a slab of the volume needs.
+struct RowRange {
+  std::size_t first = 0;
+  std::size_t count = 0;
+  std::size_t end() const { return first + count; }
+  bool operator==(const RowRange& o) const { return first == o.first && count == o.count; }
+};
+
+// Detector rows `rows` of a stack: [frames, count, columns] (a copy). InputError past the end.
+Array detector_rows(const Array& stack, RowRange rows);
+
 // "[360, 500]"
 std::string shape_string(const std::vector<std::size_t>& shape);
 

@@ -78,6 +78,10 @@ struct FieldOfView {
 };
 FieldOfView field_of_view(const Geometry& g);
 
+// The geometry of detector rows [first, first + count) of g's (3D) detector: the same rows in the
+// same place (offset_v moves with the first row), the volume unchanged.
+Geometry detector_rows_geometry(const Geometry& g, std::size_t first, std::size_t count);
+
 // Uniform angles start + range * i / count, i = 0..count-1.
 std::vector<double> uniform_angles(const UniformAngles& spec);
 

@@ -41,6 +41,14 @@ struct ArrayFile {
 
 ArrayFile read_array(const std::filesystem::path& path);
 
+// Only detector rows `rows` of a stack [views, rows, columns]: read alone where the format lets
+// a reader seek (.npy and .raw in C order, HDF5 by hyperslab, TIFF pages and stacks scanline by
+// scanline); other files are read whole and cut. InputError for a 2D array or rows past its end.
+ArrayFile read_array_rows(const std::filesystem::path& path, RowRange rows);
+
+// The array's shape from its header where the format has one (every format but NIfTI).
+std::vector<std::size_t> read_array_shape(const std::filesystem::path& path);
+
 struct WriteOptions {
   std::vector<double> voxel_size;  // per axis in array order; NIfTI pixdim (mm)
 };
@@ -61,6 +69,12 @@ Window percentile_window(const Array& image, double lo_percent = 1.0, double hi_
 // side by side, 4 pixels apart: axial (slice z/2), coronal (row y/2) and sagittal (column x/2),
 // the last two with +z up. InputError for other ranks.
 Array preview_image(const Array& image);
+// The same panel from the three planes alone (a volume streamed slab by slab): axial [y, x],
+// coronal [z, x] and sagittal [z, y], z ascending. InputError when they do not fit together.
+Array preview_panel(const Array& axial, const Array& coronal, const Array& sagittal);
+// Row y of every slice of a volume [z, y, x]: [z, x]; column x: [z, y].
+Array coronal_plane(const Array& volume, std::size_t y);
+Array sagittal_plane(const Array& volume, std::size_t x);
 
 // 8-bit grey PNG of a 2D array mapped through the window; of a 3D one, its three central slices
 // side by side (axial, coronal, sagittal; +z up), the percentile window taken over all three.

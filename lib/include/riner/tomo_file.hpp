@@ -31,10 +31,18 @@ bool is_hdf5_path(const std::filesystem::path& path);
 // InputError naming the file and the dataset for a file that is neither layout, a missing
 // dataset, a rank other than 3, or counts that do not match (image_key against the frames,
 // angles against the projections).
-TomoFile read_tomo_file(const std::filesystem::path& path);
+// With `rows`, only those detector rows of the projections, flats and darks (a hyperslab: a
+// slab of a large scan reads its own bytes).
+TomoFile read_tomo_file(const std::filesystem::path& path,
+                        std::optional<RowRange> rows = std::nullopt);
+// The projections' shape [views, rows, columns], from the file's metadata.
+std::vector<std::size_t> tomo_file_shape(const std::filesystem::path& path);
 
-// One dataset as float32.
-Array read_hdf5_dataset(const std::filesystem::path& file, const std::string& dataset);
+// One dataset as float32; with `rows`, only those of a [frames, rows, columns] dataset.
+Array read_hdf5_dataset(const std::filesystem::path& file, const std::string& dataset,
+                        std::optional<RowRange> rows = std::nullopt);
+std::vector<std::size_t> hdf5_dataset_shape(const std::filesystem::path& file,
+                                            const std::string& dataset);
 
 // "file.h5:/group/dataset" -> {"file.h5", "/group/dataset"}; nullopt for any other path.
 std::optional<std::pair<std::filesystem::path, std::string>> split_hdf5_dataset(

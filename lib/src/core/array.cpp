@@ -92,4 +92,20 @@ Array detector_row(const Array& stack, std::size_t row) {
   return out;
 }
 
+Array detector_rows(const Array& stack, RowRange rows) {
+  if (stack.rank() != 3 || rows.count == 0 || rows.end() > stack.shape[1]) {
+    throw InputError("no detector rows " + std::to_string(rows.first) + ".." +
+                     std::to_string(rows.end()) + " in frames of shape " +
+                     shape_string(stack.shape));
+  }
+  const std::size_t frames = stack.shape[0], all = stack.shape[1], columns = stack.shape[2];
+  Array out({frames, rows.count, columns});
+  for (std::size_t f = 0; f < frames; ++f) {
+    std::copy_n(stack.data.begin() + static_cast<std::ptrdiff_t>((f * all + rows.first) * columns),
+                rows.count * columns,
+                out.data.begin() + static_cast<std::ptrdiff_t>(f * rows.count * columns));
+  }
+  return out;
+}
+
 }  // namespace riner

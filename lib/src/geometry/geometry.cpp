@@ -85,4 +85,14 @@ FieldOfView field_of_view(const Geometry& g) {
   return f;
 }
 
+Geometry detector_rows_geometry(const Geometry& g, std::size_t first, std::size_t count) {
+  Geometry cut = g;
+  cut.n_v = count;
+  // Row r of the whole detector sits at (r - (n_v-1)/2 + offset_v) pitches; keep it there.
+  cut.offset_v = g.offset_v + static_cast<double>(first) +
+                 (static_cast<double>(count) - 1.0) / 2.0 -
+                 (static_cast<double>(g.n_v) - 1.0) / 2.0;
+  return cut;
+}
+
 }  // namespace riner

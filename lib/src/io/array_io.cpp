@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "io/file_access.hpp"
+#include "io/row_blocks.hpp"
 #include "io/formats.hpp"
 #include "io/stack.hpp"
 #include "riner/error.hpp"
@@ -99,6 +100,54 @@ ArrayFile read_array(const std::filesystem::path& path) {
   throw InputError(io::prefix(path) + "unknown file type");
 }
 
+ArrayFile read_array_rows(const std::filesystem::path& path, RowRange rows) {
+  if (const auto named = split_hdf5_dataset(path)) {
+    return array_file(read_hdf5_dataset(named->first, named->second, rows), FileFormat::kHdf5);
+  }
+  if (io::is_stack_path(path)) return io::read_stack_rows(path, rows);
+  std::optional<ArrayFile> file;
+  switch (format_from_path(path)) {
+    case FileFormat::kNpy:
+      file = io::read_npy_rows(path, rows);
+      break;
+    case FileFormat::kRaw:
+      file = io::read_raw_rows(path, rows);
+      break;
+    case FileFormat::kTiff: {
+      ArrayFile pages = io::read_tiff_rows(path, rows);
+      if (pages.array.rank() != 3) {
+        throw InputError(io::prefix(path) + "is one image; reading detector rows needs a stack");
+      }
+      return pages;
+    }
+    case FileFormat::kHdf5:
+      return array_file(read_tomo_file(path, rows).projections, FileFormat::kHdf5);
+    default:
+      break;
+  }
+  if (file) return std::move(*file);
+  return io::cut_rows(read_array(path), path, rows);
+}
+
+std::vector<std::size_t> read_array_shape(const std::filesystem::path& path) {
+  if (const auto named = split_hdf5_dataset(path)) {
+    return hdf5_dataset_shape(named->first, named->second);
+  }
+  if (io::is_stack_path(path)) return io::stack_shape(path);
+  switch (format_from_path(path)) {
+    case FileFormat::kNpy:
+      return io::npy_shape(path);
+    case FileFormat::kRaw:
+      return io::raw_shape(path);
+    case FileFormat::kTiff:
+      return io::tiff_shape(path);
+    case FileFormat::kHdf5:
+      return tomo_file_shape(path);
+    default:
+      return read_array(path).array.shape;
+  }
+}
+
 void write_array(const std::filesystem::path& path, const Array& array,
                  const WriteOptions& options) {
   if (array.shape.empty() || shape_size(array.shape) != array.size()) {
@@ -153,30 +202,56 @@ Window percentile_window(const Array& image, double lo_percent, double hi_percen
   return window;
 }
 
-// 2D: the image. 3D: the three central slices side by side, 4 pixels apart: axial (the middle
-// slice, as a 2D image), coronal (the middle row) and sagittal (the middle column), the last
-// two with +z up.
+Array preview_panel(const Array& axial, const Array& coronal, const Array& sagittal) {
+  if (axial.rank() != 2 || coronal.rank() != 2 || sagittal.rank() != 2 ||
+      coronal.shape[0] != sagittal.shape[0] || coronal.shape[1] != axial.shape[1] ||
+      sagittal.shape[1] != axial.shape[0]) {
+    throw InputError("preview planes of shapes " + shape_string(axial.shape) + ", " +
+                     shape_string(coronal.shape) + " and " + shape_string(sagittal.shape) +
+                     " do not belong to one volume");
+  }
+  const std::size_t nz = coronal.shape[0], ny = axial.shape[0], nx = axial.shape[1];
+  constexpr std::size_t kGap = 4;
+  Array panel({std::max(ny, nz), nx + kGap + nx + kGap + ny}, 0.0f);
+  for (std::size_t y = 0; y < ny; ++y) {
+    for (std::size_t x = 0; x < nx; ++x) panel(y, x) = axial(y, x);
+  }
+  for (std::size_t z = 0; z < nz; ++z) {
+    const std::size_t row = nz - 1 - z;
+    for (std::size_t x = 0; x < nx; ++x) panel(row, nx + kGap + x) = coronal(z, x);
+    for (std::size_t y = 0; y < ny; ++y) panel(row, 2 * (nx + kGap) + y) = sagittal(z, y);
+  }
+  return panel;
+}
+
+Array coronal_plane(const Array& volume, std::size_t y) {
+  const std::size_t nz = volume.shape[0], ny = volume.shape[1], nx = volume.shape[2];
+  Array plane({nz, nx});
+  for (std::size_t z = 0; z < nz; ++z) {
+    for (std::size_t x = 0; x < nx; ++x) plane(z, x) = volume.data[(z * ny + y) * nx + x];
+  }
+  return plane;
+}
+
+Array sagittal_plane(const Array& volume, std::size_t x) {
+  const std::size_t nz = volume.shape[0], ny = volume.shape[1], nx = volume.shape[2];
+  Array plane({nz, ny});
+  for (std::size_t z = 0; z < nz; ++z) {
+    for (std::size_t y = 0; y < ny; ++y) plane(z, y) = volume.data[(z * ny + y) * nx + x];
+  }
+  return plane;
+}
+
+// 2D: the image. 3D: the three central slices side by side (preview_panel).
 Array preview_image(const Array& image) {
   if (image.rank() == 2) return image;
   if (image.rank() != 3) {
     throw InputError("a preview needs a 2D image or a 3D volume, not rank " +
                      std::to_string(image.rank()));
   }
-  const std::size_t nz = image.shape[0], ny = image.shape[1], nx = image.shape[2];
-  constexpr std::size_t kGap = 4;
-  Array panel({std::max(ny, nz), nx + kGap + nx + kGap + ny}, 0.0f);
-  auto at = [&](std::size_t z, std::size_t y, std::size_t x) {
-    return image.data[(z * ny + y) * nx + x];
-  };
-  for (std::size_t y = 0; y < ny; ++y) {
-    for (std::size_t x = 0; x < nx; ++x) panel(y, x) = at(nz / 2, y, x);
-  }
-  for (std::size_t z = 0; z < nz; ++z) {
-    const std::size_t row = nz - 1 - z;
-    for (std::size_t x = 0; x < nx; ++x) panel(row, nx + kGap + x) = at(z, ny / 2, x);
-    for (std::size_t y = 0; y < ny; ++y) panel(row, 2 * (nx + kGap) + y) = at(z, y, nx / 2);
-  }
-  return panel;
+  return preview_panel(axial_slice(image, image.shape[0] / 2),
+                       coronal_plane(image, image.shape[1] / 2),
+                       sagittal_plane(image, image.shape[2] / 2));
 }
 
 void write_png(const std::filesystem::path& path, const Array& image, const Window& window) {

@@ -3,12 +3,17 @@
 #pragma once
 
 #include <filesystem>
+#include <optional>
+#include <vector>
 
 #include "riner/io.hpp"
 
 namespace riner::io {
 
 ArrayFile read_npy(const std::filesystem::path& path);
+std::vector<std::size_t> npy_shape(const std::filesystem::path& path);
+// Rows of a C-order stack by seeking; nullopt for a Fortran-order file (read it whole).
+std::optional<ArrayFile> read_npy_rows(const std::filesystem::path& path, RowRange rows);
 void write_npy(const std::filesystem::path& path, const Array& array);
 
 ArrayFile read_nifti(const std::filesystem::path& path);
@@ -16,10 +21,15 @@ void write_nifti(const std::filesystem::path& path, const Array& array,
                  const std::vector<double>& voxel_size);
 
 ArrayFile read_tiff(const std::filesystem::path& path);
+// Rows `rows` of every page: [count, cols] for one page, [pages, count, cols] for several.
+ArrayFile read_tiff_rows(const std::filesystem::path& path, RowRange rows);
+std::vector<std::size_t> tiff_shape(const std::filesystem::path& path);
 void write_tiff(const std::filesystem::path& path, const Array& array);
 
 // The sidecar is "<path>.json".
 ArrayFile read_raw(const std::filesystem::path& path);
+std::vector<std::size_t> raw_shape(const std::filesystem::path& path);
+std::optional<ArrayFile> read_raw_rows(const std::filesystem::path& path, RowRange rows);
 std::string raw_sidecar_json(const Array& array);
 
 // 8-bit PNG of prepared pixels (rows x cols x channels).

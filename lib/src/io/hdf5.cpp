@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <type_traits>
 
 #include "io/file_access.hpp"
@@ -21,6 +22,8 @@ class Hid {
   Hid(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
   Hid(const Hid&) = delete;
   Hid& operator=(const Hid&) = delete;
+  Hid(Hid&& other) noexcept : id_(other.id_), close_(other.close_) { other.id_ = -1; }
+  Hid& operator=(Hid&&) = delete;
   ~Hid() {
     if (id_ >= 0) close_(id_);
   }
@@ -57,37 +60,72 @@ bool exists(const Hid& file, const std::string& path) {
   return true;
 }
 
-// A dataset's shape and values as float64 or float32.
-template <typename T>
-std::vector<T> read_values(const Hid& file, const std::filesystem::path& path,
-                           const std::string& dataset, std::vector<std::size_t>& shape) {
+// A dataset, open, with its shape; InputError naming it when it is missing or not numbers.
+struct OpenDataset {
+  std::optional<Hid> set;
+  std::optional<Hid> space;
+  std::vector<hsize_t> dims;
+};
+
+OpenDataset open_dataset(const Hid& file, const std::filesystem::path& path,
+                         const std::string& dataset) {
   if (!exists(file, dataset)) throw InputError(where(path, dataset) + "no such dataset");
-  Hid set(H5Dopen2(file.get(), dataset.c_str(), H5P_DEFAULT), H5Dclose);
-  if (!set.ok()) throw InputError(where(path, dataset) + "is not a dataset");
-  Hid space(H5Dget_space(set.get()), H5Sclose);
-  const int rank = H5Sget_simple_extent_ndims(space.get());
+  OpenDataset d;
+  d.set.emplace(H5Dopen2(file.get(), dataset.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!d.set->ok()) throw InputError(where(path, dataset) + "is not a dataset");
+  d.space.emplace(H5Dget_space(d.set->get()), H5Sclose);
+  const int rank = H5Sget_simple_extent_ndims(d.space->get());
   if (rank < 0 || rank > 8) throw InputError(where(path, dataset) + "has an unreadable shape");
-  std::vector<hsize_t> dims(static_cast<std::size_t>(rank));
-  H5Sget_simple_extent_dims(space.get(), dims.data(), nullptr);
-  shape.assign(dims.begin(), dims.end());
-  Hid type(H5Dget_type(set.get()), H5Tclose);
+  d.dims.resize(static_cast<std::size_t>(rank));
+  H5Sget_simple_extent_dims(d.space->get(), d.dims.data(), nullptr);
+  Hid type(H5Dget_type(d.set->get()), H5Tclose);
   const H5T_class_t type_class = H5Tget_class(type.get());
   if (type_class != H5T_INTEGER && type_class != H5T_FLOAT) {
     throw InputError(where(path, dataset) + "holds neither integers nor floats");
   }
+  return d;
+}
+
+// A dataset's shape and values as float64 or float32; with `rows`, only those of the second
+// axis of a [frames, rows, cols] dataset (a hyperslab: the file is read for those alone).
+template <typename T>
+std::vector<T> read_values(const Hid& file, const std::filesystem::path& path,
+                           const std::string& dataset, std::vector<std::size_t>& shape,
+                           std::optional<RowRange> rows = std::nullopt) {
+  const OpenDataset d = open_dataset(file, path, dataset);
+  shape.assign(d.dims.begin(), d.dims.end());
+  hid_t file_space = H5S_ALL;
+  std::optional<Hid> memory_space;
+  if (rows) {
+    if (shape.size() != 3 || rows->count == 0 || rows->first > shape[1] ||
+        rows->count > shape[1] - rows->first) {
+      throw InputError(where(path, dataset) + "is " + shape_string(shape) + "; rows " +
+                       std::to_string(rows->first) + ".." + std::to_string(rows->end()) +
+                       " of a [frames, rows, columns] dataset asked for");
+    }
+    const hsize_t start[3] = {0, rows->first, 0};
+    const hsize_t count[3] = {d.dims[0], rows->count, d.dims[2]};
+    if (H5Sselect_hyperslab(d.space->get(), H5S_SELECT_SET, start, nullptr, count, nullptr) < 0) {
+      throw InputError(where(path, dataset) + "cannot select rows");
+    }
+    file_space = d.space->get();
+    memory_space.emplace(H5Screate_simple(3, count, nullptr), H5Sclose);
+    shape[1] = rows->count;
+  }
   std::vector<T> values(shape_size(shape));
   const hid_t memory_type = std::is_same_v<T, double> ? H5T_NATIVE_DOUBLE : H5T_NATIVE_FLOAT;
   if (!values.empty() &&
-      H5Dread(set.get(), memory_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) < 0) {
+      H5Dread(d.set->get(), memory_type, memory_space ? memory_space->get() : H5S_ALL, file_space,
+              H5P_DEFAULT, values.data()) < 0) {
     throw InputError(where(path, dataset) + "read failed (truncated or corrupt file?)");
   }
   return values;
 }
 
 Array read_float_array(const Hid& file, const std::filesystem::path& path,
-                       const std::string& dataset) {
+                       const std::string& dataset, std::optional<RowRange> rows = std::nullopt) {
   std::vector<std::size_t> shape;
-  std::vector<float> values = read_values<float>(file, path, dataset, shape);
+  std::vector<float> values = read_values<float>(file, path, dataset, shape, rows);
   return Array(std::move(shape), std::move(values));
 }
 
@@ -114,17 +152,18 @@ Array frames_with_key(const Array& all, const std::vector<double>& keys, int key
   return out;
 }
 
-TomoFile read_data_exchange(const Hid& file, const std::filesystem::path& path) {
+TomoFile read_data_exchange(const Hid& file, const std::filesystem::path& path,
+                            std::optional<RowRange> rows) {
   TomoFile t;
   t.layout = "data exchange";
   t.projections =
-      require_rank3(read_float_array(file, path, "/exchange/data"), path, "/exchange/data");
+      require_rank3(read_float_array(file, path, "/exchange/data", rows), path, "/exchange/data");
   if (exists(file, "/exchange/data_white")) {
-    t.flats = require_rank3(read_float_array(file, path, "/exchange/data_white"), path,
+    t.flats = require_rank3(read_float_array(file, path, "/exchange/data_white", rows), path,
                             "/exchange/data_white");
   }
   if (exists(file, "/exchange/data_dark")) {
-    t.darks = require_rank3(read_float_array(file, path, "/exchange/data_dark"), path,
+    t.darks = require_rank3(read_float_array(file, path, "/exchange/data_dark", rows), path,
                             "/exchange/data_dark");
   }
   if (exists(file, "/exchange/theta")) {
@@ -135,8 +174,9 @@ TomoFile read_data_exchange(const Hid& file, const std::filesystem::path& path) 
 }
 
 TomoFile read_nxtomo(const Hid& file, const std::filesystem::path& path, const std::string& data,
-                     const std::string& keys_path, const std::string& angles_path) {
-  const Array all = require_rank3(read_float_array(file, path, data), path, data);
+                     const std::string& keys_path, const std::string& angles_path,
+                     std::optional<RowRange> rows) {
+  const Array all = require_rank3(read_float_array(file, path, data, rows), path, data);
   std::vector<std::size_t> shape;
   const std::vector<double> keys = read_values<double>(file, path, keys_path, shape);
   if (keys.size() != all.shape[0]) {
@@ -171,18 +211,25 @@ bool is_hdf5_path(const std::filesystem::path& path) {
   return ext == ".h5" || ext == ".hdf5" || ext == ".hdf" || ext == ".nxs" || ext == ".nx";
 }
 
-TomoFile read_tomo_file(const std::filesystem::path& path) {
-  const Hid file = open_file(path);
-  if (exists(file, "/exchange/data")) return read_data_exchange(file, path);
+namespace {
+
+// Where a tomography file keeps its frames: the layout and the datasets.
+struct TomoLayout {
+  bool data_exchange = false;
+  std::string data;
+  std::string keys;
+  std::string angles;
+};
+
+TomoLayout find_layout(const Hid& file, const std::filesystem::path& path) {
+  if (exists(file, "/exchange/data")) return {true, "/exchange/data", "", ""};
   for (const char* entry_name : {"/entry", "/entry1"}) {
     const std::string entry = entry_name;
     for (const std::string& data : {entry + "/data/data", entry + "/instrument/detector/data"}) {
       if (!exists(file, data)) continue;
       for (const std::string& keys :
            {entry + "/instrument/detector/image_key", entry + "/data/image_key"}) {
-        if (exists(file, keys)) {
-          return read_nxtomo(file, path, data, keys, entry + "/sample/rotation_angle");
-        }
+        if (exists(file, keys)) return {false, data, keys, entry + "/sample/rotation_angle"};
       }
       throw InputError(where(path, data) + "has no image_key beside it (NXtomo)");
     }
@@ -190,6 +237,33 @@ TomoFile read_tomo_file(const std::filesystem::path& path) {
   throw InputError(io::prefix(path) +
                    "holds neither /exchange/data (Data Exchange) nor /entry/data/data (NXtomo); "
                    "name a dataset as FILE:/path");
+}
+
+}  // namespace
+
+TomoFile read_tomo_file(const std::filesystem::path& path, std::optional<RowRange> rows) {
+  const Hid file = open_file(path);
+  const TomoLayout layout = find_layout(file, path);
+  if (layout.data_exchange) return read_data_exchange(file, path, rows);
+  return read_nxtomo(file, path, layout.data, layout.keys, layout.angles, rows);
+}
+
+std::vector<std::size_t> tomo_file_shape(const std::filesystem::path& path) {
+  const Hid file = open_file(path);
+  const TomoLayout layout = find_layout(file, path);
+  const OpenDataset d = open_dataset(file, path, layout.data);
+  std::vector<std::size_t> shape(d.dims.begin(), d.dims.end());
+  if (shape.size() != 3) {
+    throw InputError(where(path, layout.data) + "is " + shape_string(shape) +
+                     "; expected [frames, rows, columns]");
+  }
+  if (!layout.data_exchange) {
+    std::vector<std::size_t> key_shape;
+    const std::vector<double> keys = read_values<double>(file, path, layout.keys, key_shape);
+    shape[0] = static_cast<std::size_t>(
+        std::count_if(keys.begin(), keys.end(), [](double k) { return static_cast<int>(k) == 0; }));
+  }
+  return shape;
 }
 
 std::optional<std::pair<std::filesystem::path, std::string>> split_hdf5_dataset(
@@ -203,9 +277,17 @@ std::optional<std::pair<std::filesystem::path, std::string>> split_hdf5_dataset(
   return std::nullopt;
 }
 
-Array read_hdf5_dataset(const std::filesystem::path& path, const std::string& dataset) {
+Array read_hdf5_dataset(const std::filesystem::path& path, const std::string& dataset,
+                        std::optional<RowRange> rows) {
   const Hid file = open_file(path);
-  return read_float_array(file, path, dataset);
+  return read_float_array(file, path, dataset, rows);
+}
+
+std::vector<std::size_t> hdf5_dataset_shape(const std::filesystem::path& path,
+                                            const std::string& dataset) {
+  const Hid file = open_file(path);
+  const OpenDataset d = open_dataset(file, path, dataset);
+  return std::vector<std::size_t>(d.dims.begin(), d.dims.end());
 }
 
 }  // namespace riner

@@ -2,10 +2,12 @@
 // (https://numpy.org/doc/stable/reference/generated/numpy.lib.format.html).
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <regex>
 
 #include "io/file_access.hpp"
 #include "io/formats.hpp"
+#include "io/row_blocks.hpp"
 #include "io/sample_type.hpp"
 #include "riner/error.hpp"
 
@@ -98,46 +100,118 @@ std::vector<float> fortran_to_c_order(const std::vector<float>& data,
   return out;
 }
 
-ArrayFile read_npy(const std::filesystem::path& path) {
-  const std::string bytes = read_file_bytes(path);
-  if (bytes.size() < kMagicSize + 4 || std::memcmp(bytes.data(), kMagic, kMagicSize) != 0) {
+namespace {
+
+// Where the data start and how they are laid out, from the first bytes of the file.
+struct NpyLayout {
+  NpyHeader header;
+  std::size_t data_start = 0;
+};
+
+NpyLayout parse_layout(const std::string& head, const std::filesystem::path& path,
+                       std::size_t file_size) {
+  if (head.size() < kMagicSize + 4 || std::memcmp(head.data(), kMagic, kMagicSize) != 0) {
     throw InputError(prefix(path) + "not a NumPy .npy file (bad magic)");
   }
-  const int major = static_cast<unsigned char>(bytes[6]);
+  const int major = static_cast<unsigned char>(head[6]);
   std::size_t header_len = 0;
-  std::size_t data_start = 0;
-  const auto* u = reinterpret_cast<const unsigned char*>(bytes.data());
+  NpyLayout layout;
+  const auto* u = reinterpret_cast<const unsigned char*>(head.data());
   if (major == 1) {
     header_len = u[8] | (u[9] << 8);
-    data_start = 10 + header_len;
+    layout.data_start = 10 + header_len;
   } else if (major == 2 || major == 3) {
-    if (bytes.size() < 12) throw InputError(prefix(path) + "truncated header");
+    if (head.size() < 12) throw InputError(prefix(path) + "truncated header");
     header_len = u[8] | (u[9] << 8) | (u[10] << 16) | (static_cast<std::size_t>(u[11]) << 24);
-    data_start = 12 + header_len;
+    layout.data_start = 12 + header_len;
   } else {
     throw InputError(prefix(path) + "unsupported .npy version " + std::to_string(major));
   }
-  if (data_start > bytes.size()) throw InputError(prefix(path) + "truncated header");
-  const NpyHeader header = parse_header(bytes.substr(data_start - header_len, header_len), path);
+  if (layout.data_start > file_size || layout.data_start > head.size())
+    throw InputError(prefix(path) + "truncated header");
+  layout.header = parse_header(head.substr(layout.data_start - header_len, header_len), path);
+  return layout;
+}
 
+void check_data_size(const NpyLayout& layout, const std::filesystem::path& path,
+                     std::size_t file_size) {
+  const std::size_t count = element_count(path, layout.header.shape);
+  const std::size_t item = sample_bytes(layout.header.type);
+  const std::size_t available = file_size - layout.data_start;
+  if (count > available / item || count * item != available) {
+    throw InputError(prefix(path) + "header says " + shape_string(layout.header.shape) + " " +
+                     sample_type_name(layout.header.type) + " (" + std::to_string(count) +
+                     " values) but the file holds " + std::to_string(available) + " data bytes");
+  }
+}
+
+// The header alone: the magic, the lengths and the dictionary (at most 4 GiB by the format).
+NpyLayout read_layout(std::ifstream& in, const std::filesystem::path& path,
+                      std::size_t file_size) {
+  std::string head(std::min<std::size_t>(file_size, 12), '\0');
+  in.read(head.data(), static_cast<std::streamsize>(head.size()));
+  if (!in) throw InputError(prefix(path) + "cannot read the header");
+  std::size_t needed = head.size();
+  if (head.size() >= 10 && std::memcmp(head.data(), kMagic, kMagicSize) == 0) {
+    const auto* u = reinterpret_cast<const unsigned char*>(head.data());
+    const int major = u[6];
+    needed = major == 1 ? 10 + (u[8] | (u[9] << 8))
+                        : 12 + (u[8] | (u[9] << 8) | (u[10] << 16) |
+                                (static_cast<std::size_t>(u[11]) << 24));
+  }
+  if (needed > head.size()) {
+    if (needed > file_size) throw InputError(prefix(path) + "truncated header");
+    const std::size_t had = head.size();
+    head.resize(needed);
+    in.read(head.data() + had, static_cast<std::streamsize>(needed - had));
+    if (!in) throw InputError(prefix(path) + "truncated header");
+  }
+  return parse_layout(head, path, file_size);
+}
+
+}  // namespace
+
+ArrayFile read_npy(const std::filesystem::path& path) {
+  const std::string bytes = read_file_bytes(path);
+  const NpyLayout layout = parse_layout(bytes, path, bytes.size());
+  const NpyHeader& header = layout.header;
+  check_data_size(layout, path, bytes.size());
   ArrayFile file;
   file.format = FileFormat::kNpy;
   file.dtype = sample_type_name(header.type);
-  const std::size_t count = element_count(path, header.shape);
-  const std::size_t item = sample_bytes(header.type);
-  const std::size_t available = bytes.size() - data_start;
-  if (count > available / item || count * item != available) {
-    throw InputError(prefix(path) + "header says " + shape_string(header.shape) + " " + file.dtype +
-                     " (" + std::to_string(count) + " values) but the file holds " +
-                     std::to_string(available) + " data bytes");
-  }
+  const std::size_t count = shape_size(header.shape);
   std::vector<float> data(count);
-  file.non_finite =
-      decode_samples(u + data_start, count, header.type, header.little_endian, data.data());
+  const auto* u = reinterpret_cast<const unsigned char*>(bytes.data());
+  file.non_finite = decode_samples(u + layout.data_start, count, header.type,
+                                   header.little_endian, data.data());
   if (header.fortran_order && header.shape.size() > 1)
     data = fortran_to_c_order(data, header.shape);
   file.array = Array(header.shape, std::move(data));
   return file;
+}
+
+std::vector<std::size_t> npy_shape(const std::filesystem::path& path) {
+  const std::uint64_t size = input_file_size(path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(prefix(path) + "cannot be opened");
+  const NpyLayout layout = read_layout(in, path, size);
+  check_data_size(layout, path, size);
+  return layout.header.shape;
+}
+
+std::optional<ArrayFile> read_npy_rows(const std::filesystem::path& path, RowRange rows) {
+  const std::uint64_t size = input_file_size(path);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(prefix(path) + "cannot be opened");
+  const NpyLayout layout = read_layout(in, path, size);
+  const NpyHeader& header = layout.header;
+  check_data_size(layout, path, size);
+  // A Fortran-order stack keeps a row's values apart: read whole and cut.
+  if (header.fortran_order || header.shape.size() != 3) return std::nullopt;
+  check_row_range(path, header.shape, rows);
+  register_input(path);
+  return read_row_blocks(in, path, layout.data_start, header.shape, rows, header.type,
+                         header.little_endian, FileFormat::kNpy);
 }
 
 void write_npy(const std::filesystem::path& path, const Array& array) {

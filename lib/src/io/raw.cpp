@@ -4,8 +4,12 @@
 // Only dtype and shape are required.
 #include <nlohmann/json.hpp>
 
+#include <fstream>
+#include <optional>
+
 #include "io/file_access.hpp"
 #include "io/formats.hpp"
+#include "io/row_blocks.hpp"
 #include "io/sample_type.hpp"
 #include "riner/error.hpp"
 
@@ -19,9 +23,15 @@ std::filesystem::path sidecar_path(const std::filesystem::path& path) {
   return sidecar;
 }
 
-}  // namespace
+struct RawLayout {
+  SampleType type = SampleType::kFloat32;
+  std::vector<std::size_t> shape;
+  bool little_endian = true;
+  bool fortran_order = false;
+  std::size_t offset = 0;
+};
 
-ArrayFile read_raw(const std::filesystem::path& path) {
+RawLayout read_sidecar(const std::filesystem::path& path) {
   const std::filesystem::path sidecar = sidecar_path(path);
   nlohmann::json meta;
   try {
@@ -37,12 +47,13 @@ ArrayFile read_raw(const std::filesystem::path& path) {
   if (!meta.contains("shape") || !meta["shape"].is_array() || meta["shape"].empty()) {
     throw bad("needs \"shape\" (a non-empty list of sizes)");
   }
-  std::vector<std::size_t> shape;
+  RawLayout layout;
+  layout.type = *type;
   for (const auto& d : meta["shape"]) {
     if (!d.is_number_unsigned() || d.get<std::uint64_t>() == 0) {
       throw bad("\"shape\" entries must be positive integers");
     }
-    shape.push_back(d.get<std::size_t>());
+    layout.shape.push_back(d.get<std::size_t>());
   }
   // json::value throws its own type_error on a non-string; name the field instead.
   auto text = [&](const char* key, const char* fallback) {
@@ -52,31 +63,64 @@ ArrayFile read_raw(const std::filesystem::path& path) {
   };
   const std::string order = text("byte_order", "little");
   if (order != "little" && order != "big") throw bad("\"byte_order\" must be little or big");
-  const std::string layout = text("order", "C");
-  if (layout != "C" && layout != "F") throw bad("\"order\" must be C or F");
-  std::size_t offset = 0;
+  layout.little_endian = order == "little";
+  const std::string memory_order = text("order", "C");
+  if (memory_order != "C" && memory_order != "F") throw bad("\"order\" must be C or F");
+  layout.fortran_order = memory_order == "F";
   if (meta.contains("offset_bytes")) {
     if (!meta["offset_bytes"].is_number_unsigned()) throw bad("\"offset_bytes\" must be >= 0");
-    offset = meta["offset_bytes"].get<std::size_t>();
+    layout.offset = meta["offset_bytes"].get<std::size_t>();
   }
+  return layout;
+}
 
-  const std::string bytes = read_file_bytes(path);
-  const std::size_t count = element_count(path, shape);
-  const std::size_t item = sample_bytes(*type);
-  if (offset > bytes.size() || count > (bytes.size() - offset) / item) {
-    throw InputError(prefix(path) + "sidecar says " + shape_string(shape) + " " +
-                     sample_type_name(*type) + " from byte " + std::to_string(offset) +
-                     " but the file has " + std::to_string(bytes.size()) + " bytes");
+void check_file_size(const RawLayout& layout, const std::filesystem::path& path,
+                     std::uint64_t bytes) {
+  const std::size_t count = element_count(path, layout.shape);
+  const std::size_t item = sample_bytes(layout.type);
+  if (layout.offset > bytes || count > (bytes - layout.offset) / item) {
+    throw InputError(prefix(path) + "sidecar says " + shape_string(layout.shape) + " " +
+                     sample_type_name(layout.type) + " from byte " +
+                     std::to_string(layout.offset) + " but the file has " +
+                     std::to_string(bytes) + " bytes");
   }
+}
+
+}  // namespace
+
+ArrayFile read_raw(const std::filesystem::path& path) {
+  const RawLayout layout = read_sidecar(path);
+  const std::string bytes = read_file_bytes(path);
+  check_file_size(layout, path, bytes.size());
   ArrayFile file;
   file.format = FileFormat::kRaw;
-  file.dtype = sample_type_name(*type);
-  std::vector<float> data(count);
-  file.non_finite = decode_samples(reinterpret_cast<const unsigned char*>(bytes.data()) + offset,
-                                   count, *type, order == "little", data.data());
-  if (layout == "F" && shape.size() > 1) data = fortran_to_c_order(data, shape);
-  file.array = Array(std::move(shape), std::move(data));
+  file.dtype = sample_type_name(layout.type);
+  std::vector<float> data(shape_size(layout.shape));
+  file.non_finite =
+      decode_samples(reinterpret_cast<const unsigned char*>(bytes.data()) + layout.offset,
+                     data.size(), layout.type, layout.little_endian, data.data());
+  if (layout.fortran_order && layout.shape.size() > 1)
+    data = fortran_to_c_order(data, layout.shape);
+  file.array = Array(layout.shape, std::move(data));
   return file;
+}
+
+std::vector<std::size_t> raw_shape(const std::filesystem::path& path) {
+  const RawLayout layout = read_sidecar(path);
+  check_file_size(layout, path, input_file_size(path));
+  return layout.shape;
+}
+
+std::optional<ArrayFile> read_raw_rows(const std::filesystem::path& path, RowRange rows) {
+  const RawLayout layout = read_sidecar(path);
+  check_file_size(layout, path, input_file_size(path));
+  if (layout.fortran_order || layout.shape.size() != 3) return std::nullopt;
+  check_row_range(path, layout.shape, rows);
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(prefix(path) + "cannot be opened");
+  register_input(path);
+  return read_row_blocks(in, path, layout.offset, layout.shape, rows, layout.type,
+                         layout.little_endian, FileFormat::kRaw);
 }
 
 std::string raw_sidecar_json(const Array& array) {

@@ -6,6 +6,8 @@
 #include <cctype>
 
 #include "io/file_access.hpp"
+#include "io/formats.hpp"
+#include "io/row_blocks.hpp"
 #include "riner/error.hpp"
 
 namespace riner::io {
@@ -87,9 +89,11 @@ std::vector<std::filesystem::path> stack_files(const std::filesystem::path& path
   return files;
 }
 
-ArrayFile read_stack(const std::filesystem::path& path,
-                     ArrayFile (*read_one)(const std::filesystem::path&)) {
-  const std::vector<std::filesystem::path> files = stack_files(path);
+namespace {
+
+// Each file, read by `read_one`, must be 2D and shaped like the first.
+template <typename ReadOne>
+ArrayFile stack_of(const std::vector<std::filesystem::path>& files, ReadOne&& read_one) {
   ArrayFile stack;
   std::vector<std::size_t> frame_shape;
   for (const std::filesystem::path& file : files) {
@@ -113,6 +117,47 @@ ArrayFile read_stack(const std::filesystem::path& path,
   }
   stack.array.shape = {files.size(), frame_shape[0], frame_shape[1]};
   return stack;
+}
+
+}  // namespace
+
+ArrayFile read_stack(const std::filesystem::path& path,
+                     ArrayFile (*read_one)(const std::filesystem::path&)) {
+  return stack_of(stack_files(path), read_one);
+}
+
+ArrayFile read_stack_rows(const std::filesystem::path& path, RowRange rows) {
+  const std::vector<std::filesystem::path> files = stack_files(path);
+  return stack_of(files, [&](const std::filesystem::path& file) {
+    const std::string ext = lower_extension(file);
+    if (ext == ".tif" || ext == ".tiff") {
+      ArrayFile frame = read_tiff_rows(file, rows);
+      if (frame.array.rank() != 2) {
+        throw InputError(prefix(file) + "has several pages; a stack is made of 2D images");
+      }
+      return frame;
+    }
+    // Another format named by a pattern: read the image whole and keep the rows.
+    ArrayFile frame = read_array(file);
+    if (frame.array.rank() != 2) return frame;  // stack_of names the mistake
+    frame.array.shape.insert(frame.array.shape.begin(), 1);
+    frame = cut_rows(std::move(frame), file, rows);
+    frame.array.shape.erase(frame.array.shape.begin());
+    return frame;
+  });
+}
+
+std::vector<std::size_t> stack_shape(const std::filesystem::path& path) {
+  const std::vector<std::filesystem::path> files = stack_files(path);
+  const std::string ext = lower_extension(files.front());
+  const std::vector<std::size_t> first = (ext == ".tif" || ext == ".tiff")
+                                             ? tiff_shape(files.front())
+                                             : read_array(files.front()).array.shape;
+  if (first.size() != 2) {
+    throw InputError(prefix(files.front()) + "is " + shape_string(first) +
+                     "; a stack is made of 2D images");
+  }
+  return {files.size(), first[0], first[1]};
 }
 
 }  // namespace riner::io

@@ -23,4 +23,9 @@ std::vector<std::filesystem::path> stack_files(const std::filesystem::path& path
 ArrayFile read_stack(const std::filesystem::path& path,
                      ArrayFile (*read_one)(const std::filesystem::path&));
 
+// Rows `rows` of every file (TIFFs, read row by row): [files, count, cols].
+ArrayFile read_stack_rows(const std::filesystem::path& path, RowRange rows);
+// [files, rows, cols] from the first file's header.
+std::vector<std::size_t> stack_shape(const std::filesystem::path& path);
+
 }  // namespace riner::io

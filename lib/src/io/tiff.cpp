@@ -5,6 +5,7 @@
 #include <cstdarg>
 #include <cstdio>
 #include <cstring>
+#include <optional>
 #include <memory>
 
 #include "io/file_access.hpp"
@@ -70,9 +71,10 @@ SampleType page_type(TIFF* tif, const std::filesystem::path& path) {
   throw InputError(prefix(path) + detail);
 }
 
-// Reads one page of rows x cols samples into out (host-order bytes, as libtiff delivers them).
-void read_page(TIFF* tif, std::size_t rows, std::size_t cols, std::size_t item, unsigned char* out,
-               const std::filesystem::path& path) {
+// Reads rows [y0, y1) of one page, cols samples each, into out (host-order bytes, as libtiff
+// delivers them). Scanlines before y0 are decoded only where a compressed strip needs them.
+void read_page(TIFF* tif, std::size_t y0, std::size_t y1, std::size_t cols, std::size_t item,
+               unsigned char* out, const std::filesystem::path& path) {
   if (TIFFIsTiled(tif)) {
     uint32_t tile_w = 0;
     uint32_t tile_h = 0;
@@ -80,13 +82,14 @@ void read_page(TIFF* tif, std::size_t rows, std::size_t cols, std::size_t item, 
     TIFFGetField(tif, TIFFTAG_TILELENGTH, &tile_h);
     if (tile_w == 0 || tile_h == 0) fail(path, "tiled TIFF without tile size");
     std::vector<unsigned char> tile(TIFFTileSize(tif));
-    for (uint32_t y0 = 0; y0 < rows; y0 += tile_h) {
+    for (std::size_t ty = y0 - y0 % tile_h; ty < y1; ty += tile_h) {
       for (uint32_t x0 = 0; x0 < cols; x0 += tile_w) {
-        if (TIFFReadTile(tif, tile.data(), x0, y0, 0, 0) < 0) fail(path, "corrupt tile data");
-        for (uint32_t y = y0; y < std::min<std::size_t>(rows, y0 + tile_h); ++y) {
+        if (TIFFReadTile(tif, tile.data(), x0, static_cast<uint32_t>(ty), 0, 0) < 0)
+          fail(path, "corrupt tile data");
+        for (std::size_t y = std::max(ty, y0); y < std::min<std::size_t>(y1, ty + tile_h); ++y) {
           const std::size_t n = std::min<std::size_t>(cols - x0, tile_w);
-          std::memcpy(out + (y * cols + x0) * item, tile.data() + (y - y0) * tile_w * item,
-                      n * item);
+          std::memcpy(out + ((y - y0) * cols + x0) * item,
+                      tile.data() + (y - ty) * tile_w * item, n * item);
         }
       }
     }
@@ -95,16 +98,15 @@ void read_page(TIFF* tif, std::size_t rows, std::size_t cols, std::size_t item, 
   if (static_cast<std::size_t>(TIFFScanlineSize(tif)) != cols * item) {
     fail(path, "scanline size does not match width x sample size");
   }
-  for (uint32_t y = 0; y < rows; ++y) {
-    if (TIFFReadScanline(tif, out + y * cols * item, y, 0) < 0) {
+  for (std::size_t y = y0; y < y1; ++y) {
+    if (TIFFReadScanline(tif, out + (y - y0) * cols * item, static_cast<uint32_t>(y), 0) < 0) {
       fail(path, "truncated or corrupt image data at row " + std::to_string(y));
     }
   }
 }
 
-}  // namespace
-
-ArrayFile read_tiff(const std::filesystem::path& path) {
+// Every page of the file, or only rows `rows` of each.
+ArrayFile read_pages(const std::filesystem::path& path, std::optional<RowRange> wanted) {
   input_file_size(path);
   install_handlers();
   t_tiff_error.clear();
@@ -119,6 +121,7 @@ ArrayFile read_tiff(const std::filesystem::path& path) {
   SampleType type = SampleType::kFloat32;
   std::vector<unsigned char> raw;
   std::size_t pages = 0;
+  RowRange range;
   do {
     uint32_t width = 0;
     uint32_t height = 0;
@@ -142,24 +145,57 @@ ArrayFile read_tiff(const std::filesystem::path& path) {
         fail(path, "page size " + std::to_string(height) + " x " + std::to_string(width) +
                        " is absurd for a file of this size");
       }
+      range = wanted ? *wanted : RowRange{0, rows};
+      if (range.count == 0 || range.first > rows || range.count > rows - range.first) {
+        fail(path, "has " + std::to_string(rows) + " rows; rows " + std::to_string(range.first) +
+                       ".." + std::to_string(range.first + range.count) + " asked for");
+      }
     } else if (height != rows || width != cols || this_type != type) {
       fail(path, "page " + std::to_string(pages) + " differs in size or type from page 0");
     }
     const std::size_t item = sample_bytes(type);
-    raw.resize((pages + 1) * rows * cols * item);
-    read_page(tif.get(), rows, cols, item, raw.data() + pages * rows * cols * item, path);
+    const std::size_t page_bytes = range.count * cols * item;
+    raw.resize((pages + 1) * page_bytes);
+    read_page(tif.get(), range.first, range.first + range.count, cols, item,
+              raw.data() + pages * page_bytes, path);
     ++pages;
   } while (TIFFReadDirectory(tif.get()));
   if (!t_tiff_error.empty()) fail(path, "corrupt directory");
 
   file.dtype = sample_type_name(type);
-  std::vector<std::size_t> shape = pages == 1 ? std::vector<std::size_t>{rows, cols}
-                                              : std::vector<std::size_t>{pages, rows, cols};
+  std::vector<std::size_t> shape = pages == 1
+                                       ? std::vector<std::size_t>{range.count, cols}
+                                       : std::vector<std::size_t>{pages, range.count, cols};
   std::vector<float> data(shape_size(shape));
   file.non_finite =
       decode_samples(raw.data(), data.size(), type, host_is_little_endian(), data.data());
   file.array = Array(std::move(shape), std::move(data));
   return file;
+}
+
+}  // namespace
+
+ArrayFile read_tiff(const std::filesystem::path& path) { return read_pages(path, std::nullopt); }
+
+ArrayFile read_tiff_rows(const std::filesystem::path& path, RowRange rows) {
+  return read_pages(path, rows);
+}
+
+std::vector<std::size_t> tiff_shape(const std::filesystem::path& path) {
+  input_file_size(path);
+  install_handlers();
+  t_tiff_error.clear();
+  TiffPtr tif(TIFFOpen(path.c_str(), "r"));
+  if (!tif) fail(path, "not a readable TIFF file");
+  uint32_t width = 0;
+  uint32_t height = 0;
+  if (!TIFFGetField(tif.get(), TIFFTAG_IMAGEWIDTH, &width) ||
+      !TIFFGetField(tif.get(), TIFFTAG_IMAGELENGTH, &height) || width == 0 || height == 0) {
+    fail(path, "page 0 has no valid size");
+  }
+  const std::size_t pages = TIFFNumberOfDirectories(tif.get());
+  if (pages <= 1) return {height, width};
+  return {pages, height, width};
 }
 
 void write_tiff(const std::filesystem::path& path, const Array& array) {

@@ -1,13 +1,14 @@
-#include "scan_source.hpp"
+#include "riner/scan_source.hpp"
 
 #include <cstdio>
 #include <cstdlib>
 
 #include "riner/error.hpp"
+#include "riner/flat_field.hpp"
 #include "riner/io.hpp"
 #include "riner/tomo_file.hpp"
 
-namespace riner::app {
+namespace riner {
 
 namespace {
 
@@ -37,6 +38,22 @@ void resolve_scan_json(ScanSource& source) {
                      ": files.projections needs files.flat (raw intensities are normalised "
                      "by it), unless it is a Data Exchange or NXtomo file");
   }
+}
+
+// Frames of a flat or dark field (one frame [rows, cols] or a stack [frames, rows, cols]), only
+// rows `rows` of each.
+Array frames_rows(const std::filesystem::path& path, RowRange rows) {
+  const std::vector<std::size_t> shape = read_array_shape(path);
+  if (shape.size() == 3) return read_array_rows(path, rows).array;
+  if (shape.size() != 2) {
+    throw InputError(path.string() + ": is " + shape_string(shape) +
+                     "; a flat or dark field is one frame or a stack of frames");
+  }
+  Array frame = read_array(path).array;
+  frame.shape.insert(frame.shape.begin(), 1);
+  Array cut = detector_rows(frame, rows);
+  cut.shape.erase(cut.shape.begin());
+  return cut;
 }
 
 double parse_offset(const std::string& text) {
@@ -88,6 +105,58 @@ LoadedScan load_scan_source(ScanSource source) {
   return loaded;
 }
 
+ScanRows::ScanRows(ScanSource source) : source_(std::move(source)) {
+  if (std::filesystem::path(source_.path).extension() == ".json") resolve_scan_json(source_);
+  if (source_.row) throw InputError("a single detector row is read whole: no slabs needed");
+  if (!source_.dark.empty() && source_.flat.empty() && !is_tomo_file(source_.path)) {
+    throw InputError("a dark field needs a flat field (and SCAN holding raw projections)");
+  }
+  tomo_file_ = source_.flat.empty() && is_tomo_file(source_.path);
+  if (tomo_file_ && !source_.dark.empty())
+    throw InputError("a tomography file brings its own dark field");
+  geometry_ = Geometry::load(find_geometry(source_.path, source_.geometry));
+  shape_ = read_array_shape(source_.path);
+  if (!geometry_.is_3d()) {
+    throw InputError(source_.path + ": the geometry is " + geometry_type_name(geometry_.type) +
+                     "; slabs of detector rows need a 3D geometry");
+  }
+  geometry_.check_measurement_shape(shape_, source_.path);
+  if (source_.offset_px == "auto") {
+    const std::size_t count = std::min(kCentreRows, rows());
+    const Scan middle = read({(rows() - count) / 2, count});
+    centre_ = estimate_centre(middle);
+    geometry_.offset_u = centre_->offset_px;
+  } else if (!source_.offset_px.empty()) {
+    geometry_.offset_u = parse_offset(source_.offset_px);
+  }
+}
+
+Scan ScanRows::read(RowRange rows, FlatFieldReport* report) const {
+  const Geometry g = detector_rows_geometry(geometry_, rows.first, rows.count);
+  if (tomo_file_) {
+    const TomoFile file = read_tomo_file(source_.path, rows);
+    if (file.flats.shape.empty()) {
+      throw InputError(source_.path + ": the file holds no flat field (" + file.layout +
+                       "); pass one with --flat");
+    }
+    return raw_scan(g, file.projections, file.flats, file.darks, std::nullopt, source_.path,
+                    report);
+  }
+  if (!source_.flat.empty()) {
+    const Array projections = read_array_rows(source_.path, rows).array;
+    const Array flats = frames_rows(source_.flat, rows);
+    const Array darks = source_.dark.empty() ? Array() : frames_rows(source_.dark, rows);
+    return raw_scan(g, projections, flats, darks, std::nullopt, source_.path, report);
+  }
+  ArrayFile file = read_array_rows(source_.path, rows);
+  Scan scan;
+  scan.geometry = g;
+  scan.measurement = std::move(file.array);
+  scan.non_finite = file.non_finite;
+  check_scan(scan, source_.path);
+  return scan;
+}
+
 std::string flat_field_line(const FlatFieldReport& r) {
   return "raw projections: flat field of " + std::to_string(r.flat_frames) + " frame(s), " +
          (r.dark_frames ? "dark field of " + std::to_string(r.dark_frames) + " frame(s)"
@@ -119,4 +188,4 @@ std::string centre_line(const CentreEstimate& e) {
   return line;
 }
 
-}  // namespace riner::app
+}  // namespace riner

@@ -1,0 +1,170 @@
+#include "reconstruct_slabs.hpp"
+
+#include <cstdio>
+
+#include "detector_outputs.hpp"
+#include "progress.hpp"
+#include "riner/error.hpp"
+#include "riner/io.hpp"
+#include "riner/slab_run.hpp"
+#include "scan_options.hpp"
+#include "summary_json.hpp"
+
+namespace riner::app {
+
+namespace {
+
+SlabOptions slab_options(const Args& args) {
+  SlabOptions options;
+  if (auto v = args.maybe("slab-slices"); v && !v->empty()) {
+    const long n = args.integer("slab-slices");
+    if (n < 1) throw UsageError("--slab-slices must be 1 or more");
+    options.slices_per_slab = static_cast<std::size_t>(n);
+  }
+  if (auto v = args.maybe("memory-limit"); v && !v->empty()) {
+    options.memory_limit = parse_memory_size(*v);
+  }
+  options.resume = args.is_set("resume");
+  return options;
+}
+
+std::string bytes_string(double bytes) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.1f GiB", bytes / (1024.0 * 1024.0 * 1024.0));
+  return text;
+}
+
+}  // namespace
+
+void add_slab_options(Args& args) {
+  args.option("slab-slices", "N",
+              "a projection stack (parallel beam) in slabs of N axial slices, each trained "
+              "alone and written as it finishes (volume/slice_NNNNN.tif, manifest.json); "
+              "default: as many as --memory-limit allows",
+              "")
+      .option("memory-limit", "SIZE",
+              "host memory a slab may take (8G, 512M); a volume larger than this goes by "
+              "slabs (default: three quarters of the machine's memory)",
+              "")
+      .flag("resume",
+            "finish a slabbed run the output folder holds: only the slabs its manifest does "
+            "not list as done are trained");
+}
+
+bool wants_slabs(const Args& args) {
+  if (args.is_set("resume")) return true;
+  for (const char* name : {"slab-slices", "memory-limit"}) {
+    if (auto v = args.maybe(name); v && !v->empty()) return true;
+  }
+  if (auto row = args.maybe("row"); row && !row->empty()) return false;
+  // Left to the scan: by slabs when a parallel-beam volume does not fit whole.
+  ScanSource source = source_from(args);
+  source.offset_px.clear();  // the geometry's size is all that is needed here
+  try {
+    const ScanRows rows(source);
+    const Geometry& g = rows.geometry();
+    return g.type == GeometryType::kParallel3d &&
+           slab_bytes(g, g.volume_shape[0]) > default_memory_limit();
+  } catch (const InputError&) {
+    return false;  // a 2D scan, or one the whole-scan path explains better
+  }
+}
+
+int reconstruct_by_slabs(const Args& args, const Console& console, const RinerConfig& config,
+                         std::chrono::steady_clock::time_point started) {
+  if (const std::string format = args.get("format"); format != "nii" && format != "tif") {
+    throw UsageError("a slabbed run writes its volume as TIFF slices (volume/); drop --format");
+  }
+  const SlabOptions options = slab_options(args);
+  ScanRows source(source_from(args));
+  if (source.centre()) console.line(centre_line(*source.centre()));
+  const std::filesystem::path out = make_output_dir(args.get("out"));
+  const std::optional<Device> device = device_from(args, config.engine);
+  SlabRun run(std::move(source), config, out, options, device);
+  const Geometry& g = run.source().geometry();
+  const std::size_t done_before = run.slabs_done();
+  {
+    char line[300];
+    std::snprintf(line, sizeof(line),
+                  "%zu slabs of up to %zu slices (%zu x %zu voxels; about %s each, limit %s)%s",
+                  run.slabs().size(), run.slices_per_slab(), g.volume_shape[1],
+                  g.volume_shape[2],
+                  bytes_string(static_cast<double>(slab_bytes(g, run.slices_per_slab()))).c_str(),
+                  bytes_string(static_cast<double>(run.memory_limit())).c_str(),
+                  done_before ? (", " + std::to_string(done_before) + " done before").c_str()
+                              : "");
+    console.line(line);
+  }
+  const std::size_t total = g.volume_shape[0];
+  double slices_before = 0.0;  // done by earlier runs: not this run's speed
+  {
+    Progress progress("slabs", total * 100, console.quiet());
+    bool first = true;
+    run.run(
+        [&](const SlabProgress& p) {
+          if (first) {
+            slices_before = p.slices_done;
+            first = false;
+          }
+          const double this_run = p.slices_done - slices_before;
+          char status[160];
+          std::snprintf(status, sizeof(status), "slab %zu/%zu, %zu/%zu slices, %.1f slices/min",
+                        p.slab->index + 1, p.slabs, static_cast<std::size_t>(p.slices_done),
+                        p.slices, p.seconds > 0 ? 60.0 * this_run / p.seconds : 0.0);
+          progress.update(static_cast<std::size_t>(100.0 * p.slices_done), status);
+        },
+        [&](const Reconstructor& r, const ReconstructionResult& result) {
+          return run_summary(r, result, check_quality(r, result, device));
+        },
+        static_cast<int>(args.integer("report-every")));
+    progress.finish();
+  }
+
+  // The whole scan's outputs from the slabs' files (this run's and earlier runs').
+  std::vector<std::size_t> dead;
+  for (const Slab& s : run.slabs()) {
+    const nlohmann::json& summary = run.manifest()["slabs"][s.index]["summary"];
+    if (!summary.is_object() || !summary.contains("dead_elements")) continue;
+    for (std::size_t e : summary["dead_elements"].get<std::vector<std::size_t>>()) {
+      dead.push_back(s.rows.first * g.n_u + e);
+    }
+  }
+  write_detector_outputs(out, run.alpha(), run.beta(), dead);
+  write_png(out / "image.png", run.preview());
+  write_text(out / "config.json", config.to_json());
+  const double wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  std::size_t peak = 0;
+  double trained_seconds = 0.0;
+  std::size_t trained_slices = 0;
+  for (const nlohmann::json& entry : run.manifest()["slabs"]) {
+    peak = std::max<std::size_t>(peak, entry.value("peak_host_bytes", std::size_t{0}));
+    trained_seconds += entry.value("seconds", 0.0);
+    trained_slices += entry.value("slices", std::size_t{0});
+  }
+  nlohmann::json summary = {
+      {"volume", run.volume_dir().string()},
+      {"shape", g.volume_shape},
+      {"voxel_mm", g.voxel_mm},
+      {"slabs", run.slabs().size()},
+      {"slices_per_slab", run.slices_per_slab()},
+      {"slabs_done_before", done_before},
+      {"memory_limit_bytes", run.memory_limit()},
+      {"slab_bytes_estimated", slab_bytes(g, run.slices_per_slab())},
+      {"peak_host_bytes", peak},
+      {"slab_seconds", trained_seconds},
+      {"slices_per_minute", trained_seconds > 0 ? 60.0 * trained_slices / trained_seconds : 0.0},
+      {"dead_elements", dead.size()},
+      {"centre", run.source().centre() ? centre_json(*run.source().centre())
+                                        : nlohmann::json(nullptr)},
+      {"wall_seconds", wall},
+      {"per_slab", run.manifest()["slabs"]}};
+  write_text(out / "summary.json", summary.dump(1) + "\n");
+  console.line("reconstructed " + shape_string(g.volume_shape) + " in " + std::to_string(run.slabs().size()) +
+               " slabs in " + format_duration(wall) + " (" + std::to_string(dead.size()) +
+               " elements flagged dead) -> " + run.volume_dir().string());
+  console.summary(summary);
+  return 0;
+}
+
+}  // namespace riner::app

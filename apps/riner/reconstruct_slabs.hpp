@@ -1,0 +1,23 @@
+// `riner reconstruct` on a projection stack by slabs of slices (riner/slab_run.hpp): asked for
+// with --slab-slices, --memory-limit or --resume, or chosen when a parallel-beam volume does not
+// fit in memory whole. Writes volume/ (one TIFF per axial slice), manifest.json, alpha.npy,
+// beta.npy, detector.png, image.png (the three central planes), config.json and summary.json.
+#pragma once
+
+#include <chrono>
+
+#include "cli_args.hpp"
+#include "cli_common.hpp"
+#include "riner/riner_config.hpp"
+
+namespace riner::app {
+
+void add_slab_options(Args& args);
+
+// Whether this run goes by slabs (it reads the geometry and the data's header, no data).
+bool wants_slabs(const Args& args);
+
+int reconstruct_by_slabs(const Args& args, const Console& console, const RinerConfig& config,
+                         std::chrono::steady_clock::time_point started);
+
+}  // namespace riner::app

@@ -1,0 +1,47 @@
+// Cutting a volume into slabs of axial slices, each trained alone on the detector rows its
+// voxels project to: how a scan larger than memory (or than one device) goes through riner.
+// Parallel beam only: there a row's rays stay in one slice, so slabs are independent and a
+// slab's result does not depend on its neighbours. A cone beam's rays cross slices (a slab
+// would need the rows of its neighbours' voxels too): it goes through whole.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "riner/array.hpp"
+#include "riner/geometry.hpp"
+
+namespace riner {
+
+struct Slab {
+  std::size_t index = 0;
+  std::size_t first_slice = 0;  // voxel slices [first_slice, first_slice + slices) of the volume
+  std::size_t slices = 0;
+  RowRange rows;  // the detector rows whose centres fall inside those slices
+};
+
+// Slabs of at most `slices_per_slab` slices covering the volume, as even as they come (64
+// slices in slabs of 30: 22, 21, 21). InputError for a cone beam cut into more than one slab,
+// or a slab no detector row falls in.
+std::vector<Slab> plan_slabs(const Geometry& g, std::size_t slices_per_slab);
+
+// The slab's own geometry: its rows of the detector and its slices of the volume, re-centred
+// on the grid (the detector rows moved by as much along the axis).
+Geometry slab_geometry(const Geometry& g, const Slab& slab);
+
+// Host memory a slab of `slices` slices takes to train and check (measured, bench/RESULTS.md
+// "Slabs"): a base for the model and the kernels, and per slice its share of the measurement
+// and of the volume in the copies the training, the ring corrections and the quality check
+// hold at once.
+std::size_t slab_bytes(const Geometry& g, std::size_t slices);
+
+// The most slices per slab within `limit` bytes (at least 1).
+std::size_t slices_within(const Geometry& g, std::size_t limit);
+
+// Three quarters of the machine's physical memory: the default limit.
+std::size_t default_memory_limit();
+
+// "8G", "512M", "2.5G", "1000000" (bytes) -> bytes; InputError for anything else.
+std::size_t parse_memory_size(const std::string& text);
+
+}  // namespace riner

@@ -1,0 +1,95 @@
+// A whole scan through riner slab by slab (riner/slab_plan.hpp): each slab's detector rows are
+// read alone (riner/scan_source.hpp's ScanRows), trained as one 3D field, and written as it
+// finishes into a folder of axial slices (volume/slice_NNNNN.tif, each written whole under a
+// temporary name and renamed), with the slab's alpha, beta and preview planes under slabs/ and
+// then its entry in manifest.json (also written atomically). A run killed at any moment and
+// started again with `resume` redoes only the slabs the manifest does not list as done: none is
+// lost, doubled or half-written. Every slab trains with the same seed, so a slab's result does
+// not depend on which run (or process) trained it.
+#pragma once
+
+#include <cstddef>
+#include <filesystem>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "riner/device.hpp"
+#include "riner/reconstructor.hpp"
+#include "riner/riner_config.hpp"
+#include "riner/scan_source.hpp"
+#include "riner/slab_plan.hpp"
+
+namespace riner {
+
+struct SlabOptions {
+  std::size_t slices_per_slab = 0;  // 0: as many as memory_limit allows
+  std::size_t memory_limit = 0;     // bytes; 0: default_memory_limit()
+  bool resume = false;              // finish a run the output folder holds
+};
+
+struct SlabProgress {
+  const Slab* slab = nullptr;  // the slab training now
+  std::size_t slabs = 0;       // in the scan
+  std::size_t slabs_done = 0;  // finished, this run and earlier ones
+  std::size_t slices = 0;      // in the volume
+  double slices_done = 0.0;    // finished, counting the slab in training by its steps
+  std::size_t slices_this_run = 0;  // finished by this run
+  double seconds = 0.0;             // this run's so far
+  int step = 0;                     // of the slab in training
+  int steps = 0;
+  bool slab_finished = false;  // called once more as each slab is written
+};
+
+class SlabRun {
+ public:
+  // Plans the slabs and reads the output folder's manifest. InputError when the folder holds
+  // another run's manifest (another scan, geometry, settings or slab size), or any run's
+  // without `resume` (nothing is overwritten unasked).
+  SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out, SlabOptions options,
+          std::optional<Device> device = std::nullopt);
+
+  const std::vector<Slab>& slabs() const { return slabs_; }
+  std::size_t slices_per_slab() const { return slices_per_slab_; }
+  std::size_t memory_limit() const { return memory_limit_; }
+  std::size_t slabs_done() const;
+  const ScanRows& source() const { return source_; }
+
+  // Per slab, after it is trained: what to record in its manifest entry (the quality report,
+  // say); may be empty.
+  using Summarise = std::function<nlohmann::json(const Reconstructor&, const ReconstructionResult&)>;
+  // Trains and writes every slab not yet done, in order. `progress` every `report_every` steps
+  // and once as each slab is written.
+  void run(const std::function<void(const SlabProgress&)>& progress = {},
+           const Summarise& summarise = {}, int report_every = 50);
+
+  // After run(): the whole detector's alpha and beta [rows, columns] from the slabs' (NaN where
+  // no slab reads a row), the three central planes as riner/io.hpp's preview_panel draws them,
+  // and the manifest.
+  Array alpha() const;
+  Array beta() const;
+  Array preview() const;
+  const nlohmann::json& manifest() const { return manifest_; }
+
+  std::filesystem::path slice_path(std::size_t slice) const;
+  std::filesystem::path volume_dir() const { return out_ / "volume"; }
+
+ private:
+  std::filesystem::path slab_file(const Slab& slab, const std::string& what) const;
+  bool is_done(const Slab& slab) const;
+  void write_manifest() const;
+  Array detector_map(const std::string& what) const;
+
+  ScanRows source_;
+  RinerConfig config_;
+  std::filesystem::path out_;
+  std::optional<Device> device_;
+  std::size_t memory_limit_ = 0;
+  std::size_t slices_per_slab_ = 0;
+  std::vector<Slab> slabs_;
+  nlohmann::json manifest_;
+};
+
+}  // namespace riner

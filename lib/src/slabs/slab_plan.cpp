@@ -1,0 +1,131 @@
+#include "riner/slab_plan.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+
+#include "riner/error.hpp"
+
+namespace riner {
+
+namespace {
+
+// Measured on the parallel-beam test scans (bench/RESULTS.md, "Slabs"): peak resident memory
+// grows by about this many copies of a slice's readings and of its voxels.
+constexpr double kReadingCopies = 6.0;
+constexpr double kVoxelCopies = 12.0;
+constexpr std::size_t kBaseBytes = std::size_t{400} << 20;  // model, kernels, libraries
+
+// The detector row (fractional index) a height z (mm) projects to in a parallel beam.
+double row_at(const Geometry& g, double z_mm) {
+  return z_mm / g.pitch_v + (static_cast<double>(g.n_v) - 1.0) / 2.0 - g.offset_v;
+}
+
+double slice_z(const Geometry& g, double k) {
+  return (k - (static_cast<double>(g.volume_shape[0]) - 1.0) / 2.0) * g.voxel_mm;
+}
+
+}  // namespace
+
+std::vector<Slab> plan_slabs(const Geometry& g, std::size_t slices_per_slab) {
+  if (!g.is_3d()) throw InputError("slabs cut a volume: the geometry is 2D");
+  const std::size_t nz = g.volume_shape[0];
+  const std::size_t per = std::max<std::size_t>(1, std::min(slices_per_slab, nz));
+  const std::size_t count = (nz + per - 1) / per;
+  if (count > 1 && g.type != GeometryType::kParallel3d) {
+    throw InputError(std::string("a ") + geometry_type_name(g.type) +
+                     " scan is not cut into slabs (its rays cross slices): it needs memory for " +
+                     "the whole volume; raise --memory-limit");
+  }
+  std::vector<Slab> slabs;
+  for (std::size_t i = 0; i < count; ++i) {
+    Slab s;
+    s.index = i;
+    s.first_slice = i * nz / count;
+    s.slices = (i + 1) * nz / count - s.first_slice;
+    if (g.type == GeometryType::kParallel3d) {
+      // Rows whose centres lie in [bottom, top) of the slab's slices, in row order (the
+      // detector's v runs along +z when pitch_v > 0).
+      const double a = row_at(g, slice_z(g, static_cast<double>(s.first_slice) - 0.5));
+      const double b = row_at(g, slice_z(g, static_cast<double>(s.first_slice + s.slices) - 0.5));
+      const double lo = std::min(a, b), hi = std::max(a, b);
+      const long first = std::max<long>(0, static_cast<long>(std::ceil(lo - 1e-9)));
+      const long end = std::min<long>(static_cast<long>(g.n_v),
+                                      static_cast<long>(std::ceil(hi - 1e-9)));
+      if (end <= first) {
+        throw InputError("slices " + std::to_string(s.first_slice) + ".." +
+                         std::to_string(s.first_slice + s.slices) +
+                         " project onto no detector row: use thicker slabs (the detector's " +
+                         "rows are coarser than the voxels) or check the geometry");
+      }
+      s.rows = {static_cast<std::size_t>(first), static_cast<std::size_t>(end - first)};
+    } else {
+      s.rows = {0, g.n_v};
+    }
+    slabs.push_back(s);
+  }
+  return slabs;
+}
+
+Geometry slab_geometry(const Geometry& g, const Slab& slab) {
+  Geometry s = detector_rows_geometry(g, slab.rows.first, slab.rows.count);
+  if (slab.slices == g.volume_shape[0]) return s;
+  s.volume_shape[0] = slab.slices;
+  // The slab's grid is centred on the axis' origin; its detector rows move down by as much.
+  const double shift_mm = slice_z(g, static_cast<double>(slab.first_slice) +
+                                         (static_cast<double>(slab.slices) - 1.0) / 2.0);
+  s.offset_v -= shift_mm / g.pitch_v;
+  return s;
+}
+
+std::size_t slab_bytes(const Geometry& g, std::size_t slices) {
+  const double nz = static_cast<double>(g.volume_shape[0]);
+  const double rows_per_slice = static_cast<double>(g.n_v) / nz;
+  const double readings = static_cast<double>(g.n_views()) * static_cast<double>(g.n_u) *
+                          rows_per_slice;
+  const double voxels = static_cast<double>(g.volume_shape[1]) *
+                        static_cast<double>(g.volume_shape[2]);
+  const double per_slice = 4.0 * (kReadingCopies * readings + kVoxelCopies * voxels);
+  return kBaseBytes + static_cast<std::size_t>(per_slice * static_cast<double>(slices));
+}
+
+std::size_t slices_within(const Geometry& g, std::size_t limit) {
+  std::size_t lo = 1, hi = g.volume_shape[0];
+  if (slab_bytes(g, hi) <= limit) return hi;
+  while (hi - lo > 1) {
+    const std::size_t mid = (lo + hi) / 2;
+    (slab_bytes(g, mid) <= limit ? lo : hi) = mid;
+  }
+  return lo;
+}
+
+std::size_t default_memory_limit() {
+  const long pages = sysconf(_SC_PHYS_PAGES);
+  const long page = sysconf(_SC_PAGE_SIZE);
+  if (pages <= 0 || page <= 0) return std::size_t{8} << 30;
+  return static_cast<std::size_t>(pages) * static_cast<std::size_t>(page) / 4 * 3;
+}
+
+std::size_t parse_memory_size(const std::string& text) {
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || !(value > 0.0) || !std::isfinite(value)) {
+    throw InputError("a memory size is a number with an optional K, M, G or T (got '" + text +
+                     "')");
+  }
+  double scale = 1.0;
+  const std::string unit(end);
+  if (unit == "K" || unit == "k" || unit == "KB" || unit == "KiB") scale = 1024.0;
+  else if (unit == "M" || unit == "MB" || unit == "MiB") scale = 1024.0 * 1024.0;
+  else if (unit == "G" || unit == "GB" || unit == "GiB") scale = 1024.0 * 1024.0 * 1024.0;
+  else if (unit == "T" || unit == "TB" || unit == "TiB") scale = 1024.0 * 1024.0 * 1024.0 * 1024.0;
+  else if (!unit.empty()) {
+    throw InputError("a memory size is a number with an optional K, M, G or T (got '" + text +
+                     "')");
+  }
+  return static_cast<std::size_t>(value * scale);
+}
+
+}  // namespace riner

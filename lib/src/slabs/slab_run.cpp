@@ -1,0 +1,239 @@
+#include "riner/slab_run.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+#include "riner/error.hpp"
+#include "riner/io.hpp"
+
+namespace riner {
+
+namespace {
+
+constexpr int kManifestVersion = 1;
+
+// What a manifest must match to be resumed: the data, its geometry, the settings and the cut.
+nlohmann::json identity(const ScanRows& source, const RinerConfig& config,
+                        std::size_t slices_per_slab) {
+  return {{"scan", std::filesystem::absolute(source.what()).lexically_normal().string()},
+          {"shape", source.shape()},
+          {"geometry", nlohmann::json::parse(source.geometry().to_json())},
+          {"config", nlohmann::json::parse(config.to_json())},
+          {"slices_per_slab", slices_per_slab}};
+}
+
+std::string numbered(const char* pattern, std::size_t n) {
+  char name[64];
+  std::snprintf(name, sizeof(name), pattern, n);
+  return name;
+}
+
+}  // namespace
+
+SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
+                 SlabOptions options, std::optional<Device> device)
+    : source_(std::move(source)),
+      config_(std::move(config)),
+      out_(std::move(out)),
+      device_(std::move(device)) {
+  config_.validate();
+  const Geometry& g = source_.geometry();
+  memory_limit_ = options.memory_limit ? options.memory_limit : default_memory_limit();
+  slices_per_slab_ = options.slices_per_slab ? std::min(options.slices_per_slab, g.volume_shape[0])
+                                             : slices_within(g, memory_limit_);
+  const std::filesystem::path path = out_ / "manifest.json";
+  const bool held_run = std::filesystem::exists(path);
+  if (held_run) {
+    if (!options.resume) {
+      throw InputError(out_.string() +
+                       " holds a slabbed run (manifest.json): pass --resume to finish it, or "
+                       "choose another output folder");
+    }
+    try {
+      // Not read_text: that marks the file an input, and this run rewrites it.
+      std::ifstream in(path);
+      manifest_ = nlohmann::json::parse(in);
+    } catch (const nlohmann::json::exception& e) {
+      throw InputError(path.string() + ": unreadable manifest (" + e.what() + ")");
+    }
+    if (!manifest_.is_object() || manifest_.value("version", 0) != kManifestVersion ||
+        !manifest_.contains("run") || !manifest_.contains("slabs") ||
+        !manifest_["slabs"].is_array() || !manifest_["run"].is_object()) {
+      throw InputError(path.string() + ": not a riner slab manifest");
+    }
+    // A resumed run keeps its slabs unless told otherwise (another machine's memory would cut
+    // the volume elsewhere).
+    const nlohmann::json& held_slices = manifest_["run"]["slices_per_slab"];
+    if (!options.slices_per_slab && held_slices.is_number_unsigned()) {
+      slices_per_slab_ = std::min(held_slices.get<std::size_t>(), g.volume_shape[0]);
+    }
+  }
+  slabs_ = plan_slabs(g, slices_per_slab_);
+  const nlohmann::json wanted = identity(source_, config_, slices_per_slab_);
+  if (held_run) {
+    for (const char* key : {"scan", "shape", "geometry", "config", "slices_per_slab"}) {
+      if (manifest_["run"].value(key, nlohmann::json()) != wanted[key]) {
+        throw InputError(path.string() + ": the run there has another " + key +
+                         " than this one; resume it with the same scan and settings, or choose "
+                         "another output folder");
+      }
+    }
+  } else {
+    manifest_ = {{"version", kManifestVersion}, {"run", wanted}, {"slabs", nlohmann::json::array()}};
+    for (const Slab& s : slabs_) {
+      manifest_["slabs"].push_back({{"index", s.index},
+                                    {"first_slice", s.first_slice},
+                                    {"slices", s.slices},
+                                    {"rows", {s.rows.first, s.rows.count}},
+                                    {"done", false}});
+    }
+  }
+  if (manifest_["slabs"].size() != slabs_.size()) {
+    throw InputError(path.string() + ": lists " + std::to_string(manifest_["slabs"].size()) +
+                     " slabs where this run plans " + std::to_string(slabs_.size()));
+  }
+  std::filesystem::create_directories(volume_dir());
+  std::filesystem::create_directories(out_ / "slabs");
+}
+
+std::filesystem::path SlabRun::slice_path(std::size_t slice) const {
+  return volume_dir() / numbered("slice_%05zu.tif", slice);
+}
+
+std::filesystem::path SlabRun::slab_file(const Slab& slab, const std::string& what) const {
+  return out_ / "slabs" / (numbered("slab_%04zu_", slab.index) + what + ".npy");
+}
+
+bool SlabRun::is_done(const Slab& slab) const {
+  if (!manifest_["slabs"][slab.index].value("done", false)) return false;
+  // The manifest is written last; its files are there unless someone removed them since.
+  for (std::size_t k = 0; k < slab.slices; ++k) {
+    if (!std::filesystem::exists(slice_path(slab.first_slice + k))) return false;
+  }
+  for (const char* what : {"alpha", "beta", "coronal", "sagittal"}) {
+    if (!std::filesystem::exists(slab_file(slab, what))) return false;
+  }
+  return true;
+}
+
+std::size_t SlabRun::slabs_done() const {
+  std::size_t n = 0;
+  for (const Slab& s : slabs_) n += is_done(s);
+  return n;
+}
+
+void SlabRun::write_manifest() const { write_text(out_ / "manifest.json", manifest_.dump(1) + "\n"); }
+
+void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
+                  const Summarise& summarise, int report_every) {
+  const auto started = std::chrono::steady_clock::now();
+  const Geometry& g = source_.geometry();
+  SlabProgress p;
+  p.slabs = slabs_.size();
+  p.slices = g.volume_shape[0];
+  double slices_done = 0.0;
+  for (const Slab& s : slabs_) {
+    if (is_done(s)) {
+      ++p.slabs_done;
+      slices_done += static_cast<double>(s.slices);
+    }
+  }
+  auto seconds = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  };
+  write_manifest();
+  for (const Slab& slab : slabs_) {
+    if (is_done(slab)) continue;
+    const auto slab_started = std::chrono::steady_clock::now();
+    Scan scan = source_.read(slab.rows);
+    scan.geometry = slab_geometry(g, slab);
+    Reconstructor r(std::move(scan), config_, device_);
+    p.slab = &slab;
+    p.slab_finished = false;
+    p.steps = r.config().training.steps;
+    r.run(
+        [&](const TrainingProgress& t) {
+          p.step = t.step;
+          p.slices_done = slices_done + static_cast<double>(slab.slices) * t.step /
+                                            std::max(1, t.total);
+          p.seconds = seconds();
+          if (progress) progress(p);
+          return true;
+        },
+        report_every);
+    const ReconstructionResult result = r.result();
+    const Array& image = result.image;
+    for (std::size_t k = 0; k < slab.slices; ++k) {
+      write_array(slice_path(slab.first_slice + k), axial_slice(image, k));
+    }
+    Array alpha = result.alpha;
+    alpha.shape = {slab.rows.count, g.n_u};
+    Array beta = r.beta();
+    beta.shape = {slab.rows.count, g.n_u};
+    write_array(slab_file(slab, "alpha"), alpha);
+    write_array(slab_file(slab, "beta"), beta);
+    write_array(slab_file(slab, "coronal"), coronal_plane(image, image.shape[1] / 2));
+    write_array(slab_file(slab, "sagittal"), sagittal_plane(image, image.shape[2] / 2));
+
+    nlohmann::json& entry = manifest_["slabs"][slab.index];
+    const TrainingStats stats = r.stats();
+    entry["done"] = true;
+    entry["seconds"] =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - slab_started).count();
+    entry["steps"] = stats.steps;
+    entry["peak_host_bytes"] = stats.peak_host_bytes;
+    entry["dead_elements"] = r.dead_elements().size();
+    entry["summary"] = summarise ? summarise(r, result) : nlohmann::json(nullptr);
+    write_manifest();
+
+    ++p.slabs_done;
+    slices_done += static_cast<double>(slab.slices);
+    p.slices_done = slices_done;
+    p.slices_this_run += slab.slices;
+    p.seconds = seconds();
+    p.slab_finished = true;
+    if (progress) progress(p);
+  }
+}
+
+Array SlabRun::detector_map(const std::string& what) const {
+  const Geometry& g = source_.geometry();
+  Array map({g.n_v, g.n_u}, NAN);
+  for (const Slab& slab : slabs_) {
+    const Array part = read_array(slab_file(slab, what)).array;
+    if (part.shape != std::vector<std::size_t>{slab.rows.count, g.n_u}) {
+      throw InputError(slab_file(slab, what).string() + ": is " + shape_string(part.shape) +
+                       "; the slab's rows are " + std::to_string(slab.rows.count) + " x " +
+                       std::to_string(g.n_u));
+    }
+    std::copy(part.data.begin(), part.data.end(),
+              map.data.begin() + static_cast<std::ptrdiff_t>(slab.rows.first * g.n_u));
+  }
+  return map;
+}
+
+Array SlabRun::alpha() const { return detector_map("alpha"); }
+Array SlabRun::beta() const { return detector_map("beta"); }
+
+Array SlabRun::preview() const {
+  const Geometry& g = source_.geometry();
+  const std::size_t nz = g.volume_shape[0], ny = g.volume_shape[1], nx = g.volume_shape[2];
+  Array coronal({nz, nx}), sagittal({nz, ny});
+  for (const Slab& slab : slabs_) {
+    const Array c = read_array(slab_file(slab, "coronal")).array;
+    const Array s = read_array(slab_file(slab, "sagittal")).array;
+    if (c.size() != slab.slices * nx || s.size() != slab.slices * ny) {
+      throw InputError(slab_file(slab, "coronal").string() + ": does not match the slab");
+    }
+    std::copy(c.data.begin(), c.data.end(),
+              coronal.data.begin() + static_cast<std::ptrdiff_t>(slab.first_slice * nx));
+    std::copy(s.data.begin(), s.data.end(),
+              sagittal.data.begin() + static_cast<std::ptrdiff_t>(slab.first_slice * ny));
+  }
+  const Array axial = read_array(slice_path(nz / 2)).array;
+  return preview_panel(axial, coronal, sagittal);
+}
+
+}  // namespace riner
