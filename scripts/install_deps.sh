@@ -6,6 +6,7 @@ packages=(
   ocl-icd-opencl-dev opencl-headers pocl-opencl-icd clinfo
   libclblast-dev libeigen3-dev doctest-dev nlohmann-json3-dev
   libtiff-dev libpng-dev libhdf5-dev
+  openmpi-bin libopenmpi-dev
   oclgrind valgrind
   python3-dev pybind11-dev python3-numpy python3-pytest python3-skimage
 )

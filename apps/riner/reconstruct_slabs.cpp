@@ -1,11 +1,14 @@
 #include "reconstruct_slabs.hpp"
 
 #include <cstdio>
+#include <cstdlib>
+#include <thread>
 
 #include "detector_outputs.hpp"
 #include "progress.hpp"
 #include "riner/error.hpp"
 #include "riner/io.hpp"
+#include "riner/slab_ranks.hpp"
 #include "riner/slab_run.hpp"
 #include "scan_options.hpp"
 #include "summary_json.hpp"
@@ -70,42 +73,102 @@ bool wants_slabs(const Args& args) {
   }
 }
 
-int reconstruct_by_slabs(const Args& args, const Console& console, const RinerConfig& config,
+namespace {
+
+// Each rank on a machine gets its own GPU, or its share of the cores (PoCL's threads are set
+// before the OpenCL platform is first opened).
+std::optional<Device> rank_device(const Args& args, Engine engine, const SlabRanks& ranks) {
+  if (engine != Engine::kOpenCL) return std::nullopt;
+  if (ranks.local_size() <= 1 || !args.get("device").empty()) return device_from(args, engine);
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const std::string share = std::to_string(std::max(1u, cores / ranks.local_size()));
+  setenv("POCL_MAX_PTHREAD_COUNT", share.c_str(), 0);
+  std::vector<int> gpus;
+  for (const DeviceInfo& d : list_devices()) {
+    if (d.type == "GPU") gpus.push_back(d.index);
+  }
+  if (gpus.empty()) return Device::open("");
+  return Device::open(std::to_string(gpus[ranks.local_rank() % gpus.size()]));
+}
+
+bool several_processes_without_mpi() {
+  const char* size = std::getenv("OMPI_COMM_WORLD_SIZE");
+  if (!size) size = std::getenv("PMI_SIZE");
+  return size && std::atoi(size) > 1 && !SlabRanks::built_with_mpi();
+}
+
+}  // namespace
+
+int reconstruct_by_slabs(const Args& args, const Console& console, const RinerConfig& settings,
                          std::chrono::steady_clock::time_point started) {
   if (const std::string format = args.get("format"); format != "nii" && format != "tif") {
     throw UsageError("a slabbed run writes its volume as TIFF slices (volume/); drop --format");
   }
-  const SlabOptions options = slab_options(args);
+  if (several_processes_without_mpi()) {
+    throw InputError("this riner was built without MPI: run one process, or install "
+                     "libopenmpi-dev and build again");
+  }
+  SlabOptions options = slab_options(args);
+  const SlabRanks ranks;
+  const bool leader = ranks.is_leader();
+  const bool speak = leader && !console.quiet();
   ScanRows source(source_from(args));
-  if (source.centre()) console.line(centre_line(*source.centre()));
+  if (source.centre() && speak) console.line(centre_line(*source.centre()));
   const std::filesystem::path out = make_output_dir(args.get("out"));
-  const std::optional<Device> device = device_from(args, config.engine);
-  SlabRun run(std::move(source), config, out, options, device);
+  const std::optional<Device> device = rank_device(args, settings.engine, ranks);
+  // On a CPU the plan splits the gradient's sums by the device's threads, and a rank has only
+  // its share of them: every rank plans for the whole machine, so the sums, and the volume,
+  // are the same for any number of ranks.
+  RinerConfig config = settings;
+  if (device && device->info().type == "CPU" && config.plan.gradient_slices <= 0) {
+    config.plan.gradient_slices =
+        2 * static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  }
+
+  // The leader plans the run (or finds it to resume) before the others join it.
+  std::optional<SlabRun> planned;
+  std::string word;
+  if (leader) {
+    try {
+      planned.emplace(std::move(source), config, out, options, device);
+      word = "ok " + new_claim_token();
+    } catch (const std::exception& e) {
+      word = "error";
+      ranks.share(word);
+      throw;
+    }
+  }
+  word = ranks.share(word);
+  if (word == "error") return 2;  // the leader says why
+  const std::string token = word.substr(3);
+  if (!leader) {
+    options.join = true;
+    planned.emplace(std::move(source), config, out, options, device);
+  }
+  SlabRun& run = *planned;
   const Geometry& g = run.source().geometry();
   const std::size_t done_before = run.slabs_done();
-  {
+  if (speak) {
     char line[300];
     std::snprintf(line, sizeof(line),
-                  "%zu slabs of up to %zu slices (%zu x %zu voxels; about %s each, limit %s)%s",
+                  "%zu slabs of up to %zu slices (%zu x %zu voxels; about %s each, limit %s)%s%s",
                   run.slabs().size(), run.slices_per_slab(), g.volume_shape[1],
                   g.volume_shape[2],
                   bytes_string(static_cast<double>(slab_bytes(g, run.slices_per_slab()))).c_str(),
                   bytes_string(static_cast<double>(run.memory_limit())).c_str(),
                   done_before ? (", " + std::to_string(done_before) + " done before").c_str()
-                              : "");
+                              : "",
+                  ranks.size() > 1 ? (", over " + std::to_string(ranks.size()) + " ranks").c_str()
+                                   : "");
     console.line(line);
   }
   const std::size_t total = g.volume_shape[0];
-  double slices_before = 0.0;  // done by earlier runs: not this run's speed
-  {
-    Progress progress("slabs", total * 100, console.quiet());
-    bool first = true;
+  try {
+    Progress progress("slabs", total * 100, !speak);
+    double slices_before = -1.0;  // done by earlier runs: not this run's speed
     run.run(
         [&](const SlabProgress& p) {
-          if (first) {
-            slices_before = p.slices_done;
-            first = false;
-          }
+          if (slices_before < 0.0) slices_before = p.slices_done;
           const double this_run = p.slices_done - slices_before;
           char status[160];
           std::snprintf(status, sizeof(status), "slab %zu/%zu, %zu/%zu slices, %.1f slices/min",
@@ -116,9 +179,17 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
         [&](const Reconstructor& r, const ReconstructionResult& result) {
           return run_summary(r, result, check_quality(r, result, device));
         },
-        static_cast<int>(args.integer("report-every")));
+        static_cast<int>(args.integer("report-every")),
+        ranks.size() > 1 ? claim_by_file(out, token) : SlabRun::Claim{});
     progress.finish();
+  } catch (const std::exception& e) {
+    if (ranks.size() == 1) throw;
+    std::fprintf(stderr, "riner: error: rank %d: %s\n", ranks.rank(), e.what());
+    ranks.abort(1);  // the other ranks would wait for this one forever
   }
+  ranks.all_ok(true);  // every rank's slabs are written
+  if (!leader) return 0;
+  run.finish();
 
   // The whole scan's outputs from the slabs' files (this run's and earlier runs').
   std::vector<std::size_t> dead;
@@ -149,6 +220,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       {"slabs", run.slabs().size()},
       {"slices_per_slab", run.slices_per_slab()},
       {"slabs_done_before", done_before},
+      {"ranks", ranks.size()},
       {"memory_limit_bytes", run.memory_limit()},
       {"slab_bytes_estimated", slab_bytes(g, run.slices_per_slab())},
       {"peak_host_bytes", peak},

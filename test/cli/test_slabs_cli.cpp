@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <utility>
 #include <chrono>
 #include <cstdio>
 #include <nlohmann/json.hpp>
@@ -36,12 +37,42 @@ Run riner_cli(const std::string& arguments, const riner::test::TempDir& dir) {
   return run;
 }
 
-std::size_t slabs_done(const std::filesystem::path& manifest) {
-  if (!std::filesystem::exists(manifest)) return 0;
-  const nlohmann::json m = nlohmann::json::parse(riner::test::read_bytes(manifest));
+// A slab is done when its record, slabs/slab_NNNN.json, is there (written last).
+std::size_t slabs_done(const std::filesystem::path& out) {
   std::size_t n = 0;
-  for (const auto& slab : m["slabs"]) n += slab.value("done", false);
+  for (std::size_t i = 0; i < 100; ++i) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "slabs/slab_%04zu.json", i);
+    n += std::filesystem::exists(out / name);
+  }
   return n;
+}
+
+void check_same_volume(const std::filesystem::path& a, const std::filesystem::path& b,
+                       std::size_t slices) {
+  for (std::size_t k = 0; k < slices; ++k) {
+    char name[32];
+    std::snprintf(name, sizeof(name), "volume/slice_%05zu.tif", k);
+    CAPTURE(name);
+    REQUIRE(std::filesystem::exists(b / name));
+    CHECK(riner::test::read_bytes(a / name) == riner::test::read_bytes(b / name));
+  }
+  for (const char* name : {"alpha.npy", "beta.npy"}) {
+    CHECK(riner::test::read_bytes(a / name) == riner::test::read_bytes(b / name));
+  }
+}
+
+std::string simulate_stack(const riner::test::TempDir& dir) {
+  riner::test::write_bytes(dir / "g3.json", R"({"type": "parallel3d",
+      "detector": {"count": [30, 20], "pitch_mm": [1.0, 1.0]},
+      "angles": {"count": 36, "range_rad": 3.141592653589793},
+      "volume": {"shape": [20, 24, 24], "voxel_mm": 1.0}})");
+  const std::string sim = (dir / "sim").string();
+  REQUIRE(riner_cli("simulate --quiet --seed 3 --geometry " + (dir / "g3.json").string() +
+                        " --out " + sim,
+                    dir)
+              .code == 0);
+  return sim + "/sino.npy";
 }
 
 }  // namespace
@@ -49,16 +80,7 @@ std::size_t slabs_done(const std::filesystem::path& manifest) {
 TEST_SUITE("cli") {
   TEST_CASE("a slabbed run killed mid-way and resumed equals an uninterrupted one") {
     riner::test::TempDir dir;
-    riner::test::write_bytes(dir / "g3.json", R"({"type": "parallel3d",
-        "detector": {"count": [30, 20], "pitch_mm": [1.0, 1.0]},
-        "angles": {"count": 36, "range_rad": 3.141592653589793},
-        "volume": {"shape": [20, 24, 24], "voxel_mm": 1.0}})");
-    const std::string sim = (dir / "sim").string();
-    REQUIRE(riner_cli("simulate --quiet --seed 3 --geometry " + (dir / "g3.json").string() +
-                          " --out " + sim,
-                      dir)
-                .code == 0);
-    const std::string scan = sim + "/sino.npy";
+    const std::string scan = simulate_stack(dir);
     const std::string common = "reconstruct " + scan + " --slab-slices 4 --steps 600 --quiet";
     const std::filesystem::path whole = dir / "whole", killed = dir / "killed";
     REQUIRE(riner_cli(common + " --out " + whole.string(), dir).code == 0);
@@ -78,14 +100,14 @@ TEST_SUITE("cli") {
     pid_t pid = 0;
     REQUIRE(posix_spawn(&pid, RINER_CLI_PATH, nullptr, nullptr, argv.data(), environ) == 0);
     const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-    while (slabs_done(killed / "manifest.json") == 0 &&
+    while (slabs_done(killed) == 0 &&
            std::chrono::steady_clock::now() < deadline) {
       std::this_thread::sleep_for(std::chrono::milliseconds(5));
     }
     kill(pid, SIGKILL);
     int status = 0;
     waitpid(pid, &status, 0);
-    const std::size_t done = slabs_done(killed / "manifest.json");
+    const std::size_t done = slabs_done(killed);
     CAPTURE(done);
     REQUIRE(done >= 1);
     REQUIRE(done < 5);  // killed mid-way, not after the end
@@ -103,13 +125,8 @@ TEST_SUITE("cli") {
     const nlohmann::json resumed =
         nlohmann::json::parse(riner::test::read_bytes(killed / "summary.json"));
     CHECK(resumed["slabs_done_before"] == done);
-    for (std::size_t k = 0; k < 20; ++k) {
-      char name[32];
-      std::snprintf(name, sizeof(name), "volume/slice_%05zu.tif", k);
-      CAPTURE(name);
-      REQUIRE(std::filesystem::exists(killed / name));
-      CHECK(riner::test::read_bytes(killed / name) == riner::test::read_bytes(whole / name));
-    }
+    check_same_volume(whole, killed, 20);
+    CHECK(resumed["per_slab"].size() == 5);
     // Nothing half-written left behind, nothing extra.
     std::size_t files = 0;
     for (const auto& entry : std::filesystem::directory_iterator(killed / "volume")) {
@@ -117,11 +134,43 @@ TEST_SUITE("cli") {
       ++files;
     }
     CHECK(files == 20);
-    for (const char* name : {"alpha.npy", "beta.npy"}) {
-      CHECK(riner::test::read_bytes(killed / name) == riner::test::read_bytes(whole / name));
-    }
     const riner::Array alpha = riner::read_array(whole / "alpha.npy").array;
     CHECK(alpha.shape == std::vector<std::size_t>{20, 30});
+  }
+
+  TEST_CASE("two and three MPI ranks share a slabbed run and give the volume of one") {
+#ifdef RINER_TEST_MPI
+    riner::test::TempDir dir;
+    const std::string scan = simulate_stack(dir);
+    const std::string common = " reconstruct " + scan + " --slab-slices 4 --steps 300 --quiet";
+    const std::string mpirun = "mpirun --allow-run-as-root --oversubscribe -n ";
+    const std::filesystem::path one = dir / "one", two = dir / "two", three = dir / "three";
+    for (const auto& [ranks, out] :
+         {std::pair<int, std::filesystem::path>{1, one}, {2, two}, {3, three}}) {
+      const std::string command = mpirun + std::to_string(ranks) + " " + RINER_CLI_PATH + common +
+                                  " --out " + out.string() + " >/dev/null 2>" +
+                                  (dir / "stderr.txt").string();
+      CAPTURE(command);
+      const int status = std::system(command.c_str());
+      CAPTURE(riner::test::read_bytes(dir / "stderr.txt"));
+      REQUIRE(WIFEXITED(status));
+      REQUIRE(WEXITSTATUS(status) == 0);
+    }
+    const nlohmann::json summary =
+        nlohmann::json::parse(riner::test::read_bytes(two / "summary.json"));
+    CHECK(summary["ranks"] == 2);
+    CHECK(summary["per_slab"].size() == 5);
+    check_same_volume(one, two, 20);
+    check_same_volume(one, three, 20);
+    // Each slab trained once: five claims, one per slab.
+    std::size_t claims = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(two / "slabs")) {
+      claims += entry.path().extension() == ".claim";
+    }
+    CHECK(claims == 5);
+#else
+    MESSAGE("riner was built without MPI (libopenmpi-dev): nothing to test");
+#endif
   }
 
   TEST_CASE("slab options name their mistakes") {

@@ -2,10 +2,12 @@
 // read alone (riner/scan_source.hpp's ScanRows), trained as one 3D field, and written as it
 // finishes into a folder of axial slices (volume/slice_NNNNN.tif, each written whole under a
 // temporary name and renamed), with the slab's alpha, beta and preview planes under slabs/ and
-// then its entry in manifest.json (also written atomically). A run killed at any moment and
-// started again with `resume` redoes only the slabs the manifest does not list as done: none is
-// lost, doubled or half-written. Every slab trains with the same seed, so a slab's result does
-// not depend on which run (or process) trained it.
+// last its record, slabs/slab_NNNN.json: a slab is done when its record is there. manifest.json
+// holds the run (scan, geometry, settings, slab size) and, after finish(), every record. A run
+// killed at any moment and started again with `resume` redoes only the slabs without a record:
+// none is lost, doubled or half-written. Every slab trains with the same seed, so a slab's
+// result does not depend on which run or process trained it: several processes (MPI ranks,
+// riner/slab_ranks.hpp) share one run by claiming slabs.
 #pragma once
 
 #include <cstddef>
@@ -28,6 +30,9 @@ struct SlabOptions {
   std::size_t slices_per_slab = 0;  // 0: as many as memory_limit allows
   std::size_t memory_limit = 0;     // bytes; 0: default_memory_limit()
   bool resume = false;              // finish a run the output folder holds
+  // A process joining the run another (the leader, MPI rank 0) has just planned in the same
+  // folder: it reads the manifest and never writes it.
+  bool join = false;
 };
 
 struct SlabProgress {
@@ -60,18 +65,26 @@ class SlabRun {
   // Per slab, after it is trained: what to record in its manifest entry (the quality report,
   // say); may be empty.
   using Summarise = std::function<nlohmann::json(const Reconstructor&, const ReconstructionResult&)>;
-  // Trains and writes every slab not yet done, in order. `progress` every `report_every` steps
-  // and once as each slab is written.
+  // Trains and writes every slab not yet done, in order, that `claim` gives this process (all
+  // of them when it is empty; a claim must be given to one process only). `progress` every
+  // `report_every` steps and once as each slab is written; its counts include other processes'
+  // slabs as their records appear.
+  using Claim = std::function<bool(const Slab&)>;
   void run(const std::function<void(const SlabProgress&)>& progress = {},
-           const Summarise& summarise = {}, int report_every = 50);
+           const Summarise& summarise = {}, int report_every = 50, const Claim& claim = {});
 
-  // After run(): the whole detector's alpha and beta [rows, columns] from the slabs' (NaN where
-  // no slab reads a row), the three central planes as riner/io.hpp's preview_panel draws them,
-  // and the manifest.
+  // Once every slab is done (after run(), and after the other processes' runs): gathers the
+  // records into the manifest and, unless joined, writes it. InputError naming the first slab
+  // without a record.
+  void finish();
+  // After finish(): the whole detector's alpha and beta [rows, columns] from the slabs' (NaN
+  // where no slab reads a row), the three central planes as riner/io.hpp's preview_panel draws
+  // them, and the manifest with each slab's record.
   Array alpha() const;
   Array beta() const;
   Array preview() const;
   const nlohmann::json& manifest() const { return manifest_; }
+  std::filesystem::path slab_record(const Slab& slab) const;
 
   std::filesystem::path slice_path(std::size_t slice) const;
   std::filesystem::path volume_dir() const { return out_ / "volume"; }
@@ -80,6 +93,7 @@ class SlabRun {
   std::filesystem::path slab_file(const Slab& slab, const std::string& what) const;
   bool is_done(const Slab& slab) const;
   void write_manifest() const;
+  std::size_t count_done() const;
   Array detector_map(const std::string& what) const;
 
   ScanRows source_;
@@ -90,6 +104,7 @@ class SlabRun {
   std::size_t slices_per_slab_ = 0;
   std::vector<Slab> slabs_;
   nlohmann::json manifest_;
+  bool join_ = false;
 };
 
 }  // namespace riner

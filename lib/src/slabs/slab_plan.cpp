@@ -12,11 +12,13 @@ namespace riner {
 
 namespace {
 
-// Measured on the parallel-beam test scans (bench/RESULTS.md, "Slabs"): peak resident memory
-// grows by about this many copies of a slice's readings and of its voxels.
-constexpr double kReadingCopies = 6.0;
+// Measured with `riner_bench --case=slab_stack` (bench/RESULTS.md, "Issue 30"): at 1024
+// columns x 720 views, a slab's peak resident memory is about 260 MB plus 24 MB per detector
+// row (32 bytes per reading: the readings, their ray segments, the carving's and the quality
+// check's filtered copies); the voxels count for little beside them.
+constexpr double kReadingCopies = 8.0;
 constexpr double kVoxelCopies = 12.0;
-constexpr std::size_t kBaseBytes = std::size_t{400} << 20;  // model, kernels, libraries
+constexpr std::size_t kBaseBytes = std::size_t{260} << 20;  // model, kernels, libraries
 
 // The detector row (fractional index) a height z (mm) projects to in a parallel beam.
 double row_at(const Geometry& g, double z_mm) {

@@ -44,9 +44,13 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
   slices_per_slab_ = options.slices_per_slab ? std::min(options.slices_per_slab, g.volume_shape[0])
                                              : slices_within(g, memory_limit_);
   const std::filesystem::path path = out_ / "manifest.json";
+  join_ = options.join;
   const bool held_run = std::filesystem::exists(path);
+  if (join_ && !held_run) {
+    throw InputError(path.string() + ": no run to join (the leader writes it first)");
+  }
   if (held_run) {
-    if (!options.resume) {
+    if (!options.resume && !join_) {
       throw InputError(out_.string() +
                        " holds a slabbed run (manifest.json): pass --resume to finish it, or "
                        "choose another output folder");
@@ -80,22 +84,19 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
                          "another output folder");
       }
     }
-  } else {
-    manifest_ = {{"version", kManifestVersion}, {"run", wanted}, {"slabs", nlohmann::json::array()}};
-    for (const Slab& s : slabs_) {
-      manifest_["slabs"].push_back({{"index", s.index},
-                                    {"first_slice", s.first_slice},
-                                    {"slices", s.slices},
-                                    {"rows", {s.rows.first, s.rows.count}},
-                                    {"done", false}});
-    }
   }
-  if (manifest_["slabs"].size() != slabs_.size()) {
-    throw InputError(path.string() + ": lists " + std::to_string(manifest_["slabs"].size()) +
-                     " slabs where this run plans " + std::to_string(slabs_.size()));
+  // The plan; done-ness is in the slabs' records.
+  manifest_ = {{"version", kManifestVersion}, {"run", wanted}, {"slabs", nlohmann::json::array()}};
+  for (const Slab& s : slabs_) {
+    manifest_["slabs"].push_back({{"index", s.index},
+                                  {"first_slice", s.first_slice},
+                                  {"slices", s.slices},
+                                  {"rows", {s.rows.first, s.rows.count}},
+                                  {"done", false}});
   }
   std::filesystem::create_directories(volume_dir());
   std::filesystem::create_directories(out_ / "slabs");
+  if (!join_) write_manifest();
 }
 
 std::filesystem::path SlabRun::slice_path(std::size_t slice) const {
@@ -106,9 +107,13 @@ std::filesystem::path SlabRun::slab_file(const Slab& slab, const std::string& wh
   return out_ / "slabs" / (numbered("slab_%04zu_", slab.index) + what + ".npy");
 }
 
+std::filesystem::path SlabRun::slab_record(const Slab& slab) const {
+  return out_ / "slabs" / numbered("slab_%04zu.json", slab.index);
+}
+
 bool SlabRun::is_done(const Slab& slab) const {
-  if (!manifest_["slabs"][slab.index].value("done", false)) return false;
-  // The manifest is written last; its files are there unless someone removed them since.
+  if (!std::filesystem::exists(slab_record(slab))) return false;
+  // The record is written last; the files are there unless someone removed them since.
   for (std::size_t k = 0; k < slab.slices; ++k) {
     if (!std::filesystem::exists(slice_path(slab.first_slice + k))) return false;
   }
@@ -124,28 +129,40 @@ std::size_t SlabRun::slabs_done() const {
   return n;
 }
 
+std::size_t SlabRun::count_done() const {
+  std::size_t n = 0;
+  for (const Slab& s : slabs_) n += std::filesystem::exists(slab_record(s));
+  return n;
+}
+
 void SlabRun::write_manifest() const { write_text(out_ / "manifest.json", manifest_.dump(1) + "\n"); }
 
 void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
-                  const Summarise& summarise, int report_every) {
+                  const Summarise& summarise, int report_every, const Claim& claim) {
   const auto started = std::chrono::steady_clock::now();
   const Geometry& g = source_.geometry();
   SlabProgress p;
   p.slabs = slabs_.size();
   p.slices = g.volume_shape[0];
-  double slices_done = 0.0;
-  for (const Slab& s : slabs_) {
-    if (is_done(s)) {
-      ++p.slabs_done;
-      slices_done += static_cast<double>(s.slices);
-    }
-  }
   auto seconds = [&] {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   };
-  write_manifest();
+  // Slices done by any process, from the records on disk.
+  auto slices_done = [&] {
+    double n = 0.0;
+    std::size_t slabs = 0;
+    for (const Slab& s : slabs_) {
+      if (std::filesystem::exists(slab_record(s))) {
+        n += static_cast<double>(s.slices);
+        ++slabs;
+      }
+    }
+    p.slabs_done = slabs;
+    return n;
+  };
   for (const Slab& slab : slabs_) {
     if (is_done(slab)) continue;
+    if (claim && !claim(slab)) continue;
     const auto slab_started = std::chrono::steady_clock::now();
     Scan scan = source_.read(slab.rows);
     scan.geometry = slab_geometry(g, slab);
@@ -153,11 +170,14 @@ void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
     p.slab = &slab;
     p.slab_finished = false;
     p.steps = r.config().training.steps;
+    double before = slices_done();
+    int reports = 0;
     r.run(
         [&](const TrainingProgress& t) {
+          // Other processes' records, now and then (a stat per slab).
+          if (++reports % 10 == 0) before = slices_done();
           p.step = t.step;
-          p.slices_done = slices_done + static_cast<double>(slab.slices) * t.step /
-                                            std::max(1, t.total);
+          p.slices_done = before + static_cast<double>(slab.slices) * t.step / std::max(1, t.total);
           p.seconds = seconds();
           if (progress) progress(p);
           return true;
@@ -177,25 +197,42 @@ void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
     write_array(slab_file(slab, "coronal"), coronal_plane(image, image.shape[1] / 2));
     write_array(slab_file(slab, "sagittal"), sagittal_plane(image, image.shape[2] / 2));
 
-    nlohmann::json& entry = manifest_["slabs"][slab.index];
+    nlohmann::json entry = manifest_["slabs"][slab.index];
     const TrainingStats stats = r.stats();
     entry["done"] = true;
     entry["seconds"] =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - slab_started).count();
     entry["steps"] = stats.steps;
     entry["peak_host_bytes"] = stats.peak_host_bytes;
+    entry["device"] = stats.device;
     entry["dead_elements"] = r.dead_elements().size();
     entry["summary"] = summarise ? summarise(r, result) : nlohmann::json(nullptr);
-    write_manifest();
+    write_text(slab_record(slab), entry.dump(1) + "\n");  // last: the slab is done
 
-    ++p.slabs_done;
-    slices_done += static_cast<double>(slab.slices);
-    p.slices_done = slices_done;
     p.slices_this_run += slab.slices;
+    p.slices_done = slices_done();
     p.seconds = seconds();
     p.slab_finished = true;
     if (progress) progress(p);
   }
+}
+
+void SlabRun::finish() {
+  for (const Slab& slab : slabs_) {
+    if (!is_done(slab)) {
+      throw InputError("slab " + std::to_string(slab.index) + " (slices " +
+                       std::to_string(slab.first_slice) + ".." +
+                       std::to_string(slab.first_slice + slab.slices) +
+                       ") is not done: run again with --resume");
+    }
+    std::ifstream in(slab_record(slab));
+    try {
+      manifest_["slabs"][slab.index] = nlohmann::json::parse(in);
+    } catch (const nlohmann::json::exception& e) {
+      throw InputError(slab_record(slab).string() + ": unreadable (" + e.what() + ")");
+    }
+  }
+  if (!join_) write_manifest();
 }
 
 Array SlabRun::detector_map(const std::string& what) const {
