@@ -4,10 +4,10 @@
 // voxels (two detector rows per slice). The scan is written to disk and the CLI runs in its own
 // process, so its peak memory is the slab run's alone: time, slices per minute, peak host
 // memory against --memory-limit, PSNR per slice against the truth, and the same rows in one
-// piece. A seam reads as a dip in the slices beside a slab border; the slices differ in content
-// (the phantom's ends are mostly air), so each slice's PSNR is taken over the FBP's of the same
-// slice before the border slices are set against the others. --ranks=N runs the CLI under
-// mpirun.
+// piece. A seam reads as a dip in the two slices either side of a slab border against the next
+// two further in (seam_step_db, mean over the borders; negative: a seam); slices differ in
+// content (the phantom's ends are mostly air), so each slice's PSNR is taken over the FBP's of
+// the same slice first. --ranks=N runs the CLI under mpirun.
 //
 //   riner_bench --case=slab_stack [--columns=1024 --views=720 --rows=64] [--slab-slices=4]
 //               [--memory-limit=SIZE] [--steps=N] [--one-piece=1] [--ranks=N] --out=DIR
@@ -150,16 +150,18 @@ std::vector<Result> slab_stack(const Options& o) {
                 : riner;
   const RunOutcome slabbed = run_cli(launcher, scan, dir + "/slabbed", flags, truth, range);
 
-  // Slices beside a border between two slabs, against the rest.
-  std::vector<bool> border(truth.shape[0], false);
+  // The slices either side of each border between two slabs against the next ones further in.
+  std::vector<double> gain(truth.shape[0]);
+  for (std::size_t k = 0; k < gain.size(); ++k) gain[k] = slabbed.psnr[k] - fbp_per_slice[k];
+  std::vector<double> at_border, inside, steps_at_border;
   for (const nlohmann::json& slab : slabbed.summary["per_slab"]) {
-    const std::size_t first = slab["first_slice"], count = slab["slices"];
-    if (first > 0) border[first] = true;
-    if (first + count < truth.shape[0]) border[first + count - 1] = true;
+    const std::size_t k = slab["first_slice"];
+    if (k < 2 || k + 1 >= gain.size()) continue;
+    const double pair = (gain[k - 1] + gain[k]) / 2.0, next = (gain[k - 2] + gain[k + 1]) / 2.0;
+    at_border.push_back(pair);
+    inside.push_back(next);
+    steps_at_border.push_back(pair - next);
   }
-  std::vector<double> at_border, inside;
-  for (std::size_t k = 0; k < border.size(); ++k)
-    (border[k] ? at_border : inside).push_back(slabbed.psnr[k] - fbp_per_slice[k]);
 
   RunOutcome whole;
   if (one_piece) {
@@ -168,19 +170,20 @@ std::vector<Result> slab_stack(const Options& o) {
     whole = run_cli(riner, scan, dir + "/one_piece", whole_flags, truth, range);
   }
   if (!png.empty()) {
-    // Coronal planes side by side: truth | FBP | slabs | one piece, +z up.
+    // Coronal planes side by side: truth | FBP | slabs | one piece, +z up, each slice drawn
+    // as tall as needed for the strip to be at least 256 pixels high, in the truth's window.
     const std::size_t nz = truth.shape[0], nx = truth.shape[2];
+    const std::size_t tall = std::max<std::size_t>(1, (256 + nz - 1) / nz);
     const riner::Array truth_coronal = riner::coronal_plane(truth, truth.shape[1] / 2);
     std::vector<const riner::Array*> panels = {&truth_coronal, &fbp_coronal, &slabbed.coronal};
     if (one_piece) panels.push_back(&whole.coronal);
-    riner::Array strip({nz, panels.size() * (nx + 4)}, 0.0f);
+    riner::Array strip({nz * tall, panels.size() * (nx + 4)}, 0.0f);
     for (std::size_t p = 0; p < panels.size(); ++p)
-      for (std::size_t z = 0; z < nz; ++z)
+      for (std::size_t row = 0; row < nz * tall; ++row)
         for (std::size_t x = 0; x < nx; ++x)
-          strip(nz - 1 - z, p * (nx + 4) + x) = (*panels[p])(z, x);
-    riner::write_png(png, strip, riner::Window{0.0f, 0.05f});
+          strip(row, p * (nx + 4) + x) = (*panels[p])(nz - 1 - row / tall, x);
+    riner::write_png(png, strip, riner::percentile_window(truth_coronal, 1.0, 99.5));
   }
-
   const nlohmann::json& s = slabbed.summary;
   const double peak = s.value("peak_host_bytes", 0.0);
   const double limit = s.value("memory_limit_bytes", 0.0);
@@ -199,7 +202,8 @@ std::vector<Result> slab_stack(const Options& o) {
             {"slices_per_minute", slices_per_minute},
             {"psnr_mean", mean(slabbed.psnr)},
             {"gain_over_fbp_border_slices", mean(at_border)},
-            {"gain_over_fbp_interior_slices", mean(inside)},
+            {"gain_over_fbp_next_slices", mean(inside)},
+            {"seam_step_db", mean(steps_at_border)},
             {"fbp_psnr_per_slice", fbp_per_slice},
             {"ranks", ranks},
             {"psnr_per_slice", slabbed.psnr},
@@ -211,10 +215,11 @@ std::vector<Result> slab_stack(const Options& o) {
            riner::bench::format(
                "%zu x %zu x %zu (%.0f MB): %d slabs of %d slices in %.0f s (%.2f slices/min), "
                "peak %.0f MB (limit %.0f MB) | PSNR %.2f dB (over FBP: border slices %+.2f, "
-               "interior %+.2f) | one piece %.2f dB in %.0f s | FBP %.2f dB",
+               "the next ones in %+.2f: seam step %+.2f) | one piece %.2f dB in %.0f s | FBP "
+               "%.2f dB",
                views, rows, columns, scan_bytes / 1e6, s["slabs"].get<int>(),
                s["slices_per_slab"].get<int>(), slabbed.wall, slices_per_minute, peak / 1e6,
-               limit / 1e6, mean(slabbed.psnr), mean(at_border), mean(inside),
+               limit / 1e6, mean(slabbed.psnr), mean(at_border), mean(inside), mean(steps_at_border),
                one_piece ? mean(whole.psnr) : 0.0, whole.wall, fbp_psnr)}};
 }
 
