@@ -150,6 +150,10 @@ int run_reconstruct(int argc, char** argv, int first) {
   const auto started = std::chrono::steady_clock::now();
   Console console(args);
   if (wants_slabs(args)) return reconstruct_by_slabs(args, console, config_from(args), started);
+  if (started_as_several_processes()) {
+    throw UsageError("several processes share only a slabbed run (a parallel-beam stack with "
+                     "--slab-slices or --memory-limit): run this one as one process");
+  }
   LoadedScan loaded = scan_from(args, console);
   const std::optional<CentreEstimate> centre_check = check_centre(loaded, console);
   Scan& scan = loaded.scan;

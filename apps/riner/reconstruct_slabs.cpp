@@ -92,12 +92,16 @@ std::optional<Device> rank_device(const Args& args, Engine engine, const SlabRan
 }
 
 bool several_processes_without_mpi() {
-  const char* size = std::getenv("OMPI_COMM_WORLD_SIZE");
-  if (!size) size = std::getenv("PMI_SIZE");
-  return size && std::atoi(size) > 1 && !SlabRanks::built_with_mpi();
+  return started_as_several_processes() && !SlabRanks::built_with_mpi();
 }
 
 }  // namespace
+
+bool started_as_several_processes() {
+  const char* size = std::getenv("OMPI_COMM_WORLD_SIZE");
+  if (!size) size = std::getenv("PMI_SIZE");
+  return size && std::atoi(size) > 1;
+}
 
 int reconstruct_by_slabs(const Args& args, const Console& console, const RinerConfig& settings,
                          std::chrono::steady_clock::time_point started) {

@@ -162,12 +162,22 @@ TEST_SUITE("cli") {
     CHECK(summary["per_slab"].size() == 5);
     check_same_volume(one, two, 20);
     check_same_volume(one, three, 20);
-    // Each slab trained once: five claims, one per slab.
+    // Every slab has its record, and the claims are cleared away at the end.
+    CHECK(slabs_done(two) == 5);
     std::size_t claims = 0;
     for (const auto& entry : std::filesystem::directory_iterator(two / "slabs")) {
       claims += entry.path().extension() == ".claim";
     }
-    CHECK(claims == 5);
+    CHECK(claims == 0);
+
+    // A run that is not slabbed is not done twice.
+    const std::string whole = mpirun + "2 " + RINER_CLI_PATH + " reconstruct " + scan +
+                              " --steps 10 --quiet --out " + (dir / "whole").string() +
+                              " >/dev/null 2>" + (dir / "stderr.txt").string();
+    const int status = std::system(whole.c_str());
+    CHECK(!(WIFEXITED(status) && WEXITSTATUS(status) == 0));
+    CHECK(riner::test::read_bytes(dir / "stderr.txt")
+              .find("several processes share only a slabbed run") != std::string::npos);
 #else
     MESSAGE("riner was built without MPI (libopenmpi-dev): nothing to test");
 #endif

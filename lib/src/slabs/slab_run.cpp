@@ -232,7 +232,13 @@ void SlabRun::finish() {
       throw InputError(slab_record(slab).string() + ": unreadable (" + e.what() + ")");
     }
   }
-  if (!join_) write_manifest();
+  if (join_) return;
+  write_manifest();
+  // The ranks' claims (this run's and a killed run's) have served their purpose.
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(out_ / "slabs", error)) {
+    if (entry.path().extension() == ".claim") std::filesystem::remove(entry.path(), error);
+  }
 }
 
 Array SlabRun::detector_map(const std::string& what) const {
