@@ -33,7 +33,11 @@ SlabOptions slab_options(const Args& args) {
 
 std::string bytes_string(double bytes) {
   char text[32];
-  std::snprintf(text, sizeof(text), "%.1f GiB", bytes / (1024.0 * 1024.0 * 1024.0));
+  if (bytes < 1024.0 * 1024.0 * 1024.0) {
+    std::snprintf(text, sizeof(text), "%.0f MiB", bytes / (1024.0 * 1024.0));
+  } else {
+    std::snprintf(text, sizeof(text), "%.1f GiB", bytes / (1024.0 * 1024.0 * 1024.0));
+  }
   return text;
 }
 
@@ -165,6 +169,15 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
                   ranks.size() > 1 ? (", over " + std::to_string(ranks.size()) + " ranks").c_str()
                                    : "");
     console.line(line);
+    if (slab_bytes(g, run.slices_per_slab()) > run.memory_limit()) {
+      std::snprintf(line, sizeof(line),
+                    "note: a slab of %zu slice(s) needs about %s, more than the limit: the run "
+                    "may take more memory than --memory-limit allows",
+                    run.slices_per_slab(),
+                    bytes_string(static_cast<double>(slab_bytes(g, run.slices_per_slab())))
+                        .c_str());
+      console.line(line);
+    }
   }
   const std::size_t total = g.volume_shape[0];
   try {
