@@ -16,6 +16,7 @@
 #include "riner/quality.hpp"
 #include "riner/reconstructor.hpp"
 #include "riner/scan.hpp"
+#include "riner/slab_ranks.hpp"
 #include "scan_options.hpp"
 #include "summary_json.hpp"
 
@@ -150,7 +151,8 @@ int run_reconstruct(int argc, char** argv, int first) {
   const auto started = std::chrono::steady_clock::now();
   Console console(args);
   if (wants_slabs(args)) return reconstruct_by_slabs(args, console, config_from(args), started);
-  if (started_as_several_processes()) {
+  // Only a slabbed run shares out its work; anything else would run N times into one folder.
+  if (SlabRanks::launched_size() > 1) {
     throw UsageError("several processes share only a slabbed run (a parallel-beam stack with "
                      "--slab-slices or --memory-limit): run this one as one process");
   }

@@ -95,24 +95,14 @@ std::optional<Device> rank_device(const Args& args, Engine engine, const SlabRan
   return Device::open(std::to_string(gpus[ranks.local_rank() % gpus.size()]));
 }
 
-bool several_processes_without_mpi() {
-  return started_as_several_processes() && !SlabRanks::built_with_mpi();
-}
-
 }  // namespace
-
-bool started_as_several_processes() {
-  const char* size = std::getenv("OMPI_COMM_WORLD_SIZE");
-  if (!size) size = std::getenv("PMI_SIZE");
-  return size && std::atoi(size) > 1;
-}
 
 int reconstruct_by_slabs(const Args& args, const Console& console, const RinerConfig& settings,
                          std::chrono::steady_clock::time_point started) {
   if (const std::string format = args.get("format"); format != "nii" && format != "tif") {
     throw UsageError("a slabbed run writes its volume as TIFF slices (volume/); drop --format");
   }
-  if (several_processes_without_mpi()) {
+  if (SlabRanks::launched_size() > 1 && !SlabRanks::built_with_mpi()) {
     throw InputError("this riner was built without MPI: run one process, or install "
                      "libopenmpi-dev and build again");
   }
@@ -182,11 +172,9 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   const std::size_t total = g.volume_shape[0];
   try {
     Progress progress("slabs", total * 100, !speak);
-    double slices_before = -1.0;  // done by earlier runs: not this run's speed
     run.run(
         [&](const SlabProgress& p) {
-          if (slices_before < 0.0) slices_before = p.slices_done;
-          const double this_run = p.slices_done - slices_before;
+          const double this_run = p.slices_done - p.slices_at_start;
           char status[160];
           std::snprintf(status, sizeof(status), "slab %zu/%zu, %zu/%zu slices, %.1f slices/min",
                         p.slab->index + 1, p.slabs, static_cast<std::size_t>(p.slices_done),

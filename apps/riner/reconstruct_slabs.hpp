@@ -17,9 +17,6 @@ void add_slab_options(Args& args);
 // Whether this run goes by slabs (it reads the geometry and the data's header, no data).
 bool wants_slabs(const Args& args);
 
-// Whether mpirun started this process as one of several (only slabbed runs share out work).
-bool started_as_several_processes();
-
 int reconstruct_by_slabs(const Args& args, const Console& console, const RinerConfig& config,
                          std::chrono::steady_clock::time_point started);
 

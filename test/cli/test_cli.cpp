@@ -8,31 +8,15 @@
 #include <cstdio>
 #include <nlohmann/json.hpp>
 
+#include "cli/cli_run.hpp"
 #include "riner/io.hpp"
 #include "support/fixture.hpp"
 
 namespace {
 
-struct Run {
-  int code = -1;
-  std::string out;  // stdout
-  std::string err;  // stderr
-};
-
-Run riner_cli(const std::string& arguments, const riner::test::TempDir& dir) {
-  const std::string err_file = (dir / "stderr.txt").string();
-  const std::string command = std::string(RINER_CLI_PATH) + " " + arguments + " 2>" + err_file;
-  Run run;
-  FILE* pipe = popen(command.c_str(), "r");
-  REQUIRE(pipe != nullptr);
-  std::array<char, 4096> buffer;
-  std::size_t n;
-  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.out.append(buffer.data(), n);
-  const int status = pclose(pipe);
-  run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  run.err = riner::test::read_bytes(err_file);
-  return run;
-}
+using riner::test::Run;
+using riner::test::riner_cli;
+using riner::test::simulate_small_parallel3d;
 
 void expect_error(const Run& run, int code, const std::string& message) {
   CAPTURE(run.err);
@@ -40,21 +24,6 @@ void expect_error(const Run& run, int code, const std::string& message) {
   CHECK(run.err.find("riner: error: " + message) != std::string::npos);
   // One line.
   CHECK(std::count(run.err.begin(), run.err.end(), '\n') == 1);
-}
-
-// A small parallel-beam stack (36 views, 30 x 20 detector, 20 x 24 x 24 volume) simulated into
-// dir/sim, its geometry in dir/g3.json; returns dir/sim.
-std::string simulate_small_parallel3d(const riner::test::TempDir& dir) {
-  riner::test::write_bytes(dir / "g3.json", R"({"type": "parallel3d",
-      "detector": {"count": [30, 20], "pitch_mm": [1.0, 1.0]},
-      "angles": {"count": 36, "range_rad": 3.141592653589793},
-      "volume": {"shape": [20, 24, 24], "voxel_mm": 1.0}})");
-  const std::string sim = (dir / "sim").string();
-  REQUIRE(riner_cli("simulate --quiet --seed 3 --geometry " + (dir / "g3.json").string() +
-                        " --out " + sim,
-                    dir)
-              .code == 0);
-  return sim;
 }
 
 // A small cone-beam geometry (36 views, 30 x 20 detector, 10 x 24 x 24 volume) as dir/g3.json;

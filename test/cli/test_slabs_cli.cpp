@@ -7,13 +7,13 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <array>
-#include <utility>
 #include <chrono>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <thread>
+#include <utility>
 
+#include "cli/cli_run.hpp"
 #include "riner/io.hpp"
 #include "support/fixture.hpp"
 
@@ -21,21 +21,8 @@ extern char** environ;
 
 namespace {
 
-struct Run {
-  int code = -1;
-  std::string err;
-};
-
-Run riner_cli(const std::string& arguments, const riner::test::TempDir& dir) {
-  const std::string err_file = (dir / "stderr.txt").string();
-  const std::string command =
-      std::string(RINER_CLI_PATH) + " " + arguments + " >/dev/null 2>" + err_file;
-  const int status = std::system(command.c_str());
-  Run run;
-  run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  run.err = riner::test::read_bytes(err_file);
-  return run;
-}
+using riner::test::Run;
+using riner::test::riner_cli;
 
 // A slab is done when its record, slabs/slab_NNNN.json, is there (written last).
 std::size_t slabs_done(const std::filesystem::path& out) {
@@ -63,16 +50,7 @@ void check_same_volume(const std::filesystem::path& a, const std::filesystem::pa
 }
 
 std::string simulate_stack(const riner::test::TempDir& dir) {
-  riner::test::write_bytes(dir / "g3.json", R"({"type": "parallel3d",
-      "detector": {"count": [30, 20], "pitch_mm": [1.0, 1.0]},
-      "angles": {"count": 36, "range_rad": 3.141592653589793},
-      "volume": {"shape": [20, 24, 24], "voxel_mm": 1.0}})");
-  const std::string sim = (dir / "sim").string();
-  REQUIRE(riner_cli("simulate --quiet --seed 3 --geometry " + (dir / "g3.json").string() +
-                        " --out " + sim,
-                    dir)
-              .code == 0);
-  return sim + "/sino.npy";
+  return riner::test::simulate_small_parallel3d(dir) + "/sino.npy";
 }
 
 }  // namespace

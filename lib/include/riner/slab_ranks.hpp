@@ -29,6 +29,9 @@ class SlabRanks {
   int local_size() const { return local_size_; }
   bool is_leader() const { return rank_ == 0; }
   static bool built_with_mpi();
+  // How many processes mpirun says it started together with this one (1 when it did not),
+  // read from the environment, with or without MPI in the build.
+  static int launched_size();
 
   // Rank 0's text, on every rank.
   std::string share(const std::string& from_leader) const;

@@ -41,7 +41,7 @@ struct SlabProgress {
   std::size_t slabs_done = 0;  // finished, this run and earlier ones
   std::size_t slices = 0;      // in the volume
   double slices_done = 0.0;    // finished, counting the slab in training by its steps
-  std::size_t slices_this_run = 0;  // finished by this run
+  double slices_at_start = 0.0;     // finished when this run began (its speed leaves them out)
   double seconds = 0.0;             // this run's so far
   int step = 0;                     // of the slab in training
   int steps = 0;
@@ -93,7 +93,6 @@ class SlabRun {
   std::filesystem::path slab_file(const Slab& slab, const std::string& what) const;
   bool is_done(const Slab& slab) const;
   void write_manifest() const;
-  std::size_t count_done() const;
   Array detector_map(const std::string& what) const;
 
   ScanRows source_;

@@ -8,6 +8,7 @@
 #include <type_traits>
 
 #include "io/file_access.hpp"
+#include "io/row_blocks.hpp"
 #include "riner/error.hpp"
 #include "riner/io.hpp"
 #include "riner/tomo_file.hpp"
@@ -97,12 +98,7 @@ std::vector<T> read_values(const Hid& file, const std::filesystem::path& path,
   hid_t file_space = H5S_ALL;
   std::optional<Hid> memory_space;
   if (rows) {
-    if (shape.size() != 3 || rows->count == 0 || rows->first > shape[1] ||
-        rows->count > shape[1] - rows->first) {
-      throw InputError(where(path, dataset) + "is " + shape_string(shape) + "; rows " +
-                       std::to_string(rows->first) + ".." + std::to_string(rows->end()) +
-                       " of a [frames, rows, columns] dataset asked for");
-    }
+    io::check_row_range(path.string() + ":" + dataset, shape, *rows);
     const hsize_t start[3] = {0, rows->first, 0};
     const hsize_t count[3] = {d.dims[0], rows->count, d.dims[2]};
     if (H5Sselect_hyperslab(d.space->get(), H5S_SELECT_SET, start, nullptr, count, nullptr) < 0) {

@@ -10,6 +10,7 @@
 
 #include "io/file_access.hpp"
 #include "io/formats.hpp"
+#include "io/row_blocks.hpp"
 #include "io/sample_type.hpp"
 #include "riner/error.hpp"
 
@@ -146,10 +147,7 @@ ArrayFile read_pages(const std::filesystem::path& path, std::optional<RowRange> 
                        " is absurd for a file of this size");
       }
       range = wanted ? *wanted : RowRange{0, rows};
-      if (range.count == 0 || range.first > rows || range.count > rows - range.first) {
-        fail(path, "has " + std::to_string(rows) + " rows; rows " + std::to_string(range.first) +
-                       ".." + std::to_string(range.first + range.count) + " asked for");
-      }
+      check_row_range(path, {1, rows, cols}, range);
     } else if (height != rows || width != cols || this_type != type) {
       fail(path, "page " + std::to_string(pages) + " differs in size or type from page 0");
     }

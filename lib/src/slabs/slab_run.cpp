@@ -129,12 +129,6 @@ std::size_t SlabRun::slabs_done() const {
   return n;
 }
 
-std::size_t SlabRun::count_done() const {
-  std::size_t n = 0;
-  for (const Slab& s : slabs_) n += std::filesystem::exists(slab_record(s));
-  return n;
-}
-
 void SlabRun::write_manifest() const { write_text(out_ / "manifest.json", manifest_.dump(1) + "\n"); }
 
 void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
@@ -160,6 +154,7 @@ void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
     p.slabs_done = slabs;
     return n;
   };
+  p.slices_at_start = slices_done();
   for (const Slab& slab : slabs_) {
     if (is_done(slab)) continue;
     if (claim && !claim(slab)) continue;
@@ -209,7 +204,6 @@ void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
     entry["summary"] = summarise ? summarise(r, result) : nlohmann::json(nullptr);
     write_text(slab_record(slab), entry.dump(1) + "\n");  // last: the slab is done
 
-    p.slices_this_run += slab.slices;
     p.slices_done = slices_done();
     p.seconds = seconds();
     p.slab_finished = true;

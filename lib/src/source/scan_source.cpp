@@ -56,6 +56,26 @@ Array frames_rows(const std::filesystem::path& path, RowRange rows) {
   return cut;
 }
 
+// Resolves a scan JSON into its files and checks the flat and dark fit SCAN; true when SCAN is
+// a tomography file that holds its own flats and darks.
+bool resolve_files(ScanSource& source) {
+  if (std::filesystem::path(source.path).extension() == ".json") resolve_scan_json(source);
+  if (!source.dark.empty() && source.flat.empty() && !is_tomo_file(source.path)) {
+    throw InputError("a dark field needs a flat field (and SCAN holding raw projections)");
+  }
+  const bool tomo_file = source.flat.empty() && is_tomo_file(source.path);
+  if (tomo_file && !source.dark.empty())
+    throw InputError("a tomography file brings its own dark field");
+  return tomo_file;
+}
+
+void require_flats(const TomoFile& file, const std::string& path) {
+  if (file.flats.shape.empty()) {
+    throw InputError(path + ": the file holds no flat field (" + file.layout +
+                     "); pass one with --flat");
+  }
+}
+
 double parse_offset(const std::string& text) {
   char* end = nullptr;
   const double value = std::strtod(text.c_str(), &end);
@@ -68,20 +88,12 @@ double parse_offset(const std::string& text) {
 }  // namespace
 
 LoadedScan load_scan_source(ScanSource source) {
-  if (std::filesystem::path(source.path).extension() == ".json") resolve_scan_json(source);
-  if (!source.dark.empty() && source.flat.empty() && !is_tomo_file(source.path)) {
-    throw InputError("a dark field needs a flat field (and SCAN holding raw projections)");
-  }
+  const bool tomo_file = resolve_files(source);
   LoadedScan loaded;
   FlatFieldReport report;
-  if (source.flat.empty() && is_tomo_file(source.path)) {
-    // A tomography file holds its own flats and darks.
-    if (!source.dark.empty()) throw InputError("a tomography file brings its own dark field");
+  if (tomo_file) {
     const TomoFile file = read_tomo_file(source.path);
-    if (file.flats.shape.empty()) {
-      throw InputError(source.path + ": the file holds no flat field (" + file.layout +
-                       "); pass one with --flat");
-    }
+    require_flats(file, source.path);
     loaded.scan =
         raw_scan(Geometry::load(find_geometry(source.path, source.geometry)), file.projections,
                  file.flats, file.darks, source.row, source.path, &report);
@@ -106,14 +118,8 @@ LoadedScan load_scan_source(ScanSource source) {
 }
 
 ScanRows::ScanRows(ScanSource source) : source_(std::move(source)) {
-  if (std::filesystem::path(source_.path).extension() == ".json") resolve_scan_json(source_);
+  tomo_file_ = resolve_files(source_);
   if (source_.row) throw InputError("a single detector row is read whole: no slabs needed");
-  if (!source_.dark.empty() && source_.flat.empty() && !is_tomo_file(source_.path)) {
-    throw InputError("a dark field needs a flat field (and SCAN holding raw projections)");
-  }
-  tomo_file_ = source_.flat.empty() && is_tomo_file(source_.path);
-  if (tomo_file_ && !source_.dark.empty())
-    throw InputError("a tomography file brings its own dark field");
   geometry_ = Geometry::load(find_geometry(source_.path, source_.geometry));
   shape_ = read_array_shape(source_.path);
   if (!geometry_.is_3d()) {
@@ -135,10 +141,7 @@ Scan ScanRows::read(RowRange rows, FlatFieldReport* report) const {
   const Geometry g = detector_rows_geometry(geometry_, rows.first, rows.count);
   if (tomo_file_) {
     const TomoFile file = read_tomo_file(source_.path, rows);
-    if (file.flats.shape.empty()) {
-      throw InputError(source_.path + ": the file holds no flat field (" + file.layout +
-                       "); pass one with --flat");
-    }
+    require_flats(file, source_.path);
     return raw_scan(g, file.projections, file.flats, file.darks, std::nullopt, source_.path,
                     report);
   }

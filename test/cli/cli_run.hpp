@@ -1,0 +1,54 @@
+// Running the riner executable from a test: its exit code, stdout and stderr, and the small
+// simulated scans several CLI suites start from.
+#pragma once
+
+#include <doctest/doctest.h>
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <string>
+
+#include "support/fixture.hpp"
+
+namespace riner::test {
+
+struct Run {
+  int code = -1;
+  std::string out;  // stdout
+  std::string err;  // stderr
+};
+
+// `riner ARGUMENTS`, its stderr kept in dir/stderr.txt.
+inline Run riner_cli(const std::string& arguments, const TempDir& dir) {
+  const std::string err_file = (dir / "stderr.txt").string();
+  const std::string command = std::string(RINER_CLI_PATH) + " " + arguments + " 2>" + err_file;
+  Run run;
+  FILE* pipe = popen(command.c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  std::array<char, 4096> buffer;
+  std::size_t n;
+  while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.out.append(buffer.data(), n);
+  const int status = pclose(pipe);
+  run.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  run.err = read_bytes(err_file);
+  return run;
+}
+
+// A small parallel-beam stack (36 views, 30 x 20 detector, 20 x 24 x 24 volume) simulated into
+// dir/sim, its geometry in dir/g3.json; returns dir/sim.
+inline std::string simulate_small_parallel3d(const TempDir& dir) {
+  write_bytes(dir / "g3.json", R"({"type": "parallel3d",
+      "detector": {"count": [30, 20], "pitch_mm": [1.0, 1.0]},
+      "angles": {"count": 36, "range_rad": 3.141592653589793},
+      "volume": {"shape": [20, 24, 24], "voxel_mm": 1.0}})");
+  const std::string sim = (dir / "sim").string();
+  REQUIRE(riner_cli("simulate --quiet --seed 3 --geometry " + (dir / "g3.json").string() +
+                        " --out " + sim,
+                    dir)
+              .code == 0);
+  return sim;
+}
+
+}  // namespace riner::test
