@@ -3,13 +3,104 @@
 
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "riner/error.hpp"
 #include "riner/fbp.hpp"
 #include "riner/io.hpp"
 #include "riner/scan.hpp"
+#include "riner/slab_fbp.hpp"
+#include "riner/slab_plan.hpp"
+#include "progress.hpp"
 #include "scan_options.hpp"
 #include "summary_json.hpp"
 
 namespace riner::app {
+
+namespace {
+
+// A parallel-beam stack goes by slabs when asked (--slab-slices, --memory-limit), when the
+// output is a folder of slices, or when its volume does not fit in memory whole.
+bool fbp_wants_slabs(const Args& args) {
+  if (auto row = args.maybe("row"); row && !row->empty()) return false;
+  const bool asked = !args.get("slab-slices").empty() || !args.get("memory-limit").empty();
+  const bool folder = std::filesystem::path(args.get("out")).extension().empty();
+  ScanSource source = source_from(args);
+  source.offset_px.clear();  // the geometry's size is all that is needed here
+  try {
+    const ScanRows rows(source);
+    const Geometry& g = rows.geometry();
+    if (g.type != GeometryType::kParallel3d) return false;
+    return asked || folder || fbp_slab_bytes(g, g.volume_shape[0]) > default_memory_limit();
+  } catch (const InputError&) {
+    return false;  // a 2D scan, or one the whole-scan path explains better
+  }
+}
+
+int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions& options) {
+  const ScanRows source(source_from(args));
+  if (source.centre()) console.line(centre_line(*source.centre()));
+  const Geometry& g = source.geometry();
+  const std::size_t limit = args.get("memory-limit").empty()
+                                ? default_memory_limit()
+                                : parse_memory_size(args.get("memory-limit"));
+  std::size_t per = fbp_slices_within(g, limit);
+  if (!args.get("slab-slices").empty()) {
+    const long n = args.integer("slab-slices");
+    if (n < 1) throw UsageError("--slab-slices must be 1 or more");
+    per = static_cast<std::size_t>(n);
+  }
+  const std::string out = args.get("out");
+  VolumeWriter writer(out, g.volume_shape, g.voxel_mm);
+  const auto start = std::chrono::steady_clock::now();
+  const std::size_t nz = g.volume_shape[0];
+  Array middle;
+  Progress progress("fbp", nz, console.quiet());
+  const SlabFbpReport report =
+      fbp_by_slabs(source, options, writer, per, [&](std::size_t first, const Array& slices) {
+        if (nz / 2 >= first && nz / 2 < first + slices.shape[0]) {
+          const std::size_t plane = slices.shape[1] * slices.shape[2];
+          const auto at = slices.data.begin() + static_cast<long>((nz / 2 - first) * plane);
+          middle = Array({slices.shape[1], slices.shape[2]},
+                         std::vector<float>(at, at + static_cast<long>(plane)));
+        }
+        progress.update(first + slices.shape[0]);
+      });
+  writer.close();
+  progress.finish();
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (args.is_set("png")) {
+    std::filesystem::path png = out;
+    png = png.extension().empty() ? png / "middle_slice.png" : png.replace_extension(".png");
+    write_png(png, middle);
+  }
+  if (report.fbp.short_scan) {
+    console.line(
+        "warning: the views do not cover the full circle; without Parker weights the "
+        "image will show streaks");
+  }
+  console.line("fbp (" + std::string(fbp_filter_name(options.filter)) + ", " +
+               engine_name(options.engine) + "): " + shape_string(g.volume_shape) + " in " +
+               std::to_string(report.slabs) + " slab(s) of up to " +
+               std::to_string(report.slices_per_slab) + " slices in " + std::to_string(seconds) +
+               " s, " + std::to_string(report.fbp.non_finite_replaced) +
+               " non-finite measurements interpolated -> " + out);
+  console.summary({{"out", out},
+                   {"shape", g.volume_shape},
+                   {"filter", fbp_filter_name(options.filter)},
+                   {"engine", engine_name(options.engine)},
+                   {"seconds", seconds},
+                   {"slabs", report.slabs},
+                   {"slices_per_slab", report.slices_per_slab},
+                   {"memory_limit_bytes", limit},
+                   {"slab_bytes_estimated", fbp_slab_bytes(g, report.slices_per_slab)},
+                   {"non_finite_replaced", report.fbp.non_finite_replaced},
+                   {"short_scan", report.fbp.short_scan},
+                   {"centre", source.centre() ? centre_json(*source.centre())
+                                              : nlohmann::json(nullptr)}});
+  return 0;
+}
+
+}  // namespace
 
 int run_fbp(int argc, char** argv, int first) {
   Args args("fbp",
@@ -17,13 +108,30 @@ int run_fbp(int argc, char** argv, int first) {
             "beam. NaN/inf measurements (dead elements) are interpolated from their neighbours "
             "first. The image is written in the format of --out's extension.");
   add_scan_options(args);
-  args.option("out", "IMAGE", "output image/volume (.nii, .npy, .tif, .raw)")
+  args.option("out", "IMAGE",
+              "output image/volume (.nii, .npy, .tif, .raw), a volume as FILE.h5[:/dataset] "
+              "(default dataset /volume), or a folder (no extension) of one TIFF per slice")
       .option("filter", "NAME", "ram-lak, shepp-logan or hann", "ram-lak")
-      .flag("png", "also write a PNG preview beside the output");
+      .flag("png", "also write a PNG preview beside the output")
+      .option("slab-slices", "N",
+              "a parallel-beam stack in slabs of N axial slices, each read, reconstructed and "
+              "written alone (default: as many as --memory-limit allows)",
+              "")
+      .option("memory-limit", "SIZE",
+              "host memory a slab may take (8G, 512M); a stack whose volume does not fit goes "
+              "by slabs (default: three quarters of the machine's memory)",
+              "");
   add_engine_flags(args);
   args.output_flags();
   if (!args.parse(argc, argv, first)) return 0;
   Console console(args);
+  if (fbp_wants_slabs(args)) {
+    FbpOptions options;
+    options.filter = parse_fbp_filter(args.get("filter"));
+    options.engine = engine_from(args);
+    options.device = device_from(args, options.engine);
+    return fbp_by_slabs_cli(args, console, options);
+  }
   const LoadedScan loaded = scan_from(args, console);
   check_centre(loaded, console);
   const Scan& scan = loaded.scan;

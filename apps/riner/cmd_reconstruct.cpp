@@ -118,7 +118,11 @@ int run_reconstruct(int argc, char** argv, int first) {
             "config.json and summary.json into the output folder.");
   add_scan_options(args);
   args.option("out", "DIR", "output folder (created if missing)")
-      .option("format", "EXT", "image format: nii, npy, tif or raw", "nii")
+      .option("format", "EXT",
+              "image format: nii, npy, tif, raw or h5 (a volume, dataset /volume); a slabbed "
+              "run writes TIFF slices (volume/) and with h5, npy or raw also gathers them into "
+              "volume.<format>",
+              "nii")
       .option("config", "FILE", "settings JSON ({\"training\": {\"steps\": 4000}, ...})", "")
       .option("set", "NAME=VALUE,...",
               "change settings after --config (training.alpha_lr_scale=0.3; `riner settings` "
@@ -161,8 +165,12 @@ int run_reconstruct(int argc, char** argv, int first) {
   Scan& scan = loaded.scan;
   const RinerConfig config = config_from(args);
   const std::string format = args.get("format");
-  if (format != "nii" && format != "npy" && format != "tif" && format != "raw") {
-    throw UsageError("--format must be nii, npy, tif or raw");
+  if (format != "nii" && format != "npy" && format != "tif" && format != "raw" &&
+      format != "h5") {
+    throw UsageError("--format must be nii, npy, tif, raw or h5");
+  }
+  if (format == "h5" && !scan.geometry.is_3d()) {
+    throw UsageError("--format h5 writes volumes; write a 2D image as nii, npy, tif or raw");
   }
   const std::filesystem::path out = make_output_dir(args.get("out"));
   if (scan.non_finite > 0) {

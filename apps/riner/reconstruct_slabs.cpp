@@ -10,6 +10,7 @@
 #include "riner/io.hpp"
 #include "riner/slab_ranks.hpp"
 #include "riner/slab_run.hpp"
+#include "riner/volume_writer.hpp"
 #include "scan_options.hpp"
 #include "summary_json.hpp"
 
@@ -95,12 +96,25 @@ std::optional<Device> rank_device(const Args& args, Engine engine, const SlabRan
   return Device::open(std::to_string(gpus[ranks.local_rank() % gpus.size()]));
 }
 
+// The slabs' TIFF slices, one at a time, into one volume file.
+void gather_slices(const SlabRun& run, const std::string& target) {
+  const Geometry& g = run.source().geometry();
+  VolumeWriter writer(target, g.volume_shape, g.voxel_mm);
+  for (std::size_t k = 0; k < g.volume_shape[0]; ++k) {
+    Array slice = read_array(run.slice_path(k)).array;
+    slice.shape.insert(slice.shape.begin(), 1);
+    writer.write(k, slice);
+  }
+  writer.close();
+}
+
 }  // namespace
 
 int reconstruct_by_slabs(const Args& args, const Console& console, const RinerConfig& settings,
                          std::chrono::steady_clock::time_point started) {
-  if (const std::string format = args.get("format"); format != "nii" && format != "tif") {
-    throw UsageError("a slabbed run writes its volume as TIFF slices (volume/); drop --format");
+  const std::string format = args.get("format");
+  if (format != "nii" && format != "tif" && format != "h5" && format != "npy" && format != "raw") {
+    throw UsageError("--format must be nii, npy, tif, raw or h5");
   }
   if (SlabRanks::launched_size() > 1 && !SlabRanks::built_with_mpi()) {
     throw InputError("this riner was built without MPI: run one process, or install "
@@ -206,6 +220,11 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
     }
   }
   write_detector_outputs(out, run.alpha(), run.beta(), dead);
+  std::string gathered;
+  if (format == "h5" || format == "npy" || format == "raw") {
+    gathered = (out / ("volume." + format)).string();
+    gather_slices(run, gathered);
+  }
   write_png(out / "image.png", run.preview());
   write_text(out / "config.json", config.to_json());
   const double wall =
@@ -220,6 +239,9 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   }
   nlohmann::json summary = {
       {"volume", run.volume_dir().string()},
+      {"volume_file", gathered.empty() ? nlohmann::json(nullptr)
+                                       : nlohmann::json(format == "h5" ? gathered + ":/volume"
+                                                                       : gathered)},
       {"shape", g.volume_shape},
       {"voxel_mm", g.voxel_mm},
       {"slabs", run.slabs().size()},

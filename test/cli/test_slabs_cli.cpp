@@ -8,6 +8,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <nlohmann/json.hpp>
 #include <thread>
@@ -61,11 +62,17 @@ TEST_SUITE("cli") {
     const std::string scan = simulate_stack(dir);
     const std::string common = "reconstruct " + scan + " --slab-slices 4 --steps 600 --quiet";
     const std::filesystem::path whole = dir / "whole", killed = dir / "killed";
-    REQUIRE(riner_cli(common + " --out " + whole.string(), dir).code == 0);
+    REQUIRE(riner_cli(common + " --format h5 --out " + whole.string(), dir).code == 0);
     const nlohmann::json summary =
         nlohmann::json::parse(riner::test::read_bytes(whole / "summary.json"));
     CHECK(summary["slabs"] == 5);
     CHECK(summary["slabs_done_before"] == 0);
+    // --format h5 gathers the slices into one dataset as well.
+    CHECK(summary["volume_file"] == (whole / "volume.h5:/volume").string());
+    const riner::Array gathered = riner::read_array((whole / "volume.h5:/volume").string()).array;
+    const riner::Array slices = riner::read_array(whole / "volume").array;
+    CHECK(gathered.shape == slices.shape);
+    CHECK(gathered.data == slices.data);
 
     // The same run, killed as soon as its first slab is written.
     std::vector<std::string> words = {RINER_CLI_PATH, "reconstruct",  scan,
@@ -178,5 +185,43 @@ TEST_SUITE("cli") {
                     dir);
     CHECK(run.code != 0);
     CHECK(run.err.find("a memory size is a number") != std::string::npos);
+  }
+
+  TEST_CASE("riner fbp by slabs writes the whole volume's slices, into a folder or an HDF5 file") {
+    riner::test::TempDir dir;
+    const std::string scan = simulate_stack(dir);
+    REQUIRE(riner_cli("fbp " + scan + " --quiet --out " + (dir / "whole.npy").string(), dir).code ==
+            0);
+    const riner::Array whole = riner::read_array((dir / "whole.npy").string()).array;
+    Run run = riner_cli("fbp " + scan + " --slab-slices 3 --json --out " +
+                            (dir / "vol.h5:/entry/recon").string(),
+                        dir);
+    REQUIRE(run.code == 0);
+    const nlohmann::json summary = nlohmann::json::parse(run.out);
+    CHECK(summary["slabs"] == 7);
+    run = riner_cli("fbp " + scan + " --slab-slices 8 --quiet --png --out " +
+                        (dir / "slices").string(),
+                    dir);
+    REQUIRE(run.code == 0);
+    CHECK(std::filesystem::exists(dir / "slices" / "middle_slice.png"));
+    for (const std::string& volume :
+         {(dir / "vol.h5:/entry/recon").string(), (dir / "slices").string()}) {
+      CAPTURE(volume);
+      const riner::Array slabbed = riner::read_array(volume).array;
+      REQUIRE(slabbed.shape == whole.shape);
+      float worst = 0.0f;
+      for (std::size_t i = 0; i < whole.size(); ++i) {
+        worst = std::max(worst, std::fabs(slabbed.data[i] - whole.data[i]));
+      }
+      CHECK(worst < 1e-5f);
+    }
+    // A folder that already holds a volume is not written over.
+    run = riner_cli("fbp " + scan + " --slab-slices 8 --quiet --out " + (dir / "slices").string(),
+                    dir);
+    CHECK(run.code != 0);
+    CHECK(run.err.find("already holds slices") != std::string::npos);
+    run = riner_cli("fbp " + scan + " --slab-slices 0 --out " + (dir / "z").string(), dir);
+    CHECK(run.code != 0);
+    CHECK(run.err.find("--slab-slices must be 1 or more") != std::string::npos);
   }
 }

@@ -11,6 +11,7 @@
 #include "io/stack.hpp"
 #include "riner/error.hpp"
 #include "riner/io.hpp"
+#include "riner/volume_writer.hpp"
 #include "riner/tomo_file.hpp"
 #include "util/atomic_file.hpp"
 
@@ -173,14 +174,22 @@ void write_array(const std::filesystem::path& path, const Array& array,
                    static_cast<std::streamsize>(array.size() * sizeof(float)));
         if (!file.flush()) throw Error(io::prefix(path) + "write failed");
       });
-      return write_text(sidecar, io::raw_sidecar_json(array));
+      return write_text(sidecar, io::raw_sidecar_json(array.shape));
     }
     case FileFormat::kPng:
       return write_png(path, array);
     case FileFormat::kJson:
       throw InputError(io::prefix(path) + "arrays are not written as JSON");
-    case FileFormat::kHdf5:
-      throw InputError(io::prefix(path) + "riner reads HDF5 but does not write it");
+    case FileFormat::kHdf5: {
+      if (array.rank() != 3) {
+        throw InputError(io::prefix(path) + "riner writes HDF5 volumes [slices, rows, columns], "
+                         "not " + shape_string(array.shape) + "; write images as .npy, .nii or .tif");
+      }
+      VolumeWriter writer(path.string(), array.shape,
+                          options.voxel_size.empty() ? 1.0 : options.voxel_size[0]);
+      writer.write(0, array);
+      return writer.close();
+    }
   }
 }
 

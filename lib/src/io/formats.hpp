@@ -3,6 +3,8 @@
 #pragma once
 
 #include <filesystem>
+#include <memory>
+#include <string>
 #include <optional>
 #include <vector>
 
@@ -15,22 +17,44 @@ std::vector<std::size_t> npy_shape(const std::filesystem::path& path);
 // Rows of a C-order stack by seeking; nullopt for a Fortran-order file (read it whole).
 std::optional<ArrayFile> read_npy_rows(const std::filesystem::path& path, RowRange rows);
 void write_npy(const std::filesystem::path& path, const Array& array);
+// What write_npy puts before the float32 C-order data.
+std::string npy_header(const std::vector<std::size_t>& shape);
 
 ArrayFile read_nifti(const std::filesystem::path& path);
 void write_nifti(const std::filesystem::path& path, const Array& array,
                  const std::vector<double>& voxel_size);
+// What write_nifti puts before the float32 data (InputError for a shape NIfTI-1 cannot hold).
+std::string nifti_header(const std::filesystem::path& path, const std::vector<std::size_t>& shape,
+                         const std::vector<double>& voxel_size);
 
 ArrayFile read_tiff(const std::filesystem::path& path);
 // Rows `rows` of every page: [count, cols] for one page, [pages, count, cols] for several.
 ArrayFile read_tiff_rows(const std::filesystem::path& path, RowRange rows);
 std::vector<std::size_t> tiff_shape(const std::filesystem::path& path);
 void write_tiff(const std::filesystem::path& path, const Array& array);
+// A float32 TIFF written a page at a time, in order (libtiff appends directories).
+class TiffPageWriter {
+ public:
+  TiffPageWriter(const std::filesystem::path& path, std::size_t pages, std::size_t rows,
+                 std::size_t cols);
+  TiffPageWriter(const TiffPageWriter&) = delete;
+  TiffPageWriter& operator=(const TiffPageWriter&) = delete;
+  ~TiffPageWriter();
+  void append(const float* page);  // rows x cols values
+  void close();                    // Error when the file cannot be completed
+
+ private:
+  struct File;
+  std::unique_ptr<File> file_;
+  std::filesystem::path path_;
+  std::size_t pages_, rows_, cols_, written_ = 0;
+};
 
 // The sidecar is "<path>.json".
 ArrayFile read_raw(const std::filesystem::path& path);
 std::vector<std::size_t> raw_shape(const std::filesystem::path& path);
 std::optional<ArrayFile> read_raw_rows(const std::filesystem::path& path, RowRange rows);
-std::string raw_sidecar_json(const Array& array);
+std::string raw_sidecar_json(const std::vector<std::size_t>& shape);
 
 // 8-bit PNG of prepared pixels (rows x cols x channels).
 void write_png_gray8(const std::filesystem::path& path, const std::vector<unsigned char>& pixels,

@@ -8,6 +8,7 @@
 #include <type_traits>
 
 #include "io/file_access.hpp"
+#include "io/hdf5_handle.hpp"
 #include "io/row_blocks.hpp"
 #include "riner/error.hpp"
 #include "riner/io.hpp"
@@ -17,24 +18,7 @@ namespace riner {
 
 namespace {
 
-// One HDF5 identifier, closed with its own function.
-class Hid {
- public:
-  Hid(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
-  Hid(const Hid&) = delete;
-  Hid& operator=(const Hid&) = delete;
-  Hid(Hid&& other) noexcept : id_(other.id_), close_(other.close_) { other.id_ = -1; }
-  Hid& operator=(Hid&&) = delete;
-  ~Hid() {
-    if (id_ >= 0) close_(id_);
-  }
-  hid_t get() const { return id_; }
-  bool ok() const { return id_ >= 0; }
-
- private:
-  hid_t id_;
-  herr_t (*close_)(hid_t);
-};
+using io::Hid;
 
 std::string where(const std::filesystem::path& file, const std::string& dataset) {
   return file.string() + ":" + dataset + ": ";

@@ -164,13 +164,13 @@ ArrayFile read_nifti(const std::filesystem::path& path) {
   return file;
 }
 
-void write_nifti(const std::filesystem::path& path, const Array& array,
-                 const std::vector<double>& voxel_size) {
-  if (array.rank() < 1 || array.rank() > 7) {
+std::string nifti_header(const std::filesystem::path& path, const std::vector<std::size_t>& shape,
+                         const std::vector<double>& voxel_size) {
+  if (shape.size() < 1 || shape.size() > 7) {
     throw InputError(prefix(path) + "NIfTI holds 1 to 7 dimensions, not " +
-                     std::to_string(array.rank()));
+                     std::to_string(shape.size()));
   }
-  for (std::size_t d : array.shape) {
+  for (std::size_t d : shape) {
     if (d > 32767) {
       throw InputError(prefix(path) + "dimension " + std::to_string(d) +
                        " exceeds NIfTI-1's limit of 32767");
@@ -180,10 +180,10 @@ void write_nifti(const std::filesystem::path& path, const Array& array,
   std::string header(kDataOffset, '\0');
   put<std::int32_t>(header, 0, 348);
   header[38] = 'r';
-  const std::size_t rank = array.rank();
+  const std::size_t rank = shape.size();
   put<std::int16_t>(header, 40, static_cast<std::int16_t>(rank));
   for (std::size_t d = 0; d < 7; ++d) {
-    const std::size_t n = d < rank ? array.shape[rank - 1 - d] : 1;
+    const std::size_t n = d < rank ? shape[rank - 1 - d] : 1;
     put<std::int16_t>(header, 42 + 2 * d, static_cast<std::int16_t>(n));
   }
   put<std::int16_t>(header, 70, 16);  // float32
@@ -198,6 +198,12 @@ void write_nifti(const std::filesystem::path& path, const Array& array,
   header[123] = 2;  // xyzt_units: millimetres
   std::memcpy(header.data() + 148, "riner", 5);
   std::memcpy(header.data() + 344, "n+1", 4);
+  return header;
+}
+
+void write_nifti(const std::filesystem::path& path, const Array& array,
+                 const std::vector<double>& voxel_size) {
+  const std::string header = nifti_header(path, array.shape, voxel_size);
   std::ofstream file(path, std::ios::binary);
   file.write(header.data(), static_cast<std::streamsize>(header.size()));
   file.write(reinterpret_cast<const char*>(array.ptr()),

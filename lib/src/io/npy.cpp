@@ -214,12 +214,12 @@ std::optional<ArrayFile> read_npy_rows(const std::filesystem::path& path, RowRan
                          header.little_endian, FileFormat::kNpy);
 }
 
-void write_npy(const std::filesystem::path& path, const Array& array) {
+std::string npy_header(const std::vector<std::size_t>& shape) {
   std::string dims;
-  for (std::size_t d = 0; d < array.shape.size(); ++d) {
-    dims += (d > 0 ? ", " : "") + std::to_string(array.shape[d]);
+  for (std::size_t d = 0; d < shape.size(); ++d) {
+    dims += (d > 0 ? ", " : "") + std::to_string(shape[d]);
   }
-  if (array.shape.size() == 1) dims += ",";  // a 1-tuple is "(n,)"
+  if (shape.size() == 1) dims += ",";  // a 1-tuple is "(n,)"
   std::string dict = "{'descr': '<f4', 'fortran_order': False, 'shape': (" + dims + "), }";
   // Pad with spaces so the data starts on a 64-byte boundary; the header ends with '\n'.
   const std::size_t unpadded = kMagicSize + 4 + dict.size() + 1;
@@ -231,6 +231,11 @@ void write_npy(const std::filesystem::path& path, const Array& array) {
   out += static_cast<char>(dict.size() & 0xff);
   out += static_cast<char>((dict.size() >> 8) & 0xff);
   out += dict;
+  return out;
+}
+
+void write_npy(const std::filesystem::path& path, const Array& array) {
+  const std::string out = npy_header(array.shape);
   std::ofstream file(path, std::ios::binary);
   file.write(out.data(), static_cast<std::streamsize>(out.size()));
   std::vector<float> le(array.data);

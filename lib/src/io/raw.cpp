@@ -123,9 +123,9 @@ std::optional<ArrayFile> read_raw_rows(const std::filesystem::path& path, RowRan
                          layout.little_endian, FileFormat::kRaw);
 }
 
-std::string raw_sidecar_json(const Array& array) {
+std::string raw_sidecar_json(const std::vector<std::size_t>& shape) {
   nlohmann::json meta = {{"dtype", "float32"},
-                         {"shape", array.shape},
+                         {"shape", shape},
                          {"byte_order", host_is_little_endian() ? "little" : "big"},
                          {"offset_bytes", 0},
                          {"order", "C"}};

@@ -196,43 +196,73 @@ std::vector<std::size_t> tiff_shape(const std::filesystem::path& path) {
   return {pages, height, width};
 }
 
+struct TiffPageWriter::File {
+  TiffPtr tif;
+};
+
+TiffPageWriter::TiffPageWriter(const std::filesystem::path& path, std::size_t pages,
+                               std::size_t rows, std::size_t cols)
+    : file_(std::make_unique<File>()), path_(path), pages_(pages), rows_(rows), cols_(cols) {
+  install_handlers();
+  t_tiff_error.clear();
+  const bool big = pages * rows * cols * sizeof(float) > (std::size_t{1} << 31);
+  file_->tif.reset(TIFFOpen(path.c_str(), big ? "w8" : "w"));
+  if (!file_->tif) throw Error(prefix(path) + "cannot create TIFF file");
+}
+
+TiffPageWriter::~TiffPageWriter() = default;
+
+void TiffPageWriter::append(const float* page) {
+  if (!file_->tif || written_ >= pages_) {
+    throw std::logic_error(prefix(path_) + "TIFF page written past the last");
+  }
+  TIFF* tif = file_->tif.get();
+  t_tiff_error.clear();
+  TIFFSetField(tif, TIFFTAG_IMAGEWIDTH, static_cast<uint32_t>(cols_));
+  TIFFSetField(tif, TIFFTAG_IMAGELENGTH, static_cast<uint32_t>(rows_));
+  TIFFSetField(tif, TIFFTAG_BITSPERSAMPLE, 32);
+  TIFFSetField(tif, TIFFTAG_SAMPLEFORMAT, SAMPLEFORMAT_IEEEFP);
+  TIFFSetField(tif, TIFFTAG_SAMPLESPERPIXEL, 1);
+  TIFFSetField(tif, TIFFTAG_PHOTOMETRIC, PHOTOMETRIC_MINISBLACK);
+  TIFFSetField(tif, TIFFTAG_PLANARCONFIG, PLANARCONFIG_CONTIG);
+  TIFFSetField(tif, TIFFTAG_COMPRESSION, COMPRESSION_NONE);
+  TIFFSetField(tif, TIFFTAG_ROWSPERSTRIP, TIFFDefaultStripSize(tif, 0));
+  if (pages_ > 1) {
+    TIFFSetField(tif, TIFFTAG_SUBFILETYPE, FILETYPE_PAGE);
+    TIFFSetField(tif, TIFFTAG_PAGENUMBER, static_cast<uint16_t>(written_),
+                 static_cast<uint16_t>(pages_));
+  }
+  std::vector<float> row(cols_);
+  for (std::size_t y = 0; y < rows_; ++y) {
+    std::memcpy(row.data(), page + y * cols_, cols_ * sizeof(float));
+    if (TIFFWriteScanline(tif, row.data(), static_cast<uint32_t>(y), 0) < 0) {
+      throw Error(prefix(path_) + "TIFF write failed: " + t_tiff_error);
+    }
+  }
+  if (!TIFFWriteDirectory(tif)) throw Error(prefix(path_) + "TIFF write failed");
+  ++written_;
+}
+
+void TiffPageWriter::close() {
+  if (written_ != pages_) {
+    throw std::logic_error(prefix(path_) + std::to_string(written_) + " of " +
+                           std::to_string(pages_) + " TIFF pages written");
+  }
+  if (file_->tif && !TIFFFlush(file_->tif.get())) throw Error(prefix(path_) + "TIFF write failed");
+  file_->tif.reset();
+}
+
 void write_tiff(const std::filesystem::path& path, const Array& array) {
   if (array.rank() != 2 && array.rank() != 3) {
     throw InputError(prefix(path) + "TIFF output takes a 2D image or a 3D stack, not rank " +
                      std::to_string(array.rank()));
   }
-  install_handlers();
-  t_tiff_error.clear();
   const std::size_t pages = array.rank() == 3 ? array.shape[0] : 1;
   const std::size_t rows = array.shape[array.rank() - 2];
   const std::size_t cols = array.shape[array.rank() - 1];
-  const bool big = array.size() * sizeof(float) > (std::size_t{1} << 31);
-  TiffPtr tif(TIFFOpen(path.c_str(), big ? "w8" : "w"));
-  if (!tif) throw Error(prefix(path) + "cannot create TIFF file");
-  std::vector<float> row(cols);
-  for (std::size_t p = 0; p < pages; ++p) {
-    TIFFSetField(tif.get(), TIFFTAG_IMAGEWIDTH, static_cast<uint32_t>(cols));
-    TIFFSetField(tif.get(), TIFFTAG_IMAGELENGTH, static_cast<uint32_t>(rows));
-    TIFFSetField(tif.get(), TIFFTAG_BITSPERSAMPLE, 32);
-    TIFFSetField(tif.get(), TIFFTAG_SAMPLEFORMAT, SAMPLEFORMAT_IEEEFP);
-    TIFFSetField(tif.get(), TIFFTAG_SAMPLESPERPIXEL, 1);
-    TIFFSetField(tif.get(), TIFFTAG_PHOTOMETRIC, PHOTOMETRIC_MINISBLACK);
-    TIFFSetField(tif.get(), TIFFTAG_PLANARCONFIG, PLANARCONFIG_CONTIG);
-    TIFFSetField(tif.get(), TIFFTAG_COMPRESSION, COMPRESSION_NONE);
-    TIFFSetField(tif.get(), TIFFTAG_ROWSPERSTRIP, TIFFDefaultStripSize(tif.get(), 0));
-    if (pages > 1) {
-      TIFFSetField(tif.get(), TIFFTAG_SUBFILETYPE, FILETYPE_PAGE);
-      TIFFSetField(tif.get(), TIFFTAG_PAGENUMBER, static_cast<uint16_t>(p),
-                   static_cast<uint16_t>(pages));
-    }
-    for (std::size_t y = 0; y < rows; ++y) {
-      std::memcpy(row.data(), array.ptr() + (p * rows + y) * cols, cols * sizeof(float));
-      if (TIFFWriteScanline(tif.get(), row.data(), static_cast<uint32_t>(y), 0) < 0) {
-        throw Error(prefix(path) + "TIFF write failed: " + t_tiff_error);
-      }
-    }
-    if (!TIFFWriteDirectory(tif.get())) throw Error(prefix(path) + "TIFF write failed");
-  }
+  TiffPageWriter writer(path, pages, rows, cols);
+  for (std::size_t p = 0; p < pages; ++p) writer.append(array.ptr() + p * rows * cols);
+  writer.close();
 }
 
 }  // namespace riner::io
