@@ -2,12 +2,28 @@
 //   fbp_filter(n_out, n_u, taps, in, out)
 //     one work-item per output sample; out[line][j] = sum_j' taps[j - j' + n_u - 1] *
 //     in[line][j'] (the ramp filter as a linear convolution; taps already hold the spacing).
+//   fbp_filter_fft(n_lines, n_u, n, spectrum, twiddles, in, out, x)
+//     the same convolution by FFT, n log n instead of n_u^2 per line: one work-group per pair of
+//     lines, the second as the imaginary part (the taps are real, so the two convolve apart),
+//     zero-padded to n, a power of two >= 2 n_u - 1 (the circular convolution is then the
+//     linear one), transformed in local memory x[n] by a radix-2 FFT (decimation in frequency:
+//     the spectrum comes out in bit-reversed order), multiplied by the taps' spectrum (given in
+//     that order, 1/n folded in) and transformed back (decimation in time from bit-reversed
+//     order to natural). twiddles[k] = exp(-2 pi i k / n), k < n / 2.
 //   fbp_backproject(n_voxels, first_slice, slice_step, g, views, view_weights, filtered, volume)
 //     one work-item per voxel of the selected axial slices first_slice + s * slice_step
 //     (volume[s] holds slice s of the selection; 2D: 0 and 1); sums over views the filtered value where the voxel projects
 //     (linear in u, bilinear in u and v in 3D), times the view weight and, for divergent beams,
 //     the distance weight (SOD / L)^2 with L the voxel's distance from the source along the
 //     central ray. Values off the detector count as 0.
+//   fbp_backproject_parallel(n_items, first_slice, slice_step, n_selected, g, views,
+//                            view_weights, filtered, volume)
+//     the same for parallel beams, shaped for them: one work-item per voxel column (x, y) and
+//     block of kParallelSlices selected slices. A parallel beam's voxel projects onto the same
+//     u for every slice and onto the same row in every view, so u is found once per view for
+//     the block, and each slice's rows and their weights once for all views; off-detector
+//     samples are clamped indices with zero weight (no branch in the loop over views).
+//     fbp_backproject_parallel_one: the same, one slice per work-item (a 2D scan).
 // Needs common.cl and ray_geometry.cl. No -D constants.
 // Buffers: taps float[2 n_u - 1]; in/out/filtered float[views][rows][n_u]; views float2 (cos,
 // sin); view_weights float[views]; volume float[selected slices][ny][nx].
@@ -22,6 +38,58 @@ __kernel void fbp_filter(const uint n_out, const int n_u, __global const float* 
   float sum = 0.0f;
   for (int k = 0; k < n_u; ++k) sum += h[-k] * line[k];
   out[gid] = sum;
+}
+
+inline float2 complex_times(const float2 a, const float2 b) {
+  return (float2)(a.x * b.x - a.y * b.y, a.x * b.y + a.y * b.x);
+}
+
+__kernel void fbp_filter_fft(const uint n_lines, const uint n_u, const uint n,
+                             __global const float2* spectrum, __global const float2* twiddles,
+                             __global const float* in, __global float* out, __local float2* x) {
+  const uint first = 2 * get_group_id(0);
+  const uint t = get_local_id(0);
+  const uint threads = get_local_size(0);
+  const int pair = first + 1 < n_lines;
+  __global const float* a = in + first * n_u;
+  __global const float* b = in + (first + 1) * n_u;
+  for (uint i = t; i < n; i += threads) {
+    x[i] = i < n_u ? (float2)(a[i], pair ? b[i] : 0.0f) : (float2)(0.0f, 0.0f);
+  }
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (uint span = n / 2; span >= 1; span /= 2) {
+    const uint stride = n / (2 * span);
+    for (uint k = t; k < n / 2; k += threads) {
+      const uint pos = k & (span - 1);
+      const uint i = (k - pos) * 2 + pos;
+      const float2 u = x[i];
+      const float2 v = x[i + span];
+      x[i] = u + v;
+      x[i + span] = complex_times(u - v, twiddles[pos * stride]);
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
+  for (uint k = t; k < n; k += threads) x[k] = complex_times(x[k], spectrum[k]);
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (uint span = 1; span < n; span *= 2) {
+    const uint stride = n / (2 * span);
+    for (uint k = t; k < n / 2; k += threads) {
+      const uint pos = k & (span - 1);
+      const uint i = (k - pos) * 2 + pos;
+      const float2 w = twiddles[pos * stride];
+      const float2 u = x[i];
+      const float2 v = complex_times(x[i + span], (float2)(w.x, -w.y));
+      x[i] = u + v;
+      x[i + span] = u - v;
+    }
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
+  __global float* out_a = out + first * n_u;
+  __global float* out_b = out + (first + 1) * n_u;
+  for (uint i = t; i < n_u; i += threads) {
+    out_a[i] = x[i].x;
+    if (pair) out_b[i] = x[i].y;
+  }
 }
 
 // Filtered value at continuous detector position (u, v) of one view, zero outside.
@@ -41,6 +109,88 @@ inline float sample_detector(__global const float* view, int n_u, int n_v, float
     if (j + 1 >= 0 && j + 1 < n_u) value += w_row * wu * view[row * n_u + j + 1];
   }
   return value;
+}
+
+#define kParallelSlices 4
+
+// One work-item's block of `slices` (1 or kParallelSlices, a constant where it is inlined, so
+// the per-slice arrays stay in registers).
+inline void backproject_parallel_block(const uint gid, const uint n_items, const uint first_slice,
+                                       const uint slice_step, const uint n_selected,
+                                       const ScanGeometry g, __global const float2* views,
+                                       __global const float* view_weights,
+                                       __global const float* filtered, __global float* volume,
+                                       const int slices) {
+  if (gid >= n_items) return;
+  const uint column = gid % (uint)(g.nx * g.ny);
+  const uint block = gid / (uint)(g.nx * g.ny);
+  const int k = column % g.nx;
+  const int i = column / g.nx;
+  const float x = ((float)k - 0.5f * (float)(g.nx - 1)) * g.voxel;
+  const float y = (0.5f * (float)(g.ny - 1) - (float)i) * g.voxel;
+  const int rows = g.is_3d ? g.n_v : 1;
+  // Each slice's two rows (clamped) and their weights (0 off the detector).
+  int row0[kParallelSlices], row1[kParallelSlices];
+  float w_row0[kParallelSlices], w_row1[kParallelSlices], sum[kParallelSlices];
+  for (int s = 0; s < slices; ++s) {
+    const uint selected = block * slices + s;
+    const int l = first_slice + min(selected, n_selected - 1) * slice_step;
+    const float z = g.is_3d ? ((float)l - 0.5f * (float)(g.nz - 1)) * g.voxel : 0.0f;
+    const float v = g.is_3d ? z / g.pitch_v + 0.5f * (float)(g.n_v - 1) - g.offset_v : 0.0f;
+    const float fv = floor(v);
+    const int r = (int)fv;
+    const float wv = v - fv;
+    w_row0[s] = (r >= 0 && r < rows) ? 1.0f - wv : 0.0f;
+    w_row1[s] = (r + 1 >= 0 && r + 1 < rows) ? wv : 0.0f;
+    row0[s] = clamp(r, 0, rows - 1) * g.n_u;
+    row1[s] = clamp(r + 1, 0, rows - 1) * g.n_u;
+    sum[s] = 0.0f;
+  }
+  // Slices on the rows' centres (a 2D scan; voxels as tall as the rows) need one row.
+  int two_rows = 0;
+  for (int s = 0; s < slices; ++s) two_rows |= w_row1[s] != 0.0f;
+  const float u_centre = 0.5f * (float)(g.n_u - 1) - g.offset_u;
+  for (int view = 0; view < g.n_views; ++view) {
+    const float2 cs = views[view];
+    const float u = (x * cs.x + y * cs.y) / g.pitch_u + u_centre;
+    const float fu = floor(u);
+    const int j = (int)fu;
+    const float wu = u - fu;
+    const float weight = view_weights[view];
+    const float w0 = (j >= 0 && j < g.n_u) ? weight * (1.0f - wu) : 0.0f;
+    const float w1 = (j + 1 >= 0 && j + 1 < g.n_u) ? weight * wu : 0.0f;
+    const int j0 = clamp(j, 0, g.n_u - 1);
+    const int j1 = clamp(j + 1, 0, g.n_u - 1);
+    __global const float* f = filtered + view * rows * g.n_u;
+    for (int s = 0; s < slices; ++s) {
+      sum[s] += w_row0[s] * (w0 * f[row0[s] + j0] + w1 * f[row0[s] + j1]);
+      if (two_rows) sum[s] += w_row1[s] * (w0 * f[row1[s] + j0] + w1 * f[row1[s] + j1]);
+    }
+  }
+  for (int s = 0; s < slices; ++s) {
+    const uint selected = block * slices + s;
+    if (selected < n_selected) volume[selected * (uint)(g.nx * g.ny) + column] = sum[s];
+  }
+}
+
+__kernel void fbp_backproject_parallel(const uint n_items, const uint first_slice,
+                                       const uint slice_step, const uint n_selected,
+                                       const ScanGeometry g, __global const float2* views,
+                                       __global const float* view_weights,
+                                       __global const float* filtered, __global float* volume) {
+  backproject_parallel_block(get_global_id(0), n_items, first_slice, slice_step, n_selected, g,
+                             views, view_weights, filtered, volume, kParallelSlices);
+}
+
+// A single slice (a 2D scan, one selected slice): the block of one.
+__kernel void fbp_backproject_parallel_one(const uint n_items, const uint first_slice,
+                                           const uint slice_step, const uint n_selected,
+                                           const ScanGeometry g, __global const float2* views,
+                                           __global const float* view_weights,
+                                           __global const float* filtered,
+                                           __global float* volume) {
+  backproject_parallel_block(get_global_id(0), n_items, first_slice, slice_step, n_selected, g,
+                             views, view_weights, filtered, volume, 1);
 }
 
 __kernel void fbp_backproject(const uint n_voxels, const uint first_slice, const uint slice_step,
