@@ -10,20 +10,23 @@
 //     the spectrum comes out in bit-reversed order), multiplied by the taps' spectrum (given in
 //     that order, 1/n folded in) and transformed back (decimation in time from bit-reversed
 //     order to natural). twiddles[k] = exp(-2 pi i k / n), k < n / 2.
-//   fbp_backproject(n_voxels, first_slice, slice_step, g, views, view_weights, filtered, volume)
-//     one work-item per voxel of the selected axial slices first_slice + s * slice_step
-//     (volume[s] holds slice s of the selection; 2D: 0 and 1); sums over views the filtered value where the voxel projects
-//     (linear in u, bilinear in u and v in 3D), times the view weight and, for divergent beams,
-//     the distance weight (SOD / L)^2 with L the voxel's distance from the source along the
-//     central ray. Values off the detector count as 0.
 //   fbp_backproject_parallel(n_items, first_slice, slice_step, n_selected, g, views,
 //                            view_weights, filtered, volume)
-//     the same for parallel beams, shaped for them: one work-item per voxel column (x, y) and
-//     block of kParallelSlices selected slices. A parallel beam's voxel projects onto the same
-//     u for every slice and onto the same row in every view, so u is found once per view for
-//     the block, and each slice's rows and their weights once for all views; off-detector
-//     samples are clamped indices with zero weight (no branch in the loop over views).
+//     the axial slices first_slice + s * slice_step, s < n_selected (volume[s] holds slice s of
+//     the selection; 2D: one), each voxel the sum over views of the filtered value where it
+//     projects (linear in u, bilinear in u and v in 3D) times the view weight and, for divergent
+//     beams, the distance weight (SOD / L)^2 with L the voxel's distance from the source along
+//     the central ray; values off the detector count as 0. Parallel beams: one work-item per
+//     voxel column (x, y) and block of kParallelSlices selected slices. A parallel beam's voxel
+//     projects onto the same u for every slice and onto the same row in every view, so u is
+//     found once per view for the block, and each slice's rows and their weights once for all
+//     views; off-detector samples are clamped indices with zero weight (no branch in the loop
+//     over views).
 //     fbp_backproject_parallel_one: the same, one slice per work-item (a 2D scan).
+//   fbp_backproject_divergent(...), fbp_backproject_divergent_one(...): the same arguments,
+//     for fan and cone beams: a voxel's u, magnification and distance weight in a view do not
+//     depend on its height, so they are found once per view for the block of slices, and only
+//     each slice's row per view.
 // Needs common.cl and ray_geometry.cl. No -D constants.
 // Buffers: taps float[2 n_u - 1]; in/out/filtered float[views][rows][n_u]; views float2 (cos,
 // sin); view_weights float[views]; volume float[selected slices][ny][nx].
@@ -90,25 +93,6 @@ __kernel void fbp_filter_fft(const uint n_lines, const uint n_u, const uint n,
     out_a[i] = x[i].x;
     if (pair) out_b[i] = x[i].y;
   }
-}
-
-// Filtered value at continuous detector position (u, v) of one view, zero outside.
-inline float sample_detector(__global const float* view, int n_u, int n_v, float u, float v) {
-  const float fu = floor(u);
-  const float fv = floor(v);
-  const int j = (int)fu;
-  const int r = (int)fv;
-  const float wu = u - fu;
-  const float wv = v - fv;
-  float value = 0.0f;
-  for (int dr = 0; dr < 2; ++dr) {
-    const int row = r + dr;
-    if (row < 0 || row >= n_v) continue;
-    const float w_row = dr ? wv : 1.0f - wv;
-    if (j >= 0 && j < n_u) value += w_row * (1.0f - wu) * view[row * n_u + j];
-    if (j + 1 >= 0 && j + 1 < n_u) value += w_row * wu * view[row * n_u + j + 1];
-  }
-  return value;
 }
 
 #define kParallelSlices 4
@@ -193,36 +177,80 @@ __kernel void fbp_backproject_parallel_one(const uint n_items, const uint first_
                              views, view_weights, filtered, volume, 1);
 }
 
-__kernel void fbp_backproject(const uint n_voxels, const uint first_slice, const uint slice_step,
-                              const ScanGeometry g,
-                              __global const float2* views, __global const float* view_weights,
-                              __global const float* filtered, __global float* volume) {
-  const uint gid = get_global_id(0);
-  if (gid >= n_voxels) return;
-  const int k = gid % g.nx;
-  const int i = (gid / g.nx) % g.ny;
-  const int l = first_slice + gid / (g.nx * g.ny) * slice_step;
+inline void backproject_divergent_block(const uint gid, const uint n_items,
+                                        const uint first_slice, const uint slice_step,
+                                        const uint n_selected, const ScanGeometry g,
+                                        __global const float2* views,
+                                        __global const float* view_weights,
+                                        __global const float* filtered, __global float* volume,
+                                        const int slices) {
+  if (gid >= n_items) return;
+  const uint column = gid % (uint)(g.nx * g.ny);
+  const uint block = gid / (uint)(g.nx * g.ny);
+  const int k = column % g.nx;
+  const int i = column / g.nx;
   const float x = ((float)k - 0.5f * (float)(g.nx - 1)) * g.voxel;
   const float y = (0.5f * (float)(g.ny - 1) - (float)i) * g.voxel;
-  const float z = g.is_3d ? ((float)l - 0.5f * (float)(g.nz - 1)) * g.voxel : 0.0f;
   const int rows = g.is_3d ? g.n_v : 1;
-  const int divergent = geometry_is_divergent(&g);
-  float sum = 0.0f;
-  for (int v = 0; v < g.n_views; ++v) {
-    const float2 cs = views[v];
+  float z_over_pitch[kParallelSlices], sum[kParallelSlices];
+  for (int s = 0; s < slices; ++s) {
+    const uint selected = block * slices + s;
+    const int l = first_slice + min(selected, n_selected - 1) * slice_step;
+    z_over_pitch[s] = g.is_3d ? ((float)l - 0.5f * (float)(g.nz - 1)) * g.voxel / g.pitch_v : 0.0f;
+    sum[s] = 0.0f;
+  }
+  const float u_centre = 0.5f * (float)(g.n_u - 1) - g.offset_u;
+  const float v_centre = g.is_3d ? 0.5f * (float)(g.n_v - 1) - g.offset_v : 0.0f;
+  for (int view = 0; view < g.n_views; ++view) {
+    const float2 cs = views[view];
     const float a = x * cs.x + y * cs.y;   // along the detector's u axis
     const float b = -x * cs.y + y * cs.x;  // towards the detector
-    float scale = 1.0f;
-    float weight = view_weights[v];
-    if (divergent) {
-      const float distance = g.sod + b;
-      scale = (g.sod + g.odd) / distance;
-      weight *= (g.sod / distance) * (g.sod / distance);
+    const float distance = g.sod + b;
+    const float scale = (g.sod + g.odd) / distance;
+    const float weight = view_weights[view] * (g.sod / distance) * (g.sod / distance);
+    const float u = a * scale / g.pitch_u + u_centre;
+    const float fu = floor(u);
+    const int j = (int)fu;
+    const float wu = u - fu;
+    const float w0 = (j >= 0 && j < g.n_u) ? weight * (1.0f - wu) : 0.0f;
+    const float w1 = (j + 1 >= 0 && j + 1 < g.n_u) ? weight * wu : 0.0f;
+    const int j0 = clamp(j, 0, g.n_u - 1);
+    const int j1 = clamp(j + 1, 0, g.n_u - 1);
+    __global const float* f = filtered + view * rows * g.n_u;
+    for (int s = 0; s < slices; ++s) {
+      const float v = z_over_pitch[s] * scale + v_centre;
+      const float fv = floor(v);
+      const int r = (int)fv;
+      const float wv = v - fv;
+      const float w_row0 = (r >= 0 && r < rows) ? 1.0f - wv : 0.0f;
+      const float w_row1 = (r + 1 >= 0 && r + 1 < rows) ? wv : 0.0f;
+      const int row0 = clamp(r, 0, rows - 1) * g.n_u;
+      const int row1 = clamp(r + 1, 0, rows - 1) * g.n_u;
+      sum[s] += w_row0 * (w0 * f[row0 + j0] + w1 * f[row0 + j1]) +
+                w_row1 * (w0 * f[row1 + j0] + w1 * f[row1 + j1]);
     }
-    const float u = a * scale / g.pitch_u + 0.5f * (float)(g.n_u - 1) - g.offset_u;
-    const float row =
-        g.is_3d ? z * scale / g.pitch_v + 0.5f * (float)(g.n_v - 1) - g.offset_v : 0.0f;
-    sum += weight * sample_detector(filtered + v * rows * g.n_u, g.n_u, rows, u, row);
   }
-  volume[gid] = sum;
+  for (int s = 0; s < slices; ++s) {
+    const uint selected = block * slices + s;
+    if (selected < n_selected) volume[selected * (uint)(g.nx * g.ny) + column] = sum[s];
+  }
+}
+
+__kernel void fbp_backproject_divergent(const uint n_items, const uint first_slice,
+                                        const uint slice_step, const uint n_selected,
+                                        const ScanGeometry g, __global const float2* views,
+                                        __global const float* view_weights,
+                                        __global const float* filtered, __global float* volume) {
+  backproject_divergent_block(get_global_id(0), n_items, first_slice, slice_step, n_selected, g,
+                              views, view_weights, filtered, volume, kParallelSlices);
+}
+
+__kernel void fbp_backproject_divergent_one(const uint n_items, const uint first_slice,
+                                            const uint slice_step, const uint n_selected,
+                                            const ScanGeometry g, __global const float2* views,
+                                            __global const float* view_weights,
+                                            __global const float* filtered,
+                                            __global float* volume) {
+  backproject_divergent_block(get_global_id(0), n_items, first_slice, slice_step, n_selected, g,
+                              views, view_weights, filtered, volume, 1);
 }

@@ -17,7 +17,7 @@ namespace riner::app {
 
 namespace {
 
-// A parallel-beam stack goes by slabs when asked (--slab-slices, --memory-limit), when the
+// A projection stack goes by slabs when asked (--slab-slices, --memory-limit), when the
 // output is a folder of slices, or when its volume does not fit in memory whole.
 bool fbp_wants_slabs(const Args& args) {
   if (auto row = args.maybe("row"); row && !row->empty()) return false;
@@ -28,7 +28,7 @@ bool fbp_wants_slabs(const Args& args) {
   try {
     const ScanRows rows(source);
     const Geometry& g = rows.geometry();
-    if (g.type != GeometryType::kParallel3d) return false;
+    if (!g.is_3d()) return false;
     return asked || folder || fbp_slab_bytes(g, g.volume_shape[0]) > default_memory_limit();
   } catch (const InputError&) {
     return false;  // a 2D scan, or one the whole-scan path explains better
@@ -114,8 +114,8 @@ int run_fbp(int argc, char** argv, int first) {
       .option("filter", "NAME", "ram-lak, shepp-logan or hann", "ram-lak")
       .flag("png", "also write a PNG preview beside the output")
       .option("slab-slices", "N",
-              "a parallel-beam stack in slabs of N axial slices, each read, reconstructed and "
-              "written alone (default: as many as --memory-limit allows)",
+              "a projection stack (parallel or cone beam) in slabs of N axial slices, each read, "
+              "reconstructed and written alone (default: as many as --memory-limit allows)",
               "")
       .option("memory-limit", "SIZE",
               "host memory a slab may take (8G, 512M); a stack whose volume does not fit goes "

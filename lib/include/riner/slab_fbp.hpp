@@ -1,8 +1,10 @@
-// FBP of a parallel-beam projection stack slab by slab (riner/slab_plan.hpp): each slab's
-// detector rows, and one more on either side (its slices' backprojection interpolates between
-// rows), are read alone (riner/scan_source.hpp), filtered, backprojected and handed to a
-// VolumeWriter, so a stack larger than memory goes through FBP in the memory of one slab. Each
-// slice is the whole volume's FBP slice (to float rounding; a test checks).
+// FBP (parallel beam) or FDK (cone beam) of a projection stack slab by slab: each slab of axial
+// slices reads alone (riner/scan_source.hpp) the detector rows its voxels reach, found from the
+// geometry (a cone beam's spread by the magnification from the nearest voxel to the farthest),
+// filters and backprojects them, and hands its slices to a VolumeWriter, so a stack larger
+// than memory goes through in the memory of one slab. Filtering is row by row and the
+// backprojection voxel by voxel, so each slice is the whole volume's (to float rounding; a test
+// checks both beams).
 #pragma once
 
 #include <cstddef>
@@ -20,6 +22,10 @@ struct SlabFbpReport {
   FbpReport fbp;  // summed over the slabs
 };
 
+// The detector rows slices [first, first + count) of g's volume project to, with the row
+// either side that bilinear sampling takes; count 0 when none.
+RowRange fbp_rows_reached(const Geometry& g, std::size_t first, std::size_t count);
+
 // Host memory FBP of a slab of `slices` slices takes (measured, bench/RESULTS.md "FBP by
 // slabs"): a base for the runtime and the kernels, the slab's readings in their copies (read,
 // normalised, filtered) and its voxels.
@@ -28,8 +34,8 @@ std::size_t fbp_slab_bytes(const Geometry& g, std::size_t slices);
 std::size_t fbp_slices_within(const Geometry& g, std::size_t limit);
 
 // Every slice of `source`'s volume into `out` (not closed), slabs of `slices_per_slab` in
-// order; `written` after each slab with its first slice and its slices. InputError as ScanRows::read
-// and plan_slabs; options.slices must select every slice (the default).
+// order (slabs as even as they come); `written` after each slab with its first slice and its
+// slices. InputError as ScanRows::read; options.slices must select every slice (the default).
 SlabFbpReport fbp_by_slabs(const ScanRows& source, const FbpOptions& options, VolumeWriter& out,
                            std::size_t slices_per_slab,
                            const std::function<void(std::size_t first_slice, const Array& slices)>&

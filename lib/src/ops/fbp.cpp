@@ -79,9 +79,10 @@ FbpOp::FbpOp(cl::Context& context, const Geometry& geometry, const std::vector<d
       program_(context.program({"common", "ray_geometry", "fbp"})),
       filter_(*program_, "fbp_filter"),
       filter_fft_(*program_, "fbp_filter_fft"),
-      backproject_(*program_, "fbp_backproject"),
       backproject_parallel_(*program_, "fbp_backproject_parallel"),
-      backproject_parallel_one_(*program_, "fbp_backproject_parallel_one") {
+      backproject_parallel_one_(*program_, "fbp_backproject_parallel_one"),
+      backproject_divergent_(*program_, "fbp_backproject_divergent"),
+      backproject_divergent_one_(*program_, "fbp_backproject_divergent_one") {
   if (taps.size() != 2 * geometry.n_u - 1 || view_weights.size() != geometry.n_views()) {
     throw Error("fbp: taps or view weights do not match the geometry");
   }
@@ -119,23 +120,18 @@ void FbpOp::backproject(const cl::Buffer<float>& filtered, cl::Buffer<float>& vo
       slice_step == 0 || first_slice + (slices - 1) * slice_step >= n_slices_) {
     throw Error("fbp_backproject: size mismatch");
   }
-  if (!divergent_) {
-    // Blocks of kParallelSlices slices; one slice alone would compute the block's others
-    // for nothing.
-    const std::size_t per_item = slices == 1 ? 1 : kParallelSlices;
-    cl::Kernel& kernel = slices == 1 ? backproject_parallel_one_ : backproject_parallel_;
-    const auto columns = static_cast<cl_uint>(slice_voxels_);
-    const auto blocks = static_cast<cl_uint>((slices + per_item - 1) / per_item);
-    kernel.set_args(columns * blocks, static_cast<cl_uint>(first_slice),
-                    static_cast<cl_uint>(slice_step), static_cast<cl_uint>(slices), geometry_,
-                    views_, view_weights_, filtered, volume);
-    context_.launch(kernel, std::size_t{columns} * blocks);
-    return;
-  }
-  const auto n = static_cast<cl_uint>(volume.size());
-  backproject_.set_args(n, static_cast<cl_uint>(first_slice), static_cast<cl_uint>(slice_step),
-                        geometry_, views_, view_weights_, filtered, volume);
-  context_.launch(backproject_, volume.size());
+  // Blocks of kParallelSlices slices per work-item; one slice alone would compute the
+  // block's others for nothing.
+  const bool one = slices == 1;
+  cl::Kernel& kernel = divergent_ ? (one ? backproject_divergent_one_ : backproject_divergent_)
+                                  : (one ? backproject_parallel_one_ : backproject_parallel_);
+  const std::size_t per_item = one ? 1 : kParallelSlices;
+  const auto columns = static_cast<cl_uint>(slice_voxels_);
+  const auto blocks = static_cast<cl_uint>((slices + per_item - 1) / per_item);
+  kernel.set_args(columns * blocks, static_cast<cl_uint>(first_slice),
+                  static_cast<cl_uint>(slice_step), static_cast<cl_uint>(slices), geometry_,
+                  views_, view_weights_, filtered, volume);
+  context_.launch(kernel, std::size_t{columns} * blocks);
 }
 
 }  // namespace riner::ops

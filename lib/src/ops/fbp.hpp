@@ -43,9 +43,10 @@ class FbpOp {
   std::shared_ptr<const cl::Program> program_;
   cl::Kernel filter_;
   cl::Kernel filter_fft_;
-  cl::Kernel backproject_;
   cl::Kernel backproject_parallel_;
   cl::Kernel backproject_parallel_one_;
+  cl::Kernel backproject_divergent_;
+  cl::Kernel backproject_divergent_one_;
 };
 
 }  // namespace riner::ops

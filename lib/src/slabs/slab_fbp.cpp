@@ -1,6 +1,7 @@
 #include "riner/slab_fbp.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "riner/error.hpp"
 #include "riner/slab_plan.hpp"
@@ -16,12 +17,47 @@ constexpr double kReadingCopies = 3.0;
 constexpr double kVoxelCopies = 2.0;
 constexpr std::size_t kBaseBytes = std::size_t{170} << 20;
 
+std::size_t slab_count(std::size_t nz, std::size_t per) {
+  per = std::max<std::size_t>(1, std::min(per, nz));
+  return (nz + per - 1) / per;
+}
+
 }  // namespace
 
-std::size_t fbp_slab_bytes(const Geometry& g, std::size_t slices) {
+RowRange fbp_rows_reached(const Geometry& g, std::size_t first, std::size_t count) {
   const double nz = static_cast<double>(g.volume_shape[0]);
-  const double rows = std::min(static_cast<double>(g.n_v),
-                               static_cast<double>(g.n_v) / nz * static_cast<double>(slices) + 2.0);
+  const double z_lo = (static_cast<double>(first) - 0.5 - (nz - 1.0) / 2.0) * g.voxel_mm;
+  const double z_hi = (static_cast<double>(first + count) - 0.5 - (nz - 1.0) / 2.0) * g.voxel_mm;
+  // Magnifications from the nearest voxel to the source to the farthest.
+  std::vector<double> scales = {1.0};
+  if (g.type == GeometryType::kCone3d) {
+    const double radius = 0.5 * g.voxel_mm *
+                          std::hypot(static_cast<double>(g.volume_shape[1]),
+                                     static_cast<double>(g.volume_shape[2]));
+    if (radius >= g.source_origin_mm) return {0, g.n_v};  // the volume reaches the source
+    scales = {(g.source_origin_mm + g.origin_detector_mm) / (g.source_origin_mm + radius),
+              (g.source_origin_mm + g.origin_detector_mm) / (g.source_origin_mm - radius)};
+  }
+  double lo = INFINITY, hi = -INFINITY;
+  for (double z : {z_lo, z_hi}) {
+    for (double scale : scales) {
+      const double v =
+          z * scale / g.pitch_v + (static_cast<double>(g.n_v) - 1.0) / 2.0 - g.offset_v;
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+  }
+  // Bilinear sampling takes the row below and the row above a position.
+  const double first_row = std::max(0.0, std::floor(lo) - 1.0);
+  const double end_row = std::min(static_cast<double>(g.n_v), std::ceil(hi) + 2.0);
+  if (!(end_row > first_row)) return {0, 0};
+  return {static_cast<std::size_t>(first_row), static_cast<std::size_t>(end_row - first_row)};
+}
+
+std::size_t fbp_slab_bytes(const Geometry& g, std::size_t slices) {
+  slices = std::min(slices, g.volume_shape[0]);
+  // The outermost slab reaches the most rows in a cone beam.
+  const double rows = static_cast<double>(fbp_rows_reached(g, 0, slices).count);
   const double readings = static_cast<double>(g.n_views()) * static_cast<double>(g.n_u) * rows;
   const double voxels = static_cast<double>(slices) * static_cast<double>(g.volume_shape[1]) *
                         static_cast<double>(g.volume_shape[2]);
@@ -46,23 +82,29 @@ SlabFbpReport fbp_by_slabs(const ScanRows& source, const FbpOptions& options, Vo
   if (options.slices.first != 0 || options.slices.step != 1 || options.slices.count != 0) {
     throw std::invalid_argument("fbp_by_slabs reconstructs every slice");
   }
+  const std::size_t nz = g.volume_shape[0];
   SlabFbpReport report;
-  const std::vector<Slab> slabs = plan_slabs(g, slices_per_slab);
-  report.slabs = slabs.size();
-  report.slices_per_slab = std::min(slices_per_slab, g.volume_shape[0]);
-  for (Slab slab : slabs) {
-    // One row more on either side: a slice between two rows takes both.
-    const std::size_t first = slab.rows.first > 0 ? slab.rows.first - 1 : 0;
-    const std::size_t end = std::min(g.n_v, slab.rows.first + slab.rows.count + 1);
-    slab.rows = {first, end - first};
-    Scan scan = source.read(slab.rows);
-    scan.geometry = slab_geometry(g, slab);
-    FbpReport part;
-    const Array slices = fbp(scan, options, &part);
-    report.fbp.non_finite_replaced += part.non_finite_replaced;
-    report.fbp.short_scan = report.fbp.short_scan || part.short_scan;
-    out.write(slab.first_slice, slices);
-    if (written) written(slab.first_slice, slices);
+  report.slabs = slab_count(nz, slices_per_slab);
+  report.slices_per_slab = (nz + report.slabs - 1) / report.slabs;
+  for (std::size_t i = 0; i < report.slabs; ++i) {
+    const std::size_t first = i * nz / report.slabs;
+    const std::size_t count = (i + 1) * nz / report.slabs - first;
+    const RowRange rows = fbp_rows_reached(g, first, count);
+    Array slices({count, g.volume_shape[1], g.volume_shape[2]});  // 0 where no row reaches
+    if (rows.count > 0) {
+      // The rows in their place on the whole detector, the whole volume's grid: the slab's
+      // slices selected from it sample exactly what the whole FBP's would.
+      Scan scan = source.read(rows);
+      scan.geometry = detector_rows_geometry(g, rows.first, rows.count);
+      FbpOptions slab = options;
+      slab.slices = {first, 1, count};
+      FbpReport part;
+      slices = fbp(scan, slab, &part);
+      report.fbp.non_finite_replaced += part.non_finite_replaced;
+      report.fbp.short_scan = report.fbp.short_scan || part.short_scan;
+    }
+    out.write(first, slices);
+    if (written) written(first, slices);
   }
   return report;
 }
