@@ -3,6 +3,7 @@
 
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "riner/destripe.hpp"
 #include "riner/error.hpp"
 #include "riner/fbp.hpp"
 #include "riner/io.hpp"
@@ -35,6 +36,12 @@ bool fbp_wants_slabs(const Args& args) {
   }
 }
 
+// --destripe METHOD: the stripe filter every sinogram goes through first (nullopt: none).
+std::optional<DestripeOptions> destripe_from(const Args& args) {
+  if (args.get("destripe").empty()) return std::nullopt;
+  return destripe_options_from(args, args.get("destripe"));
+}
+
 int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions& options) {
   const ScanRows source(source_from(args));
   if (source.centre()) console.line(centre_line(*source.centre()));
@@ -54,8 +61,10 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
   const std::size_t nz = g.volume_shape[0];
   Array middle;
   Progress progress("fbp", nz, console.quiet());
-  const SlabFbpReport report =
-      fbp_by_slabs(source, options, writer, per, [&](std::size_t first, const Array& slices) {
+  const std::optional<DestripeOptions> stripes = destripe_from(args);
+  const SlabFbpReport report = fbp_by_slabs(
+      source, options, writer, per,
+      [&](std::size_t first, const Array& slices) {
         if (nz / 2 >= first && nz / 2 < first + slices.shape[0]) {
           const std::size_t plane = slices.shape[1] * slices.shape[2];
           const auto at = slices.data.begin() + static_cast<long>((nz / 2 - first) * plane);
@@ -63,6 +72,9 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
                          std::vector<float>(at, at + static_cast<long>(plane)));
         }
         progress.update(first + slices.shape[0]);
+      },
+      [&](Scan& rows) {
+        if (stripes) rows.measurement = destripe(rows.measurement, rows.geometry, *stripes);
       });
   writer.close();
   progress.finish();
@@ -120,7 +132,12 @@ int run_fbp(int argc, char** argv, int first) {
       .option("memory-limit", "SIZE",
               "host memory a slab may take (8G, 512M); a stack whose volume does not fit goes "
               "by slabs (default: three quarters of the machine's memory)",
+              "")
+      .option("destripe", "METHOD",
+              "remove stripes from every sinogram first (riner destripe's methods: normalise, "
+              "sorting, filtering, large, dead, all)",
               "");
+  add_destripe_tuning(args);
   add_engine_flags(args);
   args.output_flags();
   if (!args.parse(argc, argv, first)) return 0;
@@ -134,8 +151,16 @@ int run_fbp(int argc, char** argv, int first) {
   }
   const LoadedScan loaded = scan_from(args, console);
   check_centre(loaded, console);
-  const Scan& scan = loaded.scan;
+  Scan scan = loaded.scan;
   const std::filesystem::path out = args.get("out");
+  const std::optional<DestripeOptions> stripes = destripe_from(args);
+  DestripeReport destripe_report;
+  if (stripes) {
+    scan.measurement = destripe(scan.measurement, scan.geometry, *stripes, &destripe_report);
+    console.line("destripe (" + std::string(destripe_method_name(stripes->method)) + "): " +
+                 std::to_string(destripe_report.dead.size()) + " dead and " +
+                 std::to_string(destripe_report.large.size()) + " large-stripe elements found");
+  }
   format_from_path(out);  // reject an unknown extension before the work
   FbpOptions options;
   options.filter = parse_fbp_filter(args.get("filter"));
@@ -169,6 +194,8 @@ int run_fbp(int argc, char** argv, int first) {
        {"seconds", seconds},
        {"non_finite_replaced", report.non_finite_replaced},
        {"short_scan", report.short_scan},
+       {"destripe", stripes ? nlohmann::json(destripe_method_name(stripes->method))
+                            : nlohmann::json(nullptr)},
        {"flat_field",
         loaded.flat_field ? flat_field_json(*loaded.flat_field) : nlohmann::json(nullptr)},
        {"centre", loaded.centre ? centre_json(*loaded.centre) : nlohmann::json(nullptr)}});

@@ -2,6 +2,11 @@
 // process exit code; errors are thrown and mapped to exit codes in main.cpp.
 #pragma once
 
+#include <string>
+
+#include "cli_args.hpp"
+#include "riner/destripe.hpp"
+
 namespace riner::app {
 
 int run_devices(int argc, char** argv, int first);
@@ -13,5 +18,11 @@ int run_reconstruct(int argc, char** argv, int first);
 int run_demo(int argc, char** argv, int first);
 int run_settings(int argc, char** argv, int first);
 int run_center(int argc, char** argv, int first);
+int run_destripe(int argc, char** argv, int first);
+
+// The stripe filter's tuning options (--size, --large-size, --snr, --sigma), shared by destripe
+// and fbp --destripe, and the options they name with `method`.
+void add_destripe_tuning(Args& args);
+DestripeOptions destripe_options_from(const Args& args, const std::string& method);
 
 }  // namespace riner::app

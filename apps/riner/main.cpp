@@ -26,6 +26,8 @@ constexpr Command kCommands[] = {
     {"simulate", riner::app::run_simulate, "simulate a ring-corrupted scan (paper protocol)"},
     {"fbp", riner::app::run_fbp, "filtered backprojection (FBP / FDK) of a scan"},
     {"center", riner::app::run_center, "estimate the centre of rotation from the scan"},
+    {"destripe", riner::app::run_destripe,
+     "classical stripe removal on the sinogram (Vo's methods), optionally with its FBP"},
     {"compare", riner::app::run_compare, "PSNR / SSIM / MAE of an image against a reference"},
     {"settings", riner::app::run_settings, "every reconstruct setting: default, range, meaning"},
 };

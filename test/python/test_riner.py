@@ -91,6 +91,20 @@ def test_fbp_matches_the_cli(cli, tmp_path, fan_scan):
     assert np.array_equal(riner.fbp(sim["sino"], g), riner.read_array(tmp_path / "fbp.npy"))
 
 
+def test_destripe_matches_the_cli(cli, tmp_path, fan_scan):
+    sim, g = fan_scan
+    riner.write_array(tmp_path / "sino.npy", sim["sino"])
+    (tmp_path / "geometry.json").write_text(json.dumps(g))
+    subprocess.run([cli, "destripe", str(tmp_path / "sino.npy"), "--method", "sorting",
+                    "--out", str(tmp_path / "clean"), "--quiet"], check=True)
+    out = riner.destripe(sim["sino"], g, method="sorting")
+    assert np.array_equal(out["sino"], riner.read_array(tmp_path / "clean" / "sino.npy"))
+    assert np.array_equal(out["stripes"], riner.read_array(tmp_path / "clean" / "stripes.npy"))
+    assert out["size"] == 21
+    with pytest.raises(riner.InputError, match="a destripe method is"):
+        riner.destripe(sim["sino"], g, method="wavelets")
+
+
 def test_arrays_come_out_as_float32_without_a_copy(tmp_path, fan_scan):
     sim, g = fan_scan
     image = riner.fbp(sim["sino"], g)

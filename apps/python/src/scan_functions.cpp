@@ -5,6 +5,7 @@
 #include "bindings.hpp"
 #include "numpy_arrays.hpp"
 #include "riner/centre.hpp"
+#include "riner/destripe.hpp"
 #include "riner/error.hpp"
 #include "riner/fbp.hpp"
 #include "riner/flat_field.hpp"
@@ -39,6 +40,34 @@ py::array fbp_of(const py::handle& measurement, const std::string& geometry_json
     image = fbp(scan, options);
   }
   return to_numpy(std::move(image));
+}
+
+// Classical stripe removal (riner/destripe.hpp): the destriped measurement and a report.
+py::dict destripe_of(const py::handle& measurement, const std::string& geometry_json,
+                     const std::string& method, std::size_t size, std::size_t large_size,
+                     double snr, double sigma) {
+  const Scan scan = scan_from(measurement, geometry_json);
+  DestripeOptions options;
+  options.method = parse_destripe_method(method);
+  options.size = size;
+  options.large_size = large_size;
+  options.snr = snr;
+  options.sigma = sigma;
+  DestripeReport report;
+  Array out;
+  {
+    py::gil_scoped_release release;
+    out = destripe(scan.measurement, scan.geometry, options, &report);
+  }
+  py::dict result;
+  result["sino"] = to_numpy(std::move(out));
+  result["stripes"] = to_numpy(std::move(report.removed));
+  result["dead_elements"] = report.dead;
+  result["large_stripe_elements"] = report.large;
+  result["size"] = report.size;
+  result["large_size"] = report.large_size;
+  result["non_finite_replaced"] = report.non_finite_replaced;
+  return result;
 }
 
 // The protocol of METHOD.md §4 on `image` (mu in 1/mm on the geometry's grid), or on the
@@ -92,6 +121,7 @@ py::dict simulate_scan(const py::object& image, const std::string& geometry_json
 
 void bind_scan_functions(py::module_& m) {
   m.def("fbp", &fbp_of);
+  m.def("destripe", &destripe_of);
   m.def("simulate",
         [](const py::object& image, const std::string& geometry_json, double mu_scale,
            std::uint64_t seed, double photons, double nonideal_fraction, double alpha_min,

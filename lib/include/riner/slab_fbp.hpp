@@ -35,10 +35,13 @@ std::size_t fbp_slices_within(const Geometry& g, std::size_t limit);
 
 // Every slice of `source`'s volume into `out` (not closed), slabs of `slices_per_slab` in
 // order (slabs as even as they come); `written` after each slab with its first slice and its
-// slices. InputError as ScanRows::read; options.slices must select every slice (the default).
+// slices; `prepare` on each slab's rows before their FBP (a stripe filter, say: rows are
+// independent sinograms). InputError as ScanRows::read; options.slices must select every slice
+// (the default).
 SlabFbpReport fbp_by_slabs(const ScanRows& source, const FbpOptions& options, VolumeWriter& out,
                            std::size_t slices_per_slab,
                            const std::function<void(std::size_t first_slice, const Array& slices)>&
-                               written = {});
+                               written = {},
+                           const std::function<void(Scan& rows)>& prepare = {});
 
 }  // namespace riner

@@ -77,7 +77,8 @@ std::size_t fbp_slices_within(const Geometry& g, std::size_t limit) {
 
 SlabFbpReport fbp_by_slabs(const ScanRows& source, const FbpOptions& options, VolumeWriter& out,
                            std::size_t slices_per_slab,
-                           const std::function<void(std::size_t, const Array&)>& written) {
+                           const std::function<void(std::size_t, const Array&)>& written,
+                           const std::function<void(Scan&)>& prepare) {
   const Geometry& g = source.geometry();
   if (options.slices.first != 0 || options.slices.step != 1 || options.slices.count != 0) {
     throw std::invalid_argument("fbp_by_slabs reconstructs every slice");
@@ -96,6 +97,7 @@ SlabFbpReport fbp_by_slabs(const ScanRows& source, const FbpOptions& options, Vo
       // slices selected from it sample exactly what the whole FBP's would.
       Scan scan = source.read(rows);
       scan.geometry = detector_rows_geometry(g, rows.first, rows.count);
+      if (prepare) prepare(scan);
       FbpOptions slab = options;
       slab.slices = {first, 1, count};
       FbpReport part;

@@ -1,0 +1,40 @@
+// The steps Vo's stripe-removal methods are built from, on one sinogram [views][columns] held
+// as a row-major vector of doubles.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+namespace riner::stripes {
+
+struct Sinogram {
+  std::size_t views = 0;
+  std::size_t columns = 0;
+  std::vector<double> values;  // [views][columns]
+  double& at(std::size_t v, std::size_t c) { return values[v * columns + c]; }
+  double at(std::size_t v, std::size_t c) const { return values[v * columns + c]; }
+};
+
+// Each column sorted over the views: sorted values and, for each, the view it came from.
+struct SortedColumns {
+  Sinogram sorted;
+  std::vector<std::size_t> view;  // [rank][column]
+};
+SortedColumns sort_columns(const Sinogram& s);
+// Values at rank k of column c put back at the view they came from.
+Sinogram unsort_columns(const Sinogram& sorted, const std::vector<std::size_t>& view);
+
+// Median over `size` (odd) neighbouring columns within each view row, mirrored at the edges
+// (scipy's 'reflect': d c b a | a b c d | d c b a).
+Sinogram median_across_columns(const Sinogram& s, std::size_t size);
+std::vector<double> median_filter(const std::vector<double>& values, std::size_t size);
+
+// Vo's algorithm 4: the elements of `values` (about 1 or 0 where there is no stripe) that stand
+// out of the noise of their sorted profile by `snr`, then grown by one on each side.
+std::vector<bool> detect_stripes(const std::vector<double>& values, double snr);
+
+// Masked columns replaced, view by view, by linear interpolation between the nearest unmasked
+// columns (held constant beyond the last).
+void interpolate_columns(Sinogram& s, const std::vector<bool>& mask);
+
+}  // namespace riner::stripes
