@@ -6,6 +6,8 @@
 #pragma once
 
 #include <cstddef>
+#include <functional>
+#include <string>
 #include <vector>
 
 #include "riner/array.hpp"
@@ -37,6 +39,10 @@ std::size_t slab_bytes(const Geometry& g, std::size_t slices);
 
 // The most slices per slab within `limit` bytes (at least 1).
 std::size_t slices_within(const Geometry& g, std::size_t limit);
+// The same for any memory model: the most of `slices` whose bytes(n), rising with n, stay
+// within `limit` (at least 1).
+std::size_t most_slices_within(std::size_t slices, std::size_t limit,
+                               const std::function<std::size_t(std::size_t)>& bytes);
 
 // Three quarters of the machine's physical memory: the default limit.
 std::size_t default_memory_limit();

@@ -66,13 +66,8 @@ std::size_t fbp_slab_bytes(const Geometry& g, std::size_t slices) {
 }
 
 std::size_t fbp_slices_within(const Geometry& g, std::size_t limit) {
-  std::size_t lo = 1, hi = g.volume_shape[0];
-  if (fbp_slab_bytes(g, hi) <= limit) return hi;
-  while (hi - lo > 1) {
-    const std::size_t mid = (lo + hi) / 2;
-    (fbp_slab_bytes(g, mid) <= limit ? lo : hi) = mid;
-  }
-  return lo;
+  return most_slices_within(g.volume_shape[0], limit,
+                            [&](std::size_t n) { return fbp_slab_bytes(g, n); });
 }
 
 SlabFbpReport fbp_by_slabs(const ScanRows& source, const FbpOptions& options, VolumeWriter& out,

@@ -93,14 +93,20 @@ std::size_t slab_bytes(const Geometry& g, std::size_t slices) {
   return kBaseBytes + static_cast<std::size_t>(per_slice * static_cast<double>(slices));
 }
 
-std::size_t slices_within(const Geometry& g, std::size_t limit) {
-  std::size_t lo = 1, hi = g.volume_shape[0];
-  if (slab_bytes(g, hi) <= limit) return hi;
+std::size_t most_slices_within(std::size_t slices, std::size_t limit,
+                               const std::function<std::size_t(std::size_t)>& bytes) {
+  std::size_t lo = 1, hi = slices;
+  if (bytes(hi) <= limit) return hi;
   while (hi - lo > 1) {
     const std::size_t mid = (lo + hi) / 2;
-    (slab_bytes(g, mid) <= limit ? lo : hi) = mid;
+    (bytes(mid) <= limit ? lo : hi) = mid;
   }
   return lo;
+}
+
+std::size_t slices_within(const Geometry& g, std::size_t limit) {
+  return most_slices_within(g.volume_shape[0], limit,
+                            [&](std::size_t n) { return slab_bytes(g, n); });
 }
 
 std::size_t default_memory_limit() {
