@@ -37,6 +37,8 @@ DestripeOptions destripe_options_from(const Args& args, const std::string& metho
   options.large_size = window_option(args, "large-size");
   options.snr = positive_option(args, "snr");
   options.sigma = positive_option(args, "sigma");
+  options.engine = engine_from(args);
+  options.device = device_from(args, options.engine);
   return options;
 }
 

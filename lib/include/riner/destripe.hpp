@@ -13,7 +13,11 @@
 #include <string_view>
 #include <vector>
 
+#include <optional>
+
 #include "riner/array.hpp"
+#include "riner/device.hpp"
+#include "riner/engine.hpp"
 #include "riner/geometry.hpp"
 
 namespace riner {
@@ -42,6 +46,11 @@ struct DestripeOptions {
   double snr = 3.0;    // how far above the noise a stripe must stand out to be detected
   double sigma = 3.0;  // filtering: the Gaussian's width in frequency bins along the views
   double drop_ratio = 0.1;  // large stripes: share of each sorted column's extremes left out
+  // The sorting step (sorting, filtering, all) runs on the device (kernels/stripe_sorting.cl)
+  // where a column's views fit its local memory, else on the CPU, as the other steps do;
+  // Engine::kReference: all on the CPU.
+  Engine engine = Engine::kOpenCL;
+  std::optional<Device> device;  // OpenCL engine; default Device::open()
 };
 
 struct DestripeReport {

@@ -3,9 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <memory>
 #include <unsupported/Eigen/FFT>
 
 #include "analytic/fbp_setup.hpp"
+#include "cl/device_access.hpp"
+#include "ops/stripe_sorting.hpp"
 #include "destripe/sinogram_ops.hpp"
 #include "riner/error.hpp"
 
@@ -50,15 +53,22 @@ void normalise(Sinogram& s, std::size_t size) {
 }
 
 // Algorithm 3: a stripe is an offset of one column, which sorting turns into an offset of one
-// column of a smooth image; a median across columns removes it there.
-void sorting(Sinogram& s, std::size_t size) {
+// column of a smooth image; a median across columns removes it there. On the device when one is
+// given and holds a column (the CPU twin below otherwise).
+void sorting(Sinogram& s, std::size_t size, ops::StripeSortingOp* device = nullptr) {
+  if (device != nullptr) {
+    const std::vector<float> in(s.values.begin(), s.values.end());
+    const std::vector<float> out = device->run(in, size);
+    s.values.assign(out.begin(), out.end());
+    return;
+  }
   const stripes::SortedColumns sorted = stripes::sort_columns(s);
   s = stripes::unsort_columns(stripes::median_across_columns(sorted.sorted, size), sorted.view);
 }
 
 // Algorithm 2: only each column's slow variation along the views (a Gaussian low-pass, the
 // columns mirrored at both ends) goes through the sorting; the fast part is kept as measured.
-void filtering(Sinogram& s, std::size_t size, double sigma) {
+void filtering(Sinogram& s, std::size_t size, double sigma, ops::StripeSortingOp* device) {
   const std::size_t pad = std::min<std::size_t>(150, s.views / 10);
   const std::size_t n = s.views + 2 * pad;
   Sinogram smooth = s;
@@ -81,7 +91,7 @@ void filtering(Sinogram& s, std::size_t size, double sigma) {
     for (std::size_t v = 0; v < s.views; ++v) smooth.at(v, c) = back[v + pad];
   }
   Sinogram corrected = smooth;
-  sorting(corrected, size);
+  sorting(corrected, size, device);
   for (std::size_t i = 0; i < s.values.size(); ++i) {
     s.values[i] += corrected.values[i] - smooth.values[i];
   }
@@ -191,6 +201,20 @@ Array destripe(const Array& measurement, const Geometry& g, const DestripeOption
   if (!(options.snr > 0.0) || !(options.sigma > 0.0)) {
     throw InputError("destripe: snr and sigma must be positive");
   }
+  // The device outlives the op that holds its context.
+  std::optional<Device> opened;
+  std::unique_ptr<ops::StripeSortingOp> device;
+  const bool sorts = options.method == DestripeMethod::kSorting ||
+                     options.method == DestripeMethod::kFiltering ||
+                     options.method == DestripeMethod::kAll;
+  if (options.engine == Engine::kOpenCL && sorts) {
+    opened = options.device ? *options.device : Device::open();
+    cl::Context& context = cl::context_of(*opened);
+    const std::size_t size = odd_at_most(options.size ? options.size : kSmallWindow, columns);
+    if (ops::StripeSortingOp::supported(context, views, size)) {
+      device = std::make_unique<ops::StripeSortingOp>(context, views, columns);
+    }
+  }
   Array out = measurement;
   DestripeReport local;
   local.non_finite_replaced = analytic::repair_non_finite(out, columns);
@@ -208,14 +232,14 @@ Array destripe(const Array& measurement, const Geometry& g, const DestripeOption
     std::vector<bool> dead, large;
     switch (options.method) {
       case DestripeMethod::kNormalise: normalise(s, size); break;
-      case DestripeMethod::kSorting: sorting(s, size); break;
-      case DestripeMethod::kFiltering: filtering(s, size, options.sigma); break;
+      case DestripeMethod::kSorting: sorting(s, size, device.get()); break;
+      case DestripeMethod::kFiltering: filtering(s, size, options.sigma, device.get()); break;
       case DestripeMethod::kLarge: large = large_stripes(s, large_size, options.snr, options.drop_ratio); break;
       case DestripeMethod::kDead: dead = dead_stripes(s, large_size, options.snr); break;
       case DestripeMethod::kAll:
         dead = dead_stripes(s, large_size, options.snr);
         large = large_stripes(s, large_size, options.snr, options.drop_ratio);
-        sorting(s, size);
+        sorting(s, size, device.get());
         break;
     }
     for (std::size_t c = 0; c < columns; ++c) {

@@ -1,0 +1,71 @@
+#include "ops/stripe_sorting.hpp"
+
+#include <algorithm>
+
+#include "riner/error.hpp"
+
+namespace riner::ops {
+
+namespace {
+
+constexpr std::size_t kMostWindow = 255;  // kernels/stripe_sorting.cl
+constexpr std::size_t kSortGroup = 256;
+
+std::size_t power_of_two_at_least(std::size_t n) {
+  std::size_t p = 1;
+  while (p < n) p *= 2;
+  return p;
+}
+
+std::size_t local_bytes(std::size_t views) {
+  return power_of_two_at_least(views) * (sizeof(float) + sizeof(cl_uint));
+}
+
+}  // namespace
+
+bool StripeSortingOp::supported(const cl::Context& context, std::size_t views, std::size_t size) {
+  return size % 2 == 1 && size <= kMostWindow && views >= 2 &&
+         local_bytes(views) + 1024 <= context.info().local_mem_bytes;
+}
+
+StripeSortingOp::StripeSortingOp(cl::Context& context, std::size_t views, std::size_t columns)
+    : context_(context),
+      views_(static_cast<cl_uint>(views)),
+      columns_(static_cast<cl_uint>(columns)),
+      padded_(static_cast<cl_uint>(power_of_two_at_least(views))),
+      program_(context.program({"stripe_sorting"})),
+      sort_(*program_, "sort_columns"),
+      median_(*program_, "median_across_columns"),
+      unsort_(*program_, "unsort_columns"),
+      in_(context, views * columns),
+      sorted_(context, views * columns),
+      filtered_(context, views * columns),
+      out_(context, views * columns),
+      order_(context, views * columns) {
+  if (!supported(context, views, 1)) {
+    throw Error("stripe sorting: a column of " + std::to_string(views) +
+                " views does not fit the device's local memory");
+  }
+}
+
+std::vector<float> StripeSortingOp::run(const std::vector<float>& sinogram, std::size_t size) {
+  const std::size_t n = static_cast<std::size_t>(views_) * columns_;
+  if (sinogram.size() != n || size % 2 == 0 || size > kMostWindow) {
+    throw Error("stripe sorting: size mismatch or an even or too wide window");
+  }
+  in_.write(std::span<const float>(sinogram));
+  const std::size_t group = std::min({kSortGroup, static_cast<std::size_t>(padded_) / 2 + 1,
+                                      sort_.max_work_group_size(context_.device())});
+  sort_.set_args(views_, columns_, padded_, in_, sorted_, order_,
+                 cl::LocalMemory{padded_ * sizeof(float)}, cl::LocalMemory{padded_ * sizeof(cl_uint)});
+  context_.launch(sort_, cl::Range(std::size_t{columns_} * group), cl::Range(group));
+  median_.set_args(views_, columns_, static_cast<cl_uint>(size), sorted_, filtered_);
+  context_.launch(median_, n);
+  unsort_.set_args(views_, columns_, filtered_, order_, out_);
+  context_.launch(unsort_, n);
+  std::vector<float> out(n);
+  out_.read(std::span<float>(out));
+  return out;
+}
+
+}  // namespace riner::ops

@@ -1,0 +1,34 @@
+// Host side of kernels/stripe_sorting.cl: Vo's sorting step (each column sorted over the views,
+// a median across columns at each rank, unsorted) on one sinogram at a time.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "cl/buffer.hpp"
+#include "cl/context.hpp"
+#include "cl/program.hpp"
+
+namespace riner::ops {
+
+class StripeSortingOp {
+ public:
+  // Error when a column of `views` readings does not fit the device's local memory, or `size`
+  // is even or past the kernel's window (supported() says so beforehand).
+  StripeSortingOp(cl::Context& context, std::size_t views, std::size_t columns);
+  static bool supported(const cl::Context& context, std::size_t views, std::size_t size);
+
+  // The sinogram [views][columns] with every column's sorted readings replaced by their median
+  // across `size` neighbouring columns at the same rank.
+  std::vector<float> run(const std::vector<float>& sinogram, std::size_t size);
+
+ private:
+  cl::Context& context_;
+  cl_uint views_, columns_, padded_;
+  std::shared_ptr<const cl::Program> program_;
+  cl::Kernel sort_, median_, unsort_;
+  cl::Buffer<float> in_, sorted_, filtered_, out_;
+  cl::Buffer<cl_uint> order_;
+};
+
+}  // namespace riner::ops
