@@ -126,3 +126,16 @@ TEST_CASE("a scan's rows normalise by the flats and darks of the same rows") {
                        std::nullopt, ""}),
       doctest::Contains("slabs of detector rows need a 3D geometry"), riner::InputError);
 }
+
+TEST_CASE("a NIfTI stack's shape comes from its header, checked against the file's size") {
+  riner::test::TempDir dir;
+  const riner::Array whole = counting_stack();
+  riner::write_array(dir / "stack.nii", whole);
+  CHECK(riner::read_array_shape(dir / "stack.nii") == whole.shape);
+  const auto size = std::filesystem::file_size(dir / "stack.nii");
+  std::filesystem::resize_file(dir / "stack.nii", size - 10);
+  CHECK_THROWS_WITH_AS(riner::read_array_shape(dir / "stack.nii"),
+                       doctest::Contains("but the file holds only"), riner::InputError);
+  std::filesystem::resize_file(dir / "stack.nii", 100);
+  CHECK_THROWS_AS(riner::read_array_shape(dir / "stack.nii"), riner::InputError);
+}

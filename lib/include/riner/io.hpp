@@ -46,7 +46,7 @@ ArrayFile read_array(const std::filesystem::path& path);
 // scanline); other files are read whole and cut. InputError for a 2D array or rows past its end.
 ArrayFile read_array_rows(const std::filesystem::path& path, RowRange rows);
 
-// The array's shape from its header where the format has one (every format but NIfTI).
+// The array's shape from its header (every format has one), checked against the file's size.
 std::vector<std::size_t> read_array_shape(const std::filesystem::path& path);
 
 struct WriteOptions {

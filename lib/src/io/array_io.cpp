@@ -144,6 +144,8 @@ std::vector<std::size_t> read_array_shape(const std::filesystem::path& path) {
       return io::tiff_shape(path);
     case FileFormat::kHdf5:
       return tomo_file_shape(path);
+    case FileFormat::kNifti:
+      return io::nifti_shape(path);
     default:
       return read_array(path).array.shape;
   }

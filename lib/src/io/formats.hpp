@@ -21,6 +21,8 @@ void write_npy(const std::filesystem::path& path, const Array& array);
 std::string npy_header(const std::vector<std::size_t>& shape);
 
 ArrayFile read_nifti(const std::filesystem::path& path);
+// The shape from the header (352 bytes read), checked against the file's size.
+std::vector<std::size_t> nifti_shape(const std::filesystem::path& path);
 void write_nifti(const std::filesystem::path& path, const Array& array,
                  const std::vector<double>& voxel_size);
 // What write_nifti puts before the float32 data (InputError for a shape NIfTI-1 cannot hold).

@@ -111,6 +111,29 @@ NiftiHeader read_header(const std::string& bytes, const std::filesystem::path& p
 
 }  // namespace
 
+std::vector<std::size_t> nifti_shape(const std::filesystem::path& path) {
+  const std::uint64_t size = input_file_size(path);
+  std::ifstream in(path, std::ios::binary);
+  std::string head(static_cast<std::size_t>(std::min<std::uint64_t>(size, kDataOffset)), '\0');
+  if (!in.read(head.data(), static_cast<std::streamsize>(head.size()))) {
+    throw InputError(prefix(path) + "cannot be read");
+  }
+  const NiftiHeader header = read_header(head, path);
+  std::vector<std::size_t> shape(header.dims.rbegin(), header.dims.rend());
+  const SampleType type = nifti_type(field<std::int16_t>(head, 70, header.swap), path);
+  float vox_offset = field<float>(head, 108, header.swap);
+  if (!(vox_offset >= static_cast<float>(kDataOffset))) vox_offset = kDataOffset;
+  const std::uint64_t needed = static_cast<std::uint64_t>(vox_offset) +
+                               static_cast<std::uint64_t>(element_count(path, shape)) *
+                                   sample_bytes(type);
+  if (size < needed) {
+    throw InputError(prefix(path) + "header says " + shape_string(shape) + " " +
+                     sample_type_name(type) + " but the file holds only " + std::to_string(size) +
+                     " bytes");
+  }
+  return shape;
+}
+
 ArrayFile read_nifti(const std::filesystem::path& path) {
   const std::string bytes = read_file_bytes(path);
   const NiftiHeader header = read_header(bytes, path);
