@@ -9,6 +9,7 @@
 #include "riner/flat_field.hpp"
 #include "riner/io.hpp"
 #include "riner/scan_source.hpp"
+#include "support/crafted_files.hpp"
 #include "support/fixture.hpp"
 #include "support/hdf5_writer.hpp"
 
@@ -138,4 +139,24 @@ TEST_CASE("a NIfTI stack's shape comes from its header, checked against the file
                        doctest::Contains("but the file holds only"), riner::InputError);
   std::filesystem::resize_file(dir / "stack.nii", 100);
   CHECK_THROWS_AS(riner::read_array_shape(dir / "stack.nii"), riner::InputError);
+}
+
+TEST_CASE("a scaled, big-endian int16 NIfTI stack's rows read alone equal its rows read whole") {
+  riner::test::TempDir dir;
+  // dims x = 4 columns, y = 5 rows, z = 3 frames; values 0..59 as big-endian int16.
+  std::string data;
+  for (int i = 0; i < 60; ++i) {
+    data += static_cast<char>((i >> 8) & 0xff);
+    data += static_cast<char>(i & 0xff);
+  }
+  riner::test::write_bytes(dir / "scaled.nii",
+                           riner::test::make_nifti({4, 5, 3}, 4, 16, 0.5f, -2.0f, data, true));
+  const riner::Array whole = riner::read_array(dir / "scaled.nii").array;
+  REQUIRE(whole.shape == std::vector<std::size_t>{3, 5, 4});
+  CHECK(whole.data[7] == doctest::Approx(0.5 * 7 - 2.0));
+  const riner::ArrayFile rows = riner::read_array_rows(dir / "scaled.nii", {1, 3});
+  const riner::Array expected = riner::detector_rows(whole, {1, 3});
+  CHECK(rows.array.shape == expected.shape);
+  CHECK(rows.array.data == expected.data);
+  CHECK(rows.voxel_size == std::vector<double>{2.0, 1.5, 1.0});
 }

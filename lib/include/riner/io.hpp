@@ -42,8 +42,9 @@ struct ArrayFile {
 ArrayFile read_array(const std::filesystem::path& path);
 
 // Only detector rows `rows` of a stack [views, rows, columns]: read alone where the format lets
-// a reader seek (.npy and .raw in C order, HDF5 by hyperslab, TIFF pages and stacks scanline by
-// scanline); other files are read whole and cut. InputError for a 2D array or rows past its end.
+// a reader seek (.npy and .raw in C order, .nii, HDF5 by hyperslab, TIFF pages and stacks
+// scanline by scanline); Fortran-order files are read whole and cut. InputError for a 2D
+// array or rows past its end.
 ArrayFile read_array_rows(const std::filesystem::path& path, RowRange rows);
 
 // The array's shape from its header (every format has one), checked against the file's size.

@@ -114,6 +114,9 @@ ArrayFile read_array_rows(const std::filesystem::path& path, RowRange rows) {
     case FileFormat::kRaw:
       file = io::read_raw_rows(path, rows);
       break;
+    case FileFormat::kNifti:
+      file = io::read_nifti_rows(path, rows);
+      break;
     case FileFormat::kTiff: {
       ArrayFile pages = io::read_tiff_rows(path, rows);
       if (pages.array.rank() != 3) {

@@ -23,6 +23,8 @@ std::string npy_header(const std::vector<std::size_t>& shape);
 ArrayFile read_nifti(const std::filesystem::path& path);
 // The shape from the header (352 bytes read), checked against the file's size.
 std::vector<std::size_t> nifti_shape(const std::filesystem::path& path);
+// Rows of a stack by seeking (scaled by scl_slope/scl_inter); nullopt for a file not 3D.
+std::optional<ArrayFile> read_nifti_rows(const std::filesystem::path& path, RowRange rows);
 void write_nifti(const std::filesystem::path& path, const Array& array,
                  const std::vector<double>& voxel_size);
 // What write_nifti puts before the float32 data (InputError for a shape NIfTI-1 cannot hold).

@@ -8,6 +8,7 @@
 
 #include "io/file_access.hpp"
 #include "io/formats.hpp"
+#include "io/row_blocks.hpp"
 #include "io/sample_type.hpp"
 #include "riner/error.hpp"
 
@@ -111,27 +112,71 @@ NiftiHeader read_header(const std::string& bytes, const std::filesystem::path& p
 
 }  // namespace
 
-std::vector<std::size_t> nifti_shape(const std::filesystem::path& path) {
-  const std::uint64_t size = input_file_size(path);
-  std::ifstream in(path, std::ios::binary);
+namespace {
+
+// A single-file NIfTI's layout from its first 352 bytes, checked against the file's size.
+struct NiftiLayout {
+  NiftiHeader header;
+  std::vector<std::size_t> shape;  // array order (the header's dims reversed)
+  SampleType type = SampleType::kFloat32;
+  std::size_t data_start = kDataOffset;
+  float slope = 0.0f, inter = 0.0f;
+};
+
+NiftiLayout read_layout(std::ifstream& in, const std::filesystem::path& path, std::uint64_t size) {
   std::string head(static_cast<std::size_t>(std::min<std::uint64_t>(size, kDataOffset)), '\0');
   if (!in.read(head.data(), static_cast<std::streamsize>(head.size()))) {
     throw InputError(prefix(path) + "cannot be read");
   }
-  const NiftiHeader header = read_header(head, path);
-  std::vector<std::size_t> shape(header.dims.rbegin(), header.dims.rend());
-  const SampleType type = nifti_type(field<std::int16_t>(head, 70, header.swap), path);
-  float vox_offset = field<float>(head, 108, header.swap);
-  if (!(vox_offset >= static_cast<float>(kDataOffset))) vox_offset = kDataOffset;
-  const std::uint64_t needed = static_cast<std::uint64_t>(vox_offset) +
-                               static_cast<std::uint64_t>(element_count(path, shape)) *
-                                   sample_bytes(type);
+  NiftiLayout l;
+  l.header = read_header(head, path);
+  l.shape.assign(l.header.dims.rbegin(), l.header.dims.rend());
+  l.type = nifti_type(field<std::int16_t>(head, 70, l.header.swap), path);
+  const float vox_offset = field<float>(head, 108, l.header.swap);
+  if (vox_offset >= static_cast<float>(kDataOffset)) l.data_start = static_cast<std::size_t>(vox_offset);
+  l.slope = field<float>(head, 112, l.header.swap);
+  l.inter = field<float>(head, 116, l.header.swap);
+  const std::uint64_t needed =
+      l.data_start + static_cast<std::uint64_t>(element_count(path, l.shape)) * sample_bytes(l.type);
   if (size < needed) {
-    throw InputError(prefix(path) + "header says " + shape_string(shape) + " " +
-                     sample_type_name(type) + " but the file holds only " + std::to_string(size) +
-                     " bytes");
+    throw InputError(prefix(path) + "header says " + shape_string(l.shape) + " " +
+                     sample_type_name(l.type) + " but the file holds only " +
+                     std::to_string(size) + " bytes");
   }
-  return shape;
+  return l;
+}
+
+}  // namespace
+
+std::vector<std::size_t> nifti_shape(const std::filesystem::path& path) {
+  const std::uint64_t size = input_file_size(path);
+  std::ifstream in(path, std::ios::binary);
+  return read_layout(in, path, size).shape;
+}
+
+std::optional<ArrayFile> read_nifti_rows(const std::filesystem::path& path, RowRange rows) {
+  const std::uint64_t size = input_file_size(path);
+  std::ifstream in(path, std::ios::binary);
+  const NiftiLayout l = read_layout(in, path, size);
+  if (l.shape.size() != 3) return std::nullopt;
+  check_row_range(path, l.shape, rows);
+  register_input(path);
+  ArrayFile file = read_row_blocks(in, path, l.data_start, l.shape, rows, l.type,
+                                   host_is_little_endian() != l.header.swap, FileFormat::kNifti);
+  // Per the standard, a zero (or absent) slope means the stored values are the values.
+  if (std::isfinite(l.slope) && l.slope != 0.0f) {
+    const float offset = std::isfinite(l.inter) ? l.inter : 0.0f;
+    file.non_finite = 0;
+    for (float& v : file.array.data) {
+      v = v * l.slope + offset;
+      file.non_finite += !std::isfinite(v);
+    }
+  }
+  file.voxel_size.assign(l.header.spacing.rbegin(), l.header.spacing.rend());
+  for (double& v : file.voxel_size) {
+    if (!(v > 0.0) || !std::isfinite(v)) v = 1.0;
+  }
+  return file;
 }
 
 ArrayFile read_nifti(const std::filesystem::path& path) {
