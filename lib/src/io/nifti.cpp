@@ -114,7 +114,8 @@ NiftiHeader read_header(const std::string& bytes, const std::filesystem::path& p
 
 namespace {
 
-// A single-file NIfTI's layout from its first 352 bytes, checked against the file's size.
+// A single-file NIfTI's layout from its header bytes (the first 352 at least), checked against
+// the file's size: where the data starts, its shape in array order, type and scaling.
 struct NiftiLayout {
   NiftiHeader header;
   std::vector<std::size_t> shape;  // array order (the header's dims reversed)
@@ -123,27 +124,61 @@ struct NiftiLayout {
   float slope = 0.0f, inter = 0.0f;
 };
 
-NiftiLayout read_layout(std::ifstream& in, const std::filesystem::path& path, std::uint64_t size) {
+NiftiLayout layout_of(const std::string& head, const std::filesystem::path& path,
+                      std::uint64_t size) {
+  NiftiLayout l;
+  l.header = read_header(head, path);
+  const bool swap = l.header.swap;
+  l.shape.assign(l.header.dims.rbegin(), l.header.dims.rend());
+  l.type = nifti_type(field<std::int16_t>(head, 70, swap), path);
+  // Single-file images put the data after the header; 0 is a common writer's shorthand.
+  const float vox_offset = field<float>(head, 108, swap);
+  if (!(vox_offset >= static_cast<float>(kDataOffset)) || vox_offset > size) {
+    if (vox_offset != 0.0f) {
+      throw InputError(prefix(path) + "vox_offset " + std::to_string(vox_offset) +
+                       " is outside the file");
+    }
+  } else {
+    l.data_start = static_cast<std::size_t>(vox_offset);
+  }
+  if (l.data_start > size) {  // vox_offset 0 defaults to 352, past a 348..351-byte file
+    throw InputError(prefix(path) + "ends at byte " + std::to_string(size) +
+                     ", before its data starts at byte " + std::to_string(l.data_start));
+  }
+  const std::uint64_t available = size - l.data_start;
+  if (element_count(path, l.shape) > available / sample_bytes(l.type)) {
+    throw InputError(prefix(path) + "header says " + shape_string(l.shape) + " " +
+                     sample_type_name(l.type) + " but the file holds only " +
+                     std::to_string(available) + " data bytes");
+  }
+  l.slope = field<float>(head, 112, swap);
+  l.inter = field<float>(head, 116, swap);
+  return l;
+}
+
+// The file's first bytes, as many as a header takes.
+NiftiLayout read_layout(const std::filesystem::path& path, std::uint64_t size,
+                        std::ifstream& in) {
   std::string head(static_cast<std::size_t>(std::min<std::uint64_t>(size, kDataOffset)), '\0');
   if (!in.read(head.data(), static_cast<std::streamsize>(head.size()))) {
     throw InputError(prefix(path) + "cannot be read");
   }
-  NiftiLayout l;
-  l.header = read_header(head, path);
-  l.shape.assign(l.header.dims.rbegin(), l.header.dims.rend());
-  l.type = nifti_type(field<std::int16_t>(head, 70, l.header.swap), path);
-  const float vox_offset = field<float>(head, 108, l.header.swap);
-  if (vox_offset >= static_cast<float>(kDataOffset)) l.data_start = static_cast<std::size_t>(vox_offset);
-  l.slope = field<float>(head, 112, l.header.swap);
-  l.inter = field<float>(head, 116, l.header.swap);
-  const std::uint64_t needed =
-      l.data_start + static_cast<std::uint64_t>(element_count(path, l.shape)) * sample_bytes(l.type);
-  if (size < needed) {
-    throw InputError(prefix(path) + "header says " + shape_string(l.shape) + " " +
-                     sample_type_name(l.type) + " but the file holds only " +
-                     std::to_string(size) + " bytes");
+  return layout_of(head, path, size);
+}
+
+// The header's scaling applied to decoded samples (a zero or absent slope means the stored
+// values are the values, per the standard), their non-finite count, and the voxel size.
+void finish(ArrayFile& file, const NiftiLayout& l) {
+  if (std::isfinite(l.slope) && l.slope != 0.0f) {
+    const float offset = std::isfinite(l.inter) ? l.inter : 0.0f;
+    for (float& v : file.array.data) v = v * l.slope + offset;
   }
-  return l;
+  file.non_finite = 0;
+  for (float v : file.array.data) file.non_finite += !std::isfinite(v);
+  file.voxel_size.assign(l.header.spacing.rbegin(), l.header.spacing.rend());
+  for (double& v : file.voxel_size) {
+    if (!(v > 0.0) || !std::isfinite(v)) v = 1.0;
+  }
 }
 
 }  // namespace
@@ -151,84 +186,34 @@ NiftiLayout read_layout(std::ifstream& in, const std::filesystem::path& path, st
 std::vector<std::size_t> nifti_shape(const std::filesystem::path& path) {
   const std::uint64_t size = input_file_size(path);
   std::ifstream in(path, std::ios::binary);
-  return read_layout(in, path, size).shape;
+  return read_layout(path, size, in).shape;
 }
 
 std::optional<ArrayFile> read_nifti_rows(const std::filesystem::path& path, RowRange rows) {
   const std::uint64_t size = input_file_size(path);
   std::ifstream in(path, std::ios::binary);
-  const NiftiLayout l = read_layout(in, path, size);
+  const NiftiLayout l = read_layout(path, size, in);
   if (l.shape.size() != 3) return std::nullopt;
   check_row_range(path, l.shape, rows);
   register_input(path);
   ArrayFile file = read_row_blocks(in, path, l.data_start, l.shape, rows, l.type,
                                    host_is_little_endian() != l.header.swap, FileFormat::kNifti);
-  // Per the standard, a zero (or absent) slope means the stored values are the values.
-  if (std::isfinite(l.slope) && l.slope != 0.0f) {
-    const float offset = std::isfinite(l.inter) ? l.inter : 0.0f;
-    file.non_finite = 0;
-    for (float& v : file.array.data) {
-      v = v * l.slope + offset;
-      file.non_finite += !std::isfinite(v);
-    }
-  }
-  file.voxel_size.assign(l.header.spacing.rbegin(), l.header.spacing.rend());
-  for (double& v : file.voxel_size) {
-    if (!(v > 0.0) || !std::isfinite(v)) v = 1.0;
-  }
+  finish(file, l);
   return file;
 }
 
 ArrayFile read_nifti(const std::filesystem::path& path) {
   const std::string bytes = read_file_bytes(path);
-  const NiftiHeader header = read_header(bytes, path);
-  const bool swap = header.swap;
-  const std::vector<std::size_t>& dims = header.dims;
-  const std::vector<double>& spacing = header.spacing;
-  const SampleType type = nifti_type(field<std::int16_t>(bytes, 70, swap), path);
-  // Single-file images put the data after the header; 0 is a common writer's shorthand.
-  float vox_offset = field<float>(bytes, 108, swap);
-  if (!(vox_offset >= static_cast<float>(kDataOffset)) || vox_offset > bytes.size()) {
-    if (vox_offset == 0.0f) {
-      vox_offset = kDataOffset;
-    } else {
-      throw InputError(prefix(path) + "vox_offset " + std::to_string(vox_offset) +
-                       " is outside the file");
-    }
-  }
-  const std::size_t start = static_cast<std::size_t>(vox_offset);
-  if (start > bytes.size()) {  // vox_offset 0 defaults to 352, past a 348..351-byte file
-    throw InputError(prefix(path) + "ends at byte " + std::to_string(bytes.size()) +
-                     ", before its data starts at byte " + std::to_string(start));
-  }
-
+  const NiftiLayout l = layout_of(bytes, path, bytes.size());
   ArrayFile file;
   file.format = FileFormat::kNifti;
-  file.dtype = sample_type_name(type);
-  std::vector<std::size_t> shape(dims.rbegin(), dims.rend());
-  file.voxel_size.assign(spacing.rbegin(), spacing.rend());
-  for (double& v : file.voxel_size) {
-    if (!(v > 0.0) || !std::isfinite(v)) v = 1.0;
-  }
-  const std::size_t count = element_count(path, shape);
-  const std::size_t item = sample_bytes(type);
-  const std::size_t available = bytes.size() - start;
-  if (count > available / item) {
-    throw InputError(prefix(path) + "header says " + shape_string(shape) + " " + file.dtype +
-                     " but the file holds only " + std::to_string(available) + " data bytes");
-  }
+  file.dtype = sample_type_name(l.type);
+  const std::size_t count = shape_size(l.shape);
   std::vector<float> data(count);
-  decode_samples(reinterpret_cast<const unsigned char*>(bytes.data()) + start, count, type,
-                 host_is_little_endian() != swap, data.data());
-  const float slope = field<float>(bytes, 112, swap);
-  const float inter = field<float>(bytes, 116, swap);
-  // Per the standard, a zero (or absent) slope means the stored values are the values.
-  if (std::isfinite(slope) && slope != 0.0f) {
-    const float offset = std::isfinite(inter) ? inter : 0.0f;
-    for (float& v : data) v = v * slope + offset;
-  }
-  for (float v : data) file.non_finite += !std::isfinite(v);
-  file.array = Array(std::move(shape), std::move(data));
+  decode_samples(reinterpret_cast<const unsigned char*>(bytes.data()) + l.data_start, count,
+                 l.type, host_is_little_endian() != l.header.swap, data.data());
+  file.array = Array(l.shape, std::move(data));
+  finish(file, l);
   return file;
 }
 
