@@ -8,17 +8,12 @@
 
 namespace riner::stripes {
 
-namespace {
-
-// Mirrored index in [0, n) of i in [-n, 2n) (scipy 'reflect').
 std::size_t reflect(long i, std::size_t n) {
   const long m = static_cast<long>(n);
   if (i < 0) i = -i - 1;
   if (i >= m) i = 2 * m - i - 1;
   return static_cast<std::size_t>(std::clamp(i, 0L, m - 1));
 }
-
-}  // namespace
 
 SortedColumns sort_columns(const Sinogram& s) {
   SortedColumns out;

@@ -15,6 +15,9 @@ struct Sinogram {
   double at(std::size_t v, std::size_t c) const { return values[v * columns + c]; }
 };
 
+// Index i in [-n, 2n) mirrored into [0, n) (scipy's 'reflect': d c b a | a b c d | d c b a).
+std::size_t reflect(long i, std::size_t n);
+
 // Each column sorted over the views: sorted values and, for each, the view it came from.
 struct SortedColumns {
   Sinogram sorted;
