@@ -109,8 +109,8 @@ int run_destripe(int argc, char** argv, int first) {
   if (args.is_set("reconstruct")) {
     FbpOptions fbp_options;
     fbp_options.filter = filter;
-    fbp_options.engine = engine_from(args);
-    fbp_options.device = device_from(args, fbp_options.engine);
+    fbp_options.engine = options.engine;
+    fbp_options.device = options.device;
     const auto fbp_start = std::chrono::steady_clock::now();
     const Array image = fbp(Scan{destriped, scan.geometry, 0}, fbp_options);
     const double fbp_seconds =

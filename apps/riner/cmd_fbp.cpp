@@ -11,6 +11,7 @@
 #include "riner/slab_fbp.hpp"
 #include "riner/slab_plan.hpp"
 #include "progress.hpp"
+#include "reconstruct_slabs.hpp"
 #include "scan_options.hpp"
 #include "summary_json.hpp"
 
@@ -21,19 +22,11 @@ namespace {
 // A projection stack goes by slabs when asked (--slab-slices, --memory-limit), when the
 // output is a folder of slices, or when its volume does not fit in memory whole.
 bool fbp_wants_slabs(const Args& args) {
-  if (auto row = args.maybe("row"); row && !row->empty()) return false;
   const bool asked = !args.get("slab-slices").empty() || !args.get("memory-limit").empty();
   const bool folder = std::filesystem::path(args.get("out")).extension().empty();
-  ScanSource source = source_from(args);
-  source.offset_px.clear();  // the geometry's size is all that is needed here
-  try {
-    const ScanRows rows(source);
-    const Geometry& g = rows.geometry();
-    if (!g.is_3d()) return false;
-    return asked || folder || fbp_slab_bytes(g, g.volume_shape[0]) > default_memory_limit();
-  } catch (const InputError&) {
-    return false;  // a 2D scan, or one the whole-scan path explains better
-  }
+  const std::optional<Geometry> g = stack_geometry(args);
+  return g && g->is_3d() &&
+         (asked || folder || fbp_slab_bytes(*g, g->volume_shape[0]) > default_memory_limit());
 }
 
 // --destripe METHOD: the stripe filter every sinogram goes through first (nullopt: none).
@@ -46,15 +39,10 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
   const ScanRows source(source_from(args));
   if (source.centre()) console.line(centre_line(*source.centre()));
   const Geometry& g = source.geometry();
-  const std::size_t limit = args.get("memory-limit").empty()
-                                ? default_memory_limit()
-                                : parse_memory_size(args.get("memory-limit"));
-  std::size_t per = fbp_slices_within(g, limit);
-  if (!args.get("slab-slices").empty()) {
-    const long n = args.integer("slab-slices");
-    if (n < 1) throw UsageError("--slab-slices must be 1 or more");
-    per = static_cast<std::size_t>(n);
-  }
+  const SlabOptions asked = slab_size_options(args);
+  const std::size_t limit = asked.memory_limit ? asked.memory_limit : default_memory_limit();
+  const std::size_t per = asked.slices_per_slab ? asked.slices_per_slab
+                                                : fbp_slices_within(g, limit);
   const std::string out = args.get("out");
   VolumeWriter writer(out, g.volume_shape, g.voxel_mm);
   const auto start = std::chrono::steady_clock::now();
@@ -66,10 +54,7 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
       source, options, writer, per,
       [&](std::size_t first, const Array& slices) {
         if (nz / 2 >= first && nz / 2 < first + slices.shape[0]) {
-          const std::size_t plane = slices.shape[1] * slices.shape[2];
-          const auto at = slices.data.begin() + static_cast<long>((nz / 2 - first) * plane);
-          middle = Array({slices.shape[1], slices.shape[2]},
-                         std::vector<float>(at, at + static_cast<long>(plane)));
+          middle = axial_slice(slices, nz / 2 - first);
         }
         progress.update(first + slices.shape[0]);
       },
@@ -142,30 +127,28 @@ int run_fbp(int argc, char** argv, int first) {
   args.output_flags();
   if (!args.parse(argc, argv, first)) return 0;
   Console console(args);
-  if (fbp_wants_slabs(args)) {
+  const auto fbp_options = [&] {
     FbpOptions options;
     options.filter = parse_fbp_filter(args.get("filter"));
     options.engine = engine_from(args);
     options.device = device_from(args, options.engine);
-    return fbp_by_slabs_cli(args, console, options);
-  }
-  const LoadedScan loaded = scan_from(args, console);
+    return options;
+  };
+  if (fbp_wants_slabs(args)) return fbp_by_slabs_cli(args, console, fbp_options());
+  LoadedScan loaded = scan_from(args, console);
   check_centre(loaded, console);
-  Scan scan = loaded.scan;
+  Scan scan = std::move(loaded.scan);  // the stripe filter may replace its measurement
   const std::filesystem::path out = args.get("out");
+  format_from_path(out);  // reject an unknown extension before the work
+  const FbpOptions options = fbp_options();
   const std::optional<DestripeOptions> stripes = destripe_from(args);
-  DestripeReport destripe_report;
   if (stripes) {
+    DestripeReport destripe_report;
     scan.measurement = destripe(scan.measurement, scan.geometry, *stripes, &destripe_report);
     console.line("destripe (" + std::string(destripe_method_name(stripes->method)) + "): " +
                  std::to_string(destripe_report.dead.size()) + " dead and " +
                  std::to_string(destripe_report.large.size()) + " large-stripe elements found");
   }
-  format_from_path(out);  // reject an unknown extension before the work
-  FbpOptions options;
-  options.filter = parse_fbp_filter(args.get("filter"));
-  options.engine = engine_from(args);
-  options.device = device_from(args, options.engine);
   FbpReport report;
   const auto start = std::chrono::steady_clock::now();
   const Array image = fbp(scan, options, &report);

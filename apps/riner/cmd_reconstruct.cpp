@@ -164,11 +164,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   const std::optional<CentreEstimate> centre_check = check_centre(loaded, console);
   Scan& scan = loaded.scan;
   const RinerConfig config = config_from(args);
-  const std::string format = args.get("format");
-  if (format != "nii" && format != "npy" && format != "tif" && format != "raw" &&
-      format != "h5") {
-    throw UsageError("--format must be nii, npy, tif, raw or h5");
-  }
+  const std::string format = output_format(args);
   if (format == "h5" && !scan.geometry.is_3d()) {
     throw UsageError("--format h5 writes volumes; write a 2D image as nii, npy, tif or raw");
   }

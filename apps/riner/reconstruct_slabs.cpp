@@ -18,7 +18,18 @@ namespace riner::app {
 
 namespace {
 
-SlabOptions slab_options(const Args& args) {
+}  // namespace
+
+std::string output_format(const Args& args) {
+  const std::string format = args.get("format");
+  if (format != "nii" && format != "npy" && format != "tif" && format != "raw" &&
+      format != "h5") {
+    throw UsageError("--format must be nii, npy, tif, raw or h5");
+  }
+  return format;
+}
+
+SlabOptions slab_size_options(const Args& args) {
   SlabOptions options;
   if (auto v = args.maybe("slab-slices"); v && !v->empty()) {
     const long n = args.integer("slab-slices");
@@ -28,6 +39,13 @@ SlabOptions slab_options(const Args& args) {
   if (auto v = args.maybe("memory-limit"); v && !v->empty()) {
     options.memory_limit = parse_memory_size(*v);
   }
+  return options;
+}
+
+namespace {
+
+SlabOptions slab_options(const Args& args) {
+  SlabOptions options = slab_size_options(args);
   options.resume = args.is_set("resume");
   return options;
 }
@@ -64,18 +82,10 @@ bool wants_slabs(const Args& args) {
   for (const char* name : {"slab-slices", "memory-limit"}) {
     if (auto v = args.maybe(name); v && !v->empty()) return true;
   }
-  if (auto row = args.maybe("row"); row && !row->empty()) return false;
   // Left to the scan: by slabs when a parallel-beam volume does not fit whole.
-  ScanSource source = source_from(args);
-  source.offset_px.clear();  // the geometry's size is all that is needed here
-  try {
-    const ScanRows rows(source);
-    const Geometry& g = rows.geometry();
-    return g.type == GeometryType::kParallel3d &&
-           slab_bytes(g, g.volume_shape[0]) > default_memory_limit();
-  } catch (const InputError&) {
-    return false;  // a 2D scan, or one the whole-scan path explains better
-  }
+  const std::optional<Geometry> g = stack_geometry(args);
+  return g && g->type == GeometryType::kParallel3d &&
+         slab_bytes(*g, g->volume_shape[0]) > default_memory_limit();
 }
 
 namespace {
@@ -112,10 +122,7 @@ void gather_slices(const SlabRun& run, const std::string& target) {
 
 int reconstruct_by_slabs(const Args& args, const Console& console, const RinerConfig& settings,
                          std::chrono::steady_clock::time_point started) {
-  const std::string format = args.get("format");
-  if (format != "nii" && format != "tif" && format != "h5" && format != "npy" && format != "raw") {
-    throw UsageError("--format must be nii, npy, tif, raw or h5");
-  }
+  const std::string format = output_format(args);
   if (SlabRanks::launched_size() > 1 && !SlabRanks::built_with_mpi()) {
     throw InputError("this riner was built without MPI: run one process, or install "
                      "libopenmpi-dev and build again");

@@ -9,10 +9,17 @@
 #include "cli_args.hpp"
 #include "cli_common.hpp"
 #include "riner/riner_config.hpp"
+#include "riner/slab_run.hpp"
 
 namespace riner::app {
 
 void add_slab_options(Args& args);
+
+// --format, checked (UsageError): nii, npy, tif, raw or h5, whole run or slabbed.
+std::string output_format(const Args& args);
+
+// --slab-slices and --memory-limit (0 where not given), as riner fbp takes them too.
+SlabOptions slab_size_options(const Args& args);
 
 // Whether this run goes by slabs (it reads the geometry and the data's header, no data).
 bool wants_slabs(const Args& args);

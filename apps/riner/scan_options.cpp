@@ -54,6 +54,17 @@ ScanSource source_from(const Args& args) {
   return source;
 }
 
+std::optional<Geometry> stack_geometry(const Args& args) {
+  if (auto row = args.maybe("row"); row && !row->empty()) return std::nullopt;
+  ScanSource source = source_from(args);
+  source.offset_px.clear();  // the geometry's size is all that is needed here
+  try {
+    return ScanRows(source).geometry();
+  } catch (const InputError&) {
+    return std::nullopt;
+  }
+}
+
 LoadedScan scan_from(const Args& args, const Console& console) {
   LoadedScan loaded = load_scan_source(source_from(args));
   for (const std::string& note : loaded.notes) console.line(note);

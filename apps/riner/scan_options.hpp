@@ -15,6 +15,11 @@ void add_scan_options(Args& args);
 // The scan as the options name it (UsageError for a combination that cannot work).
 ScanSource source_from(const Args& args);
 
+// The geometry of the projection stack the options name, from the files' headers alone (no
+// data, no centre estimate): what deciding on slabs needs. nullopt for one detector row
+// (--row), a 2D scan, or a scan the whole-scan path explains better (its InputError).
+std::optional<Geometry> stack_geometry(const Args& args);
+
 // The measurement SCAN names, or, with --flat, raw projections normalised by their flat and
 // dark fields; its detector offset from --offset-px (a number, or auto: estimated).
 // Console lines say what was done.

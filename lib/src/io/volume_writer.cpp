@@ -126,12 +126,8 @@ class FolderSink : public VolumeWriter::Sink {
  public:
   explicit FolderSink(std::filesystem::path folder) : folder_(std::move(folder)) {}
   void write(std::size_t first_slice, const Array& slices) override {
-    const std::size_t slice = slices.shape[1] * slices.shape[2];
     for (std::size_t k = 0; k < slices.shape[0]; ++k) {
-      Array one({slices.shape[1], slices.shape[2]},
-                std::vector<float>(slices.data.begin() + static_cast<long>(k * slice),
-                                   slices.data.begin() + static_cast<long>((k + 1) * slice)));
-      write_array(VolumeWriter::slice_file(folder_, first_slice + k), one);
+      write_array(VolumeWriter::slice_file(folder_, first_slice + k), axial_slice(slices, k));
     }
   }
   void close() override {}

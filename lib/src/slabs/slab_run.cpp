@@ -7,6 +7,7 @@
 
 #include "riner/error.hpp"
 #include "riner/io.hpp"
+#include "riner/volume_writer.hpp"
 
 namespace riner {
 
@@ -100,7 +101,7 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
 }
 
 std::filesystem::path SlabRun::slice_path(std::size_t slice) const {
-  return volume_dir() / numbered("slice_%05zu.tif", slice);
+  return VolumeWriter::slice_file(volume_dir(), slice);
 }
 
 std::filesystem::path SlabRun::slab_file(const Slab& slab, const std::string& what) const {
