@@ -16,14 +16,9 @@
 
 namespace riner::app {
 
-namespace {
-
-}  // namespace
-
 std::string output_format(const Args& args) {
   const std::string format = args.get("format");
-  if (format != "nii" && format != "npy" && format != "tif" && format != "raw" &&
-      format != "h5") {
+  if (format != "nii" && format != "npy" && format != "tif" && format != "raw" && format != "h5") {
     throw UsageError("--format must be nii, npy, tif, raw or h5");
   }
   return format;
@@ -47,6 +42,11 @@ namespace {
 SlabOptions slab_options(const Args& args) {
   SlabOptions options = slab_size_options(args);
   options.resume = args.is_set("resume");
+  if (auto v = args.maybe("workers"); v && !v->empty()) {
+    const long n = args.integer("workers");
+    if (n < 1 || n > 256) throw UsageError("--workers must be 1 to 256");
+    options.workers = static_cast<int>(n);
+  }
   return options;
 }
 
@@ -72,6 +72,11 @@ void add_slab_options(Args& args) {
               "host memory a slab may take (8G, 512M); a volume larger than this goes by "
               "slabs (default: three quarters of the machine's memory)",
               "")
+      .option("workers", "N",
+              "slabs trained at once on the device, each on its own queue (default: 8 on a "
+              "GPU, 1 on a CPU, whose cores MPI ranks fill; at most as many as the slabs and "
+              "--memory-limit allow); the volume is the same for any N",
+              "")
       .flag("resume",
             "finish a slabbed run the output folder holds: only the slabs its manifest does "
             "not list as done are trained");
@@ -79,7 +84,7 @@ void add_slab_options(Args& args) {
 
 bool wants_slabs(const Args& args) {
   if (args.is_set("resume")) return true;
-  for (const char* name : {"slab-slices", "memory-limit"}) {
+  for (const char* name : {"slab-slices", "memory-limit", "workers"}) {
     if (auto v = args.maybe(name); v && !v->empty()) return true;
   }
   // Left to the scan: by slabs when a parallel-beam volume does not fit whole.
@@ -124,8 +129,9 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
                          std::chrono::steady_clock::time_point started) {
   const std::string format = output_format(args);
   if (SlabRanks::launched_size() > 1 && !SlabRanks::built_with_mpi()) {
-    throw InputError("this riner was built without MPI: run one process, or install "
-                     "libopenmpi-dev and build again");
+    throw InputError(
+        "this riner was built without MPI: run one process, or install "
+        "libopenmpi-dev and build again");
   }
   SlabOptions options = slab_options(args);
   const SlabRanks ranks;
@@ -169,41 +175,45 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   const std::size_t done_before = run.slabs_done();
   if (speak) {
     char line[300];
-    std::snprintf(line, sizeof(line),
-                  "%zu slabs of up to %zu slices (%zu x %zu voxels; about %s each, limit %s)%s%s",
-                  run.slabs().size(), run.slices_per_slab(), g.volume_shape[1],
-                  g.volume_shape[2],
-                  bytes_string(static_cast<double>(slab_bytes(g, run.slices_per_slab()))).c_str(),
-                  bytes_string(static_cast<double>(run.memory_limit())).c_str(),
-                  done_before ? (", " + std::to_string(done_before) + " done before").c_str()
-                              : "",
-                  ranks.size() > 1 ? (", over " + std::to_string(ranks.size()) + " ranks").c_str()
-                                   : "");
+    std::snprintf(
+        line, sizeof(line),
+        "%zu slabs of up to %zu slices (%zu x %zu voxels; about %s each, limit %s), "
+        "%d at once%s%s",
+        run.slabs().size(), run.slices_per_slab(), g.volume_shape[1], g.volume_shape[2],
+        bytes_string(static_cast<double>(slab_bytes(g, run.slices_per_slab()))).c_str(),
+        bytes_string(static_cast<double>(run.memory_limit())).c_str(), run.workers(),
+        done_before ? (", " + std::to_string(done_before) + " done before").c_str() : "",
+        ranks.size() > 1 ? (", over " + std::to_string(ranks.size()) + " ranks").c_str() : "");
     console.line(line);
-    if (slab_bytes(g, run.slices_per_slab()) > run.memory_limit()) {
-      std::snprintf(line, sizeof(line),
-                    "note: a slab of %zu slice(s) needs about %s, more than the limit: the run "
-                    "may take more memory than --memory-limit allows",
-                    run.slices_per_slab(),
-                    bytes_string(static_cast<double>(slab_bytes(g, run.slices_per_slab())))
-                        .c_str());
+    if (slab_bytes(g, run.slices_per_slab()) * static_cast<std::size_t>(run.workers()) >
+        run.memory_limit()) {
+      std::snprintf(
+          line, sizeof(line),
+          "note: a slab of %zu slice(s) needs about %s, more than the limit: the run "
+          "may take more memory than --memory-limit allows",
+          run.slices_per_slab(),
+          bytes_string(static_cast<double>(slab_bytes(g, run.slices_per_slab()))).c_str());
       console.line(line);
     }
   }
   const std::size_t total = g.volume_shape[0];
+  const auto training_started = std::chrono::steady_clock::now();
+  double slices_at_start = static_cast<double>(total);  // until a report says otherwise
   try {
     Progress progress("slabs", total * 100, !speak);
     run.run(
         [&](const SlabProgress& p) {
+          slices_at_start = p.slices_at_start;
           const double this_run = p.slices_done - p.slices_at_start;
           char status[160];
-          std::snprintf(status, sizeof(status), "slab %zu/%zu, %zu/%zu slices, %.1f slices/min",
-                        p.slab->index + 1, p.slabs, static_cast<std::size_t>(p.slices_done),
-                        p.slices, p.seconds > 0 ? 60.0 * this_run / p.seconds : 0.0);
+          std::snprintf(status, sizeof(status), "%zu/%zu slabs, %zu/%zu slices, %.1f slices/min",
+                        p.slabs_done, p.slabs, static_cast<std::size_t>(p.slices_done), p.slices,
+                        p.seconds > 0 ? 60.0 * this_run / p.seconds : 0.0);
           progress.update(static_cast<std::size_t>(100.0 * p.slices_done), status);
         },
-        [&](const Reconstructor& r, const ReconstructionResult& result) {
-          return run_summary(r, result, check_quality(r, result, device));
+        [&](const Reconstructor& r, const ReconstructionResult& result,
+            const std::optional<Device>& own) {
+          return run_summary(r, result, check_quality(r, result, own));
         },
         static_cast<int>(args.integer("report-every")),
         ranks.size() > 1 ? claim_by_file(out, token) : SlabRun::Claim{});
@@ -214,6 +224,8 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
     ranks.abort(1);  // the other ranks would wait for this one forever
   }
   ranks.all_ok(true);  // every rank's slabs are written
+  const double training_wall =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - training_started).count();
   if (!leader) return 0;
   run.finish();
 
@@ -238,37 +250,41 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   std::size_t peak = 0;
   double trained_seconds = 0.0;
-  std::size_t trained_slices = 0;
   for (const nlohmann::json& entry : run.manifest()["slabs"]) {
     peak = std::max<std::size_t>(peak, entry.value("peak_host_bytes", std::size_t{0}));
     trained_seconds += entry.value("seconds", 0.0);
-    trained_slices += entry.value("slices", std::size_t{0});
   }
   nlohmann::json summary = {
       {"volume", run.volume_dir().string()},
-      {"volume_file", gathered.empty() ? nlohmann::json(nullptr)
-                                       : nlohmann::json(format == "h5" ? gathered + ":/volume"
-                                                                       : gathered)},
+      {"volume_file", gathered.empty()
+                          ? nlohmann::json(nullptr)
+                          : nlohmann::json(format == "h5" ? gathered + ":/volume" : gathered)},
       {"shape", g.volume_shape},
       {"voxel_mm", g.voxel_mm},
       {"slabs", run.slabs().size()},
       {"slices_per_slab", run.slices_per_slab()},
       {"slabs_done_before", done_before},
       {"ranks", ranks.size()},
+      {"workers", run.workers()},
       {"memory_limit_bytes", run.memory_limit()},
       {"slab_bytes_estimated", slab_bytes(g, run.slices_per_slab())},
       {"peak_host_bytes", peak},
       {"slab_seconds", trained_seconds},
-      {"slices_per_minute", trained_seconds > 0 ? 60.0 * trained_slices / trained_seconds : 0.0},
+      // This run's slices (all ranks and workers) per minute of its training.
+      {"slices_per_minute",
+       training_wall > 0 ? 60.0 * (static_cast<double>(total) - slices_at_start) / training_wall
+                         : 0.0},
+      {"training_seconds", training_wall},
       {"dead_elements", dead.size()},
-      {"centre", run.source().centre() ? centre_json(*run.source().centre())
-                                        : nlohmann::json(nullptr)},
+      {"centre",
+       run.source().centre() ? centre_json(*run.source().centre()) : nlohmann::json(nullptr)},
       {"wall_seconds", wall},
       {"per_slab", run.manifest()["slabs"]}};
   write_text(out / "summary.json", summary.dump(1) + "\n");
-  console.line("reconstructed " + shape_string(g.volume_shape) + " in " + std::to_string(run.slabs().size()) +
-               " slabs in " + format_duration(wall) + " (" + std::to_string(dead.size()) +
-               " elements flagged dead) -> " + run.volume_dir().string());
+  console.line("reconstructed " + shape_string(g.volume_shape) + " in " +
+               std::to_string(run.slabs().size()) + " slabs in " + format_duration(wall) + " (" +
+               std::to_string(dead.size()) + " elements flagged dead) -> " +
+               run.volume_dir().string());
   console.summary(summary);
   return 0;
 }

@@ -142,6 +142,8 @@ std::vector<Result> slab_stack(const Options& o) {
   std::string flags = "--slab-slices " + std::to_string(slab_slices);
   if (!memory.empty()) flags = "--memory-limit " + memory;
   if (steps > 0) flags += " --steps " + std::to_string(steps);
+  // Anything else for the slabbed run (--flags="--workers 8").
+  if (const std::string extra = o.get("flags", ""); !extra.empty()) flags += " " + extra;
   const std::string scan = dir + "/sino.npy";
   const int ranks = o.get_int("ranks", 1);
   const std::string launcher =
@@ -200,6 +202,7 @@ std::vector<Result> slab_stack(const Options& o) {
             {"peak_host_bytes", peak},
             {"wall_seconds", slabbed.wall},
             {"slices_per_minute", slices_per_minute},
+            {"workers", s.value("workers", 1)},
             {"psnr_mean", mean(slabbed.psnr)},
             {"gain_over_fbp_border_slices", mean(at_border)},
             {"gain_over_fbp_next_slices", mean(inside)},

@@ -168,6 +168,24 @@ TEST_SUITE("cli") {
 #endif
   }
 
+  TEST_CASE("slabs trained several at once on one device give the volume of one at a time") {
+    riner::test::TempDir dir;
+    const std::string scan = simulate_stack(dir);
+    const std::string common = "reconstruct " + scan + " --slab-slices 4 --steps 300 --quiet";
+    const std::filesystem::path one = dir / "one", three = dir / "three";
+    REQUIRE(riner_cli(common + " --workers 1 --out " + one.string(), dir).code == 0);
+    const Run run = riner_cli(common + " --workers 3 --out " + three.string(), dir);
+    CAPTURE(run.err);
+    REQUIRE(run.code == 0);
+    const nlohmann::json summary =
+        nlohmann::json::parse(riner::test::read_bytes(three / "summary.json"));
+    CHECK(summary["workers"] == 3);
+    CHECK(summary["slabs"] == 5);
+    CHECK(summary["slices_per_minute"].get<double>() > 0.0);
+    check_same_volume(one, three, 20);
+    CHECK(slabs_done(three) == 5);
+  }
+
   TEST_CASE("slab options name their mistakes") {
     riner::test::TempDir dir;
     riner::test::write_bytes(dir / "geometry.json", R"({"type": "parallel2d",
@@ -185,6 +203,11 @@ TEST_SUITE("cli") {
                     dir);
     CHECK(run.code != 0);
     CHECK(run.err.find("a memory size is a number") != std::string::npos);
+    run = riner_cli("reconstruct " + (dir / "sino.npy").string() + " --workers 0 --out " +
+                        (dir / "out").string(),
+                    dir);
+    CHECK(run.code != 0);
+    CHECK(run.err.find("--workers must be 1 to 256") != std::string::npos);
   }
 
   TEST_CASE("riner fbp by slabs writes the whole volume's slices, into a folder or an HDF5 file") {

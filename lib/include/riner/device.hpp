@@ -71,6 +71,10 @@ class Device {
   // Finishes all queued work.
   void finish() const;
 
+  // A new in-order queue in the same context: for a second training at once
+  // (riner/concurrent_trainings.hpp). Its work is ordered only against its own queue.
+  Device sibling() const;
+
  private:
   friend class detail::DeviceAccess;
   explicit Device(std::shared_ptr<cl::Context> context) : context_(std::move(context)) {}

@@ -10,6 +10,7 @@
 // riner/slab_ranks.hpp) share one run by claiming slabs.
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <filesystem>
 #include <functional>
@@ -18,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "riner/concurrent_trainings.hpp"
 #include "riner/device.hpp"
 #include "riner/reconstructor.hpp"
 #include "riner/riner_config.hpp"
@@ -33,6 +35,10 @@ struct SlabOptions {
   // A process joining the run another (the leader, MPI rank 0) has just planned in the same
   // folder: it reads the manifest and never writes it.
   bool join = false;
+  // Slabs trained at once on the device (riner/concurrent_trainings.hpp), each worker on its
+  // own queue; 0: concurrent_trainings() of the device, as many as the slabs and the memory
+  // limit allow (the workers share it). The volume does not depend on it.
+  int workers = 0;
 };
 
 struct SlabProgress {
@@ -59,16 +65,19 @@ class SlabRun {
   const std::vector<Slab>& slabs() const { return slabs_; }
   std::size_t slices_per_slab() const { return slices_per_slab_; }
   std::size_t memory_limit() const { return memory_limit_; }
+  int workers() const { return workers_; }
   std::size_t slabs_done() const;
   const ScanRows& source() const { return source_; }
 
   // Per slab, after it is trained: what to record in its manifest entry (the quality report,
-  // say); may be empty.
-  using Summarise = std::function<nlohmann::json(const Reconstructor&, const ReconstructionResult&)>;
+  // say), computed on the device the slab trained on; may be empty.
+  using Summarise = std::function<nlohmann::json(const Reconstructor&, const ReconstructionResult&,
+                                                 const std::optional<Device>&)>;
   // Trains and writes every slab not yet done, in order, that `claim` gives this process (all
-  // of them when it is empty; a claim must be given to one process only). `progress` every
-  // `report_every` steps and once as each slab is written; its counts include other processes'
-  // slabs as their records appear.
+  // of them when it is empty; a claim must be given to one process only), workers() at once.
+  // `progress` every `report_every` steps of each slab and once as each slab is written, from
+  // one thread at a time; its counts include the other workers' slabs in training and other
+  // processes' slabs as their records appear.
   using Claim = std::function<bool(const Slab&)>;
   void run(const std::function<void(const SlabProgress&)>& progress = {},
            const Summarise& summarise = {}, int report_every = 50, const Claim& claim = {});
@@ -92,6 +101,10 @@ class SlabRun {
  private:
   std::filesystem::path slab_file(const Slab& slab, const std::string& what) const;
   bool is_done(const Slab& slab) const;
+  // The slab's slices, alpha, beta and preview planes, then its record.
+  void write_slab(const Slab& slab, const Reconstructor& r, const Summarise& summarise,
+                  const std::optional<Device>& device,
+                  std::chrono::steady_clock::time_point started) const;
   void write_manifest() const;
   Array detector_map(const std::string& what) const;
 
@@ -101,6 +114,7 @@ class SlabRun {
   std::optional<Device> device_;
   std::size_t memory_limit_ = 0;
   std::size_t slices_per_slab_ = 0;
+  int workers_ = 1;
   std::vector<Slab> slabs_;
   nlohmann::json manifest_;
   bool join_ = false;

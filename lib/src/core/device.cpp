@@ -2,8 +2,10 @@
 
 #include <algorithm>
 
+#include "cl/check.hpp"
 #include "cl/context.hpp"
 #include "cl/device_list.hpp"
+#include "cl/handle.hpp"
 
 namespace riner {
 
@@ -38,5 +40,16 @@ Device Device::from_handles(cl_context context, cl_command_queue queue, bool pro
 const DeviceInfo& Device::info() const { return context_->info(); }
 bool Device::profiling() const { return context_->profiling(); }
 void Device::finish() const { context_->finish(); }
+
+Device Device::sibling() const {
+  // The same context, a new queue: kernels of different contexts do not run at once on a GPU
+  // (the driver time-slices contexts); those of one context's queues may.
+  cl_int status = CL_SUCCESS;
+  const cl_command_queue_properties props = context_->profiling() ? CL_QUEUE_PROFILING_ENABLE : 0;
+  cl::Handle<cl_command_queue> queue(
+      clCreateCommandQueue(context_->get(), context_->device(), props, &status));
+  cl::check(status, "clCreateCommandQueue", RINER_HERE);
+  return Device(std::make_shared<cl::Context>(context_->get(), queue.get(), context_->profiling()));
+}
 
 }  // namespace riner

@@ -4,9 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <mutex>
 
 #include "riner/error.hpp"
 #include "riner/io.hpp"
+#include "riner/log.hpp"
 #include "riner/volume_writer.hpp"
 
 namespace riner {
@@ -42,8 +44,23 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
   config_.validate();
   const Geometry& g = source_.geometry();
   memory_limit_ = options.memory_limit ? options.memory_limit : default_memory_limit();
-  slices_per_slab_ = options.slices_per_slab ? std::min(options.slices_per_slab, g.volume_shape[0])
-                                             : slices_within(g, memory_limit_);
+  const std::size_t nz = g.volume_shape[0];
+  const int wanted_workers = options.workers > 0 ? options.workers
+                             : device_           ? concurrent_trainings(device_->info()).trainings
+                                                 : 1;
+  // How many slabs of `slices` fit the limit at once.
+  auto fitting = [&](std::size_t slices) {
+    return static_cast<int>(std::max<std::size_t>(1, memory_limit_ / slab_bytes(g, slices)));
+  };
+  if (options.slices_per_slab) {
+    slices_per_slab_ = std::min(options.slices_per_slab, nz);
+  } else {
+    // The workers share the limit, and each gets a slab to train.
+    const int w = std::min(wanted_workers, fitting(1));
+    slices_per_slab_ =
+        std::min(slices_within(g, memory_limit_ / static_cast<std::size_t>(w)),
+                 (nz + static_cast<std::size_t>(w) - 1) / static_cast<std::size_t>(w));
+  }
   const std::filesystem::path path = out_ / "manifest.json";
   join_ = options.join;
   const bool held_run = std::filesystem::exists(path);
@@ -76,6 +93,13 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
     }
   }
   slabs_ = plan_slabs(g, slices_per_slab_);
+  workers_ = std::max(
+      1, std::min({wanted_workers, fitting(slices_per_slab_), static_cast<int>(slabs_.size())}));
+  if (device_) {
+    std::string why;
+    workers_ = usable_trainings(device_->info(), workers_, &why);
+    if (!why.empty()) warn(why);
+  }
   const nlohmann::json wanted = identity(source_, config_, slices_per_slab_);
   if (held_run) {
     for (const char* key : {"scan", "shape", "geometry", "config", "slices_per_slab"}) {
@@ -130,20 +154,24 @@ std::size_t SlabRun::slabs_done() const {
   return n;
 }
 
-void SlabRun::write_manifest() const { write_text(out_ / "manifest.json", manifest_.dump(1) + "\n"); }
+void SlabRun::write_manifest() const {
+  write_text(out_ / "manifest.json", manifest_.dump(1) + "\n");
+}
 
 void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
                   const Summarise& summarise, int report_every, const Claim& claim) {
   const auto started = std::chrono::steady_clock::now();
   const Geometry& g = source_.geometry();
-  SlabProgress p;
-  p.slabs = slabs_.size();
-  p.slices = g.volume_shape[0];
-  auto seconds = [&] {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  };
-  // Slices done by any process, from the records on disk.
-  auto slices_done = [&] {
+  std::vector<const Slab*> pending;
+  for (const Slab& slab : slabs_) {
+    if (!is_done(slab)) pending.push_back(&slab);
+  }
+  // One report at a time: the slices done are those with a record on disk (any process's)
+  // plus this process's slabs in training, counted by their steps.
+  std::mutex report_mutex;
+  std::vector<double> in_training(static_cast<std::size_t>(workers_), 0.0);
+  double recorded = 0.0;
+  auto count_records = [&] {
     double n = 0.0;
     std::size_t slabs = 0;
     for (const Slab& s : slabs_) {
@@ -152,64 +180,88 @@ void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
         ++slabs;
       }
     }
-    p.slabs_done = slabs;
-    return n;
+    recorded = n;
+    return slabs;
   };
-  p.slices_at_start = slices_done();
-  for (const Slab& slab : slabs_) {
-    if (is_done(slab)) continue;
-    if (claim && !claim(slab)) continue;
-    const auto slab_started = std::chrono::steady_clock::now();
-    Scan scan = source_.read(slab.rows);
-    scan.geometry = slab_geometry(g, slab);
-    Reconstructor r(std::move(scan), config_, device_);
+  SlabProgress shared;
+  shared.slabs = slabs_.size();
+  shared.slices = g.volume_shape[0];
+  shared.slabs_done = count_records();
+  shared.slices_at_start = recorded;
+  auto report = [&](const Slab& slab, int worker, double fraction, int step, int steps,
+                    bool finished, bool recount) {
+    if (!progress && !recount) return;
+    std::lock_guard<std::mutex> lock(report_mutex);
+    if (recount) shared.slabs_done = count_records();
+    in_training[static_cast<std::size_t>(worker)] = finished ? 0.0 : fraction * slab.slices;
+    if (!progress) return;
+    SlabProgress p = shared;
     p.slab = &slab;
-    p.slab_finished = false;
-    p.steps = r.config().training.steps;
-    double before = slices_done();
-    int reports = 0;
-    r.run(
-        [&](const TrainingProgress& t) {
-          // Other processes' records, now and then (a stat per slab).
-          if (++reports % 10 == 0) before = slices_done();
-          p.step = t.step;
-          p.slices_done = before + static_cast<double>(slab.slices) * t.step / std::max(1, t.total);
-          p.seconds = seconds();
-          if (progress) progress(p);
-          return true;
-        },
-        report_every);
-    const ReconstructionResult result = r.result();
-    const Array& image = result.image;
-    for (std::size_t k = 0; k < slab.slices; ++k) {
-      write_array(slice_path(slab.first_slice + k), axial_slice(image, k));
-    }
-    Array alpha = result.alpha;
-    alpha.shape = {slab.rows.count, g.n_u};
-    Array beta = r.beta();
-    beta.shape = {slab.rows.count, g.n_u};
-    write_array(slab_file(slab, "alpha"), alpha);
-    write_array(slab_file(slab, "beta"), beta);
-    write_array(slab_file(slab, "coronal"), coronal_plane(image, image.shape[1] / 2));
-    write_array(slab_file(slab, "sagittal"), sagittal_plane(image, image.shape[2] / 2));
+    p.step = step;
+    p.steps = steps;
+    p.slab_finished = finished;
+    p.slices_done = recorded;
+    for (double f : in_training) p.slices_done += f;
+    p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+    progress(p);
+  };
+  std::mutex read_mutex;  // the readers (HDF5's above all) are not thread-safe
+  run_concurrently(pending.size(), workers_, device_,
+                   [&](std::size_t index, int worker, const std::optional<Device>& device) {
+                     const Slab& slab = *pending[index];
+                     if (claim && !claim(slab)) return;
+                     const auto slab_started = std::chrono::steady_clock::now();
+                     Scan scan;
+                     {
+                       std::lock_guard<std::mutex> lock(read_mutex);
+                       scan = source_.read(slab.rows);
+                     }
+                     scan.geometry = slab_geometry(g, slab);
+                     Reconstructor r(std::move(scan), config_, device);
+                     const int steps = r.config().training.steps;
+                     int reports = 0;
+                     r.run(
+                         [&](const TrainingProgress& t) {
+                           // Other processes' records, now and then (a stat per slab).
+                           report(slab, worker, static_cast<double>(t.step) / std::max(1, t.total),
+                                  t.step, steps, false, ++reports % 10 == 0);
+                           return true;
+                         },
+                         report_every);
+                     write_slab(slab, r, summarise, device, slab_started);
+                     report(slab, worker, 1.0, steps, steps, true, true);
+                   });
+}
 
-    nlohmann::json entry = manifest_["slabs"][slab.index];
-    const TrainingStats stats = r.stats();
-    entry["done"] = true;
-    entry["seconds"] =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - slab_started).count();
-    entry["steps"] = stats.steps;
-    entry["peak_host_bytes"] = stats.peak_host_bytes;
-    entry["device"] = stats.device;
-    entry["dead_elements"] = r.dead_elements().size();
-    entry["summary"] = summarise ? summarise(r, result) : nlohmann::json(nullptr);
-    write_text(slab_record(slab), entry.dump(1) + "\n");  // last: the slab is done
-
-    p.slices_done = slices_done();
-    p.seconds = seconds();
-    p.slab_finished = true;
-    if (progress) progress(p);
+void SlabRun::write_slab(const Slab& slab, const Reconstructor& r, const Summarise& summarise,
+                         const std::optional<Device>& device,
+                         std::chrono::steady_clock::time_point started) const {
+  const Geometry& g = source_.geometry();
+  const ReconstructionResult result = r.result();
+  const Array& image = result.image;
+  for (std::size_t k = 0; k < slab.slices; ++k) {
+    write_array(slice_path(slab.first_slice + k), axial_slice(image, k));
   }
+  Array alpha = result.alpha;
+  alpha.shape = {slab.rows.count, g.n_u};
+  Array beta = r.beta();
+  beta.shape = {slab.rows.count, g.n_u};
+  write_array(slab_file(slab, "alpha"), alpha);
+  write_array(slab_file(slab, "beta"), beta);
+  write_array(slab_file(slab, "coronal"), coronal_plane(image, image.shape[1] / 2));
+  write_array(slab_file(slab, "sagittal"), sagittal_plane(image, image.shape[2] / 2));
+
+  nlohmann::json entry = manifest_["slabs"][slab.index];
+  const TrainingStats stats = r.stats();
+  entry["done"] = true;
+  entry["seconds"] =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
+  entry["steps"] = stats.steps;
+  entry["peak_host_bytes"] = stats.peak_host_bytes;
+  entry["device"] = stats.device;
+  entry["dead_elements"] = r.dead_elements().size();
+  entry["summary"] = summarise ? summarise(r, result, device) : nlohmann::json(nullptr);
+  write_text(slab_record(slab), entry.dump(1) + "\n");  // last: the slab is done
 }
 
 void SlabRun::finish() {
