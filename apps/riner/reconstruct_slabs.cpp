@@ -47,6 +47,10 @@ SlabOptions slab_options(const Args& args) {
     if (n < 1 || n > 256) throw UsageError("--workers must be 1 to 256");
     options.workers = static_cast<int>(n);
   }
+  options.slices_2d = args.is_set("slices-2d");
+  if (options.slices_2d && options.slices_per_slab) {
+    throw UsageError("--slices-2d trains each slice alone: leave out --slab-slices");
+  }
   return options;
 }
 
@@ -77,13 +81,16 @@ void add_slab_options(Args& args) {
               "GPU, 1 on a CPU, whose cores MPI ranks fill; at most as many as the slabs and "
               "--memory-limit allow); the volume is the same for any N",
               "")
+      .flag("slices-2d",
+            "train each axial slice of a parallel-beam stack as its own 2D scan (the mean of "
+            "its detector rows, the 2D defaults) instead of a slab of slices as one 3D field")
       .flag("resume",
             "finish a slabbed run the output folder holds: only the slabs its manifest does "
             "not list as done are trained");
 }
 
 bool wants_slabs(const Args& args) {
-  if (args.is_set("resume")) return true;
+  if (args.is_set("resume") || args.is_set("slices-2d")) return true;
   for (const char* name : {"slab-slices", "memory-limit", "workers"}) {
     if (auto v = args.maybe(name); v && !v->empty()) return true;
   }
@@ -234,8 +241,13 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   for (const Slab& s : run.slabs()) {
     const nlohmann::json& summary = run.manifest()["slabs"][s.index]["summary"];
     if (!summary.is_object() || !summary.contains("dead_elements")) continue;
+    const bool by_column = run.manifest()["slabs"][s.index].value("trained_as", "") == "slice_2d";
     for (std::size_t e : summary["dead_elements"].get<std::vector<std::size_t>>()) {
-      dead.push_back(s.rows.first * g.n_u + e);
+      if (!by_column) {
+        dead.push_back(s.rows.first * g.n_u + e);
+        continue;
+      }
+      for (std::size_t r = 0; r < s.rows.count; ++r) dead.push_back((s.rows.first + r) * g.n_u + e);
     }
   }
   write_detector_outputs(out, run.alpha(), run.beta(), dead);
@@ -266,6 +278,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       {"slabs_done_before", done_before},
       {"ranks", ranks.size()},
       {"workers", run.workers()},
+      {"slices_2d", run.slices_2d()},
       {"memory_limit_bytes", run.memory_limit()},
       {"slab_bytes_estimated", slab_bytes(g, run.slices_per_slab())},
       {"peak_host_bytes", peak},

@@ -139,7 +139,8 @@ std::vector<Result> slab_stack(const Options& o) {
   std::printf("  simulated %zu views x %zu rows x %zu columns (%.0f MB as float) in %.0f s\n",
               views, rows, columns, scan_bytes / 1e6, simulate_seconds);
 
-  std::string flags = "--slab-slices " + std::to_string(slab_slices);
+  // --slab-slices=0 leaves the slab size to riner (--flags="--slices-2d", say).
+  std::string flags = slab_slices > 0 ? "--slab-slices " + std::to_string(slab_slices) : "";
   if (!memory.empty()) flags = "--memory-limit " + memory;
   if (steps > 0) flags += " --steps " + std::to_string(steps);
   // Anything else for the slabbed run (--flags="--workers 8").

@@ -28,8 +28,8 @@ struct Concurrency {
 Concurrency concurrent_trainings(const DeviceInfo& device);
 
 // The most trainings this device's driver runs at once safely: 1 where several queues are
-// known to fail (PoCL 4 and later abort in their kernel cache, measured with PoCL 5.0), else
-// `wanted`. `why` (when given) says why it was cut.
+// known to fail (PoCL aborts now and then in pocl_release_dlhandle_cache: PoCL 5.0 at once,
+// 3.1 once in about ten runs), else `wanted`. `why` (when given) says why it was cut.
 int usable_trainings(const DeviceInfo& device, int wanted, std::string* why = nullptr);
 
 // job(index, worker, device) for every index in [0, jobs), each index handed to whichever of

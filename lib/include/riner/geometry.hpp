@@ -82,6 +82,10 @@ FieldOfView field_of_view(const Geometry& g);
 // same place (offset_v moves with the first row), the volume unchanged.
 Geometry detector_rows_geometry(const Geometry& g, std::size_t first, std::size_t count);
 
+// One axial slice of a parallel3d geometry on its own: the parallel2d scan of the slice (a
+// detector row's rays stay in the slice at its height), the same columns, views and grid.
+Geometry axial_slice_geometry(const Geometry& g);
+
 // Uniform angles start + range * i / count, i = 0..count-1.
 std::vector<double> uniform_angles(const UniformAngles& spec);
 

@@ -39,6 +39,10 @@ struct SlabOptions {
   // own queue; 0: concurrent_trainings() of the device, as many as the slabs and the memory
   // limit allow (the workers share it). The volume does not depend on it.
   int workers = 0;
+  // Each axial slice trained as its own 2D scan (parallel beam: a row's rays stay in its
+  // slice): slabs of one slice, each the mean of its detector rows, at the 2D defaults (steps
+  // from the slice's rays), instead of a slab of slices as one 3D field.
+  bool slices_2d = false;
 };
 
 struct SlabProgress {
@@ -66,6 +70,7 @@ class SlabRun {
   std::size_t slices_per_slab() const { return slices_per_slab_; }
   std::size_t memory_limit() const { return memory_limit_; }
   int workers() const { return workers_; }
+  bool slices_2d() const { return slices_2d_; }
   std::size_t slabs_done() const;
   const ScanRows& source() const { return source_; }
 
@@ -115,6 +120,7 @@ class SlabRun {
   std::size_t memory_limit_ = 0;
   std::size_t slices_per_slab_ = 0;
   int workers_ = 1;
+  bool slices_2d_ = false;
   std::vector<Slab> slabs_;
   nlohmann::json manifest_;
   bool join_ = false;

@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cstdlib>
 #include <exception>
 #include <mutex>
 #include <thread>
@@ -30,12 +29,11 @@ Concurrency concurrent_trainings(const DeviceInfo& device) {
 
 int usable_trainings(const DeviceInfo& device, int wanted, std::string* why) {
   if (wanted <= 1) return 1;
-  if (device.platform.find("Portable Computing Language") != std::string::npos &&
-      std::atoi(device.driver_version.c_str()) >= 4) {
+  if (device.platform.find("Portable Computing Language") != std::string::npos) {
     if (why) {
       *why = "PoCL " + device.driver_version +
-             " aborts with several training queues at once: one at a time (on a CPU, run "
-             "several processes: mpirun -n N)";
+             " can abort with several training queues at once (in its kernel cache): one at a "
+             "time (on a CPU, run several processes: mpirun -n N)";
     }
     return 1;
   }

@@ -85,6 +85,24 @@ FieldOfView field_of_view(const Geometry& g) {
   return f;
 }
 
+Geometry axial_slice_geometry(const Geometry& g) {
+  if (g.type != GeometryType::kParallel3d) {
+    throw InputError(std::string("an axial slice is a 2D scan of its own only in a parallel3d "
+                                 "geometry, not ") +
+                     geometry_type_name(g.type));
+  }
+  Geometry s;
+  s.type = GeometryType::kParallel2d;
+  s.n_u = g.n_u;
+  s.pitch_u = g.pitch_u;
+  s.offset_u = g.offset_u;
+  s.angles = g.angles;
+  s.uniform_angles = g.uniform_angles;
+  s.volume_shape = {g.volume_shape[1], g.volume_shape[2]};
+  s.voxel_mm = g.voxel_mm;
+  return s;
+}
+
 Geometry detector_rows_geometry(const Geometry& g, std::size_t first, std::size_t count) {
   Geometry cut = g;
   cut.n_v = count;

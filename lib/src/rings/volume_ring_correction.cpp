@@ -14,20 +14,6 @@ namespace {
 // A row counts as the slice's when its height is within this fraction of a row pitch.
 constexpr double kRowTolerance = 1e-3;
 
-// Row r of a parallel3d scan on its own: a parallel2d scan of the slice at the row's height.
-Geometry slice_geometry(const Geometry& g) {
-  Geometry s;
-  s.type = GeometryType::kParallel2d;
-  s.n_u = g.n_u;
-  s.pitch_u = g.pitch_u;
-  s.offset_u = g.offset_u;
-  s.angles = g.angles;
-  s.uniform_angles = g.uniform_angles;
-  s.volume_shape = {g.volume_shape[1], g.volume_shape[2]};
-  s.voxel_mm = g.voxel_mm;
-  return s;
-}
-
 }  // namespace
 
 std::vector<long> rows_of_slices(const Geometry& g) {
@@ -68,7 +54,7 @@ VolumeRingCorrection correct_rings_per_slice(const Array& volume, const Array& a
     return out;
   }
   const std::vector<long> rows = rows_of_slices(g);
-  const Geometry slice_g = slice_geometry(g);
+  const Geometry slice_g = axial_slice_geometry(g);
   const std::size_t ny = g.volume_shape[1];
   const std::size_t nx = g.volume_shape[2];
   std::vector<std::vector<std::size_t>> dead_by_row(g.n_v);

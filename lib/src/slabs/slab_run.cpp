@@ -19,12 +19,49 @@ constexpr int kManifestVersion = 1;
 
 // What a manifest must match to be resumed: the data, its geometry, the settings and the cut.
 nlohmann::json identity(const ScanRows& source, const RinerConfig& config,
-                        std::size_t slices_per_slab) {
-  return {{"scan", std::filesystem::absolute(source.what()).lexically_normal().string()},
-          {"shape", source.shape()},
-          {"geometry", nlohmann::json::parse(source.geometry().to_json())},
-          {"config", nlohmann::json::parse(config.to_json())},
-          {"slices_per_slab", slices_per_slab}};
+                        std::size_t slices_per_slab, bool slices_2d) {
+  nlohmann::json id = {
+      {"scan", std::filesystem::absolute(source.what()).lexically_normal().string()},
+      {"shape", source.shape()},
+      {"geometry", nlohmann::json::parse(source.geometry().to_json())},
+      {"config", nlohmann::json::parse(config.to_json())},
+      {"slices_per_slab", slices_per_slab}};
+  if (slices_2d) id["slices_2d"] = true;  // absent otherwise, as in earlier runs' manifests
+  return id;
+}
+
+// A one-slice slab's scan as the slice's own 2D scan: the mean of its detector rows (of the
+// finite readings; NaN where a column reads none).
+Scan slice_scan(const Scan& slab) {
+  const Geometry& g = slab.geometry;
+  const std::size_t views = g.n_views(), rows = g.n_v, n_u = g.n_u;
+  Scan s;
+  s.geometry = axial_slice_geometry(g);
+  s.measurement = Array({views, n_u});
+  for (std::size_t a = 0; a < views; ++a) {
+    for (std::size_t u = 0; u < n_u; ++u) {
+      double sum = 0.0;
+      int n = 0;
+      for (std::size_t r = 0; r < rows; ++r) {
+        const float v = slab.measurement.data[(a * rows + r) * n_u + u];
+        if (std::isfinite(v)) sum += v, ++n;
+      }
+      const float mean = n ? static_cast<float>(sum / n) : NAN;
+      s.measurement.data[a * n_u + u] = mean;
+      s.non_finite += !std::isfinite(mean);
+    }
+  }
+  return s;
+}
+
+// A per-column map of a slice trained in 2D, for each of its slab's rows.
+Array on_rows(const Array& columns, std::size_t rows) {
+  Array map({rows, columns.size()});
+  for (std::size_t r = 0; r < rows; ++r) {
+    std::copy(columns.data.begin(), columns.data.end(),
+              map.data.begin() + static_cast<std::ptrdiff_t>(r * columns.size()));
+  }
+  return map;
 }
 
 std::string numbered(const char* pattern, std::size_t n) {
@@ -52,7 +89,14 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
   auto fitting = [&](std::size_t slices) {
     return static_cast<int>(std::max<std::size_t>(1, memory_limit_ / slab_bytes(g, slices)));
   };
-  if (options.slices_per_slab) {
+  slices_2d_ = options.slices_2d;
+  if (slices_2d_ && g.type != GeometryType::kParallel3d) {
+    throw InputError(std::string("slices trained in 2D need a parallel3d stack, not ") +
+                     geometry_type_name(g.type));
+  }
+  if (slices_2d_) {
+    slices_per_slab_ = 1;
+  } else if (options.slices_per_slab) {
     slices_per_slab_ = std::min(options.slices_per_slab, nz);
   } else {
     // The workers share the limit, and each gets a slab to train.
@@ -88,7 +132,7 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
     // A resumed run keeps its slabs unless told otherwise (another machine's memory would cut
     // the volume elsewhere).
     const nlohmann::json& held_slices = manifest_["run"]["slices_per_slab"];
-    if (!options.slices_per_slab && held_slices.is_number_unsigned()) {
+    if (!options.slices_per_slab && !slices_2d_ && held_slices.is_number_unsigned()) {
       slices_per_slab_ = std::min(held_slices.get<std::size_t>(), g.volume_shape[0]);
     }
   }
@@ -100,10 +144,11 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
     workers_ = usable_trainings(device_->info(), workers_, &why);
     if (!why.empty()) warn(why);
   }
-  const nlohmann::json wanted = identity(source_, config_, slices_per_slab_);
+  const nlohmann::json wanted = identity(source_, config_, slices_per_slab_, slices_2d_);
   if (held_run) {
-    for (const char* key : {"scan", "shape", "geometry", "config", "slices_per_slab"}) {
-      if (manifest_["run"].value(key, nlohmann::json()) != wanted[key]) {
+    for (const char* key :
+         {"scan", "shape", "geometry", "config", "slices_per_slab", "slices_2d"}) {
+      if (manifest_["run"].value(key, nlohmann::json()) != wanted.value(key, nlohmann::json())) {
         throw InputError(path.string() + ": the run there has another " + key +
                          " than this one; resume it with the same scan and settings, or choose "
                          "another output folder");
@@ -217,6 +262,7 @@ void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
                        scan = source_.read(slab.rows);
                      }
                      scan.geometry = slab_geometry(g, slab);
+                     if (slices_2d_) scan = slice_scan(scan);
                      Reconstructor r(std::move(scan), config_, device);
                      const int steps = r.config().training.steps;
                      int reports = 0;
@@ -238,13 +284,18 @@ void SlabRun::write_slab(const Slab& slab, const Reconstructor& r, const Summari
                          std::chrono::steady_clock::time_point started) const {
   const Geometry& g = source_.geometry();
   const ReconstructionResult result = r.result();
-  const Array& image = result.image;
+  Array image = result.image;
+  Array alpha = result.alpha;
+  Array beta = r.beta();
+  if (slices_2d_) {
+    image.shape.insert(image.shape.begin(), 1);
+    alpha = on_rows(alpha, slab.rows.count);
+    beta = on_rows(beta, slab.rows.count);
+  }
   for (std::size_t k = 0; k < slab.slices; ++k) {
     write_array(slice_path(slab.first_slice + k), axial_slice(image, k));
   }
-  Array alpha = result.alpha;
   alpha.shape = {slab.rows.count, g.n_u};
-  Array beta = r.beta();
   beta.shape = {slab.rows.count, g.n_u};
   write_array(slab_file(slab, "alpha"), alpha);
   write_array(slab_file(slab, "beta"), beta);
@@ -260,6 +311,8 @@ void SlabRun::write_slab(const Slab& slab, const Reconstructor& r, const Summari
   entry["peak_host_bytes"] = stats.peak_host_bytes;
   entry["device"] = stats.device;
   entry["dead_elements"] = r.dead_elements().size();
+  // A slice trained in 2D names its dead elements by column, for every row of the slab.
+  entry["trained_as"] = slices_2d_ ? "slice_2d" : "field_3d";
   entry["summary"] = summarise ? summarise(r, result, device) : nlohmann::json(nullptr);
   write_text(slab_record(slab), entry.dump(1) + "\n");  // last: the slab is done
 }
