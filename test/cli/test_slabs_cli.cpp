@@ -255,6 +255,19 @@ TEST_SUITE("cli") {
     CHECK(slice.shape == alone.shape);
     CHECK(slice.data == alone.data);
 
+    // The same rows under a 2D geometry (tooth.h5 beside its geometry.json) go the same way:
+    // each row a slice of its own.
+    std::filesystem::create_directories(dir / "rows2d");
+    std::filesystem::copy_file(scan, dir / "rows2d" / "sino.npy");
+    std::filesystem::copy_file(dir / "row7" / "geometry.json", dir / "rows2d" / "geometry.json");
+    run = riner_cli("reconstruct " + (dir / "rows2d" / "sino.npy").string() + " --slices-2d" +
+                        settings + " --out " + (dir / "rows2d_out").string(),
+                    dir);
+    CAPTURE(run.err);
+    REQUIRE(run.code == 0);
+    CHECK(riner::read_array(dir / "rows2d_out" / "volume" / "slice_00007.tif").array.data ==
+          alone.data);
+
     // A slabbed run of this folder is resumed only as it was started.
     run = riner_cli("reconstruct " + scan + settings + " --resume --out " + stack.string(), dir);
     CHECK(run.code != 0);

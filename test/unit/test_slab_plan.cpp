@@ -119,3 +119,30 @@ TEST_CASE("a cone beam is not cut; sizes and memory parse") {
   CHECK(riner::slices_within(g, 0) == 1);
   CHECK(riner::slab_bytes(g, 8) < riner::slab_bytes(g, 16));
 }
+
+TEST_CASE("a 2D geometry as a stack of slices, and a slice of it back") {
+  riner::Geometry g;
+  g.type = riner::GeometryType::kParallel2d;
+  g.n_u = 40;
+  g.pitch_u = 0.5;
+  g.offset_u = 2.5;
+  g.uniform_angles = riner::UniformAngles{30, 0.0, M_PI};
+  g.angles = riner::uniform_angles(*g.uniform_angles);
+  g.volume_shape = {24, 28};
+  g.voxel_mm = 0.5;
+  const riner::Geometry stack = riner::stack_of_slices(g, 6);
+  CHECK(stack.type == riner::GeometryType::kParallel3d);
+  CHECK(stack.n_v == 6);
+  CHECK(stack.volume_shape == std::vector<std::size_t>{6, 24, 28});
+  CHECK(stack.pitch_v == 0.5);
+  stack.validate();
+  // Each row is a slice: the slabs of one slice read one row each.
+  const std::vector<riner::Slab> slabs = riner::plan_slabs(stack, 1);
+  REQUIRE(slabs.size() == 6);
+  for (const riner::Slab& s : slabs) CHECK(s.rows.first == s.index);
+  for (const riner::Slab& s : slabs) CHECK(s.rows.count == 1);
+  const riner::Geometry back = riner::axial_slice_geometry(stack);
+  CHECK(back.to_json() == g.to_json());
+  CHECK_THROWS_AS(riner::stack_of_slices(stack, 2), riner::InputError);
+  CHECK_THROWS_AS(riner::axial_slice_geometry(g), riner::InputError);
+}

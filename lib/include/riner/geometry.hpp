@@ -86,6 +86,10 @@ Geometry detector_rows_geometry(const Geometry& g, std::size_t first, std::size_
 // detector row's rays stay in the slice at its height), the same columns, views and grid.
 Geometry axial_slice_geometry(const Geometry& g);
 
+// A parallel2d geometry repeated over `rows` detector rows: the parallel3d stack whose slices,
+// a voxel apart, are each a row's 2D scan (axial_slice_geometry gives the 2D one back).
+Geometry stack_of_slices(const Geometry& g, std::size_t rows);
+
 // Uniform angles start + range * i / count, i = 0..count-1.
 std::vector<double> uniform_angles(const UniformAngles& spec);
 

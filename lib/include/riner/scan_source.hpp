@@ -43,7 +43,8 @@ LoadedScan load_scan_source(ScanSource source);
 class ScanRows {
  public:
   static constexpr std::size_t kCentreRows = 8;
-  // InputError as load_scan_source; also for a 2D scan or a `row` (a slice is read whole).
+  // InputError as load_scan_source; also for a 2D scan or a `row` (a slice is read whole). A
+  // stack of rows under a parallel2d geometry is read as stack_of_slices of it.
   explicit ScanRows(ScanSource source);
   const Geometry& geometry() const { return geometry_; }  // the whole detector's
   std::size_t rows() const { return geometry_.n_v; }

@@ -85,6 +85,19 @@ FieldOfView field_of_view(const Geometry& g) {
   return f;
 }
 
+Geometry stack_of_slices(const Geometry& g, std::size_t rows) {
+  if (g.type != GeometryType::kParallel2d || rows == 0) {
+    throw InputError("a stack of slices is made of a parallel2d geometry and one row or more");
+  }
+  Geometry s = g;
+  s.type = GeometryType::kParallel3d;
+  s.n_v = rows;
+  s.pitch_v = g.voxel_mm;
+  s.offset_v = 0.0;
+  s.volume_shape = {rows, g.volume_shape[0], g.volume_shape[1]};
+  return s;
+}
+
 Geometry axial_slice_geometry(const Geometry& g) {
   if (g.type != GeometryType::kParallel3d) {
     throw InputError(std::string("an axial slice is a 2D scan of its own only in a parallel3d "
