@@ -12,6 +12,7 @@
 #include "riner/slab_run.hpp"
 #include "riner/volume_writer.hpp"
 #include "scan_options.hpp"
+#include "slab_processes.hpp"
 #include "summary_json.hpp"
 
 namespace riner::app {
@@ -54,6 +55,16 @@ SlabOptions slab_options(const Args& args) {
   return options;
 }
 
+// --processes, or 0 when riner is to choose.
+int requested_processes(const Args& args) {
+  if (auto v = args.maybe("processes"); v && !v->empty()) {
+    const long n = args.integer("processes");
+    if (n < 1 || n > 1024) throw UsageError("--processes must be 1 to 1024");
+    return static_cast<int>(n);
+  }
+  return 0;
+}
+
 std::string bytes_string(double bytes) {
   char text[32];
   if (bytes < 1024.0 * 1024.0 * 1024.0) {
@@ -81,6 +92,12 @@ void add_slab_options(Args& args) {
               "GPU, 1 on a CPU, whose cores MPI ranks fill; at most as many as the slabs and "
               "--memory-limit allow); the volume is the same for any N",
               "")
+      .option("processes", "N",
+              "slab processes on this machine, each with its share of the cores, started by "
+              "riner itself (without mpirun; default: one per two cores on a CPU device with "
+              "more than two, else 1); the volume is the same for any N",
+              "")
+      .option("join-run", "TOKEN", "(used by riner's own slab processes)", "")
       .flag("slices-2d",
             "train each axial slice of a parallel-beam stack as its own 2D scan (the mean of "
             "its detector rows, the 2D defaults) instead of a slab of slices as one 3D field")
@@ -91,7 +108,7 @@ void add_slab_options(Args& args) {
 
 bool wants_slabs(const Args& args) {
   if (args.is_set("resume") || args.is_set("slices-2d")) return true;
-  for (const char* name : {"slab-slices", "memory-limit", "workers"}) {
+  for (const char* name : {"slab-slices", "memory-limit", "workers", "processes", "join-run"}) {
     if (auto v = args.maybe(name); v && !v->empty()) return true;
   }
   // Left to the scan: by slabs when a parallel-beam volume does not fit whole.
@@ -141,8 +158,11 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
         "libopenmpi-dev and build again");
   }
   SlabOptions options = slab_options(args);
+  const int requested = requested_processes(args);
   const SlabRanks ranks;
-  const bool leader = ranks.is_leader();
+  // A process riner started to share this run (slab_processes.hpp) joins like an MPI rank.
+  const std::string joined = args.get("join-run");
+  const bool leader = ranks.is_leader() && joined.empty();
   const bool speak = leader && !console.quiet();
   ScanRows source(source_from(args));
   if (source.centre() && speak) console.line(centre_line(*source.centre()));
@@ -156,6 +176,14 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
     config.plan.gradient_slices =
         2 * static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   }
+  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  int processes = 1;
+  if (ranks.size() == 1 && joined.empty()) {
+    processes = requested > 0 ? requested
+                              : default_slab_processes(device ? device->info().type : "CPU", cores);
+  }
+  // The processes share the memory limit, and each gets a slab (SlabRun plans for workers).
+  if (processes > 1) options.workers = std::max(options.workers, processes);
 
   // The leader plans the run (or finds it to resume) before the others join it.
   std::optional<SlabRun> planned;
@@ -170,9 +198,9 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       throw;
     }
   }
-  word = ranks.share(word);
+  if (joined.empty()) word = ranks.share(word);
   if (word == "error") return 2;  // the leader says why
-  const std::string token = word.substr(3);
+  const std::string token = joined.empty() ? word.substr(3) : joined;
   if (!leader) {
     options.join = true;
     planned.emplace(std::move(source), config, out, options, device);
@@ -188,9 +216,14 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
         "%d at once%s%s",
         run.slabs().size(), run.slices_per_slab(), g.volume_shape[1], g.volume_shape[2],
         bytes_string(static_cast<double>(slab_bytes(g, run.slices_per_slab()))).c_str(),
-        bytes_string(static_cast<double>(run.memory_limit())).c_str(), run.workers(),
+        bytes_string(static_cast<double>(run.memory_limit())).c_str(),
+        processes > 1 ? processes : run.workers(),
         done_before ? (", " + std::to_string(done_before) + " done before").c_str() : "",
-        ranks.size() > 1 ? (", over " + std::to_string(ranks.size()) + " ranks").c_str() : "");
+        ranks.size() > 1   ? (", over " + std::to_string(ranks.size()) + " ranks").c_str()
+        : processes > 1 ? (" in processes of " + std::to_string(std::max(1u, cores / processes)) +
+                           " threads")
+                              .c_str()
+                        : "");
     console.line(line);
     if (slab_bytes(g, run.slices_per_slab()) * static_cast<std::size_t>(run.workers()) >
         run.memory_limit()) {
@@ -208,6 +241,37 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   double slices_at_start = static_cast<double>(total);  // until a report says otherwise
   try {
     Progress progress("slabs", total * 100, !speak);
+    if (processes > 1) {
+      // This process plans and gathers; its copies train (none if every slab is done).
+      auto slices_recorded = [&](std::size_t* slabs) {
+        double n = 0.0;
+        *slabs = 0;
+        for (const Slab& slab : run.slabs()) {
+          if (std::filesystem::exists(run.slab_record(slab))) n += slab.slices, ++*slabs;
+        }
+        return n;
+      };
+      std::size_t slabs = 0;
+      slices_at_start = slices_recorded(&slabs);
+      if (slabs < run.slabs().size()) {
+        SlabProcesses copies(processes, static_cast<int>(std::max(1u, cores / processes)),
+                             {"--join-run", token, "--quiet"});
+        while (copies.running()) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(500));
+          const double done = slices_recorded(&slabs);
+          const double seconds = std::chrono::duration<double>(
+                                     std::chrono::steady_clock::now() - training_started)
+                                     .count();
+          char status[160];
+          std::snprintf(status, sizeof(status), "%zu/%zu slabs, %zu/%zu slices, %.1f slices/min",
+                        slabs, run.slabs().size(), static_cast<std::size_t>(done), total,
+                        seconds > 0 ? 60.0 * (done - slices_at_start) / seconds : 0.0);
+          progress.update(static_cast<std::size_t>(100.0 * done), status);
+        }
+        if (!copies.failure().empty()) throw Error(copies.failure());
+      }
+      progress.finish();
+    } else {
     run.run(
         [&](const SlabProgress& p) {
           slices_at_start = p.slices_at_start;
@@ -223,8 +287,9 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
           return run_summary(r, result, check_quality(r, result, own));
         },
         static_cast<int>(args.integer("report-every")),
-        ranks.size() > 1 ? claim_by_file(out, token) : SlabRun::Claim{});
+        ranks.size() > 1 || !joined.empty() ? claim_by_file(out, token) : SlabRun::Claim{});
     progress.finish();
+    }
   } catch (const std::exception& e) {
     if (ranks.size() == 1) throw;
     std::fprintf(stderr, "riner: error: rank %d: %s\n", ranks.rank(), e.what());
@@ -278,6 +343,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       {"slabs_done_before", done_before},
       {"ranks", ranks.size()},
       {"workers", run.workers()},
+      {"processes", processes},
       {"slices_2d", run.slices_2d()},
       {"memory_limit_bytes", run.memory_limit()},
       {"slab_bytes_estimated", slab_bytes(g, run.slices_per_slab())},

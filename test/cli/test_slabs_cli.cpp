@@ -189,6 +189,30 @@ TEST_SUITE("cli") {
     CHECK(slabs_done(three) == 5);
   }
 
+  TEST_CASE("riner's own slab processes share a run and give the volume of one") {
+    riner::test::TempDir dir;
+    const std::string scan = simulate_stack(dir);
+    const std::string common = "reconstruct " + scan + " --slab-slices 4 --steps 300 --quiet";
+    const std::filesystem::path one = dir / "one", three = dir / "three";
+    REQUIRE(riner_cli(common + " --processes 1 --out " + one.string(), dir).code == 0);
+    const Run run = riner_cli(common + " --processes 3 --out " + three.string(), dir);
+    CAPTURE(run.err);
+    REQUIRE(run.code == 0);
+    const nlohmann::json summary =
+        nlohmann::json::parse(riner::test::read_bytes(three / "summary.json"));
+    CHECK(summary["processes"] == 3);
+    CHECK(summary["per_slab"].size() == 5);
+    check_same_volume(one, three, 20);
+    CHECK(slabs_done(three) == 5);
+    // More than one process trained (each slab's record names its process's device threads
+    // only indirectly; the claims, cleared at the end, are gone).
+    std::size_t claims = 0;
+    for (const auto& entry : std::filesystem::directory_iterator(three / "slabs")) {
+      claims += entry.path().extension() == ".claim";
+    }
+    CHECK(claims == 0);
+  }
+
   TEST_CASE("slab options name their mistakes") {
     riner::test::TempDir dir;
     riner::test::write_bytes(dir / "geometry.json", R"({"type": "parallel2d",
@@ -211,6 +235,11 @@ TEST_SUITE("cli") {
                     dir);
     CHECK(run.code != 0);
     CHECK(run.err.find("--workers must be 1 to 256") != std::string::npos);
+    run = riner_cli("reconstruct " + (dir / "sino.npy").string() + " --processes 0 --out " +
+                        (dir / "out").string(),
+                    dir);
+    CHECK(run.code != 0);
+    CHECK(run.err.find("--processes must be 1 to 1024") != std::string::npos);
   }
 
   TEST_CASE("--slices-2d trains each slice as the 2D scan of its row, and resumes only so") {

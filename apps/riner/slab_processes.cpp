@@ -1,0 +1,114 @@
+#include "slab_processes.hpp"
+
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <iterator>
+
+#include "riner/error.hpp"
+
+extern char** environ;
+
+namespace riner::app {
+
+namespace {
+
+// This process's command line, word by word (Linux: /proc/self/cmdline).
+std::vector<std::string> own_command_line() {
+  std::ifstream in("/proc/self/cmdline", std::ios::binary);
+  const std::string all((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  std::vector<std::string> words;
+  std::string word;
+  for (char c : all) {
+    if (c == '\0') {
+      words.push_back(word);
+      word.clear();
+    } else {
+      word += c;
+    }
+  }
+  if (words.empty()) throw Error("cannot read this process's command line (/proc/self/cmdline)");
+  return words;
+}
+
+}  // namespace
+
+int default_slab_processes(const std::string& device_type, unsigned cores) {
+  if (device_type != "CPU" || cores <= 2) return 1;
+  return static_cast<int>(cores / 2);
+}
+
+SlabProcesses::SlabProcesses(int count, int threads, const std::vector<std::string>& extra) {
+  std::vector<std::string> words = own_command_line();
+  words.insert(words.end(), extra.begin(), extra.end());
+  // Everything the child needs is built before fork: between fork and exec only
+  // async-signal-safe calls (another thread may hold the allocator's lock).
+  std::vector<std::string> environment;
+  for (char** e = environ; *e != nullptr; ++e) {
+    const std::string entry(*e);
+    if (entry.rfind("POCL_MAX_PTHREAD_COUNT=", 0) == 0 || entry.rfind("RINER_THREADS=", 0) == 0) {
+      continue;
+    }
+    environment.push_back(entry);
+  }
+  environment.push_back("POCL_MAX_PTHREAD_COUNT=" + std::to_string(threads));
+  environment.push_back("RINER_THREADS=" + std::to_string(threads));
+  std::vector<char*> argv, envp;
+  for (std::string& w : words) argv.push_back(w.data());
+  argv.push_back(nullptr);
+  for (std::string& e : environment) envp.push_back(e.data());
+  envp.push_back(nullptr);
+  static const char kExecFailed[] = "riner: error: cannot start a slab process (exec failed)\n";
+  const pid_t parent = getpid();
+  for (int i = 0; i < count; ++i) {
+    const pid_t pid = fork();
+    if (pid < 0) {
+      stop_all();
+      throw Error("cannot start a slab process (fork failed)");
+    }
+    if (pid == 0) {
+      // The child dies with its parent and runs this riner again with its share of the cores.
+      prctl(PR_SET_PDEATHSIG, SIGKILL);
+      if (getppid() != parent) _exit(1);
+      execve("/proc/self/exe", argv.data(), envp.data());
+      (void)!write(2, kExecFailed, sizeof(kExecFailed) - 1);
+      _exit(127);
+    }
+    children_.push_back(pid);
+  }
+}
+
+SlabProcesses::~SlabProcesses() { stop_all(); }
+
+void SlabProcesses::stop_all() {
+  for (pid_t pid : children_) kill(pid, SIGKILL);
+  for (pid_t pid : children_) waitpid(pid, nullptr, 0);
+  children_.clear();
+}
+
+bool SlabProcesses::running() {
+  for (std::size_t i = 0; i < children_.size();) {
+    int status = 0;
+    const pid_t done = waitpid(children_[i], &status, WNOHANG);
+    if (done == 0) {
+      ++i;
+      continue;
+    }
+    children_.erase(children_.begin() + static_cast<std::ptrdiff_t>(i));
+    const bool ok = done > 0 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
+    if (!ok && failure_.empty()) {
+      failure_ = WIFSIGNALED(status)
+                     ? "a slab process was killed (signal " + std::to_string(WTERMSIG(status)) + ")"
+                     : "a slab process failed (exit " + std::to_string(WEXITSTATUS(status)) +
+                           "; its message is above)";
+      stop_all();
+      return false;
+    }
+  }
+  return !children_.empty();
+}
+
+}  // namespace riner::app

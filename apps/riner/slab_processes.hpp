@@ -1,0 +1,39 @@
+// The CLI's own way to fill a CPU's cores with a slabbed run, without mpirun: the process that
+// planned the run starts N copies of its command line, each joining the run (--join-run TOKEN)
+// with its share of the cores (POCL_MAX_PTHREAD_COUNT, RINER_THREADS), and each claims slabs
+// as MPI ranks do (riner/slab_ranks.hpp's claims). PoCL shares one pool of threads among a
+// process's queues and can abort with several at once, so processes, not queues, fill a CPU:
+// 8 processes of 2 cores gave 5.5x the slices per minute of one on 16 cores (bench/RESULTS.md,
+// "Issue 30: throughput"). The copies die with the process that started them.
+#pragma once
+
+#include <string>
+#include <sys/types.h>
+#include <vector>
+
+namespace riner::app {
+
+class SlabProcesses {
+ public:
+  // Starts `count` copies of this process's command line plus `extra` words, each with
+  // `threads` threads. Error when one cannot be started (those started are stopped).
+  SlabProcesses(int count, int threads, const std::vector<std::string>& extra);
+  ~SlabProcesses();  // stops those still running
+  SlabProcesses(const SlabProcesses&) = delete;
+  SlabProcesses& operator=(const SlabProcesses&) = delete;
+
+  // True while any is running; a failed one stops the others and is named by failure().
+  bool running();
+  const std::string& failure() const { return failure_; }
+
+ private:
+  void stop_all();
+  std::vector<pid_t> children_;
+  std::string failure_;
+};
+
+// How many processes a slabbed run on this device takes when the user leaves it to riner:
+// one per two cores on a CPU with more than two, else one.
+int default_slab_processes(const std::string& device_type, unsigned cores);
+
+}  // namespace riner::app
