@@ -54,6 +54,33 @@ std::string simulate_stack(const riner::test::TempDir& dir) {
   return riner::test::simulate_small_parallel3d(dir) + "/sino.npy";
 }
 
+std::size_t claims_left(const std::filesystem::path& out) {
+  std::size_t claims = 0;
+  for (const auto& entry : std::filesystem::directory_iterator(out / "slabs")) {
+    claims += entry.path().extension() == ".claim";
+  }
+  return claims;
+}
+
+// The small stack in 5 slabs with `option` 1 (into dir/one) and 3 (into dir/three): the same
+// volume byte for byte, every slab done; the second run's summary, and its run in `three`.
+nlohmann::json one_against_three(const riner::test::TempDir& dir, const std::string& option,
+                                 riner::test::Run* three) {
+  const std::string common =
+      "reconstruct " + simulate_stack(dir) + " --slab-slices 4 --steps 300 --quiet ";
+  REQUIRE(riner_cli(common + option + " 1 --out " + (dir / "one").string(), dir).code == 0);
+  *three = riner_cli(common + option + " 3 --out " + (dir / "three").string(), dir);
+  CAPTURE(three->err);
+  REQUIRE(three->code == 0);
+  check_same_volume(dir / "one", dir / "three", 20);
+  CHECK(slabs_done(dir / "three") == 5);
+  const nlohmann::json summary =
+      nlohmann::json::parse(riner::test::read_bytes(dir / "three" / "summary.json"));
+  CHECK(summary["slabs"] == 5);
+  CHECK(summary["per_slab"].size() == 5);
+  return summary;
+}
+
 }  // namespace
 
 TEST_SUITE("cli") {
@@ -149,11 +176,7 @@ TEST_SUITE("cli") {
     check_same_volume(one, three, 20);
     // Every slab has its record, and the claims are cleared away at the end.
     CHECK(slabs_done(two) == 5);
-    std::size_t claims = 0;
-    for (const auto& entry : std::filesystem::directory_iterator(two / "slabs")) {
-      claims += entry.path().extension() == ".claim";
-    }
-    CHECK(claims == 0);
+    CHECK(claims_left(two) == 0);
 
     // A run that is not slabbed is not done twice.
     const std::string whole = mpirun + "2 " + RINER_CLI_PATH + " reconstruct " + scan +
@@ -169,48 +192,22 @@ TEST_SUITE("cli") {
   }
 
   TEST_CASE("slabs trained several at once on one device give the volume of one at a time") {
+    riner::test::TempDir dir;
+    Run run;
+    const nlohmann::json summary = one_against_three(dir, "--workers", &run);
     // On PoCL riner holds --workers to one (it says so): the test then checks the holding;
     // on another OpenCL device, the concurrency itself.
-    riner::test::TempDir dir;
-    const std::string scan = simulate_stack(dir);
-    const std::string common = "reconstruct " + scan + " --slab-slices 4 --steps 300 --quiet";
-    const std::filesystem::path one = dir / "one", three = dir / "three";
-    REQUIRE(riner_cli(common + " --workers 1 --out " + one.string(), dir).code == 0);
-    const Run run = riner_cli(common + " --workers 3 --out " + three.string(), dir);
-    CAPTURE(run.err);
-    REQUIRE(run.code == 0);
-    const nlohmann::json summary =
-        nlohmann::json::parse(riner::test::read_bytes(three / "summary.json"));
     const bool held = run.err.find("one at a time") != std::string::npos;
     CHECK(summary["workers"] == (held ? 1 : 3));
-    CHECK(summary["slabs"] == 5);
     CHECK(summary["slices_per_minute"].get<double>() > 0.0);
-    check_same_volume(one, three, 20);
-    CHECK(slabs_done(three) == 5);
   }
 
   TEST_CASE("riner's own slab processes share a run and give the volume of one") {
     riner::test::TempDir dir;
-    const std::string scan = simulate_stack(dir);
-    const std::string common = "reconstruct " + scan + " --slab-slices 4 --steps 300 --quiet";
-    const std::filesystem::path one = dir / "one", three = dir / "three";
-    REQUIRE(riner_cli(common + " --processes 1 --out " + one.string(), dir).code == 0);
-    const Run run = riner_cli(common + " --processes 3 --out " + three.string(), dir);
-    CAPTURE(run.err);
-    REQUIRE(run.code == 0);
-    const nlohmann::json summary =
-        nlohmann::json::parse(riner::test::read_bytes(three / "summary.json"));
+    Run run;
+    const nlohmann::json summary = one_against_three(dir, "--processes", &run);
     CHECK(summary["processes"] == 3);
-    CHECK(summary["per_slab"].size() == 5);
-    check_same_volume(one, three, 20);
-    CHECK(slabs_done(three) == 5);
-    // More than one process trained (each slab's record names its process's device threads
-    // only indirectly; the claims, cleared at the end, are gone).
-    std::size_t claims = 0;
-    for (const auto& entry : std::filesystem::directory_iterator(three / "slabs")) {
-      claims += entry.path().extension() == ".claim";
-    }
-    CHECK(claims == 0);
+    CHECK(claims_left(dir / "three") == 0);  // cleared at the end
   }
 
   TEST_CASE("slab options name their mistakes") {
