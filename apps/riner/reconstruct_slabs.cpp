@@ -182,8 +182,8 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
     processes = requested > 0 ? requested
                               : default_slab_processes(device ? device->info().type : "CPU", cores);
   }
-  // The processes share the memory limit, and each gets a slab (SlabRun plans for workers).
-  if (processes > 1) options.workers = std::max(options.workers, processes);
+  // The processes of this machine share its memory, and each gets a slab.
+  options.processes = processes > 1 ? processes : ranks.local_size();
 
   // The leader plans the run (or finds it to resume) before the others join it.
   std::optional<SlabRun> planned;
@@ -209,6 +209,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   const Geometry& g = run.source().geometry();
   const std::size_t done_before = run.slabs_done();
   if (speak) {
+    const int at_once = run.workers() * std::max(1, options.processes);
     char line[300];
     std::snprintf(
         line, sizeof(line),
@@ -216,8 +217,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
         "%d at once%s%s",
         run.slabs().size(), run.slices_per_slab(), g.volume_shape[1], g.volume_shape[2],
         bytes_string(static_cast<double>(slab_bytes(g, run.slices_per_slab()))).c_str(),
-        bytes_string(static_cast<double>(run.memory_limit())).c_str(),
-        processes > 1 ? processes : run.workers(),
+        bytes_string(static_cast<double>(run.memory_limit())).c_str(), at_once,
         done_before ? (", " + std::to_string(done_before) + " done before").c_str() : "",
         ranks.size() > 1   ? (", over " + std::to_string(ranks.size()) + " ranks").c_str()
         : processes > 1 ? (" in processes of " + std::to_string(std::max(1u, cores / processes)) +
@@ -225,14 +225,16 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
                               .c_str()
                         : "");
     console.line(line);
-    if (slab_bytes(g, run.slices_per_slab()) * static_cast<std::size_t>(run.workers()) >
+    if (slab_bytes(g, run.slices_per_slab()) * static_cast<std::size_t>(at_once) >
         run.memory_limit()) {
       std::snprintf(
           line, sizeof(line),
-          "note: a slab of %zu slice(s) needs about %s, more than the limit: the run "
-          "may take more memory than --memory-limit allows",
-          run.slices_per_slab(),
-          bytes_string(static_cast<double>(slab_bytes(g, run.slices_per_slab()))).c_str());
+          "note: %d slab(s) of %zu slice(s) at once need about %s, more than the limit: the "
+          "run may take more memory than --memory-limit allows",
+          at_once, run.slices_per_slab(),
+          bytes_string(static_cast<double>(slab_bytes(g, run.slices_per_slab()) *
+                                           static_cast<std::size_t>(at_once)))
+              .c_str());
       console.line(line);
     }
   }
@@ -243,22 +245,14 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
     Progress progress("slabs", total * 100, !speak);
     if (processes > 1) {
       // This process plans and gathers; its copies train (none if every slab is done).
-      auto slices_recorded = [&](std::size_t* slabs) {
-        double n = 0.0;
-        *slabs = 0;
-        for (const Slab& slab : run.slabs()) {
-          if (std::filesystem::exists(run.slab_record(slab))) n += slab.slices, ++*slabs;
-        }
-        return n;
-      };
       std::size_t slabs = 0;
-      slices_at_start = slices_recorded(&slabs);
+      slices_at_start = run.slices_recorded(&slabs);
       if (slabs < run.slabs().size()) {
         SlabProcesses copies(processes, static_cast<int>(std::max(1u, cores / processes)),
                              {"--join-run", token, "--quiet"});
         while (copies.running()) {
           std::this_thread::sleep_for(std::chrono::milliseconds(500));
-          const double done = slices_recorded(&slabs);
+          const double done = run.slices_recorded(&slabs);
           const double seconds = std::chrono::duration<double>(
                                      std::chrono::steady_clock::now() - training_started)
                                      .count();

@@ -43,6 +43,9 @@ struct SlabOptions {
   // slice): slabs of one slice, each the mean of its detector rows, at the 2D defaults (steps
   // from the slice's rays), instead of a slab of slices as one 3D field.
   bool slices_2d = false;
+  // Processes of this machine training the run at once (MPI ranks on it, or the CLI's own
+  // slab processes), each `workers` slabs: they share the memory limit, and each gets a slab.
+  int processes = 1;
 };
 
 struct SlabProgress {
@@ -72,6 +75,9 @@ class SlabRun {
   int workers() const { return workers_; }
   bool slices_2d() const { return slices_2d_; }
   std::size_t slabs_done() const;
+  // Slices whose slab has its record (any process's, this run's or earlier runs'), and in
+  // `slabs` (when given) how many slabs that is: what progress counts as done.
+  double slices_recorded(std::size_t* slabs = nullptr) const;
   const ScanRows& source() const { return source_; }
 
   // Per slab, after it is trained: what to record in its manifest entry (the quality report,

@@ -85,22 +85,20 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
   const int wanted_workers = options.workers > 0 ? options.workers
                              : device_           ? concurrent_trainings(device_->info()).trainings
                                                  : 1;
+  const int processes = std::max(1, options.processes);
   // How many slabs of `slices` fit the limit at once.
   auto fitting = [&](std::size_t slices) {
     return static_cast<int>(std::max<std::size_t>(1, memory_limit_ / slab_bytes(g, slices)));
   };
   slices_2d_ = options.slices_2d;
-  if (slices_2d_ && g.type != GeometryType::kParallel3d) {
-    throw InputError(std::string("slices trained in 2D need a parallel3d stack, not ") +
-                     geometry_type_name(g.type));
-  }
   if (slices_2d_) {
+    (void)axial_slice_geometry(g);  // InputError now, not in the first slab, for a cone beam
     slices_per_slab_ = 1;
   } else if (options.slices_per_slab) {
     slices_per_slab_ = std::min(options.slices_per_slab, nz);
   } else {
-    // The workers share the limit, and each gets a slab to train.
-    const int w = std::min(wanted_workers, fitting(1));
+    // The slabs trained at once share the limit, and each gets a slab to train.
+    const int w = std::min(wanted_workers * processes, fitting(1));
     slices_per_slab_ =
         std::min(slices_within(g, memory_limit_ / static_cast<std::size_t>(w)),
                  (nz + static_cast<std::size_t>(w) - 1) / static_cast<std::size_t>(w));
@@ -137,8 +135,8 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
     }
   }
   slabs_ = plan_slabs(g, slices_per_slab_);
-  workers_ = std::max(
-      1, std::min({wanted_workers, fitting(slices_per_slab_), static_cast<int>(slabs_.size())}));
+  workers_ = std::max(1, std::min({wanted_workers, fitting(slices_per_slab_) / processes,
+                                    static_cast<int>(slabs_.size())}));
   if (device_) {
     std::string why;
     workers_ = usable_trainings(device_->info(), workers_, &why);
@@ -193,6 +191,19 @@ bool SlabRun::is_done(const Slab& slab) const {
   return true;
 }
 
+double SlabRun::slices_recorded(std::size_t* slabs) const {
+  double slices = 0.0;
+  std::size_t n = 0;
+  for (const Slab& s : slabs_) {
+    if (std::filesystem::exists(slab_record(s))) {
+      slices += static_cast<double>(s.slices);
+      ++n;
+    }
+  }
+  if (slabs) *slabs = n;
+  return slices;
+}
+
 std::size_t SlabRun::slabs_done() const {
   std::size_t n = 0;
   for (const Slab& s : slabs_) n += is_done(s);
@@ -215,31 +226,17 @@ void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
   // plus this process's slabs in training, counted by their steps.
   std::mutex report_mutex;
   std::vector<double> in_training(static_cast<std::size_t>(workers_), 0.0);
-  double recorded = 0.0;
-  auto count_records = [&] {
-    double n = 0.0;
-    std::size_t slabs = 0;
-    for (const Slab& s : slabs_) {
-      if (std::filesystem::exists(slab_record(s))) {
-        n += static_cast<double>(s.slices);
-        ++slabs;
-      }
-    }
-    recorded = n;
-    return slabs;
-  };
   SlabProgress shared;
   shared.slabs = slabs_.size();
   shared.slices = g.volume_shape[0];
-  shared.slabs_done = count_records();
+  double recorded = slices_recorded(&shared.slabs_done);
   shared.slices_at_start = recorded;
   auto report = [&](const Slab& slab, int worker, double fraction, int step, int steps,
                     bool finished, bool recount) {
-    if (!progress && !recount) return;
-    std::lock_guard<std::mutex> lock(report_mutex);
-    if (recount) shared.slabs_done = count_records();
-    in_training[static_cast<std::size_t>(worker)] = finished ? 0.0 : fraction * slab.slices;
     if (!progress) return;
+    std::lock_guard<std::mutex> lock(report_mutex);
+    if (recount) recorded = slices_recorded(&shared.slabs_done);
+    in_training[static_cast<std::size_t>(worker)] = finished ? 0.0 : fraction * slab.slices;
     SlabProgress p = shared;
     p.slab = &slab;
     p.step = step;
