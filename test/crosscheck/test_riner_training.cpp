@@ -252,6 +252,14 @@ TEST_SUITE("riner_training") {
     CHECK(raised.stats().steps_planned == 45000);
     CHECK(raised.stats().rays_per_step == 1);
     CHECK(raised.stats().draws_per_ray_planned == doctest::Approx(10.0));
+    // A batch over the CPU plan's 160 rays (a GPU's 640) keeps the steps of 160: 1000 draws
+    // of 4500 rays in batches of 160 are 28 125 steps, and each ray is drawn 4000 times.
+    c.training.rays_per_step = 640;
+    c.training.min_draws_per_ray = 1000.0;
+    const riner::Reconstructor wide(scan, c, riner::test::device());
+    CHECK(wide.config().training.steps == 28125);
+    CHECK(wide.stats().draws_per_ray_planned == doctest::Approx(4000.0));
+    c.training.rays_per_step = 1;
     c.training.min_draws_per_ray = 2.5;  // fewer than the default's draws: the default stays
     CHECK(riner::Reconstructor(scan, c, riner::test::device()).config().training.steps == 24000);
     c.training.min_draws_per_ray = 0.0;  // off

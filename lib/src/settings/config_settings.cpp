@@ -64,8 +64,8 @@ void add_training_sampling(Table& t) {
                        "plan's",
                        &C::training, &T::rays_per_step));
   t.push_back(field<C>("training", "min_draws_per_ray", closed_open(0, 1e6),
-                       "2D, steps -1: the steps grow until each ray is drawn this often; 0: "
-                       "off",
+                       "2D, steps -1: the steps grow until each ray is drawn this often in "
+                       "batches of at most 160 rays (a larger batch keeps those steps); 0: off",
                        &C::training, &T::min_draws_per_ray));
   t.push_back(field<C>("training", "views_per_step", closed(1, 65536),
                        "views x elements sampler: views", &C::training, &T::views_per_step));
