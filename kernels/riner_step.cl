@@ -19,9 +19,9 @@
 //     deterministic, no atomics). history[2 * slot] = data term, [2 * slot + 1] = penalties,
 //     summed by a fixed tree. When relative_beta_threshold > 0, lambda is raised to
 //     data_weight relative_beta_threshold max(m, 1e-3) / 2 where that is larger, m the batch's
-//     median ray mismatch
-//     (scratch float[n_batch]). When hold_valid_beta != 0, beta0 of every element without
-//     invalid readings gets no gradient (the beta warm-up).
+//     median ray mismatch, for elements whose readings are all finite (an element with a
+//     non-finite reading keeps lambda) (scratch float[n_batch]). When hold_valid_beta != 0,
+//     beta0 of every element without invalid readings gets no gradient (the beta warm-up).
 //   riner_step_backward(p, batch, levels, params, d_sums, cache, grad)
 //     sample i: d_mu = d_sums[b] dx through the MLP (mlp_deltas); deltas and d_mu into the
 //     cache for mlp_gradient.cl; the features' gradient into the grid: with
@@ -195,7 +195,8 @@ __kernel void riner_step_loss(const StepParams p, __global const uint* batch,
     float2 g = (float2)(0.0f);
     for (uint j = starts[i]; j < starts[i + 1]; ++j) g += ray_grads[element_rays[j]];
     float d_beta0;
-    penalty += beta_penalty(params[p.beta_offset + e], penalty_weight, &d_beta0);
+    const float weight = invalid_readings[e] != 0 ? p.lambda : penalty_weight;
+    penalty += beta_penalty(params[p.beta_offset + e], weight, &d_beta0);
     grad[p.alpha_offset + e] += g.x;
     if (!p.hold_valid_beta || invalid_readings[e] != 0) grad[p.beta_offset + e] += g.y + d_beta0;
   }

@@ -42,6 +42,7 @@ TEST_SUITE("extreme_training") {
       CAPTURE(lambda);
       riner::RinerConfig c = riner::test::tiny_config();
       c.training.lambda = lambda;
+      c.training.relative_beta_threshold = 0.0;  // lambda alone: 0 is no penalty at all
       c.training.beta_lr_scale = 30.0;
       riner::Reconstructor r(t.scan, c, riner::test::device());
       r.run();

@@ -67,7 +67,10 @@ double fit_error(const riner::Reconstructor& r, const riner::Scan& scan) {
   const riner::Array beta = r.beta();
   const double trained = fit_error(result.field_image, r.trained_alpha(), beta, scan);
   const double output = fit_error(result.image, result.alpha, beta, scan);
-  MESSAGE("fit error " << output << " (trained field " << trained << ")");
+  int off = 0;
+  for (float b : beta.data) off += b < 0.5f;
+  MESSAGE("fit error " << output << " (trained field " << trained << "), " << off
+                        << " elements off");
   return output;
 }
 
@@ -131,6 +134,9 @@ TEST_SUITE("hostile_inputs") {
     riner::test::TinyProblem t = riner::test::tiny_problem(14, 0);
     std::fill(t.scan.measurement.data.begin(), t.scan.measurement.data.end(), 0.7f);
     riner::Reconstructor r = train(t.scan, 600);
-    CHECK(fit_error(r, t.scan) < 0.03);
+    // Every element is live: none may be switched off. With beta's absolute threshold alone
+    // two were, and the fit over the rest read 0.020; over all 50 it is 0.032.
+    for (float b : r.beta().data) CHECK(b >= 0.5f);
+    CHECK(fit_error(r, t.scan) < 0.04);
   }
 }

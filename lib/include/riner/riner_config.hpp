@@ -164,14 +164,15 @@ struct TrainingConfig {
   // the mean |residual| of its rays exceeds 2 lambda beta / data_weight: 0.1 at the default
   // 0.2, above what alpha errors leave on live elements, below a dead element's.
   double data_weight = 0.2;
-  // When > 0, the threshold is also at least this many times the batch's median ray mismatch
-  // (lambda is raised to data_weight * relative_beta_threshold * median / 2 where that is
-  // larger, step by step), so a loose fit (a noisy scan, a dense edge still being learnt at
-  // 10^3 columns) does not switch live elements off: 39 of 1100 on a simulated neutron square
-  // with 2 dead at 0, exactly the 2 at 20 (measured when it replaced lambda). Off by default:
-  // at 20 the dead element of the tests' 48^2 scan stays on (beta 0.92 after 1500 steps), and
-  // on the shared scans it was mixed (bench/RESULTS.md, issue 29).
-  double relative_beta_threshold = 0.0;
+  // When > 0, the threshold of an element whose readings are all finite is also at least this
+  // many times the batch's median ray mismatch (lambda is raised to data_weight *
+  // relative_beta_threshold * median / 2 where that is larger, step by step), so a loose fit (a
+  // noisy scan, a dense edge still being learnt at 10^3 columns) does not switch live elements
+  // off: 39 of 1100 on a simulated neutron square with 2 dead at 0 (441 and the square's middle
+  // with 640 rays per step), exactly the 2 at 20. An element with a non-finite reading (a
+  // simulated dead one, zero counts) keeps lambda, so it is still switched off as before
+  // (bench/RESULTS.md, issue 29).
+  double relative_beta_threshold = 20.0;
   std::uint64_t seed = 0;
 
   // Steps for a scan of this dimension: `steps`, or the dimension's default when it is -1.

@@ -59,7 +59,8 @@ std::vector<double> ray_sums(const StepInputs& in, const model::Batch& batch,
 }
 
 // lambda, or with a relative threshold, data_weight * threshold * the batch's median ray
-// mismatch / 2 where that is larger (riner_step.cl, riner_step_loss).
+// mismatch / 2 where that is larger (riner_step.cl, riner_step_loss); the elements with a
+// non-finite reading keep lambda (losses()).
 double penalty_weight(const StepInputs& in, const model::Batch& batch,
                       const std::vector<double>& params, const std::vector<double>& sums) {
   const model::ParameterLayout& l = *in.layout;
@@ -104,7 +105,9 @@ void losses(const StepInputs& in, const model::Batch& batch, const std::vector<d
   }
   for (std::uint32_t e : batch.elements) {
     double d_beta0 = 0.0;
-    result.penalty += beta_penalty(params[l.beta_offset + e], weight, &d_beta0);
+    const double w =
+        in.invalid_readings && (*in.invalid_readings)[e] != 0 ? in.lambda : weight;
+    result.penalty += beta_penalty(params[l.beta_offset + e], w, &d_beta0);
     if (with_gradient && beta_learns(e)) result.grad[l.beta_offset + e] += d_beta0;
   }
   result.penalty += ring_prior(batch, result.sums, in.ring_lambda, &result.d_sums);

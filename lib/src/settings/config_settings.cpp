@@ -185,8 +185,9 @@ void add_training_schedule(Table& t) {
   t.push_back(field<C>("training", "data_weight", open(0, 1e6), "multiplies the data term",
                        &C::training, &T::data_weight));
   t.push_back(field<C>("training", "relative_beta_threshold", closed_open(0, 1e6),
-                       "> 0: an element stays on up to this many times the batch's median ray "
-                       "mismatch, when that is above the absolute threshold",
+                       "> 0: an element whose readings are all finite stays on up to this many "
+                       "times the batch's median ray mismatch, when that is above the "
+                       "absolute threshold; 0: off",
                        &C::training, &T::relative_beta_threshold));
   t.push_back(field<C>("training", "seed", closed(0, 18446744073709551615.0),
                        "seed of the initial weights and the sampler", &C::training, &T::seed));
