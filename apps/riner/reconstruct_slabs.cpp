@@ -179,8 +179,17 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   int processes = 1;
   if (ranks.size() == 1 && joined.empty()) {
-    processes = requested > 0 ? requested
-                              : default_slab_processes(device ? device->info().type : "CPU", cores);
+    const std::size_t limit = options.memory_limit ? options.memory_limit : default_memory_limit();
+    const std::size_t fitting = limit / slab_bytes(source.geometry(), 1);
+    const std::string type = device ? device->info().type : "CPU";
+    processes = requested > 0 ? requested : default_slab_processes(type, cores, fitting);
+    if (requested == 0 && processes < default_slab_processes(type, cores, cores) && speak) {
+      console.line("memory: " + std::to_string(processes) + " slab process(es) instead of " +
+                   std::to_string(default_slab_processes(type, cores, cores)) +
+                   ", each slice's slab needs about " +
+                   bytes_string(static_cast<double>(slab_bytes(source.geometry(), 1))) +
+                   " of the limit's " + bytes_string(static_cast<double>(limit)));
+    }
   }
   // The processes of this machine share its memory, and each gets a slab.
   options.processes = processes > 1 ? processes : ranks.local_size();
@@ -240,6 +249,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   }
   const std::size_t total = g.volume_shape[0];
   const auto training_started = std::chrono::steady_clock::now();
+  const double training_started_unix = unix_seconds();
   double slices_at_start = static_cast<double>(total);  // until a report says otherwise
   try {
     Progress progress("slabs", total * 100, !speak);
@@ -319,10 +329,9 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   write_text(out / "config.json", config.to_json());
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  std::size_t peak = 0;
+  const std::size_t peak = slab_machine_peak_bytes(run.manifest()["slabs"], training_started_unix);
   double trained_seconds = 0.0;
   for (const nlohmann::json& entry : run.manifest()["slabs"]) {
-    peak = std::max<std::size_t>(peak, entry.value("peak_host_bytes", std::size_t{0}));
     trained_seconds += entry.value("seconds", 0.0);
   }
   nlohmann::json summary = {

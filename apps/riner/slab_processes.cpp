@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <fstream>
 #include <iterator>
 
@@ -36,9 +37,10 @@ std::vector<std::string> own_command_line() {
 
 }  // namespace
 
-int default_slab_processes(const std::string& device_type, unsigned cores) {
+int default_slab_processes(const std::string& device_type, unsigned cores,
+                           std::size_t slabs_fitting) {
   if (device_type != "CPU" || cores <= 2) return 1;
-  return static_cast<int>(cores / 2);
+  return static_cast<int>(std::clamp<std::size_t>(slabs_fitting, 1, cores / 2));
 }
 
 SlabProcesses::SlabProcesses(int count, int threads, const std::vector<std::string>& extra) {

@@ -33,7 +33,10 @@ class SlabProcesses {
 };
 
 // How many processes a slabbed run on this device takes when the user leaves it to riner:
-// one per two cores on a CPU with more than two, else one.
-int default_slab_processes(const std::string& device_type, unsigned cores);
+// one per two cores on a CPU with more than two, else one; never more than the slabs of one
+// slice that fit the memory limit together (`slabs_fitting`, at least 1), since each process
+// trains a slab of its own.
+int default_slab_processes(const std::string& device_type, unsigned cores,
+                           std::size_t slabs_fitting);
 
 }  // namespace riner::app

@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <thread>
 #include <utility>
@@ -208,6 +209,17 @@ TEST_SUITE("cli") {
     const nlohmann::json summary = one_against_three(dir, "--processes", &run);
     CHECK(summary["processes"] == 3);
     CHECK(claims_left(dir / "three") == 0);  // cleared at the end
+    // The machine's memory is every process's peak together.
+    const nlohmann::json manifest =
+        nlohmann::json::parse(riner::test::read_bytes(dir / "three" / "manifest.json"));
+    std::map<std::string, std::size_t> process_peak;
+    for (const nlohmann::json& slab : manifest["slabs"]) {
+      std::size_t& p = process_peak[slab["process"].get<std::string>()];
+      p = std::max(p, slab["peak_host_bytes"].get<std::size_t>());
+    }
+    std::size_t sum = 0;
+    for (const auto& [process, peak] : process_peak) sum += peak;
+    CHECK(summary["peak_host_bytes"].get<std::size_t>() == sum);
   }
 
   TEST_CASE("slab options name their mistakes") {

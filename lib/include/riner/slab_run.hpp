@@ -132,4 +132,14 @@ class SlabRun {
   bool join_ = false;
 };
 
+// Seconds since the Unix epoch (the slab records' finished_unix).
+double unix_seconds();
+
+// A slabbed run's host memory on its busiest machine, from the manifest's slab records: over
+// the records finished at or after `since_unix` (this invocation's), each process's largest
+// peak_host_bytes, summed over the processes of each host (they train at the same time);
+// the largest record's when none finished since (every slab was done before, or records
+// written before riner named their process).
+std::size_t slab_machine_peak_bytes(const nlohmann::json& slabs, double since_unix);
+
 }  // namespace riner

@@ -4,7 +4,9 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 #include <mutex>
+#include <unistd.h>
 
 #include "riner/error.hpp"
 #include "riner/io.hpp"
@@ -14,6 +16,13 @@
 namespace riner {
 
 namespace {
+
+// host:pid, unique among the processes of a run at one time.
+std::string this_process_name() {
+  char host[256] = {};
+  if (gethostname(host, sizeof(host) - 1) != 0) host[0] = '\0';
+  return std::string(host) + ":" + std::to_string(static_cast<long>(getpid()));
+}
 
 constexpr int kManifestVersion = 1;
 
@@ -305,7 +314,11 @@ void SlabRun::write_slab(const Slab& slab, const Reconstructor& r, const Summari
   entry["seconds"] =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   entry["steps"] = stats.steps;
-  entry["peak_host_bytes"] = stats.peak_host_bytes;
+  entry["peak_host_bytes"] = stats.peak_host_bytes;  // this process's, so far
+  // Which process trained it, and when it finished: a run's memory on a machine is the sum of
+  // its processes' peaks (slab_machine_peak_bytes).
+  entry["process"] = this_process_name();
+  entry["finished_unix"] = unix_seconds();
   entry["device"] = stats.device;
   entry["dead_elements"] = r.dead_elements().size();
   // A slice trained in 2D names its dead elements by column, for every row of the slab.
@@ -374,6 +387,32 @@ Array SlabRun::preview() const {
   }
   const Array axial = read_array(slice_path(nz / 2)).array;
   return preview_panel(axial, coronal, sagittal);
+}
+
+double unix_seconds() {
+  return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+std::size_t slab_machine_peak_bytes(const nlohmann::json& slabs, double since_unix) {
+  std::map<std::string, std::size_t> process_peak;
+  std::size_t largest = 0;
+  for (const nlohmann::json& entry : slabs) {
+    const std::size_t peak = entry.value("peak_host_bytes", std::size_t{0});
+    largest = std::max(largest, peak);
+    const std::string process = entry.value("process", std::string());
+    if (process.empty() || entry.value("finished_unix", 0.0) < since_unix) continue;
+    std::size_t& p = process_peak[process];
+    p = std::max(p, peak);
+  }
+  if (process_peak.empty()) return largest;
+  std::map<std::string, std::size_t> host_sum;
+  for (const auto& [process, peak] : process_peak) {
+    host_sum[process.substr(0, process.rfind(':'))] += peak;
+  }
+  std::size_t busiest = 0;
+  for (const auto& [host, sum] : host_sum) busiest = std::max(busiest, sum);
+  return busiest;
 }
 
 }  // namespace riner
