@@ -40,7 +40,7 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
   if (source.centre()) console.line(centre_line(*source.centre()));
   const Geometry& g = source.geometry();
   const SlabOptions asked = slab_size_options(args);
-  const std::size_t limit = asked.memory_limit ? asked.memory_limit : default_memory_limit();
+  const std::size_t limit = asked.limit();
   const std::size_t per = asked.slices_per_slab ? asked.slices_per_slab
                                                 : fbp_slices_within(g, limit);
   const std::string out = args.get("out");

@@ -179,16 +179,16 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   int processes = 1;
   if (ranks.size() == 1 && joined.empty()) {
-    const std::size_t limit = options.memory_limit ? options.memory_limit : default_memory_limit();
-    const std::size_t fitting = limit / slab_bytes(source.geometry(), 1);
+    const std::size_t limit = options.limit();
+    const std::size_t one_slice = slab_bytes(source.geometry(), 1);
     const std::string type = device ? device->info().type : "CPU";
-    processes = requested > 0 ? requested : default_slab_processes(type, cores, fitting);
-    if (requested == 0 && processes < default_slab_processes(type, cores, cores) && speak) {
+    const int by_cores = default_slab_processes(type, cores, cores);  // memory aside
+    processes = requested > 0 ? requested : default_slab_processes(type, cores, limit / one_slice);
+    if (requested == 0 && processes < by_cores && speak) {
       console.line("memory: " + std::to_string(processes) + " slab process(es) instead of " +
-                   std::to_string(default_slab_processes(type, cores, cores)) +
-                   ", each slice's slab needs about " +
-                   bytes_string(static_cast<double>(slab_bytes(source.geometry(), 1))) +
-                   " of the limit's " + bytes_string(static_cast<double>(limit)));
+                   std::to_string(by_cores) + ", each slice's slab needs about " +
+                   bytes_string(static_cast<double>(one_slice)) + " of the limit's " +
+                   bytes_string(static_cast<double>(limit)));
     }
   }
   // The processes of this machine share its memory, and each gets a slab.

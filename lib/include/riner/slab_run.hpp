@@ -46,6 +46,9 @@ struct SlabOptions {
   // Processes of this machine training the run at once (MPI ranks on it, or the CLI's own
   // slab processes), each `workers` slabs: they share the memory limit, and each gets a slab.
   int processes = 1;
+
+  // memory_limit, or default_memory_limit() when it is 0.
+  std::size_t limit() const { return memory_limit ? memory_limit : default_memory_limit(); }
 };
 
 struct SlabProgress {

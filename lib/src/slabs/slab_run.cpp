@@ -89,7 +89,7 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
       device_(std::move(device)) {
   config_.validate();
   const Geometry& g = source_.geometry();
-  memory_limit_ = options.memory_limit ? options.memory_limit : default_memory_limit();
+  memory_limit_ = options.limit();
   const std::size_t nz = g.volume_shape[0];
   const int wanted_workers = options.workers > 0 ? options.workers
                              : device_           ? concurrent_trainings(device_->info()).trainings
