@@ -1,5 +1,8 @@
 // riner fbp: filtered backprojection (FBP, or FDK for cone beam) of a scan.
 #include <chrono>
+#include <filesystem>
+#include <functional>
+#include <optional>
 
 #include "cli_common.hpp"
 #include "commands.hpp"
@@ -19,14 +22,27 @@ namespace riner::app {
 
 namespace {
 
+// The slices per slab a GPU's own memory holds (the whole volume on a device that works in
+// host memory, or with the reference engine).
+std::size_t fbp_device_slices(const Geometry& g, const SlabOptions& asked,
+                              const FbpOptions& options) {
+  if (options.engine != Engine::kOpenCL || !options.device) return g.volume_shape[0];
+  const std::size_t limit = asked.device_limit(options.device->info());
+  if (limit == 0) return g.volume_shape[0];
+  return fbp_device_slices_within(g, limit, options.device->info().max_alloc_bytes);
+}
+
 // A projection stack goes by slabs when asked (--slab-slices, --memory-limit), when the
-// output is a folder of slices, or when its volume does not fit in memory whole.
-bool fbp_wants_slabs(const Args& args) {
+// output is a folder of slices, or when its volume does not fit in memory whole (the host's,
+// or the GPU's).
+// `options` (which opens the device) only for a stack that would fit whole.
+bool fbp_wants_slabs(const Args& args, const std::function<const FbpOptions&()>& options) {
   const bool asked = !args.get("slab-slices").empty() || !args.get("memory-limit").empty();
   const bool folder = std::filesystem::path(args.get("out")).extension().empty();
   const std::optional<Geometry> g = stack_geometry(args);
   return g && g->is_3d() &&
-         (asked || folder || fbp_slab_bytes(*g, g->volume_shape[0]) > default_memory_limit());
+         (asked || folder || fbp_slab_bytes(*g, g->volume_shape[0]) > default_memory_limit() ||
+          fbp_device_slices(*g, SlabOptions{}, options()) < g->volume_shape[0]);
 }
 
 // --destripe METHOD: the stripe filter every sinogram goes through first (nullopt: none).
@@ -41,8 +57,10 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
   const Geometry& g = source.geometry();
   const SlabOptions asked = slab_size_options(args);
   const std::size_t limit = asked.limit();
-  const std::size_t per = asked.slices_per_slab ? asked.slices_per_slab
-                                                : fbp_slices_within(g, limit);
+  const std::size_t per =
+      asked.slices_per_slab
+          ? asked.slices_per_slab
+          : std::min(fbp_slices_within(g, limit), fbp_device_slices(g, asked, options));
   const std::string out = args.get("out");
   VolumeWriter writer(out, g.volume_shape, g.voxel_mm);
   const auto start = std::chrono::steady_clock::now();
@@ -115,8 +133,9 @@ int run_fbp(int argc, char** argv, int first) {
               "reconstructed and written alone (default: as many as --memory-limit allows)",
               "")
       .option("memory-limit", "SIZE",
-              "host memory a slab may take (8G, 512M); a stack whose volume does not fit goes "
-              "by slabs (default: three quarters of the machine's memory)",
+              "memory a slab may take, on the host and on a GPU (8G, 512M); a stack whose "
+              "volume does not fit goes by slabs (default: three quarters of the machine's "
+              "memory, nine tenths of a GPU's)",
               "")
       .option("destripe", "METHOD",
               "remove stripes from every sinogram first (riner destripe's methods: normalise, "
@@ -127,20 +146,25 @@ int run_fbp(int argc, char** argv, int first) {
   args.output_flags();
   if (!args.parse(argc, argv, first)) return 0;
   Console console(args);
-  const auto fbp_options = [&] {
-    FbpOptions options;
-    options.filter = parse_fbp_filter(args.get("filter"));
-    options.engine = engine_from(args);
-    options.device = device_from(args, options.engine);
-    return options;
+  // Made once, when first needed: an unreadable scan is reported before a bad option.
+  std::optional<FbpOptions> made;
+  const auto fbp_options = [&]() -> const FbpOptions& {
+    if (!made) {
+      FbpOptions options;
+      options.filter = parse_fbp_filter(args.get("filter"));
+      options.engine = engine_from(args);
+      options.device = device_from(args, options.engine);
+      made = std::move(options);
+    }
+    return *made;
   };
-  if (fbp_wants_slabs(args)) return fbp_by_slabs_cli(args, console, fbp_options());
+  if (fbp_wants_slabs(args, fbp_options)) return fbp_by_slabs_cli(args, console, fbp_options());
   LoadedScan loaded = scan_from(args, console);
   check_centre(loaded, console);
   Scan scan = std::move(loaded.scan);  // the stripe filter may replace its measurement
   const std::filesystem::path out = args.get("out");
   format_from_path(out);  // reject an unknown extension before the work
-  const FbpOptions options = fbp_options();
+  const FbpOptions& options = fbp_options();
   const std::optional<DestripeOptions> stripes = destripe_from(args);
   if (stripes) {
     DestripeReport destripe_report;

@@ -84,8 +84,9 @@ void add_slab_options(Args& args) {
               "default: as many as --memory-limit allows",
               "")
       .option("memory-limit", "SIZE",
-              "host memory a slab may take (8G, 512M); a volume larger than this goes by "
-              "slabs (default: three quarters of the machine's memory)",
+              "memory the slabs may take, on the host and on a GPU (8G, 512M); a volume larger "
+              "than this goes by slabs (default: three quarters of the machine's memory, nine "
+              "tenths of a GPU's)",
               "")
       .option("workers", "N",
               "slabs trained at once on the device, each on its own queue (default: 8 on a "
@@ -234,6 +235,16 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
                               .c_str()
                         : "");
     console.line(line);
+    if (run.device_bound()) {
+      std::snprintf(line, sizeof(line),
+                    "device memory: slabs of %zu slice(s), %d at once, each about %s of the "
+                    "device's %s",
+                    run.slices_per_slab(), run.workers(),
+                    bytes_string(static_cast<double>(slab_device_bytes(g, run.slices_per_slab())))
+                        .c_str(),
+                    bytes_string(static_cast<double>(run.device_memory_limit())).c_str());
+      console.line(line);
+    }
     if (slab_bytes(g, run.slices_per_slab()) * static_cast<std::size_t>(at_once) >
         run.memory_limit()) {
       std::snprintf(
@@ -350,6 +361,10 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       {"slices_2d", run.slices_2d()},
       {"memory_limit_bytes", run.memory_limit()},
       {"slab_bytes_estimated", slab_bytes(g, run.slices_per_slab())},
+      {"device_memory_limit_bytes", run.device_memory_limit()},
+      {"slab_device_bytes_estimated",
+       run.device_memory_limit() ? slab_device_bytes(g, run.slices_per_slab()) : 0},
+      {"device_bound", run.device_bound()},
       {"peak_host_bytes", peak},
       {"slab_seconds", trained_seconds},
       // This run's slices (all ranks and workers) per minute of its training.

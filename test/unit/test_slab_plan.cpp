@@ -146,3 +146,55 @@ TEST_CASE("a 2D geometry as a stack of slices, and a slice of it back") {
   CHECK_THROWS_AS(riner::stack_of_slices(stack, 2), riner::InputError);
   CHECK_THROWS_AS(riner::axial_slice_geometry(g), riner::InputError);
 }
+
+TEST_CASE("a GPU's own memory bounds the slabs trained on it at once") {
+  // A synchrotron stack: 2560 columns, 3600 views, 2000 rows, its volume on the same grid.
+  riner::Geometry g = parallel3d(2000, 2000, 1.0, 0.0);
+  g.n_u = 2560;
+  g.angles.clear();
+  for (int i = 0; i < 3600; ++i) g.angles.push_back(M_PI * i / 3600.0);
+  g.volume_shape = {2000, 2560, 2560};
+  const std::size_t gib = std::size_t{1} << 30;
+  riner::SlabMemory host_only{96 * gib, 0, 0};
+  const riner::SlabSizing cpu = riner::size_slabs(g, host_only, 8, 1);
+  CHECK_FALSE(cpu.device_bound);
+  CHECK(cpu.workers * riner::slab_bytes(g, cpu.slices_per_slab) <= 96 * gib);
+
+  // A 16 GB GPU (14 GB usable, buffers up to 4 GB): the slabs its 8 workers hold at once fit
+  // in it, and their largest buffer within one allocation.
+  riner::SlabMemory gpu{96 * gib, 14 * gib, 4 * gib};
+  const riner::SlabSizing on_gpu = riner::size_slabs(g, gpu, 8, 1);
+  MESSAGE("host only: " << cpu.slices_per_slab << " slices x " << cpu.workers
+                        << "; a 16 GB GPU: " << on_gpu.slices_per_slab << " x " << on_gpu.workers);
+  CHECK(on_gpu.workers == 8);
+  CHECK(on_gpu.slices_per_slab < cpu.slices_per_slab);
+  CHECK(on_gpu.device_bound);
+  CHECK(on_gpu.workers * riner::slab_device_bytes(g, on_gpu.slices_per_slab) <= 14 * gib);
+  CHECK(riner::slab_largest_buffer_bytes(g, on_gpu.slices_per_slab) <= 4 * gib);
+  CHECK(on_gpu.workers * riner::slab_bytes(g, on_gpu.slices_per_slab) <= 96 * gib);
+  // An 80 GB one does not bind before the host's memory does.
+  const riner::SlabSizing big = riner::size_slabs(g, {96 * gib, 72 * gib, 20 * gib}, 8, 1);
+  CHECK(big.slices_per_slab == cpu.slices_per_slab);
+  CHECK_FALSE(big.device_bound);
+
+  // An 8 GB GPU with 2 GB buffers: thinner slabs still, never none.
+  riner::SlabMemory small{96 * gib, 7 * gib, 2 * gib};
+  const riner::SlabSizing little = riner::size_slabs(g, small, 8, 1);
+  CHECK(little.slices_per_slab >= 1);
+  CHECK(little.slices_per_slab < on_gpu.slices_per_slab);
+  CHECK(little.workers * riner::slab_device_bytes(g, little.slices_per_slab) <= 7 * gib);
+  CHECK(riner::slab_largest_buffer_bytes(g, little.slices_per_slab) <= 2 * gib);
+
+  // Slabs of a size asked for: the workers are what the device holds of them, at least one.
+  const riner::SlabSizing asked = riner::size_slabs(g, small, 8, 1, 40);
+  CHECK(asked.slices_per_slab == 40);
+  CHECK(asked.workers == 1);
+  CHECK(asked.device_bound);
+  const std::size_t per_40 = riner::slab_device_bytes(g, 40);
+  CHECK(per_40 > riner::slab_device_bytes(g, 20));
+  // Slabs no thicker than gives each worker one, and workers no more than the slabs.
+  const riner::Geometry few = parallel3d(6, 6, 1.0, 0.0);
+  const riner::SlabSizing tiny = riner::size_slabs(few, gpu, 8, 1);
+  CHECK(tiny.slices_per_slab == 1);
+  CHECK(tiny.workers == 6);
+}

@@ -32,6 +32,13 @@ RowRange fbp_rows_reached(const Geometry& g, std::size_t first, std::size_t coun
 std::size_t fbp_slab_bytes(const Geometry& g, std::size_t slices);
 // The most slices per slab within `limit` bytes (at least 1).
 std::size_t fbp_slices_within(const Geometry& g, std::size_t limit);
+// Memory FBP of a slab takes on a device with its own (a GPU): its readings in two copies
+// (weighted, filtered) and its voxels.
+std::size_t fbp_slab_device_bytes(const Geometry& g, std::size_t slices);
+// The most slices per slab whose FBP fits `device_limit` bytes of a device's memory with no
+// buffer over `max_alloc` (0: no bound); at least 1.
+std::size_t fbp_device_slices_within(const Geometry& g, std::size_t device_limit,
+                                     std::size_t max_alloc);
 
 // Every slice of `source`'s volume into `out` (not closed), slabs of `slices_per_slab` in
 // order (slabs as even as they come); `written` after each slab with its first slice and its

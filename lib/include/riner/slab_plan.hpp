@@ -37,12 +37,41 @@ Geometry slab_geometry(const Geometry& g, const Slab& slab);
 // hold at once.
 std::size_t slab_bytes(const Geometry& g, std::size_t slices);
 
+// Memory a slab of `slices` slices takes on a device with its own memory (a GPU; measured,
+// bench/RESULTS.md "device memory"): the model and the training's per-sample caches, and per
+// slice the quality check's FBP (its readings in two copies) and the voxels it evaluates.
+std::size_t slab_device_bytes(const Geometry& g, std::size_t slices);
+// The largest single device buffer of such a slab: one copy of its readings.
+std::size_t slab_largest_buffer_bytes(const Geometry& g, std::size_t slices);
+
 // The most slices per slab within `limit` bytes (at least 1).
 std::size_t slices_within(const Geometry& g, std::size_t limit);
 // The same for any memory model: the most of `slices` whose bytes(n), rising with n, stay
 // within `limit` (at least 1).
 std::size_t most_slices_within(std::size_t slices, std::size_t limit,
                                const std::function<std::size_t(std::size_t)>& bytes);
+
+// What bounds a run's slabs: the host's memory, shared by every slab the machine trains at once
+// (all its processes'), and a device's own memory, shared by the slabs one process trains on it
+// at once.
+struct SlabMemory {
+  std::size_t host_limit = 0;        // bytes
+  std::size_t device_limit = 0;      // bytes; 0: the device works in host memory (a CPU)
+  std::size_t device_max_alloc = 0;  // the device's largest buffer; 0: no bound
+};
+
+struct SlabSizing {
+  std::size_t slices_per_slab = 1;
+  int workers = 1;             // slabs one process trains at once
+  bool device_bound = false;   // the device's memory, not the host's, cut the slabs or workers
+};
+
+// Slabs as thick as the memory allows with `wanted_workers` slabs trained at once by each of
+// `processes` processes (fewer where not even one slice each fits), and no thicker than makes a
+// slab for each; `slices_per_slab` when given (not 0). Then the workers the slabs' size leaves
+// room for, at most the slabs there are.
+SlabSizing size_slabs(const Geometry& g, const SlabMemory& memory, int wanted_workers,
+                      int processes, std::size_t slices_per_slab = 0);
 
 // Three quarters of the machine's physical memory: the default limit.
 std::size_t default_memory_limit();

@@ -49,6 +49,10 @@ struct SlabOptions {
 
   // memory_limit, or default_memory_limit() when it is 0.
   std::size_t limit() const { return memory_limit ? memory_limit : default_memory_limit(); }
+  // What the slabs on `device` may take of its own memory: 0 for a device that works in host
+  // memory (a CPU: limit() covers it); else nine tenths of what it has, and at most
+  // memory_limit when that is set.
+  std::size_t device_limit(const DeviceInfo& device) const;
 };
 
 struct SlabProgress {
@@ -75,6 +79,10 @@ class SlabRun {
   const std::vector<Slab>& slabs() const { return slabs_; }
   std::size_t slices_per_slab() const { return slices_per_slab_; }
   std::size_t memory_limit() const { return memory_limit_; }
+  // The device's memory the slabs may take (SlabOptions::device_limit); 0: none of its own.
+  std::size_t device_memory_limit() const { return device_memory_limit_; }
+  // Whether the device's memory, not the host's, cut the slabs' size or the workers.
+  bool device_bound() const { return device_bound_; }
   int workers() const { return workers_; }
   bool slices_2d() const { return slices_2d_; }
   std::size_t slabs_done() const;
@@ -127,6 +135,8 @@ class SlabRun {
   std::filesystem::path out_;
   std::optional<Device> device_;
   std::size_t memory_limit_ = 0;
+  std::size_t device_memory_limit_ = 0;
+  bool device_bound_ = false;
   std::size_t slices_per_slab_ = 0;
   int workers_ = 1;
   bool slices_2d_ = false;

@@ -70,6 +70,35 @@ std::size_t fbp_slices_within(const Geometry& g, std::size_t limit) {
                             [&](std::size_t n) { return fbp_slab_bytes(g, n); });
 }
 
+std::size_t fbp_slab_device_bytes(const Geometry& g, std::size_t slices) {
+  slices = std::min(slices, g.volume_shape[0]);
+  const double rows = static_cast<double>(fbp_rows_reached(g, 0, slices).count);
+  const double readings = static_cast<double>(g.n_views()) * static_cast<double>(g.n_u) * rows;
+  const double voxels = static_cast<double>(slices) * static_cast<double>(g.volume_shape[1]) *
+                        static_cast<double>(g.volume_shape[2]);
+  return static_cast<std::size_t>(4.0 * (2.0 * readings + voxels));
+}
+
+std::size_t fbp_device_slices_within(const Geometry& g, std::size_t device_limit,
+                                     std::size_t max_alloc) {
+  const std::size_t nz = g.volume_shape[0];
+  std::size_t slices = most_slices_within(
+      nz, device_limit, [&](std::size_t n) { return fbp_slab_device_bytes(g, n); });
+  if (max_alloc) {
+    slices = std::min(slices, most_slices_within(nz, max_alloc, [&](std::size_t n) {
+                        const double rows = static_cast<double>(fbp_rows_reached(g, 0, n).count);
+                        const double voxels = static_cast<double>(n) *
+                                              static_cast<double>(g.volume_shape[1]) *
+                                              static_cast<double>(g.volume_shape[2]);
+                        return static_cast<std::size_t>(
+                            4.0 * std::max(static_cast<double>(g.n_views()) *
+                                               static_cast<double>(g.n_u) * rows,
+                                           voxels));
+                      }));
+  }
+  return slices;
+}
+
 SlabFbpReport fbp_by_slabs(const ScanRows& source, const FbpOptions& options, VolumeWriter& out,
                            std::size_t slices_per_slab,
                            const std::function<void(std::size_t, const Array&)>& written,

@@ -20,6 +20,23 @@ constexpr double kReadingCopies = 8.0;
 constexpr double kVoxelCopies = 12.0;
 constexpr std::size_t kBaseBytes = std::size_t{260} << 20;  // model, kernels, libraries
 
+// On a device (PoCL's buffers, counted as on a GPU; bench/RESULTS.md "device memory"): the
+// model, the per-sample caches and the batch (95-256 MB measured), then per slice the quality
+// check's FBP with its readings in two copies and the voxels (2048 columns x 1440 views: 26.4
+// MB per slice against 32 MB here).
+constexpr std::size_t kDeviceBaseBytes = std::size_t{256} << 20;
+constexpr double kDeviceReadingCopies = 2.0;
+constexpr double kDeviceVoxelCopies = 2.0;
+
+double readings_per_slice(const Geometry& g) {
+  return static_cast<double>(g.n_views()) * static_cast<double>(g.n_u) *
+         static_cast<double>(g.n_v) / static_cast<double>(g.volume_shape[0]);
+}
+
+double voxels_per_slice(const Geometry& g) {
+  return static_cast<double>(g.volume_shape[1]) * static_cast<double>(g.volume_shape[2]);
+}
+
 // The detector row (fractional index) a height z (mm) projects to in a parallel beam.
 double row_at(const Geometry& g, double z_mm) {
   return z_mm / g.pitch_v + (static_cast<double>(g.n_v) - 1.0) / 2.0 - g.offset_v;
@@ -83,14 +100,67 @@ Geometry slab_geometry(const Geometry& g, const Slab& slab) {
 }
 
 std::size_t slab_bytes(const Geometry& g, std::size_t slices) {
-  const double nz = static_cast<double>(g.volume_shape[0]);
-  const double rows_per_slice = static_cast<double>(g.n_v) / nz;
-  const double readings = static_cast<double>(g.n_views()) * static_cast<double>(g.n_u) *
-                          rows_per_slice;
-  const double voxels = static_cast<double>(g.volume_shape[1]) *
-                        static_cast<double>(g.volume_shape[2]);
-  const double per_slice = 4.0 * (kReadingCopies * readings + kVoxelCopies * voxels);
+  const double per_slice =
+      4.0 * (kReadingCopies * readings_per_slice(g) + kVoxelCopies * voxels_per_slice(g));
   return kBaseBytes + static_cast<std::size_t>(per_slice * static_cast<double>(slices));
+}
+
+std::size_t slab_device_bytes(const Geometry& g, std::size_t slices) {
+  const double per_slice = 4.0 * (kDeviceReadingCopies * readings_per_slice(g) +
+                                  kDeviceVoxelCopies * voxels_per_slice(g));
+  return kDeviceBaseBytes + static_cast<std::size_t>(per_slice * static_cast<double>(slices));
+}
+
+std::size_t slab_largest_buffer_bytes(const Geometry& g, std::size_t slices) {
+  return static_cast<std::size_t>(4.0 * readings_per_slice(g) * static_cast<double>(slices));
+}
+
+SlabSizing size_slabs(const Geometry& g, const SlabMemory& memory, int wanted_workers,
+                      int processes, std::size_t slices_per_slab) {
+  const std::size_t nz = g.volume_shape[0];
+  wanted_workers = std::max(1, wanted_workers);
+  processes = std::max(1, processes);
+  const bool device = memory.device_limit > 0;
+  // How many slabs of `slices` fit at once in each memory.
+  auto host_fit = [&](std::size_t slices) {
+    return static_cast<int>(std::max<std::size_t>(1, memory.host_limit / slab_bytes(g, slices)));
+  };
+  auto device_fit = [&](std::size_t slices) {
+    if (!device) return wanted_workers;
+    return static_cast<int>(
+        std::max<std::size_t>(1, memory.device_limit / slab_device_bytes(g, slices)));
+  };
+  SlabSizing out;
+  if (slices_per_slab) {
+    out.slices_per_slab = std::min(slices_per_slab, nz);
+  } else {
+    // The slabs trained at once share each limit, and each gets a slab to train.
+    const int on_host = std::min(wanted_workers * processes, host_fit(1));
+    const int on_device = std::min(wanted_workers, device_fit(1));
+    std::size_t slices =
+        std::min(slices_within(g, memory.host_limit / static_cast<std::size_t>(on_host)),
+                 (nz + static_cast<std::size_t>(on_host) - 1) / static_cast<std::size_t>(on_host));
+    if (device) {
+      const std::size_t share = memory.device_limit / static_cast<std::size_t>(on_device);
+      std::size_t on_gpu = most_slices_within(
+          nz, share, [&](std::size_t n) { return slab_device_bytes(g, n); });
+      if (memory.device_max_alloc) {
+        on_gpu = std::min(on_gpu, most_slices_within(nz, memory.device_max_alloc, [&](std::size_t n) {
+                            return slab_largest_buffer_bytes(g, n);
+                          }));
+      }
+      out.device_bound = on_gpu < slices;
+      slices = std::min(slices, on_gpu);
+    }
+    out.slices_per_slab = std::max<std::size_t>(1, slices);
+  }
+  const std::size_t slabs = (nz + out.slices_per_slab - 1) / out.slices_per_slab;
+  const int by_host = host_fit(out.slices_per_slab) / processes;
+  const int by_device = device_fit(out.slices_per_slab);
+  out.device_bound = out.device_bound || (device && by_device < std::min(wanted_workers, by_host));
+  out.workers = std::max(1, std::min({wanted_workers, by_host, by_device,
+                                      static_cast<int>(std::min<std::size_t>(slabs, 1 << 20))}));
+  return out;
 }
 
 std::size_t most_slices_within(std::size_t slices, std::size_t limit,

@@ -81,6 +81,12 @@ std::string numbered(const char* pattern, std::size_t n) {
 
 }  // namespace
 
+std::size_t SlabOptions::device_limit(const DeviceInfo& device) const {
+  if (device.type == "CPU" || device.global_mem_bytes == 0) return 0;
+  const auto own = static_cast<std::size_t>(0.9 * static_cast<double>(device.global_mem_bytes));
+  return memory_limit ? std::min(memory_limit, own) : own;
+}
+
 SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
                  SlabOptions options, std::optional<Device> device)
     : source_(std::move(source)),
@@ -90,28 +96,18 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
   config_.validate();
   const Geometry& g = source_.geometry();
   memory_limit_ = options.limit();
-  const std::size_t nz = g.volume_shape[0];
   const int wanted_workers = options.workers > 0 ? options.workers
                              : device_           ? concurrent_trainings(device_->info()).trainings
                                                  : 1;
   const int processes = std::max(1, options.processes);
-  // How many slabs of `slices` fit the limit at once.
-  auto fitting = [&](std::size_t slices) {
-    return static_cast<int>(std::max<std::size_t>(1, memory_limit_ / slab_bytes(g, slices)));
-  };
+  if (device_) device_memory_limit_ = options.device_limit(device_->info());
+  const SlabMemory memory{memory_limit_, device_memory_limit_,
+                          device_memory_limit_ ? device_->info().max_alloc_bytes : 0};
   slices_2d_ = options.slices_2d;
-  if (slices_2d_) {
-    (void)axial_slice_geometry(g);  // InputError now, not in the first slab, for a cone beam
-    slices_per_slab_ = 1;
-  } else if (options.slices_per_slab) {
-    slices_per_slab_ = std::min(options.slices_per_slab, nz);
-  } else {
-    // The slabs trained at once share the limit, and each gets a slab to train.
-    const int w = std::min(wanted_workers * processes, fitting(1));
-    slices_per_slab_ =
-        std::min(slices_within(g, memory_limit_ / static_cast<std::size_t>(w)),
-                 (nz + static_cast<std::size_t>(w) - 1) / static_cast<std::size_t>(w));
-  }
+  if (slices_2d_) (void)axial_slice_geometry(g);  // InputError now, not in the first slab
+  SlabSizing sizing = size_slabs(g, memory, wanted_workers, processes,
+                                 slices_2d_ ? 1 : options.slices_per_slab);
+  slices_per_slab_ = sizing.slices_per_slab;
   const std::filesystem::path path = out_ / "manifest.json";
   join_ = options.join;
   const bool held_run = std::filesystem::exists(path);
@@ -141,11 +137,12 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
     const nlohmann::json& held_slices = manifest_["run"]["slices_per_slab"];
     if (!options.slices_per_slab && !slices_2d_ && held_slices.is_number_unsigned()) {
       slices_per_slab_ = std::min(held_slices.get<std::size_t>(), g.volume_shape[0]);
+      sizing = size_slabs(g, memory, wanted_workers, processes, slices_per_slab_);
     }
   }
   slabs_ = plan_slabs(g, slices_per_slab_);
-  workers_ = std::max(1, std::min({wanted_workers, fitting(slices_per_slab_) / processes,
-                                    static_cast<int>(slabs_.size())}));
+  workers_ = sizing.workers;
+  device_bound_ = sizing.device_bound;
   if (device_) {
     std::string why;
     workers_ = usable_trainings(device_->info(), workers_, &why);
