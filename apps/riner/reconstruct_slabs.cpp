@@ -48,9 +48,16 @@ SlabOptions slab_options(const Args& args) {
     if (n < 1 || n > 256) throw UsageError("--workers must be 1 to 256");
     options.workers = static_cast<int>(n);
   }
+  if (args.is_set("slices-2d") && args.is_set("field-3d")) {
+    throw UsageError("--slices-2d and --field-3d: choose one");
+  }
   options.slices_2d = args.is_set("slices-2d");
   if (options.slices_2d && options.slices_per_slab) {
     throw UsageError("--slices-2d trains each slice alone: leave out --slab-slices");
+  }
+  if (!options.slices_2d && !options.slices_per_slab && !args.is_set("field-3d")) {
+    const std::optional<Geometry> g = stack_geometry(args);
+    options.slices_2d = g && slices_2d_by_default(*g);
   }
   return options;
 }
@@ -101,21 +108,31 @@ void add_slab_options(Args& args) {
       .option("join-run", "TOKEN", "(used by riner's own slab processes)", "")
       .flag("slices-2d",
             "train each axial slice of a parallel-beam stack as its own 2D scan (the mean of "
-            "its detector rows, the 2D defaults) instead of a slab of slices as one 3D field")
+            "its detector rows, the 2D defaults) instead of a slab of slices as one 3D field "
+            "(the default for slices of 256 x 256 voxels or more)")
+      .flag("field-3d",
+            "train a parallel-beam stack in slabs of slices, each one 3D field (the default "
+            "for slices under 256 x 256 voxels, and with --slab-slices)")
       .flag("resume",
             "finish a slabbed run the output folder holds: only the slabs its manifest does "
             "not list as done are trained");
 }
 
+bool slices_2d_by_default(const Geometry& g) {
+  return g.type == GeometryType::kParallel3d && g.volume_shape[1] >= kSlices2dFromPx &&
+         g.volume_shape[2] >= kSlices2dFromPx;
+}
+
 bool wants_slabs(const Args& args) {
-  if (args.is_set("resume") || args.is_set("slices-2d")) return true;
+  if (args.is_set("resume") || args.is_set("slices-2d") || args.is_set("field-3d")) return true;
   for (const char* name : {"slab-slices", "memory-limit", "workers", "processes", "join-run"}) {
     if (auto v = args.maybe(name); v && !v->empty()) return true;
   }
-  // Left to the scan: by slabs when a parallel-beam volume does not fit whole.
+  // Left to the scan: by slabs when a parallel-beam volume does not fit whole, or when its
+  // slices are large enough to train each alone.
   const std::optional<Geometry> g = stack_geometry(args);
   return g && g->type == GeometryType::kParallel3d &&
-         slab_bytes(*g, g->volume_shape[0]) > default_memory_limit();
+         (slices_2d_by_default(*g) || slab_bytes(*g, g->volume_shape[0]) > default_memory_limit());
 }
 
 namespace {

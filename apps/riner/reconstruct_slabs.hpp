@@ -1,6 +1,7 @@
 // `riner reconstruct` on a projection stack by slabs of slices (riner/slab_run.hpp): asked for
-// with --slab-slices, --memory-limit or --resume, or chosen when a parallel-beam volume does not
-// fit in memory whole. Writes volume/ (one TIFF per axial slice), manifest.json, alpha.npy,
+// with --slab-slices, --memory-limit, --slices-2d, --field-3d or --resume, or chosen when a
+// parallel-beam volume does not fit in memory whole or its slices are large enough to train
+// each alone. Writes volume/ (one TIFF per axial slice), manifest.json, alpha.npy,
 // beta.npy, detector.png, image.png (the three central planes), config.json and summary.json.
 #pragma once
 
@@ -20,6 +21,13 @@ std::string output_format(const Args& args);
 
 // --slab-slices and --memory-limit (0 where not given), as riner fbp takes them too.
 SlabOptions slab_size_options(const Args& args);
+
+// A parallel-beam stack whose slices are at least this wide trains each slice alone in 2D by
+// default: on 256² slices that is 10-15 dB above slabs of 3D fields at the same or less time
+// (bench/RESULTS.md, "a slab as one field or each slice in 2D"); on smaller ones (savu_proj3d's
+// 160²) the 3D field is what was measured, and a 2D slice's 24 000 steps cost the most there.
+constexpr std::size_t kSlices2dFromPx = 256;
+bool slices_2d_by_default(const Geometry& g);
 
 // Whether this run goes by slabs (it reads the geometry and the data's header, no data).
 bool wants_slabs(const Args& args);

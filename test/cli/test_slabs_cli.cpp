@@ -317,6 +317,40 @@ TEST_SUITE("cli") {
     CHECK(run.err.find("--slices-2d trains each slice alone") != std::string::npos);
   }
 
+  TEST_CASE("slices of 256 x 256 or more train alone in 2D by default; --field-3d keeps 3D slabs") {
+    riner::test::TempDir dir;
+    riner::test::write_bytes(dir / "g.json", R"({"type": "parallel3d",
+        "detector": {"count": [260, 2], "pitch_mm": [1.0, 1.0]},
+        "angles": {"count": 12, "range_rad": 3.141592653589793},
+        "volume": {"shape": [2, 256, 256], "voxel_mm": 1.0}})");
+    REQUIRE(riner_cli("simulate --quiet --seed 2 --geometry " + (dir / "g.json").string() +
+                          " --out " + (dir / "sim").string(),
+                      dir)
+                .code == 0);
+    const std::string scan = (dir / "sim" / "sino.npy").string();
+    const std::string settings = " --steps 20 --quiet --out ";
+    Run run = riner_cli("reconstruct " + scan + settings + (dir / "default").string(), dir);
+    CAPTURE(run.err);
+    REQUIRE(run.code == 0);
+    nlohmann::json summary =
+        nlohmann::json::parse(riner::test::read_bytes(dir / "default" / "summary.json"));
+    CHECK(summary["slices_2d"] == true);
+    CHECK(summary["slabs"] == 2);
+    CHECK(summary["per_slab"][1]["trained_as"] == "slice_2d");
+    run = riner_cli("reconstruct " + scan + " --field-3d" + settings + (dir / "field").string(),
+                    dir);
+    CAPTURE(run.err);
+    REQUIRE(run.code == 0);
+    summary = nlohmann::json::parse(riner::test::read_bytes(dir / "field" / "summary.json"));
+    CHECK(summary["slices_2d"] == false);
+    CHECK(summary["per_slab"][0]["trained_as"] == "field_3d");
+    run = riner_cli("reconstruct " + scan + " --field-3d --slices-2d" + settings +
+                        (dir / "both").string(),
+                    dir);
+    CHECK(run.code == 2);
+    CHECK(run.err.find("--slices-2d and --field-3d: choose one") != std::string::npos);
+  }
+
   TEST_CASE("riner fbp by slabs writes the whole volume's slices, into a folder or an HDF5 file") {
     riner::test::TempDir dir;
     const std::string scan = simulate_stack(dir);
