@@ -103,7 +103,8 @@ int run_simulate(int argc, char** argv, int first) {
             "simulation.json into the output folder.");
   args.option("phantom", "NAME|FILE",
               "shepp-logan, faint-square (a faint square with sharp corners and a dense line), "
-              "or an image/volume file on the grid",
+              "tube-wall (a tube whose wall is centred on the axis: object rings), or an "
+              "image/volume file on the grid",
               "shepp-logan")
       .option("geometry", "PRESET|FILE",
               "fan2d-paper, cone3d-paper, parallel3d, or a geometry JSON", "fan2d-paper")
@@ -137,7 +138,8 @@ int run_simulate(int argc, char** argv, int first) {
   const Engine engine = engine_from(args);
   const std::filesystem::path out = make_output_dir(args.get("out"));
   const std::string phantom_name = args.get("phantom");
-  const bool phantom = phantom_name == "shepp-logan" || phantom_name == "faint-square";
+  const bool phantom = phantom_name == "shepp-logan" || phantom_name == "faint-square" ||
+                       phantom_name == "tube-wall";
   std::string projector_name = args.get("projector");
   if (projector_name != "exact" && projector_name != "joseph") {
     throw UsageError("--projector must be exact or joseph");
@@ -147,8 +149,9 @@ int run_simulate(int argc, char** argv, int first) {
   SimulatedScan sim;
   sim.scan.geometry = g;
   if (phantom) {
-    const Phantom p =
-        phantom_name == "shepp-logan" ? shepp_logan(g, args.number("mu-scale")) : faint_square(g);
+    const Phantom p = phantom_name == "shepp-logan"    ? shepp_logan(g, args.number("mu-scale"))
+                      : phantom_name == "faint-square" ? faint_square(g)
+                                                       : tube_wall(g);
     sim.ground_truth = rasterize(p, g, static_cast<int>(args.integer("supersample")));
     if (projector_name == "exact") sim.clean = exact_projections(p, g);
   } else {

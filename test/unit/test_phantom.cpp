@@ -60,4 +60,25 @@ TEST_SUITE("phantom") {
     CHECK(p.value_at({0.0, 54.0, 0.0}) == doctest::Approx(0.1));
     CHECK(p.value_at({64.0, 0.0, 0.0}) == 0.0);  // outside the head
   }
+
+  TEST_CASE("the tube wall: its wall about the axis, its content and the water around it") {
+    const riner::Geometry g =
+        riner::test::make_geometry(riner::GeometryType::kFan2d, 1, 64, 1, {256, 256}, 2.0, 1.0);
+    const riner::Phantom p = riner::tube_wall(g);
+    const riner::TubeWallShape t = riner::tube_wall_shape(g);
+    CHECK(t.inner_mm == doctest::Approx(59.904));
+    CHECK(t.outer_mm == doctest::Approx(66.048));
+    const double mid = 0.5 * (t.inner_mm + t.outer_mm);
+    for (double phi = 0.0; phi < 2.0 * M_PI; phi += 0.7) {  // the same all the way round
+      CHECK(p.value_at({mid * std::cos(phi), mid * std::sin(phi), 0.0}) == doctest::Approx(t.wall));
+    }
+    CHECK(p.value_at({0.0, 40.0, 0.0}) == doctest::Approx(t.inside));
+    CHECK(p.value_at({0.0, -80.0, 0.0}) == doctest::Approx(t.water));
+    CHECK(p.value_at({0.0, 120.0, 0.0}) == 0.0);
+    // The ray just outside the wall's outer tangent crosses only water: a chord of the
+    // water disc.
+    const riner::Ray tangent{{-200.0, t.outer_mm + 1e-6, 0.0}, {1.0, 0.0, 0.0}};
+    const double water = 2.0 * std::sqrt(std::pow(0.39 * 256.0, 2) - t.outer_mm * t.outer_mm);
+    CHECK(p.line_integral(tangent) == doctest::Approx(water * t.water).epsilon(1e-6));
+  }
 }

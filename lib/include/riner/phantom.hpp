@@ -48,6 +48,22 @@ Phantom shepp_logan(const Geometry& g, double mu_scale = 0.1);
 // grid's height.
 Phantom faint_square(const Geometry& g);
 
+// Real concentric structure (issue 32: a ring about the axis that is object, not artifact): a
+// water-like disc (0.02 / mm, radius 0.39 x the grid's smaller width) holding a tube whose wall
+// (0.045 / mm, radii 0.234-0.258 x the width, 6 px at 256) is centred on the rotation axis,
+// filled with 0.018 / mm, and four off-centre discs. In 3D cylinders along z (0.6 x the
+// grid's height).
+Phantom tube_wall(const Geometry& g);
+// Its wall: the inner and outer radius (mm) and the value there.
+struct TubeWallShape {
+  double inner_mm = 0.0;
+  double outer_mm = 0.0;
+  double wall = 0.045;
+  double inside = 0.018;
+  double water = 0.02;
+};
+TubeWallShape tube_wall_shape(const Geometry& g);
+
 // Voxel averages over supersample^d points per voxel, on the geometry's grid.
 Array rasterize(const Phantom& phantom, const Geometry& g, int supersample = 4);
 

@@ -153,6 +153,39 @@ Phantom faint_square(const Geometry& g) {
   return p;
 }
 
+TubeWallShape tube_wall_shape(const Geometry& g) {
+  g.validate();
+  const std::size_t rank = g.volume_shape.size();
+  const double width = g.voxel_mm * static_cast<double>(std::min(g.volume_shape[rank - 1],
+                                                                 g.volume_shape[rank - 2]));
+  TubeWallShape t;
+  t.inner_mm = 0.234 * width;
+  t.outer_mm = 0.258 * width;
+  return t;
+}
+
+Phantom tube_wall(const Geometry& g) {
+  const TubeWallShape t = tube_wall_shape(g);
+  const std::size_t rank = g.volume_shape.size();
+  const double width = g.voxel_mm * static_cast<double>(std::min(g.volume_shape[rank - 1],
+                                                                 g.volume_shape[rank - 2]));
+  const double z = g.is_3d() ? 0.3 * g.voxel_mm * static_cast<double>(g.volume_shape[0]) : 1.0;
+  Phantom p;
+  // Values add up where discs overlap: water, the wall on it, the tube's content on both.
+  auto disc = [&](double x, double y, double r_mm, double value) {
+    p.ellipsoids.push_back({{x * width, y * width, 0.0}, {r_mm, r_mm, z}, {1, 0, 0, 0, 1, 0, 0, 0, 1},
+                            value});
+  };
+  disc(0.0, 0.0, 0.39 * width, t.water);
+  disc(0.0, 0.0, t.outer_mm, t.wall - t.water);
+  disc(0.0, 0.0, t.inner_mm, t.inside - t.wall);
+  disc(0.12, -0.08, 0.04 * width, 0.012);
+  disc(-0.14, 0.06, 0.03 * width, -0.008);
+  disc(0.29, 0.16, 0.035 * width, 0.015);
+  disc(-0.04, -0.31, 0.027 * width, 0.008);
+  return p;
+}
+
 Array rasterize(const Phantom& phantom, const Geometry& g, int supersample) {
   if (supersample < 1 || supersample > 64) throw InputError("supersample must be in 1..64");
   g.validate();
