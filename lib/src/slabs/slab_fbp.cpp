@@ -54,15 +54,29 @@ RowRange fbp_rows_reached(const Geometry& g, std::size_t first, std::size_t coun
   return {static_cast<std::size_t>(first_row), static_cast<std::size_t>(end_row - first_row)};
 }
 
-std::size_t fbp_slab_bytes(const Geometry& g, std::size_t slices) {
+namespace {
+
+// What FBP of the first `slices` slices holds: the readings of the rows they reach (the
+// outermost slab reaches the most rows in a cone beam) and their voxels.
+struct SlabSize {
+  double readings = 0.0;
+  double voxels = 0.0;
+};
+
+SlabSize fbp_slab_size(const Geometry& g, std::size_t slices) {
   slices = std::min(slices, g.volume_shape[0]);
-  // The outermost slab reaches the most rows in a cone beam.
   const double rows = static_cast<double>(fbp_rows_reached(g, 0, slices).count);
-  const double readings = static_cast<double>(g.n_views()) * static_cast<double>(g.n_u) * rows;
-  const double voxels = static_cast<double>(slices) * static_cast<double>(g.volume_shape[1]) *
-                        static_cast<double>(g.volume_shape[2]);
+  return {static_cast<double>(g.n_views()) * static_cast<double>(g.n_u) * rows,
+          static_cast<double>(slices) * static_cast<double>(g.volume_shape[1]) *
+              static_cast<double>(g.volume_shape[2])};
+}
+
+}  // namespace
+
+std::size_t fbp_slab_bytes(const Geometry& g, std::size_t slices) {
+  const SlabSize s = fbp_slab_size(g, slices);
   return kBaseBytes +
-         static_cast<std::size_t>(4.0 * (kReadingCopies * readings + kVoxelCopies * voxels));
+         static_cast<std::size_t>(4.0 * (kReadingCopies * s.readings + kVoxelCopies * s.voxels));
 }
 
 std::size_t fbp_slices_within(const Geometry& g, std::size_t limit) {
@@ -71,12 +85,8 @@ std::size_t fbp_slices_within(const Geometry& g, std::size_t limit) {
 }
 
 std::size_t fbp_slab_device_bytes(const Geometry& g, std::size_t slices) {
-  slices = std::min(slices, g.volume_shape[0]);
-  const double rows = static_cast<double>(fbp_rows_reached(g, 0, slices).count);
-  const double readings = static_cast<double>(g.n_views()) * static_cast<double>(g.n_u) * rows;
-  const double voxels = static_cast<double>(slices) * static_cast<double>(g.volume_shape[1]) *
-                        static_cast<double>(g.volume_shape[2]);
-  return static_cast<std::size_t>(4.0 * (2.0 * readings + voxels));
+  const SlabSize s = fbp_slab_size(g, slices);
+  return static_cast<std::size_t>(4.0 * (2.0 * s.readings + s.voxels));
 }
 
 std::size_t fbp_device_slices_within(const Geometry& g, std::size_t device_limit,
@@ -85,15 +95,10 @@ std::size_t fbp_device_slices_within(const Geometry& g, std::size_t device_limit
   std::size_t slices = most_slices_within(
       nz, device_limit, [&](std::size_t n) { return fbp_slab_device_bytes(g, n); });
   if (max_alloc) {
+    // Its largest buffer: the readings, or the volume.
     slices = std::min(slices, most_slices_within(nz, max_alloc, [&](std::size_t n) {
-                        const double rows = static_cast<double>(fbp_rows_reached(g, 0, n).count);
-                        const double voxels = static_cast<double>(n) *
-                                              static_cast<double>(g.volume_shape[1]) *
-                                              static_cast<double>(g.volume_shape[2]);
-                        return static_cast<std::size_t>(
-                            4.0 * std::max(static_cast<double>(g.n_views()) *
-                                               static_cast<double>(g.n_u) * rows,
-                                           voxels));
+                        const SlabSize s = fbp_slab_size(g, n);
+                        return static_cast<std::size_t>(4.0 * std::max(s.readings, s.voxels));
                       }));
   }
   return slices;
