@@ -24,6 +24,10 @@ void add_scan_options(Args& args) {
               "frames (averaged)",
               "")
       .option("dark", "FILE", "dark field (no beam) for --flat, likewise; default: none (0)", "")
+      .option("flat-after", "FILE",
+              "flats taken after the scan (--flat: before it): each view's flat field is "
+              "interpolated between the two, for a beam that drifts during the scan",
+              "")
       .option("row", "N",
               "reconstruct detector row N of a projection stack with a 2D geometry (one slice)", "")
       .option("offset-px", "PX|auto",
@@ -35,7 +39,8 @@ void add_scan_options(Args& args) {
 ScanSource source_from(const Args& args) {
   ScanSource source{args.get("SCAN"), args.get("geometry"),
                     args.get("flat"), args.get("dark"),
-                    std::nullopt,     args.has("offset-px") ? args.get("offset-px") : ""};
+                    std::nullopt,     args.has("offset-px") ? args.get("offset-px") : "",
+                    args.get("flat-after")};
   if (const std::string r = args.get("row"); !r.empty()) {
     const long n = args.integer("row");
     if (n < 0) throw UsageError("--row must be 0 or more");
@@ -49,6 +54,9 @@ ScanSource source_from(const Args& args) {
   }
   if (!scan_json && !source.dark.empty() && source.flat.empty()) {
     throw UsageError("--dark needs --flat (and SCAN holding raw projections)");
+  }
+  if (!source.flat_after.empty() && source.flat.empty()) {
+    throw UsageError("--flat-after needs --flat (the flats before the scan)");
   }
   if (source.offset_px != "auto" && !source.offset_px.empty()) args.number("offset-px");
   return source;

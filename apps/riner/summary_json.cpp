@@ -196,7 +196,13 @@ nlohmann::json flat_field_json(const FlatFieldReport& r) {
   return {{"flat_frames", r.flat_frames},
           {"dark_frames", r.dark_frames},
           {"invalid_readings", r.invalid_readings},
-          {"pixels_without_beam", r.pixels_without_beam}};
+          {"pixels_without_beam", r.pixels_without_beam},
+          {"flat_series", r.flat_series},
+          {"flat_change", r.flat_change},
+          {"air_first", std::isfinite(r.air_first) ? nlohmann::json(r.air_first) : nullptr},
+          {"air_last", std::isfinite(r.air_last) ? nlohmann::json(r.air_last) : nullptr},
+          {"air_drift_sigmas", r.air_drift_sigmas},
+          {"air_drifts", air_drifts(r)}};
 }
 
 nlohmann::json device_json(const DeviceInfo& d) {

@@ -95,7 +95,7 @@ TEST_CASE("a scan's rows normalise by the flats and darks of the same rows") {
       "angles": {"count": 4, "range_rad": 3.141592653589793},
       "volume": {"shape": [6, 5, 5], "voxel_mm": 1.0}})");
   const riner::ScanSource spec{(dir / "raw.npy").string(), "", (dir / "flat.npy").string(),
-                               (dir / "dark.npy").string(), std::nullopt, ""};
+                               (dir / "dark.npy").string(), std::nullopt, "", ""};
   const riner::LoadedScan whole = riner::load_scan_source(spec);
   const riner::ScanRows rows(spec);
   CHECK(rows.shape() == std::vector<std::size_t>{4, 6, 5});
@@ -124,7 +124,7 @@ TEST_CASE("a scan's rows normalise by the flats and darks of the same rows") {
   riner::write_array(dir / "sino.npy", riner::Array({4, 5}, 0.5f));
   CHECK_THROWS_WITH_AS(
       riner::ScanRows({(dir / "sino.npy").string(), (dir / "g2.json").string(), "", "",
-                       std::nullopt, ""}),
+                       std::nullopt, "", ""}),
       doctest::Contains("slabs of detector rows need a 3D geometry"), riner::InputError);
 }
 

@@ -2,7 +2,11 @@
 // readings NaN and counted.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
 
 #include "riner/error.hpp"
 #include "riner/flat_field.hpp"
@@ -93,5 +97,89 @@ TEST_SUITE("flat_field") {
     CHECK(message(Array({2, 3}, 100.0f), Array({4, 3, 2}, 1.0f)).find("the dark field is") == 0);
     CHECK(message(Array({2, 3}, 100.0f), Array({2, 3}, 60.0f)).find("no projection reading") == 0);
     CHECK(message(Array({2, 3}, 100.0f), Array({0, 2, 3})).find("the dark field") == 0);
+  }
+}
+
+TEST_SUITE("flat_field") {
+  // A beam that weakens by 4% over 200 views, on a 40-element detector whose 8 outer elements
+  // see air: flats before and after, Poisson-free readings.
+  struct Drifting {
+    Array raw{{200, 40}};
+    Array rho_true{{200, 40}};
+    Array before{{3, 40}};
+    Array after{{2, 40}};
+  };
+  Drifting drifting_scan(double drop) {
+    Drifting d;
+    auto beam = [&](std::size_t e, double at) {  // at: position on the views' axis
+      return (2000.0 + 20.0 * static_cast<double>(e)) * (1.0 - drop * (at + 0.5) / 200.0);
+    };
+    for (std::size_t e = 0; e < 40; ++e) {
+      for (std::size_t f = 0; f < 3; ++f) d.before.data[f * 40 + e] = beam(e, -0.5);
+      for (std::size_t f = 0; f < 2; ++f) d.after.data[f * 40 + e] = beam(e, 199.5);
+      for (std::size_t v = 0; v < 200; ++v) {
+        const bool air = e < 4 || e >= 36;
+        const double rho = air ? 0.0 : 0.5 + 0.3 * std::sin(0.1 * v + 0.2 * e);
+        d.rho_true.data[v * 40 + e] = static_cast<float>(rho);
+        d.raw.data[v * 40 + e] = static_cast<float>(beam(e, static_cast<double>(v)) * std::exp(-rho));
+      }
+    }
+    return d;
+  }
+
+  TEST_CASE("flats before and after: each view's flat interpolated, the drift measured") {
+    const Drifting d = drifting_scan(0.04);
+    const riner::FlatStack flats = riner::flats_before_after(d.before, d.after, d.raw.shape);
+    REQUIRE(flats.frames.shape == std::vector<std::size_t>{5, 40});
+    CHECK(flats.positions == std::vector<double>{-0.5, -0.5, -0.5, 199.5, 199.5});
+    FlatFieldReport report;
+    const Array rho =
+        riner::flat_field_normalise(d.raw, flats.frames, Array(), &report, flats.positions);
+    double worst = 0.0;
+    for (std::size_t i = 0; i < rho.size(); ++i) {
+      worst = std::max(worst, std::fabs(static_cast<double>(rho.data[i]) - d.rho_true.data[i]));
+    }
+    CHECK(worst < 1e-5);
+    CHECK(report.flat_frames == 5);
+    CHECK(report.flat_series == 2);
+    CHECK(report.flat_change == doctest::Approx(-0.04 * 200.0 / 200.0).epsilon(0.02));
+    CHECK_FALSE(riner::air_drifts(report));  // the flats followed the beam
+    CHECK(riner::air_drift_line(report).empty());
+
+    // The flats before alone (averaged, as riner did): the air reads the drift, and says so.
+    FlatFieldReport one;
+    const Array stale = riner::flat_field_normalise(d.raw, d.before, Array(), &one);
+    CHECK(one.flat_series == 1);
+    CHECK(one.air_first == doctest::Approx(0.002).epsilon(0.1));  // -ln(1 - 0.04 * 10 / 200)
+    CHECK(one.air_last == doctest::Approx(0.0388).epsilon(0.05));
+    CHECK(riner::air_drifts(one));
+    CHECK(riner::air_drift_line(one).find("--flat-after") != std::string::npos);
+    worst = 0.0;
+    for (std::size_t i = 0; i < stale.size(); ++i) {
+      worst = std::max(worst, std::fabs(static_cast<double>(stale.data[i]) - d.rho_true.data[i]));
+    }
+    CHECK(worst > 0.03);  // the last views read the drift as attenuation
+  }
+
+  TEST_CASE("a steady beam is not called drift, noise or no noise; flats of two shapes are an error") {
+    const Drifting steady = drifting_scan(0.0);
+    FlatFieldReport report;
+    (void)riner::flat_field_normalise(steady.raw, steady.before, Array(), &report);
+    CHECK(report.air_first == doctest::Approx(0.0));
+    CHECK_FALSE(riner::air_drifts(report));
+    // With noise (1% per reading) and a drift under it, still nothing.
+    Drifting noisy = drifting_scan(0.002);
+    std::uint32_t state = 12345u;
+    for (float& x : noisy.raw.data) {
+      state = state * 1664525u + 1013904223u;
+      x *= 1.0f + 0.01f * (static_cast<float>(state >> 8) / 16777216.0f - 0.5f) * 3.46f;
+    }
+    (void)riner::flat_field_normalise(noisy.raw, noisy.before, Array(), &report);
+    CHECK_FALSE(riner::air_drifts(report));
+    CHECK_THROWS_AS(riner::flats_before_after(steady.before, Array({2, 30}), steady.raw.shape),
+                    riner::InputError);
+    // A position per frame, or an error.
+    CHECK_THROWS_AS(riner::flat_field_normalise(steady.raw, steady.before, Array(), nullptr, {0.0}),
+                    riner::InputError);
   }
 }

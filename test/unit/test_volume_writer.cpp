@@ -110,7 +110,7 @@ TEST_CASE("a stack's FBP (parallel) or FDK (cone) by slabs equals its FBP whole"
     riner::FbpOptions options;
     options.engine = riner::Engine::kReference;
     const riner::Array whole = riner::fbp(riner::Scan{sino, g}, options);
-    const riner::ScanRows source({(dir / "sino.npy").string(), "", "", "", std::nullopt, ""});
+    const riner::ScanRows source({(dir / "sino.npy").string(), "", "", "", std::nullopt, "", ""});
     const std::size_t nz = g.volume_shape[0];
     for (std::size_t per : {std::size_t{1}, std::size_t{3}, nz}) {
       CAPTURE(per);

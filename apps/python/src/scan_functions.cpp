@@ -174,7 +174,7 @@ void bind_scan_functions(py::module_& m) {
     LoadedScan loaded;
     {
       py::gil_scoped_release release;
-      loaded = load_scan_source({path, geometry, flat, dark, row, offset_px});
+      loaded = load_scan_source({path, geometry, flat, dark, row, offset_px, ""});
     }
     const nlohmann::json notes = {
         {"flat_field",

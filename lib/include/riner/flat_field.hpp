@@ -5,8 +5,10 @@
 
 #include <cstddef>
 #include <filesystem>
+#include <limits>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "riner/array.hpp"
 #include "riner/scan.hpp"
@@ -21,25 +23,66 @@ struct FlatFieldReport {
   std::size_t invalid_readings = 0;
   // Detector pixels with F - D <= 0 or no finite flat or dark frame: all their readings are NaN.
   std::size_t pixels_without_beam = 0;
+  // Flat series taken at different times (before and after the scan, say) and the beam's
+  // change from the first to the last, the median over pixels of (F - D) last / first - 1.
+  std::size_t flat_series = 1;
+  double flat_change = 0.0;
+  // The check of the flats against the projections (flat_field_drift): the air's reading, -ln
+  // of its light over the flat's, in the first and the last tenth of the views, and the change
+  // between them in units of its noise; NaN when the projections show no air.
+  double air_first = std::numeric_limits<double>::quiet_NaN();
+  double air_last = std::numeric_limits<double>::quiet_NaN();
+  double air_drift_sigmas = 0.0;
 };
+
+// Whether the air reads differently at the scan's start and end by more than
+// kAirDriftSigmas of its noise and kAirDriftLeast: a beam or detector that drifted during the
+// scan, which a flat field taken at one time turns into rings and bands.
+constexpr double kAirDriftSigmas = 6.0;
+constexpr double kAirDriftLeast = 0.005;
+bool air_drifts(const FlatFieldReport& report);
+// One line naming the drift and what to do about it (empty when air_drifts is false).
+std::string air_drift_line(const FlatFieldReport& report);
 
 // projections: [views, elements] or [views, rows, columns]. flats and darks: one frame (the
 // shape of one view) or a stack of frames along a first axis, averaged per pixel over their
 // finite values; darks may be Array() (no dark: D = 0). InputError when a frame's shape is not a
 // view's, or when no reading is left valid.
+// flat_positions: where each flat frame was taken on the views' axis (-0.5: before view 0,
+// views - 0.5: after the last); frames at one position are a series, averaged. With two or more
+// series each view's flat is interpolated linearly between the series either side of it (the
+// first's and the last's beyond them): a beam that drifts during the scan. Empty: one series.
 Array flat_field_normalise(const Array& projections, const Array& flats, const Array& darks,
-                           FlatFieldReport* report = nullptr);
+                           FlatFieldReport* report = nullptr,
+                           const std::vector<double>& flat_positions = {});
+
+// The check of a normalised measurement [views, ...] against drift: the elements (pixels) whose
+// median reading over the views is among the lowest 5% (at least 3) are taken for air, and
+// their mean reading per view compared between the first and the last tenth of the views.
+// Sets report's air_first, air_last and air_drift_sigmas.
+void flat_field_drift(const Array& rho, FlatFieldReport& report);
 
 // A scan from raw arrays: normalised, with only detector row `row` (when set: a 2D slice of a
 // 3D stack) and checked against the geometry. `what` names the data in messages.
 Scan raw_scan(Geometry geometry, const Array& projections, const Array& flats, const Array& darks,
               std::optional<std::size_t> row, const std::string& what,
-              FlatFieldReport* report = nullptr);
+              FlatFieldReport* report = nullptr, const std::vector<double>& flat_positions = {});
+
+// Flats before the scan and flats after it as one stack with their positions (for
+// flat_field_normalise), for projections of `projections_shape`; `after` may be Array() (then
+// `before` alone, one series). InputError when their frames differ in shape.
+struct FlatStack {
+  Array frames;
+  std::vector<double> positions;
+};
+FlatStack flats_before_after(const Array& before, const Array& after,
+                             const std::vector<std::size_t>& projections_shape);
 
 // The same from files: each a file, a folder of TIFFs or a pattern (riner/io.hpp's read_array);
-// `darks` may be empty. The geometry as load_scan finds it.
+// `darks` and `flats_after` may be empty. The geometry as load_scan finds it.
 Scan load_raw_scan(const std::filesystem::path& projections, const std::filesystem::path& flats,
                    const std::filesystem::path& darks, const std::filesystem::path& geometry = {},
-                   FlatFieldReport* report = nullptr, std::optional<std::size_t> row = {});
+                   FlatFieldReport* report = nullptr, std::optional<std::size_t> row = {},
+                   const std::filesystem::path& flats_after = {});
 
 }  // namespace riner

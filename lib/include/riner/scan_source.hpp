@@ -22,6 +22,7 @@ struct ScanSource {
   std::string dark;
   std::optional<std::size_t> row;
   std::string offset_px;  // "", a number, or "auto"
+  std::string flat_after;  // flats taken after the scan: each view's flat interpolated
 };
 
 struct LoadedScan {

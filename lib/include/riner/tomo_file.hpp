@@ -22,6 +22,9 @@ struct TomoFile {
   Array projections;               // [views, rows, columns]
   Array flats;                     // [frames, rows, columns]; empty shape when the file has none
   Array darks;                     // likewise
+  // Where each flat was taken among the projections (NXtomo's image_key order: the projections
+  // before it, less a half); empty when the file does not say (Data Exchange): one series.
+  std::vector<double> flat_positions;
   std::vector<double> angles_deg;  // per projection, as the file states them (may be empty)
 };
 

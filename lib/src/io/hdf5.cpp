@@ -168,6 +168,11 @@ TomoFile read_nxtomo(const Hid& file, const std::filesystem::path& path, const s
   t.projections = frames_with_key(all, keys, 0);
   t.flats = frames_with_key(all, keys, 1);
   t.darks = frames_with_key(all, keys, 2);
+  double projections_before = 0.0;
+  for (double key : keys) {
+    if (static_cast<int>(key) == 0) projections_before += 1.0;
+    if (static_cast<int>(key) == 1) t.flat_positions.push_back(projections_before - 0.5);
+  }
   if (t.projections.shape.empty()) {
     throw InputError(where(path, keys_path) + "no frame has image_key 0 (a projection)");
   }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <vector>
 
@@ -47,10 +48,138 @@ std::vector<double> frame_mean(const Array& frames, const std::vector<std::size_
   return sum;
 }
 
+// The frames of `flats` at each distinct position, in order of position.
+struct FlatSeries {
+  double position = 0.0;
+  Array frames;
+};
+
+std::vector<FlatSeries> flat_series(const Array& flats, const std::vector<double>& positions,
+                                    const std::vector<std::size_t>& view_shape) {
+  const bool stack = flats.rank() == view_shape.size() + 1;
+  const std::size_t frames = stack ? flats.shape[0] : 1;
+  if (positions.empty()) return {{0.0, flats}};
+  if (positions.size() != frames) {
+    throw InputError(std::to_string(positions.size()) + " flat positions for " +
+                     std::to_string(frames) + " flat frames");
+  }
+  std::vector<double> distinct = positions;
+  std::sort(distinct.begin(), distinct.end());
+  distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+  const std::size_t pixels = shape_size(view_shape);
+  std::vector<FlatSeries> out;
+  for (double at : distinct) {
+    std::vector<std::size_t> members;
+    for (std::size_t f = 0; f < frames; ++f) {
+      if (positions[f] == at) members.push_back(f);
+    }
+    std::vector<std::size_t> shape = view_shape;
+    shape.insert(shape.begin(), members.size());
+    Array series(shape);
+    for (std::size_t m = 0; m < members.size(); ++m) {
+      std::copy(flats.ptr() + members[m] * pixels, flats.ptr() + (members[m] + 1) * pixels,
+                series.data.begin() + static_cast<std::ptrdiff_t>(m * pixels));
+    }
+    out.push_back({at, std::move(series)});
+  }
+  return out;
+}
+
+double median_of(std::vector<double> values) {
+  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const auto mid = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), mid, values.end());
+  return *mid;
+}
+
 }  // namespace
 
+bool air_drifts(const FlatFieldReport& r) {
+  return std::isfinite(r.air_first) && std::isfinite(r.air_last) &&
+         r.air_drift_sigmas > kAirDriftSigmas && std::fabs(r.air_last - r.air_first) > kAirDriftLeast;
+}
+
+std::string air_drift_line(const FlatFieldReport& r) {
+  if (!air_drifts(r)) return "";
+  char line[400];
+  std::snprintf(line, sizeof(line),
+                "note: the air reads %.4f in the first tenth of the views and %.4f in the last "
+                "(%.1f%% %s light, %.0f times its noise): the beam or the detector drifted "
+                "during the scan, and a flat field from one time leaves rings and bands; %s",
+                r.air_first, r.air_last, 100.0 * std::fabs(std::expm1(r.air_first - r.air_last)),
+                r.air_last > r.air_first ? "less" : "more", r.air_drift_sigmas,
+                r.flat_series > 1 ? "the flats before and after did not follow it (check them)"
+                                  : "give flats from after the scan too (--flat-after)");
+  return line;
+}
+
+void flat_field_drift(const Array& rho, FlatFieldReport& r) {
+  r.air_first = r.air_last = std::numeric_limits<double>::quiet_NaN();
+  r.air_drift_sigmas = 0.0;
+  if (rho.rank() < 2 || rho.shape[0] < 20) return;
+  const std::size_t views = rho.shape[0];
+  const std::size_t pixels = rho.size() / views;
+  // Air: the elements that read least over the scan (each element's median over the views),
+  // among at most kDriftPixels of them spread over the detector (a stack's frames are large).
+  constexpr std::size_t kDriftPixels = 4096;
+  const std::size_t stride = std::max<std::size_t>(1, pixels / kDriftPixels);
+  std::vector<std::pair<double, std::size_t>> level;
+  std::vector<double> column(views);
+  for (std::size_t p = 0; p < pixels; p += stride) {
+    std::size_t n = 0;
+    for (std::size_t v = 0; v < views; ++v) {
+      const float x = rho.data[v * pixels + p];
+      if (std::isfinite(x)) column[n++] = x;
+    }
+    if (n * 2 < views) continue;
+    level.push_back({median_of(std::vector<double>(column.begin(), column.begin() + n)), p});
+  }
+  if (level.size() < 3) return;
+  std::sort(level.begin(), level.end());
+  const std::size_t air = std::max<std::size_t>(3, level.size() / 20);
+  // The air's mean reading per view.
+  std::vector<double> per_view(views, 0.0);
+  for (std::size_t v = 0; v < views; ++v) {
+    double sum = 0.0;
+    std::size_t n = 0;
+    for (std::size_t a = 0; a < air; ++a) {
+      const float x = rho.data[v * pixels + level[a].second];
+      if (std::isfinite(x)) {
+        sum += x;
+        ++n;
+      }
+    }
+    per_view[v] = n ? sum / static_cast<double>(n) : std::numeric_limits<double>::quiet_NaN();
+  }
+  // Its noise from view to view (differences of neighbours: a slow drift does not enter).
+  std::vector<double> steps;
+  for (std::size_t v = 1; v < views; ++v) {
+    if (std::isfinite(per_view[v]) && std::isfinite(per_view[v - 1])) {
+      steps.push_back(std::fabs(per_view[v] - per_view[v - 1]));
+    }
+  }
+  const double sigma = 1.4826 * median_of(steps) / std::sqrt(2.0);
+  const std::size_t tenth = std::max<std::size_t>(2, views / 10);
+  auto mean_of = [&](std::size_t first) {
+    double sum = 0.0;
+    std::size_t n = 0;
+    for (std::size_t v = first; v < first + tenth; ++v) {
+      if (std::isfinite(per_view[v])) {
+        sum += per_view[v];
+        ++n;
+      }
+    }
+    return n ? sum / static_cast<double>(n) : std::numeric_limits<double>::quiet_NaN();
+  };
+  r.air_first = mean_of(0);
+  r.air_last = mean_of(views - tenth);
+  const double error = sigma * std::sqrt(2.0 / static_cast<double>(tenth));
+  r.air_drift_sigmas = error > 0.0 ? std::fabs(r.air_last - r.air_first) / error
+                                   : (r.air_last != r.air_first ? 1e9 : 0.0);
+}
+
 Array flat_field_normalise(const Array& projections, const Array& flats, const Array& darks,
-                           FlatFieldReport* report) {
+                           FlatFieldReport* report, const std::vector<double>& flat_positions) {
   if (projections.rank() != 2 && projections.rank() != 3) {
     throw InputError("projections are " + shape_string(projections.shape) +
                      "; expected [views, elements] or [views, rows, columns]");
@@ -58,22 +187,47 @@ Array flat_field_normalise(const Array& projections, const Array& flats, const A
   const std::vector<std::size_t> view_shape(projections.shape.begin() + 1, projections.shape.end());
   const std::size_t pixels = shape_size(view_shape);
   FlatFieldReport r;
-  const std::vector<double> flat = frame_mean(flats, view_shape, "the flat field", &r.flat_frames);
   std::vector<double> dark(pixels, 0.0);
   if (!darks.shape.empty()) dark = frame_mean(darks, view_shape, "the dark field", &r.dark_frames);
-
-  // Per pixel: the beam's strength F - D, NaN where there is none.
-  std::vector<double> beam(pixels);
-  for (std::size_t p = 0; p < pixels; ++p) {
-    beam[p] = flat[p] - dark[p];
-    if (!(beam[p] > 0.0)) {
-      beam[p] = std::numeric_limits<double>::quiet_NaN();
-      ++r.pixels_without_beam;
+  // Each series' beam F - D per pixel, NaN where there is none (in any series).
+  const std::vector<FlatSeries> series = flat_series(flats, flat_positions, view_shape);
+  std::vector<std::vector<double>> beams;
+  std::vector<char> no_beam(pixels, 0);
+  for (const FlatSeries& s : series) {
+    std::size_t frames = 0;
+    std::vector<double> beam = frame_mean(s.frames, view_shape, "the flat field", &frames);
+    r.flat_frames += frames;
+    for (std::size_t p = 0; p < pixels; ++p) {
+      beam[p] -= dark[p];
+      if (!(beam[p] > 0.0)) no_beam[p] = 1;
     }
+    beams.push_back(std::move(beam));
+  }
+  r.flat_series = series.size();
+  for (std::size_t p = 0; p < pixels; ++p) r.pixels_without_beam += no_beam[p];
+  if (beams.size() > 1) {
+    std::vector<double> change;
+    for (std::size_t p = 0; p < pixels; ++p) {
+      if (!no_beam[p]) change.push_back(beams.back()[p] / beams.front()[p] - 1.0);
+    }
+    r.flat_change = change.empty() ? 0.0 : median_of(change);
   }
   Array rho(projections.shape);
   const std::size_t views = projections.shape[0];
+  std::vector<double> beam(pixels);
   for (std::size_t v = 0; v < views; ++v) {
+    // This view's beam: between the series either side of it.
+    const double at = static_cast<double>(v);
+    std::size_t hi = 0;
+    while (hi < series.size() && series[hi].position < at) ++hi;
+    const std::size_t lo = hi == 0 ? 0 : hi - 1;
+    hi = std::min(hi, series.size() - 1);
+    const double span = series[hi].position - series[lo].position;
+    const double w = span > 0.0 ? (at - series[lo].position) / span : 0.0;
+    for (std::size_t p = 0; p < pixels; ++p) {
+      beam[p] = no_beam[p] ? std::numeric_limits<double>::quiet_NaN()
+                           : (1.0 - w) * beams[lo][p] + w * beams[hi][p];
+    }
     for (std::size_t p = 0; p < pixels; ++p) {
       const std::size_t i = v * pixels + p;
       const double light = static_cast<double>(projections.data[i]) - dark[p];
@@ -90,12 +244,44 @@ Array flat_field_normalise(const Array& projections, const Array& flats, const A
         "no projection reading is above its dark field under a flat field above "
         "its dark: check the flat and dark files");
   }
+  flat_field_drift(rho, r);
   if (report) *report = r;
   return rho;
 }
 
+FlatStack flats_before_after(const Array& before, const Array& after,
+                             const std::vector<std::size_t>& projections_shape) {
+  if (after.shape.empty()) return {before, {}};
+  const std::size_t view_rank = projections_shape.size() - 1;
+  auto frames_of = [&](const Array& a) { return a.rank() == view_rank + 1 ? a.shape[0] : 1; };
+  auto frame_shape = [&](const Array& a) {
+    return std::vector<std::size_t>(a.shape.end() - static_cast<std::ptrdiff_t>(
+                                                        std::min(view_rank, a.rank())),
+                                    a.shape.end());
+  };
+  const std::vector<std::size_t> view = frame_shape(before);
+  if (view != frame_shape(after) || after.rank() < view_rank || after.rank() > view_rank + 1) {
+    throw InputError("the flats after the scan are " + shape_string(after.shape) +
+                     ", the flats before " + shape_string(before.shape) +
+                     ": they must be frames of one shape");
+  }
+  const std::size_t views = projections_shape[0];
+  const std::size_t n_before = frames_of(before);
+  const std::size_t n_after = frames_of(after);
+  std::vector<std::size_t> shape = view;
+  shape.insert(shape.begin(), n_before + n_after);
+  FlatStack out{Array(shape), {}};
+  std::copy(before.data.begin(), before.data.end(), out.frames.data.begin());
+  std::copy(after.data.begin(), after.data.end(),
+            out.frames.data.begin() + static_cast<std::ptrdiff_t>(before.size()));
+  out.positions.assign(n_before, -0.5);
+  out.positions.resize(n_before + n_after, static_cast<double>(views) - 0.5);
+  return out;
+}
+
 Scan raw_scan(Geometry geometry, const Array& projections, const Array& flats, const Array& darks,
-              std::optional<std::size_t> row, const std::string& what, FlatFieldReport* report) {
+              std::optional<std::size_t> row, const std::string& what, FlatFieldReport* report,
+              const std::vector<double>& flat_positions) {
   Scan scan;
   scan.geometry = std::move(geometry);
   FlatFieldReport r;
@@ -105,9 +291,10 @@ Scan raw_scan(Geometry geometry, const Array& projections, const Array& flats, c
       const Array projection_row = detector_row(projections, *row);
       const Array flat_row = detector_row(flats, *row);
       const Array dark_row = darks.shape.empty() ? Array() : detector_row(darks, *row);
-      scan.measurement = flat_field_normalise(projection_row, flat_row, dark_row, &r);
+      scan.measurement =
+          flat_field_normalise(projection_row, flat_row, dark_row, &r, flat_positions);
     } else {
-      scan.measurement = flat_field_normalise(projections, flats, darks, &r);
+      scan.measurement = flat_field_normalise(projections, flats, darks, &r, flat_positions);
     }
   } catch (const InputError& e) {
     throw InputError(what + ": " + e.what());
@@ -125,12 +312,15 @@ Scan raw_scan(Geometry geometry, const Array& projections, const Array& flats, c
 
 Scan load_raw_scan(const std::filesystem::path& projections, const std::filesystem::path& flats,
                    const std::filesystem::path& darks, const std::filesystem::path& geometry,
-                   FlatFieldReport* report, std::optional<std::size_t> row) {
+                   FlatFieldReport* report, std::optional<std::size_t> row,
+                   const std::filesystem::path& flats_after) {
   Geometry g = Geometry::load(find_geometry(projections, geometry));
   const ArrayFile raw = read_array(projections);
-  const Array flat = read_array(flats).array;
+  const Array after = flats_after.empty() ? Array() : read_array(flats_after).array;
+  const FlatStack flat = flats_before_after(read_array(flats).array, after, raw.array.shape);
   const Array dark = darks.empty() ? Array() : read_array(darks).array;
-  return raw_scan(std::move(g), raw.array, flat, dark, row, projections.string(), report);
+  return raw_scan(std::move(g), raw.array, flat.frames, dark, row, projections.string(), report,
+                  flat.positions);
 }
 
 }  // namespace riner

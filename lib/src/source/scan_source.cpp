@@ -63,6 +63,9 @@ bool resolve_files(ScanSource& source) {
   if (!source.dark.empty() && source.flat.empty() && !is_tomo_file(source.path)) {
     throw InputError("a dark field needs a flat field (and SCAN holding raw projections)");
   }
+  if (!source.flat_after.empty() && source.flat.empty()) {
+    throw InputError("flats after the scan need the flats before it (--flat)");
+  }
   const bool tomo_file = source.flat.empty() && is_tomo_file(source.path);
   if (tomo_file && !source.dark.empty())
     throw InputError("a tomography file brings its own dark field");
@@ -96,16 +99,19 @@ LoadedScan load_scan_source(ScanSource source) {
     require_flats(file, source.path);
     loaded.scan =
         raw_scan(Geometry::load(find_geometry(source.path, source.geometry)), file.projections,
-                 file.flats, file.darks, source.row, source.path, &report);
+                 file.flats, file.darks, source.row, source.path, &report, file.flat_positions);
     loaded.flat_field = report;
     loaded.notes.push_back(file.layout + " file: " + flat_field_line(report));
   } else if (source.flat.empty()) {
     loaded.scan = load_scan(source.path, source.geometry, source.row);
   } else {
-    loaded.scan =
-        load_raw_scan(source.path, source.flat, source.dark, source.geometry, &report, source.row);
+    loaded.scan = load_raw_scan(source.path, source.flat, source.dark, source.geometry, &report,
+                                source.row, source.flat_after);
     loaded.flat_field = report;
     loaded.notes.push_back(flat_field_line(report));
+  }
+  if (loaded.flat_field && air_drifts(*loaded.flat_field)) {
+    loaded.notes.push_back(air_drift_line(*loaded.flat_field));
   }
   if (source.offset_px == "auto") {
     loaded.centre = estimate_centre(loaded.scan);
@@ -148,13 +154,17 @@ Scan ScanRows::read(RowRange rows, FlatFieldReport* report) const {
     const TomoFile file = read_tomo_file(source_.path, rows);
     require_flats(file, source_.path);
     return raw_scan(g, file.projections, file.flats, file.darks, std::nullopt, source_.path,
-                    report);
+                    report, file.flat_positions);
   }
   if (!source_.flat.empty()) {
     const Array projections = read_array_rows(source_.path, rows).array;
-    const Array flats = frames_rows(source_.flat, rows);
+    const FlatStack flats = flats_before_after(
+        frames_rows(source_.flat, rows),
+        source_.flat_after.empty() ? Array() : frames_rows(source_.flat_after, rows),
+        projections.shape);
     const Array darks = source_.dark.empty() ? Array() : frames_rows(source_.dark, rows);
-    return raw_scan(g, projections, flats, darks, std::nullopt, source_.path, report);
+    return raw_scan(g, projections, flats.frames, darks, std::nullopt, source_.path, report,
+                    flats.positions);
   }
   ArrayFile file = read_array_rows(source_.path, rows);
   Scan scan;
@@ -166,7 +176,14 @@ Scan ScanRows::read(RowRange rows, FlatFieldReport* report) const {
 }
 
 std::string flat_field_line(const FlatFieldReport& r) {
-  return "raw projections: flat field of " + std::to_string(r.flat_frames) + " frame(s), " +
+  char series[120] = "";
+  if (r.flat_series > 1) {
+    std::snprintf(series, sizeof(series),
+                  " in %zu series interpolated by view (the beam %+.2f%% from first to last)",
+                  r.flat_series, 100.0 * r.flat_change);
+  }
+  return "raw projections: flat field of " + std::to_string(r.flat_frames) + " frame(s)" +
+         series + ", " +
          (r.dark_frames ? "dark field of " + std::to_string(r.dark_frames) + " frame(s)"
                         : std::string("no dark field")) +
          "; " + std::to_string(r.invalid_readings) +
