@@ -299,3 +299,30 @@ def test_load_scan_reads_a_scan_json_naming_raw_files(tmp_path):
         riner.load_scan(tmp_path / "scan.json", flat=tmp_path / "flat.npy")
     with pytest.raises(riner.InputError, match="nothing.npy"):
         riner.load_scan(tmp_path / "nothing.npy", geometry=tmp_path / "scan.json")
+
+
+def test_load_scan_interpolates_flats_before_and_after_a_drifting_beam(tmp_path):
+    g = riner.parallel_beam(np.linspace(0, np.pi, 41), columns=40, image_shape=(32, 32))
+    sim = riner.simulate(None, g, seed=4, photons=0, dead=0)
+    views = sim["sino"].shape[0]
+    drop = 0.08 * (np.arange(views)[:, None] + 0.5) / views  # 8% less light by the end
+    before = np.full((40,), 5000.0, dtype=np.float32)
+    after = (before * 0.92).astype(np.float32)
+    riner.write_array(tmp_path / "raw.npy", (before * (1 - drop) * np.exp(-sim["sino"])).astype(np.float32))
+    riner.write_array(tmp_path / "before.npy", before)
+    riner.write_array(tmp_path / "after.npy", after)
+    for name in ("geometry.json", "scan.json"):
+        (tmp_path / name).write_text(json.dumps(g))
+    sino, _, notes = riner.load_scan(tmp_path / "raw.npy", flat=tmp_path / "before.npy",
+                                     flat_after=tmp_path / "after.npy")
+    assert np.allclose(sino, sim["sino"], atol=1e-4, equal_nan=True)
+    assert notes["flat_field"]["flat_series"] == 2 and not notes["flat_field"]["air_drifts"]
+    _, _, stale = riner.load_scan(tmp_path / "raw.npy", flat=tmp_path / "before.npy")
+    assert stale["flat_field"]["air_drifts"]
+    # The same through a scan JSON's files.
+    (tmp_path / "scan.json").write_text(json.dumps(dict(
+        g, files={"projections": "raw.npy", "flat": "before.npy", "flat_after": "after.npy"})))
+    sino_json, _, _ = riner.load_scan(tmp_path / "scan.json")
+    assert np.array_equal(sino_json, sino, equal_nan=True)
+    with pytest.raises(riner.InputError, match="flat_after needs flat"):
+        riner.load_scan(tmp_path / "raw.npy", flat_after=tmp_path / "after.npy")

@@ -260,22 +260,27 @@ def reconstruct(sino, geometry, flat=None, dark=None, center=None, config=None, 
     return Reconstruction(image, alpha, beta, summary, field)
 
 
-def load_scan(path, geometry=None, flat=None, dark=None, row=None, center=None):
+def load_scan(path, geometry=None, flat=None, dark=None, row=None, center=None,
+              flat_after=None):
     """A scan from files, as `riner reconstruct SCAN` reads it: a measurement (.npy, .nii, .tif,
     a TIFF folder or pattern, "file.h5:/dataset"), raw projections with flat (and dark) files,
     a Data Exchange / NXtomo file with its own flats and darks, or a scan JSON naming its
     files. geometry: a JSON path (default: geometry.json beside the scan); row: one detector
-    row of a stack (a 2D slice); center "auto" estimates the offset. Returns (sino, geometry
+    row of a stack (a 2D slice); center "auto" estimates the offset; flat_after: flats taken
+    after the scan (each view's flat interpolated between the two). Returns (sino, geometry
     dict, notes dict with flat_field and centre)."""
     if center not in (None, "auto"):
         raise InputError(f"center must be None or 'auto' here (got {center!r}); "
                          "set the geometry's detector.offset_px instead")
     if dark is not None and flat is None and not os.fspath(path).endswith(".json"):
         raise InputError("dark needs flat")
+    if flat_after is not None and flat is None:
+        raise InputError("flat_after needs flat")
     sino, geometry_json, notes = _riner.load_scan(
         os.fspath(path), "" if geometry is None else os.fspath(geometry),
         "" if flat is None else os.fspath(flat), "" if dark is None else os.fspath(dark),
-        row, "" if center is None else center)
+        row, "" if center is None else center,
+        "" if flat_after is None else os.fspath(flat_after))
     return sino, json.loads(geometry_json), json.loads(notes)
 
 

@@ -170,11 +170,12 @@ void bind_scan_functions(py::module_& m) {
   // A scan as the CLI's SCAN options name it -> (measurement, geometry JSON, notes JSON).
   m.def("load_scan", [](const std::string& path, const std::string& geometry,
                         const std::string& flat, const std::string& dark,
-                        std::optional<std::size_t> row, const std::string& offset_px) {
+                        std::optional<std::size_t> row, const std::string& offset_px,
+                        const std::string& flat_after) {
     LoadedScan loaded;
     {
       py::gil_scoped_release release;
-      loaded = load_scan_source({path, geometry, flat, dark, row, offset_px, ""});
+      loaded = load_scan_source({path, geometry, flat, dark, row, offset_px, flat_after});
     }
     const nlohmann::json notes = {
         {"flat_field",

@@ -40,6 +40,7 @@ struct ScanFiles {
   std::filesystem::path projections;  // raw intensities, with
   std::filesystem::path flat;         // their flat field (may be empty for a tomography file)
   std::filesystem::path dark;         // and dark field (may be empty: D = 0)
+  std::filesystem::path flat_after;   // flats taken after the scan (may be empty)
 };
 
 // The "files" of a scan JSON; std::nullopt when it has none. InputError naming the JSON for

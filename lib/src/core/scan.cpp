@@ -79,10 +79,11 @@ std::optional<ScanFiles> read_scan_files(const std::filesystem::path& scan_json)
                                   : key == "projections" ? &out.projections
                                   : key == "flat"        ? &out.flat
                                   : key == "dark"        ? &out.dark
+                                  : key == "flat_after"  ? &out.flat_after
                                                          : nullptr;
     if (!slot) {
       throw InputError(where + ": files." + key +
-                       " is not a scan file (measurement, projections, flat, dark)");
+                       " is not a scan file (measurement, projections, flat, dark, flat_after)");
     }
     if (!value.is_string() || value.get<std::string>().empty()) {
       throw InputError(where + ": files." + key + " must be a path");
@@ -98,6 +99,9 @@ std::optional<ScanFiles> read_scan_files(const std::filesystem::path& scan_json)
   }
   if (out.flat.empty() && !out.dark.empty()) {
     throw InputError(where + ": files.dark needs files.flat");
+  }
+  if (out.flat.empty() && !out.flat_after.empty()) {
+    throw InputError(where + ": files.flat_after needs files.flat");
   }
   return out;
 }

@@ -33,6 +33,7 @@ void resolve_scan_json(ScanSource& source) {
   source.path = (files->measurement.empty() ? files->projections : files->measurement).string();
   source.flat = files->flat.string();
   source.dark = files->dark.string();
+  source.flat_after = files->flat_after.string();
   if (!files->projections.empty() && source.flat.empty() && !is_tomo_file(source.path)) {
     throw InputError(source.geometry +
                      ": files.projections needs files.flat (raw intensities are normalised "
