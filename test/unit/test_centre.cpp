@@ -121,9 +121,30 @@ TEST_SUITE("centre") {
     CHECK_THROWS_WITH_AS(riner::estimate_centre(scan_with_offset(short_scan, 1.0)),
                          doctest::Contains("no two are half a turn apart"), riner::InputError);
     riner::Scan fan;
-    fan.geometry = riner::test::small_fan2d();
+    fan.geometry = with_angles(riner::test::small_fan2d(), 40, 1.2 * M_PI, true);
     fan.measurement = riner::Array(fan.geometry.measurement_shape());
-    CHECK_THROWS_WITH_AS(riner::estimate_centre(fan), doctest::Contains("needs a parallel beam"),
+    CHECK_THROWS_WITH_AS(riner::estimate_centre(fan),
+                         doctest::Contains("views that step evenly over a full turn"),
                          riner::InputError);
+    riner::Scan cone;
+    cone.geometry = riner::test::small_cone3d();
+    cone.measurement = riner::Array(cone.geometry.measurement_shape());
+    CHECK_THROWS_WITH_AS(riner::estimate_centre(cone),
+                         doctest::Contains("needs a parallel or a fan beam"), riner::InputError);
+  }
+
+  TEST_CASE("a fan beam over a full turn: the offset from conjugate rays") {
+    for (const double offset : {2.7, -4.2, 0.0}) {
+      const riner::CentreEstimate e =
+          riner::estimate_centre(scan_with_offset(riner::test::small_fan2d(), offset));
+      CAPTURE(offset);
+      CHECK(e.method == "conjugate rays");
+      CHECK(std::fabs(e.offset_px - offset) < 0.15);
+      CHECK(e.axis_column == doctest::Approx(48.0 - e.offset_px));
+      CHECK(e.pairs > 1000);
+    }
+    // The turn's end view as well (91 views, the last at 360 degrees).
+    const riner::Geometry closed = with_angles(riner::test::small_fan2d(), 91, 2.0 * M_PI, true);
+    CHECK(std::fabs(riner::estimate_centre(scan_with_offset(closed, 1.6)).offset_px - 1.6) < 0.15);
   }
 }

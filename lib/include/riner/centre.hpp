@@ -21,7 +21,8 @@ struct CentreEstimate {
   // The spread of the estimates of the single view pairs (standard deviation, px): small when
   // they agree. With one pair, the width of the matching cost's minimum instead.
   double spread_px = 0.0;
-  std::size_t pairs = 0;  // view pairs half a turn apart that were compared
+  // View pairs half a turn apart that were compared (conjugate rays: the ray pairs).
+  std::size_t pairs = 0;
   std::size_t rows = 0;   // detector rows compared (1 in 2D)
   std::string method;     // "sinogram" or "view pairs": which gave offset_px
   // Each method's own answer (NaN where it has none): the cross-check.
@@ -34,6 +35,8 @@ struct CentreEstimate {
 // step) or between two views (interpolated in angle; a 360-degree scan with an odd number of
 // views). Non-finite readings are left out (pairs) or interpolated along the row (sinogram).
 // InputError for a divergent beam or a scan where neither works.
+// Fan beam (2D) over a full turn: from conjugate rays (method "conjugate rays",
+// preprocessing/centre_conjugate.hpp), within 32 px of the geometry's offset.
 CentreEstimate estimate_centre(const Scan& scan);
 
 }  // namespace riner

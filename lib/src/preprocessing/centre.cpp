@@ -7,6 +7,7 @@
 #include <span>
 #include <vector>
 
+#include "preprocessing/centre_conjugate.hpp"
 #include "preprocessing/centre_sinogram.hpp"
 #include "riner/error.hpp"
 
@@ -200,8 +201,26 @@ std::optional<CentreEstimate> from_view_pairs(const Scan& scan) {
 
 CentreEstimate estimate_centre(const Scan& scan) {
   const Geometry& g = scan.geometry;
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  if (g.type == GeometryType::kFan2d) {
+    const std::optional<preprocessing::ConjugateAxis> axis = preprocessing::conjugate_axis(scan);
+    if (!axis) {
+      throw InputError(
+          "centre finding in a fan beam needs views that step evenly over a full turn and a "
+          "detector of at least 8 elements; pass the offset with --offset-px");
+    }
+    CentreEstimate e;
+    e.offset_px = axis->offset_px;
+    e.axis_column = 0.5 * (static_cast<double>(g.n_u) - 1.0) - e.offset_px;
+    e.rows = 1;
+    e.pairs = axis->rays;
+    e.method = "conjugate rays";
+    e.sinogram_offset_px = kNaN;
+    e.pairs_offset_px = kNaN;
+    return e;
+  }
   if (g.is_divergent()) {
-    throw InputError(std::string("centre finding needs a parallel beam (this scan is ") +
+    throw InputError(std::string("centre finding needs a parallel or a fan beam (this scan is ") +
                      geometry_type_name(g.type) + "); pass the offset with --offset-px");
   }
   if (g.n_u < 8) throw InputError("centre finding needs a detector of at least 8 elements");
@@ -212,7 +231,6 @@ CentreEstimate estimate_centre(const Scan& scan) {
         "the views cover no evenly spaced half-turn and no two are half a turn apart (or either "
         "side of it); pass the offset with --offset-px");
   }
-  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   CentreEstimate e = pairs ? *pairs : CentreEstimate{};
   e.pairs_offset_px = pairs ? pairs->offset_px : kNaN;
   e.method = "view pairs";

@@ -207,6 +207,13 @@ std::string centre_line(const CentreEstimate& e) {
     }
     return out;
   }
+  if (e.method == "conjugate rays") {
+    std::snprintf(line, sizeof(line),
+                  "centre of rotation: offset %.2f px (axis at column %.2f) from %zu conjugate "
+                  "ray pairs of the full turn",
+                  e.offset_px, e.axis_column, e.pairs);
+    return line;
+  }
   std::snprintf(line, sizeof(line),
                 "centre of rotation: offset %.2f px (axis at column %.2f), spread %.2f px over "
                 "%zu view pair(s) x %zu row(s)",

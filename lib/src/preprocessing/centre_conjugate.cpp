@@ -1,0 +1,138 @@
+#include "preprocessing/centre_conjugate.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "riner/rays.hpp"
+
+namespace riner::preprocessing {
+
+namespace {
+
+// At most this many views and elements enter the cost (evenly spread): enough rays, a cost of
+// a few milliseconds per offset.
+constexpr std::size_t kMostViews = 180;
+constexpr std::size_t kMostElements = 512;
+
+// The reading at fractional element u of a view, linear between elements; NaN off the detector
+// or next to a non-finite reading.
+double reading_at(const Array& rho, std::size_t view, double u, std::size_t n_u) {
+  if (!(u >= 0.0) || u > static_cast<double>(n_u - 1)) return std::numeric_limits<double>::quiet_NaN();
+  const auto e = std::min(static_cast<std::size_t>(u), n_u - 2);
+  const double w = u - static_cast<double>(e);
+  const float* row = rho.ptr() + view * n_u;
+  return (1.0 - w) * row[e] + w * row[e + 1];
+}
+
+struct Turn {
+  double first = 0.0;  // the first view's source angle (rad)
+  double step = 0.0;   // between views, signed
+  std::size_t views = 0;  // views in a full turn (the scan may hold one more, the turn's end)
+};
+
+// The sources' angles about the axis, checked to step evenly over at least a full turn less
+// two steps.
+std::optional<Turn> full_turn(const Geometry& g) {
+  const std::size_t n = g.n_views();
+  if (n < 8) return std::nullopt;
+  std::vector<double> angle(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    const Vec3 s = detector_ray(g, v, 0.0).origin;
+    angle[v] = std::atan2(s.y, s.x);
+    if (v > 0) {  // unwrap
+      while (angle[v] - angle[v - 1] > M_PI) angle[v] -= 2.0 * M_PI;
+      while (angle[v] - angle[v - 1] < -M_PI) angle[v] += 2.0 * M_PI;
+    }
+  }
+  Turn t;
+  t.first = angle[0];
+  t.step = (angle[n - 1] - angle[0]) / static_cast<double>(n - 1);
+  if (t.step == 0.0) return std::nullopt;
+  for (std::size_t v = 1; v < n; ++v) {
+    if (std::fabs(angle[v] - angle[v - 1] - t.step) > 0.1 * std::fabs(t.step)) return std::nullopt;
+  }
+  const double per_turn = 2.0 * M_PI / std::fabs(t.step);
+  if (static_cast<double>(n) < per_turn - 2.0) return std::nullopt;
+  t.views = static_cast<std::size_t>(std::lround(per_turn));
+  if (t.views > n) t.views = n;
+  return t;
+}
+
+struct Cost {
+  double mean = std::numeric_limits<double>::infinity();
+  std::size_t rays = 0;
+};
+
+Cost conjugate_cost(const Scan& scan, const Turn& turn, double offset_px) {
+  Geometry g = scan.geometry;
+  g.offset_u = offset_px;
+  const std::size_t n_u = g.n_u;
+  const std::size_t view_step = std::max<std::size_t>(1, turn.views / kMostViews);
+  const std::size_t element_step = std::max<std::size_t>(1, n_u / kMostElements);
+  double sum = 0.0;
+  std::size_t rays = 0;
+  for (std::size_t v = 0; v < turn.views; v += view_step) {
+    for (std::size_t e = 0; e < n_u; e += element_step) {
+      const double here = scan.measurement.data[v * n_u + e];
+      if (!std::isfinite(here)) continue;
+      const Ray ray = detector_ray(g, v, static_cast<double>(e));
+      const Vec3& s = ray.origin;
+      const Vec3& d = ray.direction;
+      const double along = s.x * d.x + s.y * d.y;
+      // Where the line leaves the source circle (a source half a turn on), and its point
+      // nearest the axis.
+      const double px = s.x - 2.0 * along * d.x, py = s.y - 2.0 * along * d.y;
+      const Vec3 nearest{s.x - along * d.x, s.y - along * d.y, 0.0};
+      double f = (std::atan2(py, px) - turn.first) / turn.step;
+      const auto n = static_cast<double>(turn.views);
+      f = std::fmod(f, n);
+      if (f < 0.0) f += n;
+      const auto v0 = static_cast<std::size_t>(f) % turn.views;
+      const std::size_t v1 = (v0 + 1) % turn.views;
+      const double w = f - std::floor(f);
+      const double a = reading_at(scan.measurement, v0, project_to_detector(g, v0, nearest).u, n_u);
+      const double b = reading_at(scan.measurement, v1, project_to_detector(g, v1, nearest).u, n_u);
+      const double there = (1.0 - w) * a + w * b;
+      if (!std::isfinite(there)) continue;
+      sum += (here - there) * (here - there);
+      ++rays;
+    }
+  }
+  return {rays ? sum / static_cast<double>(rays) : std::numeric_limits<double>::infinity(), rays};
+}
+
+}  // namespace
+
+std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, double search_px) {
+  const Geometry& g = scan.geometry;
+  if (g.type != GeometryType::kFan2d || g.n_u < 8) return std::nullopt;
+  const std::optional<Turn> turn = full_turn(g);
+  if (!turn) return std::nullopt;
+  // Half pixels over the search, then a parabola through the best and its neighbours.
+  constexpr double kStep = 0.5;
+  const auto steps = static_cast<long>(std::ceil(search_px / kStep));
+  std::vector<double> offsets, costs;
+  for (long k = -steps; k <= steps; ++k) {
+    offsets.push_back(g.offset_u + static_cast<double>(k) * kStep);
+    costs.push_back(conjugate_cost(scan, *turn, offsets.back()).mean);
+  }
+  const auto best = static_cast<std::size_t>(
+      std::min_element(costs.begin(), costs.end()) - costs.begin());
+  if (!std::isfinite(costs[best])) return std::nullopt;
+  ConjugateAxis out;
+  out.offset_px = offsets[best];
+  if (best > 0 && best + 1 < costs.size()) {
+    const double c0 = costs[best - 1], c1 = costs[best], c2 = costs[best + 1];
+    const double curvature = c0 - 2.0 * c1 + c2;
+    if (curvature > 0.0) out.offset_px += 0.5 * kStep * (c0 - c2) / curvature;
+  }
+  const Cost at = conjugate_cost(scan, *turn, out.offset_px);
+  out.rays = at.rays;
+  const double edges = 0.5 * (costs.front() + costs.back());
+  out.cost_ratio = edges > 0.0 ? at.mean / edges : 0.0;
+  return out;
+}
+
+}  // namespace riner::preprocessing

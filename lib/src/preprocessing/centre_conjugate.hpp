@@ -1,0 +1,30 @@
+// The rotation axis of a full-turn fan-beam scan from conjugate rays: a ray leaves the source
+// circle where the source of a view about half a turn later sits, and that view's ray back
+// through the same line reads the same line integral. Both rays are computed with the
+// geometry's detector offset, so they meet only when that offset is the scan's: the offset is
+// where the mean squared difference of every ray and its conjugate (read between the two
+// nearest views, each through the line's point nearest the axis) is least, on a grid of half
+// pixels, then a parabola through the three best. The geometry's own conventions (rotation
+// direction, detector orientation) come in through its ray functions, so nothing here assumes
+// them.
+#pragma once
+
+#include <cstddef>
+#include <optional>
+
+#include "riner/scan.hpp"
+
+namespace riner::preprocessing {
+
+struct ConjugateAxis {
+  double offset_px = 0.0;    // the detector offset (geometry's u) that puts the axis there
+  std::size_t rays = 0;      // ray pairs compared at that offset
+  double cost_ratio = 0.0;   // the cost there over the cost at the search's edges (lower: surer)
+};
+
+// Fan beam (2D). Searches the geometry's offset +- search_px. nullopt when the views do not
+// cover a full turn less two steps, evenly spaced (within 10% of the step), or the detector is
+// under 8 elements.
+std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, double search_px = 32.0);
+
+}  // namespace riner::preprocessing
