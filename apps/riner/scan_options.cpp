@@ -80,7 +80,7 @@ LoadedScan scan_from(const Args& args, const Console& console) {
 }
 
 std::optional<CentreEstimate> check_centre(const LoadedScan& loaded, const Console& console) {
-  if (loaded.centre || loaded.scan.geometry.is_divergent()) return std::nullopt;
+  if (loaded.centre || loaded.scan.geometry.type == GeometryType::kCone3d) return std::nullopt;
   std::optional<CentreEstimate> e;
   try {
     e = estimate_centre(loaded.scan);
@@ -91,10 +91,12 @@ std::optional<CentreEstimate> check_centre(const LoadedScan& loaded, const Conso
   if (std::fabs(e->offset_px - given) > kCentreDoubtPx) {
     char line[300];
     std::snprintf(line, sizeof(line),
-                  "note: the scan's own sinogram puts the rotation axis at offset %.2f px, the "
+                  "note: the scan's own %s the rotation axis at offset %.2f px, the "
                   "geometry at %.2f: a wrong axis doubles edges and leaves arcs (pass "
                   "--offset-px auto, or check the geometry)",
-                  e->offset_px, given);
+                  e->method == "conjugate rays" ? "conjugate rays put" : "sinogram puts",
+                  e->offset_px,
+                  given);
     console.line(line);
   }
   return e;

@@ -12,9 +12,13 @@ namespace riner::preprocessing {
 namespace {
 
 // At most this many views and elements enter the cost (evenly spread): enough rays, a cost of
-// a few milliseconds per offset.
-constexpr std::size_t kMostViews = 180;
-constexpr std::size_t kMostElements = 512;
+// a few milliseconds per offset; the coarse search takes a sixth of them.
+struct RaySample {
+  std::size_t views = 180;
+  std::size_t elements = 512;
+};
+constexpr RaySample kFine{};
+constexpr RaySample kCoarse{60, 256};
 
 // The reading at fractional element u of a view, linear between elements; NaN off the detector
 // or next to a non-finite reading.
@@ -65,12 +69,12 @@ struct Cost {
   std::size_t rays = 0;
 };
 
-Cost conjugate_cost(const Scan& scan, const Turn& turn, double offset_px) {
+Cost conjugate_cost(const Scan& scan, const Turn& turn, double offset_px, RaySample sample) {
   Geometry g = scan.geometry;
   g.offset_u = offset_px;
   const std::size_t n_u = g.n_u;
-  const std::size_t view_step = std::max<std::size_t>(1, turn.views / kMostViews);
-  const std::size_t element_step = std::max<std::size_t>(1, n_u / kMostElements);
+  const std::size_t view_step = std::max<std::size_t>(1, turn.views / sample.views);
+  const std::size_t element_step = std::max<std::size_t>(1, n_u / sample.elements);
   double sum = 0.0;
   std::size_t rays = 0;
   for (std::size_t v = 0; v < turn.views; v += view_step) {
@@ -110,13 +114,28 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, double search_px) 
   if (g.type != GeometryType::kFan2d || g.n_u < 8) return std::nullopt;
   const std::optional<Turn> turn = full_turn(g);
   if (!turn) return std::nullopt;
-  // Half pixels over the search, then a parabola through the best and its neighbours.
+  // Every 2 px over the search on a sixth of the rays, half pixels around the best on all of
+  // them, then a parabola through the best and its neighbours.
+  constexpr double kCoarseStep = 2.0;
   constexpr double kStep = 0.5;
-  const auto steps = static_cast<long>(std::ceil(search_px / kStep));
+  const auto coarse_steps = static_cast<long>(std::ceil(search_px / kCoarseStep));
+  double coarse_best = g.offset_u;
+  double coarse_least = std::numeric_limits<double>::infinity();
+  double edges = 0.0;
+  for (long k = -coarse_steps; k <= coarse_steps; ++k) {
+    const double at = g.offset_u + static_cast<double>(k) * kCoarseStep;
+    const double c = conjugate_cost(scan, *turn, at, kCoarse).mean;
+    if (c < coarse_least) {
+      coarse_least = c;
+      coarse_best = at;
+    }
+    if (k == -coarse_steps || k == coarse_steps) edges += 0.5 * c;
+  }
+  if (!std::isfinite(coarse_least)) return std::nullopt;
   std::vector<double> offsets, costs;
-  for (long k = -steps; k <= steps; ++k) {
-    offsets.push_back(g.offset_u + static_cast<double>(k) * kStep);
-    costs.push_back(conjugate_cost(scan, *turn, offsets.back()).mean);
+  for (long k = -5; k <= 5; ++k) {
+    offsets.push_back(coarse_best + static_cast<double>(k) * kStep);
+    costs.push_back(conjugate_cost(scan, *turn, offsets.back(), kFine).mean);
   }
   const auto best = static_cast<std::size_t>(
       std::min_element(costs.begin(), costs.end()) - costs.begin());
@@ -128,10 +147,10 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, double search_px) 
     const double curvature = c0 - 2.0 * c1 + c2;
     if (curvature > 0.0) out.offset_px += 0.5 * kStep * (c0 - c2) / curvature;
   }
-  const Cost at = conjugate_cost(scan, *turn, out.offset_px);
+  const Cost at = conjugate_cost(scan, *turn, out.offset_px, kFine);
   out.rays = at.rays;
-  const double edges = 0.5 * (costs.front() + costs.back());
-  out.cost_ratio = edges > 0.0 ? at.mean / edges : 0.0;
+  const double coarse_here = conjugate_cost(scan, *turn, out.offset_px, kCoarse).mean;
+  out.cost_ratio = edges > 0.0 ? coarse_here / edges : 0.0;
   return out;
 }
 

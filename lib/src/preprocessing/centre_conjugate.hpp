@@ -3,8 +3,8 @@
 // through the same line reads the same line integral. Both rays are computed with the
 // geometry's detector offset, so they meet only when that offset is the scan's: the offset is
 // where the mean squared difference of every ray and its conjugate (read between the two
-// nearest views, each through the line's point nearest the axis) is least, on a grid of half
-// pixels, then a parabola through the three best. The geometry's own conventions (rotation
+// nearest views, each through the line's point nearest the axis) is least: every 2 px on a
+// sixth of the rays, half pixels around the best on all, then a parabola through the three best. The geometry's own conventions (rotation
 // direction, detector orientation) come in through its ray functions, so nothing here assumes
 // them.
 #pragma once
