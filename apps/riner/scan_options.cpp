@@ -80,7 +80,7 @@ LoadedScan scan_from(const Args& args, const Console& console) {
 }
 
 std::optional<CentreEstimate> check_centre(const LoadedScan& loaded, const Console& console) {
-  if (loaded.centre || loaded.scan.geometry.type == GeometryType::kCone3d) return std::nullopt;
+  if (loaded.centre) return std::nullopt;
   std::optional<CentreEstimate> e;
   try {
     e = estimate_centre(loaded.scan);

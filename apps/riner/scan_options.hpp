@@ -29,9 +29,9 @@ LoadedScan scan_from(const Args& args, const Console& console);
 // offset is doubted aloud: half a pixel blurs little, a few pixels double edges.
 constexpr double kCentreDoubtPx = 1.0;
 
-// A parallel-beam or fan-beam scan whose offset was given (not auto): the scan's own estimate,
-// and a console note when the two differ by more than kCentreDoubtPx. nullopt for cone beams,
-// auto offsets, and scans without a half-turn or a view pair (a fan beam: a full turn).
+// A scan whose offset was given (not auto): the scan's own estimate, and a console note when
+// the two differ by more than kCentreDoubtPx. nullopt for auto offsets, and scans without a
+// half-turn or a view pair (a fan or cone beam: a full turn).
 std::optional<CentreEstimate> check_centre(const LoadedScan& loaded, const Console& console);
 
 }  // namespace riner::app

@@ -127,10 +127,11 @@ TEST_SUITE("centre") {
                          doctest::Contains("views that step evenly over a full turn"),
                          riner::InputError);
     riner::Scan cone;
-    cone.geometry = riner::test::small_cone3d();
+    cone.geometry = with_angles(riner::test::small_cone3d(), 30, M_PI, true);
     cone.measurement = riner::Array(cone.geometry.measurement_shape());
     CHECK_THROWS_WITH_AS(riner::estimate_centre(cone),
-                         doctest::Contains("needs a parallel or a fan beam"), riner::InputError);
+                         doctest::Contains("views that step evenly over a full turn"),
+                         riner::InputError);
   }
 
   TEST_CASE("a fan beam over a full turn: the offset from conjugate rays") {
@@ -146,5 +147,15 @@ TEST_SUITE("centre") {
     // The turn's end view as well (91 views, the last at 360 degrees).
     const riner::Geometry closed = with_angles(riner::test::small_fan2d(), 91, 2.0 * M_PI, true);
     CHECK(std::fabs(riner::estimate_centre(scan_with_offset(closed, 1.6)).offset_px - 1.6) < 0.15);
+  }
+
+  TEST_CASE("a cone beam over a full turn: the offset from the fan through the source's plane") {
+    const riner::Geometry cone = with_angles(riner::test::small_cone3d(), 120, 2.0 * M_PI, false);
+    for (const double offset : {2.2, -3.4}) {
+      const riner::CentreEstimate e = riner::estimate_centre(scan_with_offset(cone, offset));
+      CAPTURE(offset);
+      CHECK(e.method == "conjugate rays");
+      CHECK(std::fabs(e.offset_px - offset) < 0.2);
+    }
   }
 }

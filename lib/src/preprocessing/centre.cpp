@@ -10,6 +10,7 @@
 #include "preprocessing/centre_conjugate.hpp"
 #include "preprocessing/centre_sinogram.hpp"
 #include "riner/error.hpp"
+#include "riner/rays.hpp"
 
 namespace riner {
 
@@ -199,15 +200,47 @@ std::optional<CentreEstimate> from_view_pairs(const Scan& scan) {
 
 }  // namespace
 
+namespace {
+
+// A cone beam's rays through the source's plane (z = 0) are a fan: that row of every view (read
+// between the two rows around it) as a fan-beam scan with the cone's distances.
+Scan midplane_fan(const Scan& cone) {
+  const Geometry& g = cone.geometry;
+  const double v = std::clamp(project_to_detector(g, 0, Vec3{0.0, 0.0, 0.0}).v, 0.0,
+                              static_cast<double>(g.n_v - 1));
+  const auto r0 = std::min(static_cast<std::size_t>(v), g.n_v > 1 ? g.n_v - 2 : 0);
+  const std::size_t r1 = std::min(r0 + 1, g.n_v - 1);
+  const double w = v - static_cast<double>(r0);
+  Scan fan;
+  fan.geometry = g;
+  fan.geometry.type = GeometryType::kFan2d;
+  fan.geometry.n_v = 1;
+  fan.geometry.offset_v = 0.0;
+  fan.geometry.volume_shape = {g.volume_shape[1], g.volume_shape[2]};
+  const std::size_t views = g.n_views(), n_u = g.n_u;
+  fan.measurement = Array({views, n_u});
+  for (std::size_t a = 0; a < views; ++a) {
+    const float* row0 = cone.measurement.ptr() + (a * g.n_v + r0) * n_u;
+    const float* row1 = cone.measurement.ptr() + (a * g.n_v + r1) * n_u;
+    for (std::size_t e = 0; e < n_u; ++e) {
+      fan.measurement.data[a * n_u + e] = static_cast<float>((1.0 - w) * row0[e] + w * row1[e]);
+    }
+  }
+  return fan;
+}
+
+}  // namespace
+
 CentreEstimate estimate_centre(const Scan& scan) {
   const Geometry& g = scan.geometry;
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-  if (g.type == GeometryType::kFan2d) {
-    const std::optional<preprocessing::ConjugateAxis> axis = preprocessing::conjugate_axis(scan);
+  if (g.is_divergent()) {
+    const std::optional<preprocessing::ConjugateAxis> axis =
+        preprocessing::conjugate_axis(g.type == GeometryType::kCone3d ? midplane_fan(scan) : scan);
     if (!axis) {
       throw InputError(
-          "centre finding in a fan beam needs views that step evenly over a full turn and a "
-          "detector of at least 8 elements; pass the offset with --offset-px");
+          "centre finding in a fan or cone beam needs views that step evenly over a full turn "
+          "and a detector of at least 8 elements; pass the offset with --offset-px");
     }
     CentreEstimate e;
     e.offset_px = axis->offset_px;
@@ -218,10 +251,6 @@ CentreEstimate estimate_centre(const Scan& scan) {
     e.sinogram_offset_px = kNaN;
     e.pairs_offset_px = kNaN;
     return e;
-  }
-  if (g.is_divergent()) {
-    throw InputError(std::string("centre finding needs a parallel or a fan beam (this scan is ") +
-                     geometry_type_name(g.type) + "); pass the offset with --offset-px");
   }
   if (g.n_u < 8) throw InputError("centre finding needs a detector of at least 8 elements");
   const std::optional<CentreEstimate> pairs = from_view_pairs(scan);

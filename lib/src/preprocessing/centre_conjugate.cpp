@@ -119,23 +119,42 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, double search_px) 
   constexpr double kCoarseStep = 2.0;
   constexpr double kStep = 0.5;
   const auto coarse_steps = static_cast<long>(std::ceil(search_px / kCoarseStep));
+  std::vector<double> coarse_at;
+  std::vector<Cost> coarse;
+  std::size_t most_rays = 0;
+  for (long k = -coarse_steps; k <= coarse_steps; ++k) {
+    coarse_at.push_back(g.offset_u + static_cast<double>(k) * kCoarseStep);
+    coarse.push_back(conjugate_cost(scan, *turn, coarse_at.back(), kCoarse));
+    most_rays = std::max(most_rays, coarse.back().rays);
+  }
+  // An offset that leaves most conjugates off the detector compares only the few rays left
+  // (often air): it does not count.
+  const auto enough = [&](const Cost& c, std::size_t most) { return 2 * c.rays >= most; };
   double coarse_best = g.offset_u;
   double coarse_least = std::numeric_limits<double>::infinity();
   double edges = 0.0;
-  for (long k = -coarse_steps; k <= coarse_steps; ++k) {
-    const double at = g.offset_u + static_cast<double>(k) * kCoarseStep;
-    const double c = conjugate_cost(scan, *turn, at, kCoarse).mean;
-    if (c < coarse_least) {
-      coarse_least = c;
-      coarse_best = at;
+  std::size_t edge_count = 0;
+  for (std::size_t k = 0; k < coarse.size(); ++k) {
+    if (!enough(coarse[k], most_rays)) continue;
+    if (coarse[k].mean < coarse_least) {
+      coarse_least = coarse[k].mean;
+      coarse_best = coarse_at[k];
     }
-    if (k == -coarse_steps || k == coarse_steps) edges += 0.5 * c;
+    edges += coarse[k].mean;  // the mean over the search, for cost_ratio
+    ++edge_count;
   }
   if (!std::isfinite(coarse_least)) return std::nullopt;
+  edges /= static_cast<double>(std::max<std::size_t>(1, edge_count));
   std::vector<double> offsets, costs;
+  std::vector<Cost> fine;
+  std::size_t most_fine = 0;
   for (long k = -5; k <= 5; ++k) {
     offsets.push_back(coarse_best + static_cast<double>(k) * kStep);
-    costs.push_back(conjugate_cost(scan, *turn, offsets.back(), kFine).mean);
+    fine.push_back(conjugate_cost(scan, *turn, offsets.back(), kFine));
+    most_fine = std::max(most_fine, fine.back().rays);
+  }
+  for (const Cost& c : fine) {
+    costs.push_back(enough(c, most_fine) ? c.mean : std::numeric_limits<double>::infinity());
   }
   const auto best = static_cast<std::size_t>(
       std::min_element(costs.begin(), costs.end()) - costs.begin());
@@ -145,7 +164,9 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, double search_px) 
   if (best > 0 && best + 1 < costs.size()) {
     const double c0 = costs[best - 1], c1 = costs[best], c2 = costs[best + 1];
     const double curvature = c0 - 2.0 * c1 + c2;
-    if (curvature > 0.0) out.offset_px += 0.5 * kStep * (c0 - c2) / curvature;
+    if (std::isfinite(curvature) && curvature > 0.0) {
+      out.offset_px += 0.5 * kStep * (c0 - c2) / curvature;
+    }
   }
   const Cost at = conjugate_cost(scan, *turn, out.offset_px, kFine);
   out.rays = at.rays;

@@ -19,7 +19,7 @@ namespace riner::preprocessing {
 struct ConjugateAxis {
   double offset_px = 0.0;    // the detector offset (geometry's u) that puts the axis there
   std::size_t rays = 0;      // ray pairs compared at that offset
-  double cost_ratio = 0.0;   // the cost there over the cost at the search's edges (lower: surer)
+  double cost_ratio = 0.0;   // the cost there over its mean over the search (lower: surer)
 };
 
 // Fan beam (2D). Searches the geometry's offset +- search_px. nullopt when the views do not
