@@ -490,7 +490,8 @@ TEST_SUITE("cli") {
     REQUIRE(run.code == 0);
     summary = nlohmann::json::parse(run.out);
     CHECK(summary["flat_field"]["flat_series"] == 2);
-    CHECK(summary["flat_field"]["flat_change"].get<double>() == doctest::Approx(-0.05).epsilon(0.01));
+    CHECK(summary["flat_field"]["flat_change"].get<double>() ==
+          doctest::Approx(-0.05).epsilon(0.01));
     CHECK(summary["flat_field"]["air_drifts"] == false);
     CHECK(run.err.find("drifted") == std::string::npos);
     REQUIRE(riner_cli("fbp " + d + "rho.npy --out " + d + "truth.nii --quiet", dir).code == 0);

@@ -308,7 +308,8 @@ def test_load_scan_interpolates_flats_before_and_after_a_drifting_beam(tmp_path)
     drop = 0.08 * (np.arange(views)[:, None] + 0.5) / views  # 8% less light by the end
     before = np.full((40,), 5000.0, dtype=np.float32)
     after = (before * 0.92).astype(np.float32)
-    riner.write_array(tmp_path / "raw.npy", (before * (1 - drop) * np.exp(-sim["sino"])).astype(np.float32))
+    raw = before * (1 - drop) * np.exp(-sim["sino"])
+    riner.write_array(tmp_path / "raw.npy", raw.astype(np.float32))
     riner.write_array(tmp_path / "before.npy", before)
     riner.write_array(tmp_path / "after.npy", after)
     for name in ("geometry.json", "scan.json"):

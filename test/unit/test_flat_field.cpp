@@ -121,7 +121,8 @@ TEST_SUITE("flat_field") {
         const bool air = e < 4 || e >= 36;
         const double rho = air ? 0.0 : 0.5 + 0.3 * std::sin(0.1 * v + 0.2 * e);
         d.rho_true.data[v * 40 + e] = static_cast<float>(rho);
-        d.raw.data[v * 40 + e] = static_cast<float>(beam(e, static_cast<double>(v)) * std::exp(-rho));
+        d.raw.data[v * 40 + e] =
+            static_cast<float>(beam(e, static_cast<double>(v)) * std::exp(-rho));
       }
     }
     return d;
@@ -161,7 +162,7 @@ TEST_SUITE("flat_field") {
     CHECK(worst > 0.03);  // the last views read the drift as attenuation
   }
 
-  TEST_CASE("a steady beam is not called drift, noise or no noise; flats of two shapes are an error") {
+  TEST_CASE("a steady beam is not called drift, noisy or not; flats of two shapes are an error") {
     const Drifting steady = drifting_scan(0.0);
     FlatFieldReport report;
     (void)riner::flat_field_normalise(steady.raw, steady.before, Array(), &report);

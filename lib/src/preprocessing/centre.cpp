@@ -198,10 +198,6 @@ std::optional<CentreEstimate> from_view_pairs(const Scan& scan) {
   return e;
 }
 
-}  // namespace
-
-namespace {
-
 // A cone beam's rays through the source's plane (z = 0) are a fan: that row of every view (read
 // between the two rows around it) as a fan-beam scan with the cone's distances.
 Scan midplane_fan(const Scan& cone) {

@@ -23,7 +23,8 @@ constexpr RaySample kCoarse{60, 256};
 // The reading at fractional element u of a view, linear between elements; NaN off the detector
 // or next to a non-finite reading.
 double reading_at(const Array& rho, std::size_t view, double u, std::size_t n_u) {
-  if (!(u >= 0.0) || u > static_cast<double>(n_u - 1)) return std::numeric_limits<double>::quiet_NaN();
+  if (!(u >= 0.0) || u > static_cast<double>(n_u - 1))
+    return std::numeric_limits<double>::quiet_NaN();
   const auto e = std::min(static_cast<std::size_t>(u), n_u - 2);
   const double w = u - static_cast<double>(e);
   const float* row = rho.ptr() + view * n_u;
@@ -31,8 +32,8 @@ double reading_at(const Array& rho, std::size_t view, double u, std::size_t n_u)
 }
 
 struct Turn {
-  double first = 0.0;  // the first view's source angle (rad)
-  double step = 0.0;   // between views, signed
+  double first = 0.0;     // the first view's source angle (rad)
+  double step = 0.0;      // between views, signed
   std::size_t views = 0;  // views in a full turn (the scan may hold one more, the turn's end)
 };
 
@@ -132,19 +133,13 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, double search_px) 
   const auto enough = [&](const Cost& c, std::size_t most) { return 2 * c.rays >= most; };
   double coarse_best = g.offset_u;
   double coarse_least = std::numeric_limits<double>::infinity();
-  double edges = 0.0;
-  std::size_t edge_count = 0;
   for (std::size_t k = 0; k < coarse.size(); ++k) {
-    if (!enough(coarse[k], most_rays)) continue;
-    if (coarse[k].mean < coarse_least) {
+    if (enough(coarse[k], most_rays) && coarse[k].mean < coarse_least) {
       coarse_least = coarse[k].mean;
       coarse_best = coarse_at[k];
     }
-    edges += coarse[k].mean;  // the mean over the search, for cost_ratio
-    ++edge_count;
   }
   if (!std::isfinite(coarse_least)) return std::nullopt;
-  edges /= static_cast<double>(std::max<std::size_t>(1, edge_count));
   std::vector<double> offsets, costs;
   std::vector<Cost> fine;
   std::size_t most_fine = 0;
@@ -156,11 +151,12 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, double search_px) 
   for (const Cost& c : fine) {
     costs.push_back(enough(c, most_fine) ? c.mean : std::numeric_limits<double>::infinity());
   }
-  const auto best = static_cast<std::size_t>(
-      std::min_element(costs.begin(), costs.end()) - costs.begin());
+  const auto best =
+      static_cast<std::size_t>(std::min_element(costs.begin(), costs.end()) - costs.begin());
   if (!std::isfinite(costs[best])) return std::nullopt;
   ConjugateAxis out;
   out.offset_px = offsets[best];
+  out.rays = fine[best].rays;
   if (best > 0 && best + 1 < costs.size()) {
     const double c0 = costs[best - 1], c1 = costs[best], c2 = costs[best + 1];
     const double curvature = c0 - 2.0 * c1 + c2;
@@ -168,10 +164,6 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, double search_px) 
       out.offset_px += 0.5 * kStep * (c0 - c2) / curvature;
     }
   }
-  const Cost at = conjugate_cost(scan, *turn, out.offset_px, kFine);
-  out.rays = at.rays;
-  const double coarse_here = conjugate_cost(scan, *turn, out.offset_px, kCoarse).mean;
-  out.cost_ratio = edges > 0.0 ? coarse_here / edges : 0.0;
   return out;
 }
 

@@ -4,9 +4,9 @@
 // geometry's detector offset, so they meet only when that offset is the scan's: the offset is
 // where the mean squared difference of every ray and its conjugate (read between the two
 // nearest views, each through the line's point nearest the axis) is least: every 2 px on a
-// sixth of the rays, half pixels around the best on all, then a parabola through the three best. The geometry's own conventions (rotation
-// direction, detector orientation) come in through its ray functions, so nothing here assumes
-// them.
+// sixth of the rays, half pixels around the best on all, then a parabola through the three
+// best. The geometry's own conventions (rotation direction, detector orientation) come in
+// through its ray functions, so nothing here assumes them.
 #pragma once
 
 #include <cstddef>
@@ -17,9 +17,8 @@
 namespace riner::preprocessing {
 
 struct ConjugateAxis {
-  double offset_px = 0.0;    // the detector offset (geometry's u) that puts the axis there
-  std::size_t rays = 0;      // ray pairs compared at that offset
-  double cost_ratio = 0.0;   // the cost there over its mean over the search (lower: surer)
+  double offset_px = 0.0;  // the detector offset (geometry's u) that puts the axis there
+  std::size_t rays = 0;    // ray pairs compared at the best offset of the half-pixel grid
 };
 
 // Fan beam (2D). Searches the geometry's offset +- search_px. nullopt when the views do not

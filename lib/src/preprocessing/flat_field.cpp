@@ -8,15 +8,17 @@
 
 #include "riner/error.hpp"
 #include "riner/io.hpp"
+#include "util/robust_statistics.hpp"
 
 namespace riner {
 
 namespace {
 
-// Per-pixel mean over the finite values of a frame or a stack of frames shaped like one view;
-// NaN where no frame is finite.
+// Per-pixel mean over the finite values of a frame or a stack of frames shaped like one view
+// (only the frames `members` lists, when given); NaN where no frame is finite.
 std::vector<double> frame_mean(const Array& frames, const std::vector<std::size_t>& view_shape,
-                               const char* what, std::size_t* frame_count) {
+                               const char* what, std::size_t* frame_count,
+                               const std::vector<std::size_t>* members = nullptr) {
   const std::size_t pixels = shape_size(view_shape);
   std::vector<std::size_t> one_frame_shape = frames.shape;
   std::size_t count = 1;
@@ -29,10 +31,11 @@ std::vector<double> frame_mean(const Array& frames, const std::vector<std::size_
                      "; it must be one frame of a view's shape " + shape_string(view_shape) +
                      " or a stack of them");
   }
+  if (members) count = members->size();
   std::vector<double> sum(pixels, 0.0);
   std::vector<std::size_t> finite(pixels, 0);
-  for (std::size_t f = 0; f < count; ++f) {
-    const float* frame = frames.ptr() + f * pixels;
+  for (std::size_t m = 0; m < count; ++m) {
+    const float* frame = frames.ptr() + (members ? (*members)[m] : m) * pixels;
     for (std::size_t p = 0; p < pixels; ++p) {
       if (std::isfinite(frame[p])) {
         sum[p] += frame[p];
@@ -48,17 +51,18 @@ std::vector<double> frame_mean(const Array& frames, const std::vector<std::size_
   return sum;
 }
 
-// The frames of `flats` at each distinct position, in order of position.
+// The flat frames taken at one position (their indices), in order of position; one series of
+// every frame when no positions are given.
 struct FlatSeries {
   double position = 0.0;
-  Array frames;
+  std::vector<std::size_t> members;  // empty: every frame
 };
 
 std::vector<FlatSeries> flat_series(const Array& flats, const std::vector<double>& positions,
                                     const std::vector<std::size_t>& view_shape) {
+  if (positions.empty()) return {{0.0, {}}};
   const bool stack = flats.rank() == view_shape.size() + 1;
   const std::size_t frames = stack ? flats.shape[0] : 1;
-  if (positions.empty()) return {{0.0, flats}};
   if (positions.size() != frames) {
     throw InputError(std::to_string(positions.size()) + " flat positions for " +
                      std::to_string(frames) + " flat frames");
@@ -66,21 +70,13 @@ std::vector<FlatSeries> flat_series(const Array& flats, const std::vector<double
   std::vector<double> distinct = positions;
   std::sort(distinct.begin(), distinct.end());
   distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
-  const std::size_t pixels = shape_size(view_shape);
   std::vector<FlatSeries> out;
   for (double at : distinct) {
-    std::vector<std::size_t> members;
+    FlatSeries s{at, {}};
     for (std::size_t f = 0; f < frames; ++f) {
-      if (positions[f] == at) members.push_back(f);
+      if (positions[f] == at) s.members.push_back(f);
     }
-    std::vector<std::size_t> shape = view_shape;
-    shape.insert(shape.begin(), members.size());
-    Array series(shape);
-    for (std::size_t m = 0; m < members.size(); ++m) {
-      std::copy(flats.ptr() + members[m] * pixels, flats.ptr() + (members[m] + 1) * pixels,
-                series.data.begin() + static_cast<std::ptrdiff_t>(m * pixels));
-    }
-    out.push_back({at, std::move(series)});
+    out.push_back(std::move(s));
   }
   return out;
 }
@@ -96,7 +92,8 @@ double median_of(std::vector<double> values) {
 
 bool air_drifts(const FlatFieldReport& r) {
   return std::isfinite(r.air_first) && std::isfinite(r.air_last) &&
-         r.air_drift_sigmas > kAirDriftSigmas && std::fabs(r.air_last - r.air_first) > kAirDriftLeast;
+         r.air_drift_sigmas > kAirDriftSigmas &&
+         std::fabs(r.air_last - r.air_first) > kAirDriftLeast;
 }
 
 std::string air_drift_line(const FlatFieldReport& r) {
@@ -158,7 +155,7 @@ void flat_field_drift(const Array& rho, FlatFieldReport& r) {
       steps.push_back(std::fabs(per_view[v] - per_view[v - 1]));
     }
   }
-  const double sigma = 1.4826 * median_of(steps) / std::sqrt(2.0);
+  const double sigma = util::kMadToSigma * median_of(steps) / std::sqrt(2.0);
   const std::size_t tenth = std::max<std::size_t>(2, views / 10);
   auto mean_of = [&](std::size_t first) {
     double sum = 0.0;
@@ -195,7 +192,8 @@ Array flat_field_normalise(const Array& projections, const Array& flats, const A
   std::vector<char> no_beam(pixels, 0);
   for (const FlatSeries& s : series) {
     std::size_t frames = 0;
-    std::vector<double> beam = frame_mean(s.frames, view_shape, "the flat field", &frames);
+    std::vector<double> beam = frame_mean(flats, view_shape, "the flat field", &frames,
+                                          s.members.empty() ? nullptr : &s.members);
     r.flat_frames += frames;
     for (std::size_t p = 0; p < pixels; ++p) {
       beam[p] -= dark[p];
@@ -214,7 +212,6 @@ Array flat_field_normalise(const Array& projections, const Array& flats, const A
   }
   Array rho(projections.shape);
   const std::size_t views = projections.shape[0];
-  std::vector<double> beam(pixels);
   for (std::size_t v = 0; v < views; ++v) {
     // This view's beam: between the series either side of it.
     const double at = static_cast<double>(v);
@@ -225,18 +222,15 @@ Array flat_field_normalise(const Array& projections, const Array& flats, const A
     const double span = series[hi].position - series[lo].position;
     const double w = span > 0.0 ? (at - series[lo].position) / span : 0.0;
     for (std::size_t p = 0; p < pixels; ++p) {
-      beam[p] = no_beam[p] ? std::numeric_limits<double>::quiet_NaN()
-                           : (1.0 - w) * beams[lo][p] + w * beams[hi][p];
-    }
-    for (std::size_t p = 0; p < pixels; ++p) {
       const std::size_t i = v * pixels + p;
       const double light = static_cast<double>(projections.data[i]) - dark[p];
-      if (!(light > 0.0) || std::isnan(beam[p])) {
+      if (!(light > 0.0) || no_beam[p]) {
         rho.data[i] = std::numeric_limits<float>::quiet_NaN();
         ++r.invalid_readings;
         continue;
       }
-      rho.data[i] = static_cast<float>(-std::log(light / beam[p]));
+      const double beam = (1.0 - w) * beams[lo][p] + w * beams[hi][p];
+      rho.data[i] = static_cast<float>(-std::log(light / beam));
     }
   }
   if (r.invalid_readings == rho.size()) {

@@ -56,6 +56,13 @@ std::array<double, 9> turned_about_z(double phi) {
   return {std::cos(phi), std::sin(phi), 0, -std::sin(phi), std::cos(phi), 0, 0, 0, 1};
 }
 
+// The grid's smaller side across the axis (mm): the built-in phantoms scale with it.
+double grid_width_mm(const Geometry& g) {
+  const std::size_t rank = g.volume_shape.size();
+  return g.voxel_mm *
+         static_cast<double>(std::min(g.volume_shape[rank - 1], g.volume_shape[rank - 2]));
+}
+
 }  // namespace
 
 double Phantom::value_at(const Vec3& p) const {
@@ -126,9 +133,7 @@ Phantom shepp_logan(const Geometry& g, double mu_scale) {
 
 Phantom faint_square(const Geometry& g) {
   g.validate();
-  const std::size_t rank = g.volume_shape.size();
-  const double width = g.voxel_mm * static_cast<double>(std::min(g.volume_shape[rank - 1],
-                                                                 g.volume_shape[rank - 2]));
+  const double width = grid_width_mm(g);
   const double height = g.is_3d() ? g.voxel_mm * static_cast<double>(g.volume_shape[0]) : 1.0;
   const double side = 0.6 * width;
   const double mu = 0.4 / side;
@@ -155,9 +160,7 @@ Phantom faint_square(const Geometry& g) {
 
 TubeWallShape tube_wall_shape(const Geometry& g) {
   g.validate();
-  const std::size_t rank = g.volume_shape.size();
-  const double width = g.voxel_mm * static_cast<double>(std::min(g.volume_shape[rank - 1],
-                                                                 g.volume_shape[rank - 2]));
+  const double width = grid_width_mm(g);
   TubeWallShape t;
   t.inner_mm = 0.234 * width;
   t.outer_mm = 0.258 * width;
@@ -166,15 +169,13 @@ TubeWallShape tube_wall_shape(const Geometry& g) {
 
 Phantom tube_wall(const Geometry& g) {
   const TubeWallShape t = tube_wall_shape(g);
-  const std::size_t rank = g.volume_shape.size();
-  const double width = g.voxel_mm * static_cast<double>(std::min(g.volume_shape[rank - 1],
-                                                                 g.volume_shape[rank - 2]));
+  const double width = grid_width_mm(g);
   const double z = g.is_3d() ? 0.3 * g.voxel_mm * static_cast<double>(g.volume_shape[0]) : 1.0;
   Phantom p;
   // Values add up where discs overlap: water, the wall on it, the tube's content on both.
   auto disc = [&](double x, double y, double r_mm, double value) {
-    p.ellipsoids.push_back({{x * width, y * width, 0.0}, {r_mm, r_mm, z}, {1, 0, 0, 0, 1, 0, 0, 0, 1},
-                            value});
+    p.ellipsoids.push_back(
+        {{x * width, y * width, 0.0}, {r_mm, r_mm, z}, {1, 0, 0, 0, 1, 0, 0, 0, 1}, value});
   };
   disc(0.0, 0.0, 0.39 * width, t.water);
   disc(0.0, 0.0, t.outer_mm, t.wall - t.water);

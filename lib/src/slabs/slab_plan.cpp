@@ -145,9 +145,10 @@ SlabSizing size_slabs(const Geometry& g, const SlabMemory& memory, int wanted_wo
       std::size_t on_gpu = most_slices_within(
           nz, share, [&](std::size_t n) { return slab_device_bytes(g, n); });
       if (memory.device_max_alloc) {
-        on_gpu = std::min(on_gpu, most_slices_within(nz, memory.device_max_alloc, [&](std::size_t n) {
-                            return slab_largest_buffer_bytes(g, n);
-                          }));
+        on_gpu = std::min(on_gpu, most_slices_within(nz, memory.device_max_alloc,
+                                                     [&](std::size_t n) {
+                                                       return slab_largest_buffer_bytes(g, n);
+                                                     }));
       }
       out.device_bound = on_gpu < slices;
       slices = std::min(slices, on_gpu);
