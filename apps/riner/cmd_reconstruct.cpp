@@ -91,6 +91,7 @@ RinerConfig config_from(const Args& args) {
     config.rings.air_reference = false;
     config.rings.gradient_reference = false;
     config.rings.response_reference = false;
+    config.rings.mirror_reference = false;
   }
   config.engine = engine_from(args);
   config.validate();

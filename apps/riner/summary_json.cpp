@@ -27,6 +27,11 @@ nlohmann::json ring_summary(const std::optional<RingCorrection>& rings) {
     out["even_to_odd"] = std::isfinite(rings->even_to_odd) ? nlohmann::json(rings->even_to_odd)
                                                            : nlohmann::json(nullptr);
   }
+  // The mirror correction's evidence.
+  if (rings->elements_moved != 0 || rings->largest_even_sigmas != 0.0) {
+    out["elements_moved"] = rings->elements_moved;
+    out["largest_even_sigmas"] = rings->largest_even_sigmas;
+  }
   return out;
 }
 
@@ -37,6 +42,7 @@ nlohmann::json volume_ring_summary(const std::optional<VolumeRingCorrection>& ri
           {"gradient_applied", rings->gradient_applied},
           {"response_applied", rings->response_applied},
           {"gradient_after_response_applied", rings->gradient_after_response_applied},
+          {"mirror_applied", rings->mirror_applied},
           {"mean_response_change", rings->mean_response_change},
           {"note", rings->note}};
 }
@@ -165,6 +171,7 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
           {"gradient_ring_correction", ring_summary(result.gradient_rings)},
           {"response_ring_correction", ring_summary(result.response_rings)},
           {"gradient_after_response_ring_correction", gradient_again},
+          {"mirror_ring_correction", ring_summary(result.mirror_rings)},
           {"slice_ring_corrections", volume_ring_summary(result.volume_rings)},
           {"final_loss", history.empty() ? 0.0 : history.back().data_loss}};
 }

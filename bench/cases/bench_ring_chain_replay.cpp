@@ -7,9 +7,10 @@
 //       dead elements, the geometry, the reference (DeepLesion: the ground truth; a real scan:
 //       its FBP) and which pixels the reconstruction zeroed as skipped air
 //   riner_bench --case=ring_chain_replay --replay=DIR [--order=agrg] [--config=JSON] [--json=F]
-//       run the corrections in `order` (a = air, g = radial gradient, r = detector response;
-//       the default is the reconstruction's chain) on every saved scan; DeepLesion: PSNR / SSIM
-//       against the truth, real scans: the quality report against FBP
+//       [--images=OUT] (each result as OUT/SCAN_ORDER.npy)
+//       run the corrections in `order` (a = air, g = radial gradient, r = detector response,
+//       m = mirror pairs; the default is the reconstruction's chain) on every saved scan;
+//       DeepLesion: PSNR / SSIM against the truth, real scans: the quality report against FBP
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -34,7 +35,7 @@ using riner::bench::Options;
 using riner::bench::Result;
 namespace fs = std::filesystem;
 
-constexpr const char* kChain = "agrg";  // --order's default: riner::correct_rings_in_order's
+constexpr const char* kChain = "magrg";  // --order's default: riner::correct_rings_in_order's
 
 struct Saved {
   riner::Geometry geometry;
@@ -55,8 +56,11 @@ riner::Array replay(const std::string& order, const Saved& s,
       r = riner::correct_rings_from_gradient(image, alpha, s.geometry, c.gradient);
     } else if (step == 'r') {
       r = riner::correct_rings_from_response(image, alpha, s.geometry, s.dead, c.response);
+    } else if (step == 'm') {
+      r = riner::correct_rings_from_mirrors(image, alpha, s.geometry, s.dead, c.mirror);
     } else {
-      throw riner::InputError(std::string("--order: unknown step '") + step + "' (a, g or r)");
+      throw riner::InputError(std::string("--order: unknown step '") + step +
+                              "' (a, g, r or m)");
     }
     image = std::move(r.image);
     alpha = std::move(r.alpha);
@@ -144,6 +148,8 @@ std::vector<Result> ring_chain_replay(const Options& o) {
     return results;
   }
   const std::string order = o.get("order", kChain);
+  const std::string images_dir = o.get("images", "");
+  if (!images_dir.empty()) fs::create_directories(images_dir);
   std::vector<fs::path> dirs;
   for (const auto& entry : fs::directory_iterator(replay_dir)) {
     if (entry.is_directory()) dirs.push_back(entry.path());
@@ -155,6 +161,9 @@ std::vector<Result> ring_chain_replay(const Options& o) {
     const Saved s = load(dir);
     const riner::Array image = replay(order, s, config.rings);
     const std::string name = dir.filename().string();
+    if (!images_dir.empty()) {
+      riner::write_array(fs::path(images_dir) / (name + "_" + order + ".npy"), image);
+    }
     nlohmann::json row{{"scan", name}, {"order", order}};
     std::string line;
     if (s.simulated) {
@@ -174,12 +183,14 @@ std::vector<Result> ring_chain_replay(const Options& o) {
                   {"specks_per_10k", q.specks_per_10k},
                   {"fbp_specks_per_10k", q.fbp_specks_per_10k},
                   {"centre_sigmas", q.centre.sigmas},
-                  {"edge_ratio", q.edge_strength / q.fbp_edge_strength}});
+                  {"edge_ratio", q.edge_strength / q.fbp_edge_strength},
+                  {"lost_object_share", q.lost.share}});
       line = riner::bench::format(
           "%-12s %s  ring %.5f (FBP/3 %.5f)  specks %.3f (FBP %.3f)  centre %.2f sigma  edges "
-          "%.3f of FBP's",
+          "%.3f of FBP's  lost %.4f%%",
           name.c_str(), order.c_str(), q.ring_index, q.fbp_ring_index / 3, q.specks_per_10k,
-          q.fbp_specks_per_10k, q.centre.sigmas, q.edge_strength / q.fbp_edge_strength);
+          q.fbp_specks_per_10k, q.centre.sigmas, q.edge_strength / q.fbp_edge_strength,
+          100 * q.lost.share);
     }
     std::fprintf(stderr, "%s\n", line.c_str());
     results.push_back({"ring_chain_replay", row, line});

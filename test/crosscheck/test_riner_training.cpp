@@ -89,7 +89,8 @@ TEST_SUITE("riner_training") {
       riner::RinerConfig c = riner::test::tiny_config();
       c.engine = engine;
       c.training.steps = 60;
-      c.rings.air_reference = c.rings.gradient_reference = c.rings.response_reference = false;
+      c.rings.air_reference = c.rings.gradient_reference = c.rings.response_reference =
+          c.rings.mirror_reference = false;
       c.training.tail_average_steps = 0;
       riner::Reconstructor last(t.scan, c, riner::test::device());
       c.training.tail_average_steps = 30;

@@ -83,6 +83,7 @@ TEST_SUITE("volume_ring_correction") {
     riner::RingCorrectionConfig gradient;
     gradient.air_reference = false;
     gradient.response_reference = false;
+    gradient.mirror_reference = false;
     const riner::VolumeRingCorrection c =
         riner::correct_rings_per_slice(trained, alpha, g, {}, gradient);
     CHECK(c.note.empty());
@@ -116,7 +117,7 @@ TEST_SUITE("volume_ring_correction") {
       CHECK(slice_rms(c.image, trained, s) < 0.1 * before);
       CHECK(row_change(c.alpha, alpha, g.n_u, s) < 0.1 * ring_row);
     }
-    // All three corrections, as the Reconstructor runs them: every slice is a 2D scan.
+    // All the corrections, as the Reconstructor runs them: every slice is a 2D scan.
     const riner::VolumeRingCorrection all =
         riner::correct_rings_per_slice(trained, alpha, g, {}, riner::RingCorrectionConfig{});
     CHECK(all.slices == kSlices);

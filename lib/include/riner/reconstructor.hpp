@@ -53,6 +53,7 @@ struct ReconstructionResult {
   std::optional<RingCorrection> gradient_rings;
   std::optional<RingCorrection> response_rings;
   std::optional<RingCorrection> gradient_after_response_rings;
+  std::optional<RingCorrection> mirror_rings;
   // 3D: the same corrections slice by slice (parallel beam; a cone beam gets a note).
   std::optional<VolumeRingCorrection> volume_rings;
 };

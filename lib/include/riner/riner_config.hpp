@@ -206,6 +206,11 @@ struct RingCorrectionConfig {
   // first pass keeps the edges of broad structure, so the narrow rings beside them wait until
   // the response correction has taken it (bench/RESULTS.md, issue 13).
   bool gradient_after_response = true;
+  // Before all of them, objects centred on the axis that training put into alpha go back into
+  // the image (correct_rings_from_mirrors): a tube's wall, a cylinder's edge (bench/RESULTS.md,
+  // issue 32).
+  bool mirror_reference = true;
+  MirrorRingSettings mirror;
   // Parallel-beam volumes: the three above, slice by slice (riner/volume_ring_correction.hpp).
   // Off by default: the 3D field holds few rings; on the simulated parallel-beam head the chain
   // costs 0.13 dB, and on the real savu_proj3d it raises the ring index (bench/RESULTS.md).

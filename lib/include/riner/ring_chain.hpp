@@ -1,6 +1,6 @@
-// The ring corrections of riner/ring_correction.hpp as a reconstruction runs them: air, radial
-// gradient, detector response, radial gradient again, each that the settings turn on, each fed
-// the image and alpha the one before left. Used for a slice (Reconstructor) and for each slice of a
+// The ring corrections of riner/ring_correction.hpp as a reconstruction runs them: mirror pairs,
+// air, radial gradient, detector response, radial gradient again, each that the settings turn
+// on, each fed the image and alpha the one before left. Used for a slice (Reconstructor) and for each slice of a
 // parallel-beam volume (riner/volume_ring_correction.hpp).
 #pragma once
 
@@ -22,6 +22,7 @@ struct RingChain {
   std::optional<RingCorrection> gradient;
   std::optional<RingCorrection> response;
   std::optional<RingCorrection> gradient_after_response;
+  std::optional<RingCorrection> mirror;
 };
 
 // 2D geometry; `dead_elements` as correct_rings_from_response takes them.

@@ -24,14 +24,19 @@
 //   radial gradient leaves. Rings can only make structure that is even about the axis, so the
 //   correction needs the even part to stand out over the odd one (the responses' own level).
 //
-// The chain runs air, gradient, response, then the gradient again (RingCorrectionConfig): the
-// first gradient pass keeps the steps of broad structure, the response step takes the broad
+// - Mirror pairs: the other way round, objects centred on the axis (a tube's wall, a
+//   cylindrical sample's edge) that training put into alpha go back into the image, where
+//   -ln(alpha)'s even part stands out against its odd part (correct_rings_from_mirrors).
+//
+// The chain runs mirror pairs, air, gradient, response, then the gradient again
+// (RingCorrectionConfig): the mirror step first gives back what training took from the object,
+// the first gradient pass keeps the steps of broad structure, the response step takes the broad
 // structure away, and the second pass sees the narrow rings that sat beside it.
 //
-// What neither can see: an object that is itself rotationally symmetric about the axis (a
-// sample holder, a container, a cylindrical sample's edge) looks exactly like a ring. Such an
-// object would need a large change of the detector response to explain, far beyond the 1-2%
-// that training leaves, so a correction whose mean change of ln(alpha) exceeds
+// What the image-side corrections cannot see: an object that is itself rotationally symmetric
+// about the axis (a sample holder, a container, a cylindrical sample's edge) looks exactly like a
+// ring. Such an object would need a large change of the detector response to explain, far beyond
+// the 1-2% that training leaves, so a correction whose mean change of ln(alpha) exceeds
 // max_mean_response_change is not applied.
 #pragma once
 
@@ -78,6 +83,10 @@ struct RingCorrection {
   std::size_t air_pixels = 0;  // air reference: air pixels after erosion, in the final pass
   // Detector response: rms of -ln(alpha)'s broad structure even about the axis over the odd one.
   double even_to_odd = 0.0;
+  // Mirror pairs: elements whose even structure stood out against the odd part's noise, and the
+  // largest such excess in units of that noise.
+  std::size_t elements_moved = 0;
+  double largest_even_sigmas = 0.0;
 };
 
 // `image` on the 2D geometry's grid ([n_y, n_x]) and `alpha` with one value per detector
@@ -130,5 +139,34 @@ RingCorrection correct_rings_from_response(const Array& image, const Array& alph
                                            const Geometry& geometry,
                                            const std::vector<std::size_t>& dead_elements,
                                            const ResponseRingSettings& settings = {});
+
+struct MirrorRingSettings {
+  // Gaussian smoothing across elements (sigma, in elements) of -ln(alpha)'s even and odd parts
+  // before they are compared: a ray's neighbours see nearly the same object.
+  double smoothing_elements = 1.0;
+  // The odd part's noise is its robust spread over this many elements on either side.
+  int window_elements = 25;
+  // Even structure at least this many times that noise, where the odd part stays below it, is
+  // an object on the axis; so many elements on either side go with it.
+  double min_sigmas = 4.0;
+  int grow_elements = 2;
+  // Largest mean |change of ln(alpha)| over the elements still taken (a sanity bound: this
+  // correction moves objects, which may be large).
+  double max_mean_response_change = 1.0;
+};
+
+// The other way round: an object centred on the rotation axis (a tube's wall, a cylindrical
+// sample's edge) that training put into alpha goes back into the image. A detector's own
+// errors are as odd about the axis as they are even (each element errs alone), while anything
+// rotationally symmetric in the image is even only. So where -ln(alpha)'s even part stands out
+// against its odd part's local noise by min_sigmas while the odd part does not, the even part
+// there is taken for an object: the rotationally symmetric profile whose projections match it
+// (least squares; elsewhere held near no change) is added to the image and taken out of alpha,
+// keeping the data fit. Elements without a mirror on the detector (an offset detector's far
+// side) give no evidence. Same inputs and guarantees as correct_rings_from_response.
+RingCorrection correct_rings_from_mirrors(const Array& image, const Array& alpha,
+                                         const Geometry& geometry,
+                                         const std::vector<std::size_t>& dead_elements,
+                                         const MirrorRingSettings& settings = {});
 
 }  // namespace riner

@@ -28,6 +28,7 @@ struct VolumeRingCorrection {
   std::size_t gradient_applied = 0;
   std::size_t gradient_after_response_applied = 0;
   std::size_t response_applied = 0;
+  std::size_t mirror_applied = 0;
   // Mean |ln(alpha_new / alpha)| over the corrected rows' elements.
   double mean_response_change = 0.0;
   // Why nothing was done, when nothing was ("" otherwise).

@@ -5,7 +5,6 @@
 #include <numeric>
 
 #include "riner/error.hpp"
-#include "riner/rays.hpp"
 #include "riner/ring_correction.hpp"
 #include "rings/radial.hpp"
 #include "rings/ring_profile.hpp"
@@ -21,16 +20,6 @@ constexpr double kCurvatureWeight = 0.1;
 constexpr double kRidgeWeight = 1e-9;
 // Below this, an element's alpha is not a response (ln would blow up).
 constexpr double kSmallestResponse = 1e-6;
-
-// Signed distance of each element's ray (view 0) from the rotation axis, in mm.
-std::vector<double> ray_distances(const Geometry& g) {
-  std::vector<double> d(g.n_u);
-  for (std::size_t e = 0; e < g.n_u; ++e) {
-    const Ray ray = detector_ray(g, 0, static_cast<double>(e));
-    d[e] = ray.origin.x * ray.direction.y - ray.origin.y * ray.direction.x;
-  }
-  return d;
-}
 
 // Per profile node, the fraction of the image's pixels there that are air (pixels shared
 // between the two nodes around their radius, as the profile is interpolated).
@@ -80,7 +69,7 @@ ResponseStructure response_structure(const Array& alpha, const Geometry& g,
     r.offset[e] = -std::log(a);
     ++r.count;
   }
-  r.distance = ray_distances(g);
+  r.distance = rings::ray_distances(g);
   r.sigma_mm = scale_px * g.voxel_mm;
   r.broad.assign(n, 0.0);
   for (std::size_t e = 0; e < n; ++e) {

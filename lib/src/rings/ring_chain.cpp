@@ -5,12 +5,19 @@ namespace riner {
 RingChain correct_rings_in_order(const Array& image, const Array& alpha, const Geometry& g,
                                  const std::vector<std::size_t>& dead_elements,
                                  const RingCorrectionConfig& config) {
-  RingChain out{image, alpha, std::nullopt, std::nullopt, std::nullopt, std::nullopt};
+  RingChain out{image, alpha, std::nullopt, std::nullopt, std::nullopt, std::nullopt,
+                std::nullopt};
   const auto take = [&out](std::optional<RingCorrection>& slot, RingCorrection c) {
     out.image = c.image;
     out.alpha = c.alpha;
     slot = std::move(c);
   };
+  // First: what training put into alpha that is an object goes back before the others judge
+  // the image's rings (after them, it would undo their rings: bench/RESULTS.md, issue 32).
+  if (config.mirror_reference) {
+    take(out.mirror,
+         correct_rings_from_mirrors(out.image, out.alpha, g, dead_elements, config.mirror));
+  }
   if (config.air_reference) {
     take(out.air, correct_rings_from_air(out.image, out.alpha, g, config.air));
   }

@@ -74,6 +74,30 @@ const std::vector<settings::Setting<ResponseRingSettings>>& response_settings() 
   return table;
 }
 
+const std::vector<settings::Setting<MirrorRingSettings>>& mirror_settings() {
+  using S = MirrorRingSettings;
+  static const std::vector<settings::Setting<S>> table = {
+      field<S>("rings", "mirror_smoothing_elements", closed(0, 100),
+               "mirror correction: Gaussian smoothing of -ln alpha's even and odd parts, in "
+               "elements",
+               &S::smoothing_elements),
+      field<S>("rings", "mirror_window_elements", closed(1, 10000),
+               "mirror correction: elements on either side that set the odd part's noise",
+               &S::window_elements),
+      field<S>("rings", "mirror_min_sigmas", open_closed(0, 1000),
+               "mirror correction: even structure this many times the odd noise is an object on "
+               "the axis",
+               &S::min_sigmas),
+      field<S>("rings", "mirror_grow_elements", closed(0, 1000),
+               "mirror correction: elements on either side taken with such structure",
+               &S::grow_elements),
+      field<S>("rings", "mirror_max_mean_response_change", open_closed(0, 10),
+               "mirror correction: largest mean absolute change of ln alpha still applied",
+               &S::max_mean_response_change),
+  };
+  return table;
+}
+
 namespace {
 
 template <typename S>
@@ -91,5 +115,6 @@ void validate(const char* what, const GradientRingSettings& s) {
 void validate(const char* what, const ResponseRingSettings& s) {
   check(what, s, response_settings());
 }
+void validate(const char* what, const MirrorRingSettings& s) { check(what, s, mirror_settings()); }
 
 }  // namespace riner::rings

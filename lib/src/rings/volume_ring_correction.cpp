@@ -83,6 +83,7 @@ VolumeRingCorrection correct_rings_per_slice(const Array& volume, const Array& a
     out.response_applied += chain.response && chain.response->applied;
     out.gradient_after_response_applied +=
         chain.gradient_after_response && chain.gradient_after_response->applied;
+    out.mirror_applied += chain.mirror && chain.mirror->applied;
     std::copy(chain.image.data.begin(), chain.image.data.end(),
               out.image.data.begin() + static_cast<std::ptrdiff_t>(s * ny * nx));
     std::copy(chain.alpha.data.begin(), chain.alpha.data.end(),

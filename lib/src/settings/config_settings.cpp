@@ -214,6 +214,13 @@ void add_rings(Table& t) {
   t.push_back(field<C>("rings", "gradient_after_response", {},
                        "the gradient correction again after the response correction (both on)",
                        &C::rings, &R::gradient_after_response));
+  t.push_back(field<C>("rings", "mirror_reference", {},
+                       "2D (3D: slice_by_slice): objects on the axis back from alpha's even "
+                       "structure that its odd part does not share",
+                       &C::rings, &R::mirror_reference));
+  for (const auto& s : rings::mirror_settings()) {
+    t.push_back(settings::lift<C>(s, &C::rings, &R::mirror));
+  }
   t.push_back(field<C>("rings", "slice_by_slice", {},
                        "parallel 3D: the corrections above, each slice with its detector row "
                        "(off: measured to cost 0.13 dB on a simulated head, more rings on savu)",

@@ -207,6 +207,7 @@ RinerConfig RinerConfig::paper() {
   c.rings.air_reference = false;
   c.rings.gradient_reference = false;
   c.rings.response_reference = false;
+  c.rings.mirror_reference = false;
   return c;
 }
 

@@ -114,8 +114,8 @@ bool on_plateau(const TrainingConfig& t, const std::vector<LossRecord>& history)
 // Whether the ring corrections change image and alpha: in 2D when any is on; in 3D only slice
 // by slice (rings.slice_by_slice).
 bool corrects_rings(const RinerConfig& c, const Geometry& g) {
-  const bool any =
-      c.rings.air_reference || c.rings.gradient_reference || c.rings.response_reference;
+  const bool any = c.rings.air_reference || c.rings.gradient_reference ||
+                   c.rings.response_reference || c.rings.mirror_reference;
   return any && (!g.is_3d() || c.rings.slice_by_slice);
 }
 
@@ -180,6 +180,7 @@ ReconstructionResult Reconstructor::evaluate_result() const {
     r.gradient_rings = std::move(chain.gradient);
     r.response_rings = std::move(chain.response);
     r.gradient_after_response_rings = std::move(chain.gradient_after_response);
+    r.mirror_rings = std::move(chain.mirror);
   }
   // Each correction subtracts its profile along whole circles; where a circle leaves the
   // sampled region, that would paint the ring into the skipped air. No second ramp: the field's
