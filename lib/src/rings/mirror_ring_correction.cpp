@@ -2,7 +2,6 @@
 #include <algorithm>
 #include <cmath>
 
-#include "riner/error.hpp"
 #include "riner/ring_correction.hpp"
 #include "rings/radial.hpp"
 #include "rings/ring_profile.hpp"
@@ -13,8 +12,6 @@ namespace riner {
 
 namespace {
 
-// Below this, an element's alpha is not a response (ln would blow up).
-constexpr double kSmallestResponse = 1e-6;
 // Even structure below this (in -ln alpha) is not worth moving, whatever the noise.
 constexpr double kSmallestStructure = 1e-4;
 // An object's even structure stands this many times above the odd part beside it; a detector's
@@ -206,49 +203,25 @@ RingCorrection correct_rings_from_mirrors(const Array& image, const Array& alpha
                                           const MirrorRingSettings& settings) {
   rings::check_inputs("mirror ring correction", image, alpha, geometry);
   rings::validate("mirror ring correction", settings);
-  const std::size_t n = geometry.n_u;
-  std::vector<char> usable(n, 1);
-  for (std::size_t e : dead_elements) {
-    if (e >= n) {
-      throw InputError("mirror ring correction: dead element " + std::to_string(e) +
-                       " of a detector with " + std::to_string(n) + " elements");
-    }
-    usable[e] = 0;
-  }
+  rings::check_dead_elements("mirror ring correction", dead_elements, geometry.n_u);
   RingCorrection out = rings::unchanged(image, alpha, geometry.voxel_mm);
-  if (!rings::all_finite(image) || n < 2) return out;
-  std::vector<double> offset(n, 0.0);
-  for (std::size_t e = 0; e < n; ++e) {
-    const double a = alpha.data[e];
-    usable[e] = usable[e] && std::isfinite(a) && a > kSmallestResponse;
-    if (usable[e]) offset[e] = -std::log(a);
-  }
-  const MirrorParts parts = mirror_parts(offset, usable, rings::ray_distances(geometry));
+  if (!rings::all_finite(image) || geometry.n_u < 2) return out;
+  const rings::ResponseOffsets offsets = rings::response_offsets(alpha, dead_elements);
+  const MirrorParts parts =
+      mirror_parts(offsets.offset, offsets.usable, rings::ray_distances(geometry));
   const EvenEvidence evidence = even_evidence(parts, settings);
   out.elements_moved = evidence.count;
   out.largest_even_sigmas = evidence.largest_sigmas;
   if (evidence.count == 0) return out;
 
-  const std::size_t ny = image.shape[0];
-  const std::size_t nx = image.shape[1];
-  const std::size_t nodes =
-      static_cast<std::size_t>(
-          std::ceil(0.5 * std::hypot(static_cast<double>(nx - 1), static_cast<double>(ny - 1)))) +
-      2;
-  // Inside the grid's inscribed circle only, as the response correction (its fit_gain says why).
-  const auto solved = static_cast<Eigen::Index>(0.5 * static_cast<double>(std::min(nx, ny) - 1));
-  if (solved < 3) return out;
+  const rings::ProfileNodes at = rings::profile_nodes(image);
+  if (at.solved < 3) return out;
   Eigen::MatrixXd weights;
-  const Eigen::VectorXd gain =
-      fit_gain(evidence, geometry, out.radius_step_mm, nodes, solved, weights, out.measured_radii);
+  const Eigen::VectorXd gain = fit_gain(evidence, geometry, out.radius_step_mm, at.nodes,
+                                        at.solved, weights, out.measured_radii);
   if (out.measured_radii == 0) return out;
-  out.profile.assign(nodes, 0.0);
-  for (Eigen::Index k = 0; k < solved; ++k) out.profile[static_cast<std::size_t>(k)] = -gain[k];
-  const Eigen::VectorXd change = weights * -gain;
-  if (rings::fold_into_alpha(out, std::vector<double>(change.begin(), change.end()),
-                             settings.max_mean_response_change)) {
-    rings::subtract_profile(out, image, geometry);
-  }
+  rings::move_gain_into_image(out, image, geometry, gain, weights, at.nodes,
+                              settings.max_mean_response_change);
   return out;
 }
 

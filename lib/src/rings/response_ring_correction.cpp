@@ -4,7 +4,6 @@
 #include <limits>
 #include <numeric>
 
-#include "riner/error.hpp"
 #include "riner/ring_correction.hpp"
 #include "rings/radial.hpp"
 #include "rings/ring_profile.hpp"
@@ -18,8 +17,6 @@ namespace {
 // nodes few rays reach (the axis) from taking up what the rest cannot fit (bench/RESULTS.md).
 constexpr double kCurvatureWeight = 0.1;
 constexpr double kRidgeWeight = 1e-9;
-// Below this, an element's alpha is not a response (ln would blow up).
-constexpr double kSmallestResponse = 1e-6;
 
 // Per profile node, the fraction of the image's pixels there that are air (pixels shared
 // between the two nodes around their radius, as the profile is interpolated).
@@ -59,16 +56,10 @@ ResponseStructure response_structure(const Array& alpha, const Geometry& g,
                                      const std::vector<std::size_t>& dead, double scale_px) {
   ResponseStructure r;
   const std::size_t n = g.n_u;
-  r.usable.assign(n, 1);
-  for (std::size_t e : dead) r.usable[e] = 0;
-  r.offset.assign(n, 0.0);
-  for (std::size_t e = 0; e < n; ++e) {
-    const double a = alpha.data[e];
-    r.usable[e] = r.usable[e] && std::isfinite(a) && a > kSmallestResponse;
-    if (!r.usable[e]) continue;
-    r.offset[e] = -std::log(a);
-    ++r.count;
-  }
+  rings::ResponseOffsets offsets = rings::response_offsets(alpha, dead);
+  r.usable = std::move(offsets.usable);
+  r.offset = std::move(offsets.offset);
+  r.count = offsets.count;
   r.distance = rings::ray_distances(g);
   r.sigma_mm = scale_px * g.voxel_mm;
   r.broad.assign(n, 0.0);
@@ -163,12 +154,7 @@ RingCorrection correct_rings_from_response(const Array& image, const Array& alph
                                            const ResponseRingSettings& settings) {
   rings::check_inputs("response ring correction", image, alpha, geometry);
   rings::validate("response ring correction", settings);
-  for (std::size_t e : dead_elements) {
-    if (e >= geometry.n_u) {
-      throw InputError("response ring correction: dead element " + std::to_string(e) +
-                       " of a detector with " + std::to_string(geometry.n_u) + " elements");
-    }
-  }
+  rings::check_dead_elements("response ring correction", dead_elements, geometry.n_u);
   RingCorrection out = rings::unchanged(image, alpha, geometry.voxel_mm);
   if (!rings::all_finite(image)) return out;
   const double threshold = rings::air_threshold(image, settings.air_fraction);
@@ -180,28 +166,15 @@ RingCorrection correct_rings_from_response(const Array& image, const Array& alph
   out.even_to_odd = even_to_odd(structure);
   if (out.even_to_odd == 0.0 || out.even_to_odd < settings.min_even_to_odd) return out;
 
-  const std::size_t ny = image.shape[0];
-  const std::size_t nx = image.shape[1];
-  const std::size_t nodes =
-      static_cast<std::size_t>(
-          std::ceil(0.5 * std::hypot(static_cast<double>(nx - 1), static_cast<double>(ny - 1)))) +
-      2;
-  const auto solved = static_cast<Eigen::Index>(0.5 * static_cast<double>(std::min(nx, ny) - 1));
-  if (solved < 3) return out;
+  const rings::ProfileNodes at = rings::profile_nodes(image);
+  if (at.solved < 3) return out;
   Eigen::MatrixXd weights;
   const Eigen::VectorXd gain =
-      fit_gain(structure, image, geometry, settings, threshold, out.radius_step_mm, nodes, solved,
-               weights, out.measured_radii);
+      fit_gain(structure, image, geometry, settings, threshold, out.radius_step_mm, at.nodes,
+               at.solved, weights, out.measured_radii);
   if (out.measured_radii == 0) return out;
-
-  // Apply: the image gains g, so the profile it loses is -g (0 beyond the solved nodes).
-  out.profile.assign(nodes, 0.0);
-  for (Eigen::Index k = 0; k < solved; ++k) out.profile[static_cast<std::size_t>(k)] = -gain[k];
-  const Eigen::VectorXd change = weights * -gain.head(solved);
-  if (rings::fold_into_alpha(out, std::vector<double>(change.begin(), change.end()),
-                             settings.max_mean_response_change)) {
-    rings::subtract_profile(out, image, geometry);
-  }
+  rings::move_gain_into_image(out, image, geometry, gain, weights, at.nodes,
+                              settings.max_mean_response_change);
   return out;
 }
 

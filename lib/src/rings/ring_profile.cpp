@@ -100,6 +100,52 @@ void subtract_profile(RingCorrection& out, const Array& image, const Geometry& g
   }
 }
 
+void check_dead_elements(const char* what, const std::vector<std::size_t>& dead, std::size_t n_u) {
+  for (std::size_t e : dead) {
+    if (e >= n_u) {
+      throw InputError(std::string(what) + ": dead element " + std::to_string(e) +
+                       " of a detector with " + std::to_string(n_u) + " elements");
+    }
+  }
+}
+
+ResponseOffsets response_offsets(const Array& alpha, const std::vector<std::size_t>& dead) {
+  constexpr double kSmallestResponse = 1e-6;
+  const std::size_t n = alpha.size();
+  ResponseOffsets r{std::vector<char>(n, 1), std::vector<double>(n, 0.0)};
+  for (std::size_t e : dead) r.usable[e] = 0;
+  for (std::size_t e = 0; e < n; ++e) {
+    const double a = alpha.data[e];
+    r.usable[e] = r.usable[e] && std::isfinite(a) && a > kSmallestResponse;
+    if (!r.usable[e]) continue;
+    r.offset[e] = -std::log(a);
+    ++r.count;
+  }
+  return r;
+}
+
+ProfileNodes profile_nodes(const Array& image) {
+  const auto ny = static_cast<double>(image.shape[0]);
+  const auto nx = static_cast<double>(image.shape[1]);
+  ProfileNodes p;
+  p.nodes = static_cast<std::size_t>(std::ceil(0.5 * std::hypot(nx - 1.0, ny - 1.0))) + 2;
+  p.solved = static_cast<Eigen::Index>(0.5 * (std::min(nx, ny) - 1.0));
+  return p;
+}
+
+void move_gain_into_image(RingCorrection& out, const Array& image, const Geometry& g,
+                          const Eigen::VectorXd& gain, const Eigen::MatrixXd& weights,
+                          std::size_t nodes, double max_mean_response_change) {
+  const Eigen::Index solved = weights.cols();
+  out.profile.assign(nodes, 0.0);
+  for (Eigen::Index k = 0; k < solved; ++k) out.profile[static_cast<std::size_t>(k)] = -gain[k];
+  const Eigen::VectorXd change = weights * -gain.head(solved);
+  if (fold_into_alpha(out, std::vector<double>(change.begin(), change.end()),
+                      max_mean_response_change)) {
+    subtract_profile(out, image, g);
+  }
+}
+
 bool fold_into_alpha(RingCorrection& out, const std::vector<double>& change,
                      double max_mean_response_change) {
   const std::size_t n = change.size();

@@ -3,6 +3,8 @@
 // data fit, unless the response would have to change more than a ring can explain.
 #pragma once
 
+#include <Eigen/Dense>
+#include <cstddef>
 #include <vector>
 
 #include "riner/geometry.hpp"
@@ -38,6 +40,33 @@ std::vector<double> ring_projection_weights(std::size_t nodes, double step_mm, c
 // That integral of `profile` for every element: what the ring adds to each element's readings.
 std::vector<double> ring_projections(const std::vector<double>& profile, double step_mm,
                                      const Geometry& g);
+
+// Each element's -ln(alpha) where it is a response: live (not in `dead`; an index beyond the
+// detector is an InputError prefixed with `what`), alpha finite and above 1e-6 (below, ln would
+// blow up); 0 elsewhere.
+struct ResponseOffsets {
+  std::vector<char> usable;
+  std::vector<double> offset;
+  std::size_t count = 0;  // usable elements
+};
+void check_dead_elements(const char* what, const std::vector<std::size_t>& dead, std::size_t n_u);
+ResponseOffsets response_offsets(const Array& alpha, const std::vector<std::size_t>& dead);
+
+// A profile's nodes for an image: one per pixel of radius out to the farthest pixel, plus a
+// spare; `solved` of them lie inside the grid's inscribed circle, beyond which the grid's
+// corners cut a ring differently in every view (no longer a per-element offset).
+struct ProfileNodes {
+  std::size_t nodes = 0;
+  Eigen::Index solved = 0;
+};
+ProfileNodes profile_nodes(const Array& image);
+
+// The image gains `gain` (per solved node; `weights`: every element's projection weights on
+// them): out.profile = -gain, folded into alpha (fold_into_alpha) and, when that is applied,
+// subtracted from the image.
+void move_gain_into_image(RingCorrection& out, const Array& image, const Geometry& g,
+                          const Eigen::VectorXd& gain, const Eigen::MatrixXd& weights,
+                          std::size_t nodes, double max_mean_response_change);
 
 // The air rule of the corrections: pixels below fraction times kAirReferencePercentile's value.
 // Returns that threshold (not positive when the image has no positive values).
