@@ -1,5 +1,6 @@
 // riner fbp: filtered backprojection (FBP, or FDK for cone beam) of a scan.
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <functional>
 #include <optional>
@@ -36,6 +37,16 @@ std::size_t fbp_device_slices(const Geometry& g, const SlabOptions& asked,
 // output is a folder of slices, or when its volume does not fit in memory whole (the host's,
 // or the GPU's).
 // `options` (which opens the device) only for a stack that would fit whole.
+void note_half_acquisition(const Console& console, double overlap_mm) {
+  if (overlap_mm <= 0.0) return;
+  char line[200];
+  std::snprintf(line, sizeof(line),
+                "half acquisition: the axis lies near one end of the detector; conjugate rays "
+                "blended over +-%.1f mm around it",
+                overlap_mm);
+  console.line(line);
+}
+
 bool fbp_wants_slabs(const Args& args, const std::function<const FbpOptions&()>& options) {
   const bool asked = !args.get("slab-slices").empty() || !args.get("memory-limit").empty();
   const bool folder = std::filesystem::path(args.get("out")).extension().empty();
@@ -93,6 +104,7 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
         "warning: the views do not cover the full circle; without Parker weights the "
         "image will show streaks");
   }
+  note_half_acquisition(console, report.fbp.half_acquisition_overlap_mm);
   console.line("fbp (" + std::string(fbp_filter_name(options.filter)) + ", " +
                engine_name(options.engine) + "): " + shape_string(g.volume_shape) + " in " +
                std::to_string(report.slabs) + " slab(s) of up to " +
@@ -110,6 +122,7 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
                    {"slab_bytes_estimated", fbp_slab_bytes(g, report.slices_per_slab)},
                    {"non_finite_replaced", report.fbp.non_finite_replaced},
                    {"short_scan", report.fbp.short_scan},
+                   {"half_acquisition_overlap_mm", report.fbp.half_acquisition_overlap_mm},
                    {"centre", source.centre() ? centre_json(*source.centre())
                                               : nlohmann::json(nullptr)}});
   return 0;
@@ -189,6 +202,7 @@ int run_fbp(int argc, char** argv, int first) {
         "warning: the views do not cover the full circle; without Parker weights the "
         "image will show streaks");
   }
+  note_half_acquisition(console, report.half_acquisition_overlap_mm);
   console.line("fbp (" + std::string(fbp_filter_name(options.filter)) + ", " +
                engine_name(options.engine) + "): " + shape_string(image.shape) + " in " +
                std::to_string(seconds) + " s, " + std::to_string(report.non_finite_replaced) +
@@ -201,6 +215,7 @@ int run_fbp(int argc, char** argv, int first) {
        {"seconds", seconds},
        {"non_finite_replaced", report.non_finite_replaced},
        {"short_scan", report.short_scan},
+       {"half_acquisition_overlap_mm", report.half_acquisition_overlap_mm},
        {"destripe", stripes ? nlohmann::json(destripe_method_name(stripes->method))
                             : nlohmann::json(nullptr)},
        {"flat_field",

@@ -46,6 +46,9 @@ struct FbpReport {
   std::size_t non_finite_replaced = 0;  // NaN/inf measurements interpolated from neighbours
   bool short_scan = false;  // views miss part of the circle (half-circle for parallel beams);
                             // no Parker weighting is applied, so expect streaks
+  // A full turn with the axis near one end of the detector (half acquisition): the overlap
+  // around the axis, +- this many mm, blended between conjugate rays; 0 for a centred detector.
+  double half_acquisition_overlap_mm = 0.0;
 };
 
 // The image/volume on the scan geometry's grid, mu in 1/mm. Non-finite measurements are

@@ -51,13 +51,14 @@ SliceSelection SliceSelection::spread(std::size_t nz, std::size_t most) {
 }
 
 Array fbp(const Scan& scan, const FbpOptions& options, FbpReport* report) {
-  const Geometry& g = scan.geometry;
-  g.validate();
-  g.check_measurement_shape(scan.measurement.shape);
+  scan.geometry.validate();
+  scan.geometry.check_measurement_shape(scan.measurement.shape);
+  Geometry g = scan.geometry;  // a half acquisition's detector widens below
   Array weighted = scan.measurement;
   FbpReport local;
   local.non_finite_replaced = analytic::repair_non_finite(weighted, g.n_u);
   analytic::cosine_weight(weighted, g);
+  local.half_acquisition_overlap_mm = analytic::extend_half_acquisition(weighted, g);
   const std::vector<double> taps =
       analytic::filter_taps(g.n_u, analytic::filter_spacing(g), options.filter);
   const std::vector<double> view_weights = analytic::view_weights(g, &local.short_scan);

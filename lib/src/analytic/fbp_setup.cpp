@@ -6,6 +6,8 @@
 #include <numeric>
 #include <unsupported/Eigen/FFT>
 
+#include "riner/rays.hpp"
+
 namespace riner::analytic {
 
 std::size_t repair_non_finite(Array& measurement, std::size_t n_u) {
@@ -50,6 +52,80 @@ void cosine_weight(Array& measurement, const Geometry& g) {
   }
   for (std::size_t i = 0; i < measurement.size(); ++i)
     measurement.data[i] *= weight[i % weight.size()];
+}
+
+namespace {
+
+// Signed distance from the axis, in the axial plane, of each detector column's ray through the
+// detector's middle row at view 0.
+std::vector<double> column_distances(const Geometry& g) {
+  std::vector<double> d(g.n_u);
+  const double middle_row = g.is_3d() ? 0.5 * (static_cast<double>(g.n_v) - 1.0) : 0.0;
+  for (std::size_t j = 0; j < g.n_u; ++j) {
+    const Ray ray = detector_ray(g, 0, static_cast<double>(j), middle_row);
+    const double across = std::hypot(ray.direction.x, ray.direction.y);
+    d[j] = (ray.origin.x * ray.direction.y - ray.origin.y * ray.direction.x) / across;
+  }
+  return d;
+}
+
+// Whether the views cover a full turn: no gap between neighbouring angles (mod 2 pi) of more
+// than three mean steps.
+bool full_turn(const Geometry& g) {
+  const std::size_t n = g.n_views();
+  if (n < 2) return false;
+  std::vector<double> phase(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    phase[i] = std::fmod(g.angles[i], 2.0 * M_PI);
+    if (phase[i] < 0.0) phase[i] += 2.0 * M_PI;
+  }
+  std::sort(phase.begin(), phase.end());
+  double largest_gap = phase.front() + 2.0 * M_PI - phase.back();
+  for (std::size_t i = 1; i < n; ++i) largest_gap = std::max(largest_gap, phase[i] - phase[i - 1]);
+  return largest_gap <= 3.0 * 2.0 * M_PI / static_cast<double>(n);
+}
+
+// Below this share of the far side's reach, the near side makes a half acquisition.
+constexpr double kCentredShare = 0.8;
+
+}  // namespace
+
+double extend_half_acquisition(Array& measurement, Geometry& g) {
+  if (g.n_u < 2 || !full_turn(g)) return 0.0;
+  const std::vector<double> d = column_distances(g);
+  const auto [low, high] = std::minmax_element(d.begin(), d.end());
+  if (!(*low < 0.0 && *high > 0.0)) return 0.0;
+  const double overlap = std::min(-*low, *high);
+  const double far = std::max(-*low, *high);
+  if (overlap >= kCentredShare * far) return 0.0;
+  const double side = *high > -*low ? 1.0 : -1.0;  // the far side's sign
+  const std::size_t n = g.n_u;
+  std::vector<float> weight(n);
+  for (std::size_t j = 0; j < n; ++j) {
+    const double t = side * d[j];  // -overlap .. far
+    const double s = std::sin(0.25 * M_PI * (std::min(t, overlap) + overlap) / overlap);
+    weight[j] = static_cast<float>(2.0 * s * s);
+  }
+  // Columns to add on the near end: as many as the far side has beyond the overlap.
+  const bool near_first = std::fabs(d.front()) < std::fabs(d.back());
+  std::size_t beyond = 0;
+  for (double v : d) beyond += side * v > overlap;
+  const std::size_t lines = measurement.size() / n;
+  std::vector<std::size_t> shape = measurement.shape;
+  shape.back() = n + beyond;
+  Array wide(shape, 0.0f);
+  const std::size_t start = near_first ? beyond : 0;
+  for (std::size_t line = 0; line < lines; ++line) {
+    for (std::size_t j = 0; j < n; ++j) {
+      wide.data[line * (n + beyond) + start + j] = measurement.data[line * n + j] * weight[j];
+    }
+  }
+  measurement = std::move(wide);
+  // Element j keeps its place: (j' - (n' - 1) / 2 + offset') = (j - (n - 1) / 2 + offset).
+  const double half = 0.5 * static_cast<double>(beyond);
+  g.offset_u += near_first ? -half : half;
+  g.n_u = n + beyond;
+  return overlap;
 }
 
 double filter_spacing(const Geometry& g) {

@@ -20,6 +20,18 @@ std::size_t repair_non_finite(Array& measurement, std::size_t n_u);
 // angle to the central ray); parallel beams are unchanged.
 void cosine_weight(Array& measurement, const Geometry& g);
 
+// A full turn seen by a detector whose one side reaches much farther from the axis than the
+// other (half acquisition, an offset axis): a ray beyond the near side's reach has no conjugate,
+// so it counts twice, and across the overlap |d| < o around the axis the two conjugates blend as
+// 2 w(d) with w(d) + w(-d) = 1 (sin^2 in the ray's distance d from the axis), which also takes
+// the near edge to 0. The filtered views reach beyond the near edge (the ramp's tails), where the
+// conjugates need them, so the detector is extended there with zeros to mirror the far side:
+// `measurement` is weighted and widened, `g` gets the new element count and offset (the old
+// elements stay where they were). Returns o in mm; 0 (nothing changed) for a centred detector
+// (near side over 80% of the far one's reach), a scan short of a full turn, or a detector on one
+// side of the axis only.
+double extend_half_acquisition(Array& measurement, Geometry& g);
+
 // Detector spacing the filter works in: the pitch, scaled to the isocentre for divergent beams.
 double filter_spacing(const Geometry& g);
 
