@@ -91,6 +91,17 @@ TEST_SUITE("quality: lost object") {
     const double u = 91.5 * 0.5;
     CHECK(riner::field_of_view(g).radius_mm ==
           doctest::Approx(370.0 * std::sin(std::atan(u / 740.0))));
+    // Half acquisition: the axis 32.5 elements from one end (offset -60). Over a full turn
+    // every line is seen from one side or the other, so the field reaches the farther end
+    // (152.5 elements, 76.25 mm); over a half turn only the nearer one (16.25 mm).
+    g.type = riner::GeometryType::kParallel2d;
+    g.offset_u = -60.0;
+    g.angles = riner::uniform_angles({360, 0.0, 2.0 * M_PI});
+    CHECK(riner::is_half_acquisition(g));
+    CHECK(riner::field_radius_px(g) == doctest::Approx(152.5));
+    g.angles = riner::uniform_angles({180, 0.0, M_PI});
+    CHECK_FALSE(riner::is_half_acquisition(g));
+    CHECK(riner::field_radius_px(g) == doctest::Approx(32.5));
   }
 }
 

@@ -69,9 +69,19 @@ struct Geometry {
   void save(const std::filesystem::path& path) const;
 };
 
-// The cylinder (disc in 2D) around the axis that every view's detector sees whole: its radius
-// from the detector's nearer end, its half height (3D) from the rows at the largest
-// magnification. Zero when the axis is off the detector.
+// Whether the views go all the way round: no gap between neighbouring angles (mod 2 pi) of more
+// than three mean steps.
+bool covers_full_turn(const Geometry& g);
+
+// Half acquisition: a full turn with the axis near one end of the detector (its nearer end
+// under this share of the farther end's reach from the axis, the axis on the detector). Every
+// line through the field is then measured from one side of the axis or the other.
+constexpr double kHalfAcquisitionShare = 0.8;
+bool is_half_acquisition(const Geometry& g);
+
+// The cylinder (disc in 2D) around the axis that the scan sees whole: its radius from the
+// detector's nearer end (a half acquisition's: from its farther end), its half height (3D)
+// from the rows at the largest magnification. Zero when the axis is off the detector.
 struct FieldOfView {
   double radius_mm = 0.0;
   double half_height_mm = 0.0;

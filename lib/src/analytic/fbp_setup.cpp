@@ -69,35 +69,16 @@ std::vector<double> column_distances(const Geometry& g) {
   return d;
 }
 
-// Whether the views cover a full turn: no gap between neighbouring angles (mod 2 pi) of more
-// than three mean steps.
-bool full_turn(const Geometry& g) {
-  const std::size_t n = g.n_views();
-  if (n < 2) return false;
-  std::vector<double> phase(n);
-  for (std::size_t i = 0; i < n; ++i) {
-    phase[i] = std::fmod(g.angles[i], 2.0 * M_PI);
-    if (phase[i] < 0.0) phase[i] += 2.0 * M_PI;
-  }
-  std::sort(phase.begin(), phase.end());
-  double largest_gap = phase.front() + 2.0 * M_PI - phase.back();
-  for (std::size_t i = 1; i < n; ++i) largest_gap = std::max(largest_gap, phase[i] - phase[i - 1]);
-  return largest_gap <= 3.0 * 2.0 * M_PI / static_cast<double>(n);
-}
-
-// Below this share of the far side's reach, the near side makes a half acquisition.
-constexpr double kCentredShare = 0.8;
-
 }  // namespace
 
 double extend_half_acquisition(Array& measurement, Geometry& g) {
-  if (g.n_u < 2 || !full_turn(g)) return 0.0;
+  if (g.n_u < 2 || !covers_full_turn(g)) return 0.0;
   const std::vector<double> d = column_distances(g);
   const auto [low, high] = std::minmax_element(d.begin(), d.end());
   if (!(*low < 0.0 && *high > 0.0)) return 0.0;
   const double overlap = std::min(-*low, *high);
   const double far = std::max(-*low, *high);
-  if (overlap >= kCentredShare * far) return 0.0;
+  if (overlap >= kHalfAcquisitionShare * far) return 0.0;
   const double side = *high > -*low ? 1.0 : -1.0;  // the far side's sign
   const std::size_t n = g.n_u;
   std::vector<float> weight(n);

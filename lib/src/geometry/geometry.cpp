@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
+#include <vector>
 
 #include "riner/array.hpp"
 #include "riner/error.hpp"
@@ -68,15 +70,43 @@ void Geometry::check_measurement_shape(const std::vector<std::size_t>& shape,
   throw InputError(message);
 }
 
+namespace {
+
+// How far the detector's two ends lie from the axis (mm on the detector), nearer end first;
+// {0, 0} when the axis is off the detector.
+std::pair<double, double> detector_ends(std::size_t n, double offset, double pitch) {
+  const double lo = (-0.5 - 0.5 * (static_cast<double>(n) - 1.0) + offset) * pitch;
+  const double hi =
+      (static_cast<double>(n) - 0.5 - 0.5 * (static_cast<double>(n) - 1.0) + offset) * pitch;
+  if (!(lo < 0.0 && hi > 0.0)) return {0.0, 0.0};
+  return {std::min(-lo, hi), std::max(-lo, hi)};
+}
+
+}  // namespace
+
+bool covers_full_turn(const Geometry& g) {
+  const std::size_t n = g.n_views();
+  if (n < 2) return false;
+  std::vector<double> phase(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    phase[i] = std::fmod(g.angles[i], 2.0 * M_PI);
+    if (phase[i] < 0.0) phase[i] += 2.0 * M_PI;
+  }
+  std::sort(phase.begin(), phase.end());
+  double largest_gap = phase.front() + 2.0 * M_PI - phase.back();
+  for (std::size_t i = 1; i < n; ++i) largest_gap = std::max(largest_gap, phase[i] - phase[i - 1]);
+  return largest_gap <= 3.0 * 2.0 * M_PI / static_cast<double>(n);
+}
+
+bool is_half_acquisition(const Geometry& g) {
+  const auto [nearer, farther] = detector_ends(g.n_u, g.offset_u, g.pitch_u);
+  return farther > 0.0 && nearer < kHalfAcquisitionShare * farther && covers_full_turn(g);
+}
+
 FieldOfView field_of_view(const Geometry& g) {
-  auto nearer_end = [](std::size_t n, double offset, double pitch) {
-    const double lo = (-0.5 - 0.5 * (static_cast<double>(n) - 1.0) + offset) * pitch;
-    const double hi =
-        (static_cast<double>(n) - 0.5 - 0.5 * (static_cast<double>(n) - 1.0) + offset) * pitch;
-    return lo < 0.0 && hi > 0.0 ? std::min(-lo, hi) : 0.0;
-  };
-  const double u = nearer_end(g.n_u, g.offset_u, g.pitch_u);
-  const double v = g.is_3d() ? nearer_end(g.n_v, g.offset_v, g.pitch_v) : 0.0;
+  const auto [nearer, farther] = detector_ends(g.n_u, g.offset_u, g.pitch_u);
+  const double u = is_half_acquisition(g) ? farther : nearer;
+  const double v = g.is_3d() ? detector_ends(g.n_v, g.offset_v, g.pitch_v).first : 0.0;
   if (!g.is_divergent()) return {u, v};
   const double sdd = g.source_origin_mm + g.origin_detector_mm;
   FieldOfView f;
