@@ -82,7 +82,7 @@ LoadedScan scan_from(const Args& args, const Console& console) {
 std::optional<CentreEstimate> check_centre(const LoadedScan& loaded, const Console& console) {
   if (loaded.centre) return std::nullopt;
   const Geometry& g = loaded.scan.geometry;
-  if (std::fabs(g.offset_u) > kCentreSearchShare * static_cast<double>(g.n_u)) {
+  if (!centre_search_covers(g)) {
     console.line("note: the rotation axis lies outside the detector's central half (half "
                  "acquisition?): the centre finders search there only, so the geometry's offset "
                  "is not checked");

@@ -28,8 +28,6 @@ LoadedScan scan_from(const Args& args, const Console& console);
 // Further from the scan's own estimate of its axis (`riner center`) than this, the geometry's
 // offset is doubted aloud: half a pixel blurs little, a few pixels double edges.
 constexpr double kCentreDoubtPx = 1.0;
-// The centre finders search offsets within this share of the detector's width either way.
-constexpr double kCentreSearchShare = 0.25;
 
 // A scan whose offset was given (not auto): the scan's own estimate, and a console note when
 // the two differ by more than kCentreDoubtPx. nullopt for auto offsets, and scans without a

@@ -40,4 +40,12 @@ struct CentreEstimate {
 // likewise from the fan of its rays through the source's plane.
 CentreEstimate estimate_centre(const Scan& scan);
 
+// A parallel beam's centre finders search offsets within this share of the detector's width
+// either way of its middle (a half acquisition's axis lies beyond).
+constexpr double kCentreSearchShare = 0.25;
+
+// Whether estimate_centre searches where the geometry puts the axis: a divergent beam's search
+// follows the geometry's offset, a parallel beam's stays within kCentreSearchShare.
+bool centre_search_covers(const Geometry& g);
+
 }  // namespace riner

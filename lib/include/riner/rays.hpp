@@ -5,6 +5,8 @@
 
 #include <cstddef>
 
+#include <vector>
+
 #include "riner/geometry.hpp"
 
 namespace riner {
@@ -25,6 +27,11 @@ struct Ray {
 // The ray to detector element (u, v) at `view`. u and v are element indices and may be
 // fractional (positions inside an element); v is ignored in 2D.
 Ray detector_ray(const Geometry& g, std::size_t view, double u, double v = 0.0);
+
+// Signed distance from the rotation axis, in the axial plane, of each detector column's ray at
+// view 0 (through the detector's middle row in 3D): a ring about the axis projects the same at
+// d and -d, and a ray at d has its conjugate at -d.
+std::vector<double> column_ray_distances(const Geometry& g);
 
 // Where detector element (u, v) sits in the world at `view` (its centre for integer indices).
 Vec3 detector_position(const Geometry& g, std::size_t view, double u, double v = 0.0);

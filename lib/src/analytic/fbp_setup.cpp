@@ -54,26 +54,9 @@ void cosine_weight(Array& measurement, const Geometry& g) {
     measurement.data[i] *= weight[i % weight.size()];
 }
 
-namespace {
-
-// Signed distance from the axis, in the axial plane, of each detector column's ray through the
-// detector's middle row at view 0.
-std::vector<double> column_distances(const Geometry& g) {
-  std::vector<double> d(g.n_u);
-  const double middle_row = g.is_3d() ? 0.5 * (static_cast<double>(g.n_v) - 1.0) : 0.0;
-  for (std::size_t j = 0; j < g.n_u; ++j) {
-    const Ray ray = detector_ray(g, 0, static_cast<double>(j), middle_row);
-    const double across = std::hypot(ray.direction.x, ray.direction.y);
-    d[j] = (ray.origin.x * ray.direction.y - ray.origin.y * ray.direction.x) / across;
-  }
-  return d;
-}
-
-}  // namespace
-
 double extend_half_acquisition(Array& measurement, Geometry& g) {
   if (g.n_u < 2 || !covers_full_turn(g)) return 0.0;
-  const std::vector<double> d = column_distances(g);
+  const std::vector<double> d = column_ray_distances(g);
   const auto [low, high] = std::minmax_element(d.begin(), d.end());
   if (!(*low < 0.0 && *high > 0.0)) return 0.0;
   const double overlap = std::min(-*low, *high);

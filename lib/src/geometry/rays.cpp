@@ -43,6 +43,17 @@ Vec3 detector_position(const Geometry& g, std::size_t view, double u, double v) 
   return {a * c - b * s, a * s + b * c, z};
 }
 
+std::vector<double> column_ray_distances(const Geometry& g) {
+  std::vector<double> d(g.n_u);
+  const double middle_row = g.is_3d() ? 0.5 * (static_cast<double>(g.n_v) - 1.0) : 0.0;
+  for (std::size_t j = 0; j < g.n_u; ++j) {
+    const Ray ray = detector_ray(g, 0, static_cast<double>(j), middle_row);
+    const double across = std::hypot(ray.direction.x, ray.direction.y);
+    d[j] = (ray.origin.x * ray.direction.y - ray.origin.y * ray.direction.x) / across;
+  }
+  return d;
+}
+
 Ray detector_ray(const Geometry& g, std::size_t view, double u, double v) {
   const double c = std::cos(g.angles[view]);
   const double s = std::sin(g.angles[view]);

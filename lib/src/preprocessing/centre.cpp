@@ -147,7 +147,10 @@ double best_axis(std::span<const LinePair> lines, std::size_t n_u, double* width
       best = a;
     }
   };
-  for (double a = centre - 0.25 * n; a <= centre + 0.25 * n; a += kCoarseStepPx) consider(a);
+  for (double a = centre - kCentreSearchShare * n; a <= centre + kCentreSearchShare * n;
+       a += kCoarseStepPx) {
+    consider(a);
+  }
   const double coarse = best;
   for (double a = coarse - kCoarseStepPx; a <= coarse + kCoarseStepPx + 1e-9; a += kFineStepPx) {
     consider(a);
@@ -226,6 +229,11 @@ Scan midplane_fan(const Scan& cone) {
 }
 
 }  // namespace
+
+bool centre_search_covers(const Geometry& g) {
+  return g.is_divergent() ||
+         std::fabs(g.offset_u) <= kCentreSearchShare * static_cast<double>(g.n_u);
+}
 
 CentreEstimate estimate_centre(const Scan& scan) {
   const Geometry& g = scan.geometry;

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "analytic/fbp_setup.hpp"
+#include "riner/centre.hpp"
 #include "util/parallel.hpp"
 #include "util/robust_statistics.hpp"
 
@@ -186,7 +187,8 @@ double row_axis(const std::vector<std::vector<Row>>& turns) {
   }
   const double nb = static_cast<double>(n / by_columns);
   std::vector<double> candidates;
-  for (double a = 0.25 * (nb - 1.0); a <= 0.75 * (nb - 1.0) + 1e-9; a += 0.5) {
+  for (double a = (0.5 - kCentreSearchShare) * (nb - 1.0);
+       a <= (0.5 + kCentreSearchShare) * (nb - 1.0) + 1e-9; a += 0.5) {
     candidates.push_back(a);
   }
   const Minimum c = minimise(coarse, candidates);

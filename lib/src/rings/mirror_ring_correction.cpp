@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "riner/rays.hpp"
 #include "riner/ring_correction.hpp"
 #include "rings/radial.hpp"
 #include "rings/ring_profile.hpp"
@@ -117,20 +118,18 @@ EvenEvidence even_evidence(const MirrorParts& parts, const MirrorRingSettings& s
     if (parts.paired[e]) paired_even.push_back(even[e]);
   }
   if (paired_even.empty()) return ev;
-  const std::vector<double> level(n, util::quantile(paired_even, 0.5));
+  const double level = util::quantile(paired_even, 0.5);
   // Around each element (its grow neighbourhood), the even part's excess and the odd part as
   // root mean squares: one bad element makes both alike, an object only the even one.
   const auto grow = static_cast<std::ptrdiff_t>(s.grow_elements);
-  const std::vector<double> none(n, 0.0);
-  const auto near_rms = [&](const std::vector<double>& v, const std::vector<double>& minus,
-                            std::ptrdiff_t e) {
+  const auto near_rms = [&](const std::vector<double>& v, double minus, std::ptrdiff_t e) {
     double sum = 0.0;
     double count = 0.0;
     for (std::ptrdiff_t j = std::max<std::ptrdiff_t>(0, e - grow);
          j <= std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(n) - 1, e + grow); ++j) {
       const auto k = static_cast<std::size_t>(j);
       if (!parts.paired[k]) continue;
-      sum += (v[k] - minus[k]) * (v[k] - minus[k]);
+      sum += (v[k] - minus) * (v[k] - minus);
       count += 1.0;
     }
     return count > 0.0 ? std::sqrt(sum / count) : 0.0;
@@ -139,10 +138,10 @@ EvenEvidence even_evidence(const MirrorParts& parts, const MirrorRingSettings& s
   for (std::size_t e = 0; e < n; ++e) {
     if (!parts.paired[e] || parts.mirror_gap[e] <= kMirrorGapWindows * s.window_elements) continue;
     ev.judged[e] = 1;
-    const double excess = std::fabs(even[e] - level[e]);
+    const double excess = std::fabs(even[e] - level);
     if (excess <= kSmallestStructure || excess <= s.min_sigmas * noise[e]) continue;
     const auto at = static_cast<std::ptrdiff_t>(e);
-    if (near_rms(even, level, at) <= kEvenOverOdd * near_rms(odd, none, at)) continue;
+    if (near_rms(even, level, at) <= kEvenOverOdd * near_rms(odd, 0.0, at)) continue;
     seed[e] = 1;
     if (noise[e] > 0.0) ev.largest_sigmas = std::max(ev.largest_sigmas, excess / noise[e]);
   }
@@ -156,7 +155,7 @@ EvenEvidence even_evidence(const MirrorParts& parts, const MirrorRingSettings& s
   }
   for (std::size_t e = 0; e < n; ++e) {
     if (!ev.object[e]) continue;
-    ev.target[e] = even[e] - level[e];
+    ev.target[e] = even[e] - level;
     ++ev.count;
   }
   return ev;
@@ -173,22 +172,18 @@ Eigen::VectorXd fit_gain(const EvenEvidence& ev, const Geometry& g, double step_
   weights.resize(n, solved);
   Eigen::VectorXd w = Eigen::VectorXd::Zero(n);
   Eigen::VectorXd target = Eigen::VectorXd::Zero(n);
+  Eigen::VectorXd object = Eigen::VectorXd::Zero(n);
   for (Eigen::Index e = 0; e < n; ++e) {
     const auto i = static_cast<std::size_t>(e);
     const std::vector<double> row = rings::ring_projection_weights(nodes, step_mm, g, i);
     for (Eigen::Index k = 0; k < solved; ++k) weights(e, k) = row[static_cast<std::size_t>(k)];
     w[e] = ev.object[i] ? 1.0 : ev.judged[i] ? kHoldWeight : 0.0;
     target[e] = ev.target[i];
+    object[e] = ev.object[i] ? 1.0 : 0.0;
   }
   const Eigen::MatrixXd weighted = w.asDiagonal() * weights;
-  measured = 0;
-  for (Eigen::Index k = 0; k < solved; ++k) {
-    double reach = 0.0;
-    for (Eigen::Index e = 0; e < n; ++e) {
-      if (ev.object[static_cast<std::size_t>(e)]) reach += weights(e, k);
-    }
-    measured += reach > 0.0;
-  }
+  // Radii some object element's ray reaches.
+  measured = static_cast<std::size_t>(((weights.transpose() * object).array() > 0.0).count());
   Eigen::MatrixXd normal = weighted.transpose() * weighted;
   const double scale = normal.trace() / static_cast<double>(solved);
   normal.diagonal().array() += kRidgeWeight * scale;
@@ -208,7 +203,7 @@ RingCorrection correct_rings_from_mirrors(const Array& image, const Array& alpha
   if (!rings::all_finite(image) || geometry.n_u < 2) return out;
   const rings::ResponseOffsets offsets = rings::response_offsets(alpha, dead_elements);
   const MirrorParts parts =
-      mirror_parts(offsets.offset, offsets.usable, rings::ray_distances(geometry));
+      mirror_parts(offsets.offset, offsets.usable, column_ray_distances(geometry));
   const EvenEvidence evidence = even_evidence(parts, settings);
   out.elements_moved = evidence.count;
   out.largest_even_sigmas = evidence.largest_sigmas;
@@ -217,8 +212,8 @@ RingCorrection correct_rings_from_mirrors(const Array& image, const Array& alpha
   const rings::ProfileNodes at = rings::profile_nodes(image);
   if (at.solved < 3) return out;
   Eigen::MatrixXd weights;
-  const Eigen::VectorXd gain = fit_gain(evidence, geometry, out.radius_step_mm, at.nodes,
-                                        at.solved, weights, out.measured_radii);
+  const Eigen::VectorXd gain = fit_gain(evidence, geometry, out.radius_step_mm, at.nodes, at.solved,
+                                        weights, out.measured_radii);
   if (out.measured_radii == 0) return out;
   rings::move_gain_into_image(out, image, geometry, gain, weights, at.nodes,
                               settings.max_mean_response_change);

@@ -4,6 +4,7 @@
 #include <limits>
 #include <numeric>
 
+#include "riner/rays.hpp"
 #include "riner/ring_correction.hpp"
 #include "rings/radial.hpp"
 #include "rings/ring_profile.hpp"
@@ -60,7 +61,7 @@ ResponseStructure response_structure(const Array& alpha, const Geometry& g,
   r.usable = std::move(offsets.usable);
   r.offset = std::move(offsets.offset);
   r.count = offsets.count;
-  r.distance = rings::ray_distances(g);
+  r.distance = column_ray_distances(g);
   r.sigma_mm = scale_px * g.voxel_mm;
   r.broad.assign(n, 0.0);
   for (std::size_t e = 0; e < n; ++e) {

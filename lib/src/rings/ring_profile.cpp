@@ -38,15 +38,6 @@ bool all_finite(const Array& image) {
                      [](float v) { return std::isfinite(v); });
 }
 
-std::vector<double> ray_distances(const Geometry& g) {
-  std::vector<double> d(g.n_u);
-  for (std::size_t e = 0; e < g.n_u; ++e) {
-    const Ray ray = detector_ray(g, 0, static_cast<double>(e));
-    d[e] = ray.origin.x * ray.direction.y - ray.origin.y * ray.direction.x;
-  }
-  return d;
-}
-
 std::vector<double> ring_projection_weights(std::size_t nodes, double step_mm, const Geometry& g,
                                             std::size_t element) {
   std::vector<double> weights(nodes, 0.0);

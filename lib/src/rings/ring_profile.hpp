@@ -28,10 +28,6 @@ RingCorrection unchanged(const Array& image, const Array& alpha, double radius_s
 
 bool all_finite(const Array& image);
 
-// Signed distance of each element's ray (view 0) from the rotation axis, in mm: a ring's
-// projection is the same at d and -d.
-std::vector<double> ray_distances(const Geometry& g);
-
 // The line integral of a piecewise-linear profile with `nodes` nodes (at index * step_mm)
 // along detector element `element`'s ray (view 0: a ring is the same in every view), as one
 // weight per node: the integral is their dot product with the profile.
