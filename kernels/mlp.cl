@@ -1,6 +1,6 @@
 // mlp.cl: the small MLP, input -> [width, ReLU] x MLP_HIDDEN -> 1 (linear output), one sample
 // per work-item with the hidden layers in explicit float16 vectors (on CPUs this is what the
-// compiler turns into full-width SIMD; see bench/RESULTS.md).
+// compiler turns into full-width SIMD; see docs/history/RESULTS.md).
 //   Helpers: mlp_forward(w, in, act) -> output; mlp_backward(w, g, in, act, d_out, d_in);
 //            mlp_deltas(w, act, d_out, delta, d_in) (no weight gradients: see mlp_gradient.cl)
 //   mlp_forward_batch(n, params, offset, inputs, outputs)    one work-item per sample

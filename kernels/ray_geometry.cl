@@ -1,5 +1,5 @@
 // ray_geometry.cl: the scan geometry on the device (helpers only, no __kernel). The device copy
-// of lib/src/geometry/rays.cpp; conventions in README.md, "Geometry convention".
+// of lib/src/geometry/rays.cpp; conventions in docs/guide/scans.md, "Geometry convention".
 //
 // ScanGeometry is passed by value; its host mirror is riner::ops::DeviceGeometry (16 four-byte
 // members, 64 bytes, no padding). Per-view rotations come as a float2 (cos, sin) table computed

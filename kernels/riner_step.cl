@@ -32,7 +32,7 @@
 //     centre.
 //
 // Ring prior (riner's addition; off when ring_lambda = 0): a detector offset constant over
-// views can always be explained by a ring in the image instead (README, "Rings and the
+// views can always be explained by a ring in the image instead (docs/method.md, "Rings and the
 // detector response"). The block of the batch holds block_views views of the same
 // block_elements adjacent elements, view-major from block_first. For each inner element e,
 // r_e = mean over the block's views of sums(v, e - 1) - 2 sums(v, e) + sums(v, e + 1), and the
@@ -270,7 +270,7 @@ __kernel void riner_step_field_evaluate(const FieldGrid g, __constant const Grid
   const uint k = index % g.nx;
   const uint row = (index / g.nx) % g.ny;
   const uint slice = index / (g.nx * g.ny);
-  // Voxel centre (README, "Geometry convention") in the encoding's normalised cube.
+  // Voxel centre (docs/guide/scans.md, "Geometry convention") in the encoding's normalised cube.
   float pos[3];
   pos[0] = ((float)k - 0.5f * (float)(g.nx - 1)) * g.voxel / g.extent + 0.5f;
   pos[1] = (0.5f * (float)(g.ny - 1) - (float)row) * g.voxel / g.extent + 0.5f;

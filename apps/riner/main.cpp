@@ -40,7 +40,8 @@ void print_usage(std::FILE* out) {
                "commands:\n");
   for (const Command& c : kCommands) std::fprintf(out, "  %-12s %s\n", c.name, c.summary);
   std::fprintf(out,
-               "\n`riner <command> --help` describes a command.\n"
+               "\n`riner <command> --help` describes a command; the guide, in the same order:\n"
+               "docs/guide/command-line.md.\n"
                "Device choice: --device or RINER_DEVICE (index or name substring).\n");
 }
 

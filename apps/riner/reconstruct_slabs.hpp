@@ -24,8 +24,9 @@ SlabOptions slab_size_options(const Args& args);
 
 // A parallel-beam stack whose slices are at least this wide trains each slice alone in 2D by
 // default: on 256² slices that is 10-15 dB above slabs of 3D fields at the same or less time
-// (bench/RESULTS.md, "a slab as one field or each slice in 2D"); on smaller ones (savu_proj3d's
-// 160²) the 3D field is what was measured, and a 2D slice's 24 000 steps cost the most there.
+// (docs/history/RESULTS.md, "a slab as one field or each slice in 2D"); on smaller ones
+// (savu_proj3d's 160²) the 3D field is what was measured, and a 2D slice's 24 000 steps cost the
+// most there.
 constexpr std::size_t kSlices2dFromPx = 256;
 bool slices_2d_by_default(const Geometry& g);
 

@@ -3,8 +3,9 @@
 // with its share of the cores (POCL_MAX_PTHREAD_COUNT, RINER_THREADS), and each claims slabs
 // as MPI ranks do (riner/slab_ranks.hpp's claims). PoCL shares one pool of threads among a
 // process's queues and can abort with several at once, so processes, not queues, fill a CPU:
-// 8 processes of 2 cores gave 5.5x the slices per minute of one on 16 cores (bench/RESULTS.md,
-// "Issue 30: throughput"). The copies die with the process that started them.
+// 8 processes of 2 cores gave 5.5x the slices per minute of one on 16 cores
+// (docs/history/RESULTS.md, "Issue 30: throughput"). The copies die with the process that
+// started them.
 #pragma once
 
 #include <string>

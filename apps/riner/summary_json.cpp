@@ -89,7 +89,8 @@ QualityCheck check_quality(const Reconstructor& r, const ReconstructionResult& r
     return check;
   }
   // The measures are per slice: a spread of them tells as much as the whole volume, and the
-  // FDK of all of it would cost more than the set-up of training (bench/RESULTS.md, issue 14).
+  // FDK of all of it would cost more than the set-up of training (docs/history/RESULTS.md, issue
+  // 14).
   options.slices = SliceSelection::spread(g.volume_shape[0], kQualitySlices);
   const std::vector<std::size_t> slices = options.slices.slices(g.volume_shape[0]);
   Array image({slices.size(), g.volume_shape[1], g.volume_shape[2]});

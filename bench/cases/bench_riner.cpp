@@ -258,7 +258,7 @@ nlohmann::json real_scan_run(const riner::Scan& scan, const riner::Array& fbp_im
 // --npy=PREFIX for the images and responses as .npy (both of the first seed). --seeds=N runs
 // seeds s .. s + N - 1 (s: --seed=N or the config's, 0 by default), one row each, and a row
 // counting how many pass each of issue 13's bars: ring index <= FBP's / 3, specks <= FBP's, centre
-// <= 1 sigma (one seed's numbers can pass a bar another's fails: bench/RESULTS.md), how many
+// <= 1 sigma (one seed's numbers can pass a bar another's fails: docs/history/RESULTS.md), how many
 // keep their edges (edge strength >= 0.8 of FBP's: a blur passes the other bars) and how many
 // lose no object (issue 29: quality.lost_object 0).
 std::vector<Result> riner_real_scan(const Options& o) {

@@ -1,5 +1,5 @@
 // Ring-correction chains replayed on saved training results: train once, then try orders and
-// settings of the corrections in seconds instead of retraining (bench/RESULTS.md, issue 13).
+// settings of the corrections in seconds instead of retraining (docs/history/RESULTS.md, issue 13).
 //
 //   riner_bench --case=ring_chain_replay --save=DIR [--first=0] [--last=9] [--seed-offset=0]
 //   riner_bench --case=ring_chain_replay --save=DIR --scan=SINO.npy --tag=NAME [--seed=N]

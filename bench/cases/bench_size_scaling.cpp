@@ -115,7 +115,7 @@ std::vector<Result> size_scaling(const Options& o) {
       const double draws_per_ray =
           static_cast<double>(st.steps) * rays_per_step / static_cast<double>(g.n_views() * g.n_u);
       // beta below 0.5 on a live element takes its rays out of training: at size it was the
-      // first sign of a loose fit (bench/RESULTS.md, issue 29).
+      // first sign of a loose fit (docs/history/RESULTS.md, issue 29).
       const riner::Array beta = r.beta();
       int live_off = 0, dead_found = 0, dead = 0;
       for (std::size_t e = 0; e < beta.size(); ++e) {

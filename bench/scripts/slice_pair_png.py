@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
 """Axial slices of two volumes (or two 2D images, slice 0) side by side in one 8-bit PNG, same window per slice (the first
-volume's 1st-99th percentile), for the PNG pairs in bench/RESULTS.md. Python's standard library
+volume's 1st-99th percentile), for the PNG pairs in docs/history/RESULTS.md. Python's standard library
 only: reads float32 .npy and NIfTI-1 (.nii) volumes [z, y, x] as riner writes them.
 
   slice_pair_png.py FIRST SECOND OUT.png Z [Z ...]

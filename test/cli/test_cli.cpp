@@ -6,6 +6,9 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <sstream>
+#include <string>
+#include <vector>
 #include <nlohmann/json.hpp>
 
 #include "cli/cli_run.hpp"
@@ -52,6 +55,28 @@ TEST_SUITE("cli") {
     const Run help = riner_cli("fbp --help", dir);
     CHECK(help.code == 0);
     CHECK(help.out.find("usage: riner fbp SCAN") == 0);
+  }
+
+  TEST_CASE("the guide lists the commands of riner --help, in its order") {
+    riner::test::TempDir dir;
+    const Run help = riner_cli("--help", dir);
+    REQUIRE(help.code == 0);
+    std::vector<std::string> listed;  // "  name   summary" lines under "commands:"
+    std::istringstream lines(help.out.substr(help.out.find("commands:\n") + 10));
+    for (std::string line; std::getline(lines, line) && line.rfind("  ", 0) == 0;) {
+      listed.push_back(line.substr(2, line.find(' ', 2) - 2));
+    }
+    REQUIRE(listed.size() >= 10);
+    const std::string guide =
+        riner::test::read_bytes(std::string(RINER_SOURCE_DIR) + "/docs/guide/command-line.md");
+    std::size_t at = 0;
+    for (const std::string& name : listed) {
+      const std::size_t row = guide.find("| `riner " + name, at);
+      CHECK_MESSAGE(row != std::string::npos,
+                    (std::string("docs/guide/command-line.md: no row for `riner ") + name +
+                     "` after the previous"));
+      if (row != std::string::npos) at = row;
+    }
   }
 
   TEST_CASE("simulate -> fbp -> compare, with JSON summaries") {
@@ -537,19 +562,20 @@ TEST_SUITE("cli") {
                  tooth.string() + ": no detector row 2 in frames of shape [181, 2, 640]");
   }
 
-  TEST_CASE("settings: one table for the list, the README, --set and config.json") {
+  TEST_CASE("settings: one table for the list, docs/settings.md, --set and config.json") {
     riner::test::TempDir dir;
     const Run list = riner_cli("settings --json", dir);
     REQUIRE(list.code == 0);
     const auto settings = nlohmann::json::parse(list.out)["settings"];
     CHECK(settings.size() >= 60);
-    // The README's table is the one `riner settings --markdown` prints.
+    // docs/settings.md is what `riner settings --markdown` prints.
     const Run markdown = riner_cli("settings --markdown", dir);
     REQUIRE(markdown.code == 0);
-    const std::string readme =
-        riner::test::read_bytes(std::string(RINER_SOURCE_DIR) + "/README.md");
-    CHECK_MESSAGE(readme.find(markdown.out) != std::string::npos,
-                  "README.md's settings table is out of date: paste `riner settings --markdown`");
+    const std::string page =
+        riner::test::read_bytes(std::string(RINER_SOURCE_DIR) + "/docs/settings.md");
+    CHECK_MESSAGE(page == markdown.out,
+                  "docs/settings.md is out of date: riner settings --markdown > docs/settings.md");
+    CHECK(markdown.out.find("| `training.steps` | `-1` |") != std::string::npos);
 
     const std::string sim = (dir / "sim").string();
     REQUIRE(riner_cli("simulate --quiet --seed 3 --out " + sim, dir).code == 0);

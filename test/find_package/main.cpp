@@ -1,5 +1,6 @@
-// The README's library example, built against the installed package by CI: simulate a small
-// ring scan, reconstruct it with FBP and with Riner, save the image and the detector response.
+// The library example of docs/guide/library.md, built against the installed package by CI:
+// simulate a small ring scan, reconstruct it with FBP and with Riner, save the image and the
+// detector response.
 #include <cmath>
 #include <cstdio>
 

@@ -258,7 +258,7 @@ def test_a_small_cone_beam_volume():
 
 def test_deeplesion_slice_reconstructs_to_the_clis_psnr(cli, shared, tmp_path):
     # The same scan, seed and settings through the CLI and through Python (300 steps here; the
-    # closing measurement at the defaults is in bench/RESULTS.md).
+    # closing measurement at the defaults is in docs/history/RESULTS.md).
     truth = riner.read_array(shared / "deeplesion" / "slice_0.nii") * 0.1  # 1/cm -> 1/mm
     sim = riner.simulate(truth, "fan2d-paper", seed=0)
     riner.write_array(tmp_path / "sino.npy", sim["sino"])

@@ -343,9 +343,9 @@ TEST_SUITE("ring_correction") {
   }
 
   TEST_CASE("gradient: a soft disc about the axis keeps its edge, a narrow ring beside it goes") {
-    // The wood's case (bench/RESULTS.md, issue 13): training left a soft disc at the axis, and a
-    // Gaussian high-pass of its edge put rings on both sides of it. Disc: +0.0005/mm inside 30 mm,
-    // falling to 0 at 34 mm; the ring at 12 mm as above, inside the ellipse.
+    // The wood's case (docs/history/RESULTS.md, issue 13): training left a soft disc at the axis,
+    // and a Gaussian high-pass of its edge put rings on both sides of it. Disc: +0.0005/mm inside
+    // 30 mm, falling to 0 at 34 mm; the ring at 12 mm as above, inside the ellipse.
     const riner::Geometry g = ring_geometry();
     const riner::Array truth =
         sum_of(phantom(g, false), painted(g, [](const riner::Vec3& c) {

@@ -6,11 +6,11 @@
 
 Arrays are numpy arrays: a sinogram [views, columns] (2D) or a projection stack
 [views, rows, columns] (3D), images [y, x] or volumes [z, y, x] in 1/mm. A geometry is the
-scan contract of riner's README (a dict, a JSON file, or a preset name); parallel_beam() and
-divergent_beam() build one from tomopy/algotom-style arguments. Errors raise riner.InputError
-(also a ValueError) for bad input, riner.OpenCLError for device failures (both riner.Error, a
-RuntimeError), TypeError for arrays of the wrong kind; Ctrl-C during training raises
-KeyboardInterrupt once training has stopped.
+scan contract of riner's docs/guide/scans.md (a dict, a JSON file, or a preset name);
+parallel_beam() and divergent_beam() build one from tomopy/algotom-style arguments. Errors
+raise riner.InputError (also a ValueError) for bad input, riner.OpenCLError for device
+failures (both riner.Error, a RuntimeError), TypeError for arrays of the wrong kind; Ctrl-C
+during training raises KeyboardInterrupt once training has stopped.
 """
 
 import json

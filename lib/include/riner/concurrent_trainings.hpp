@@ -20,7 +20,7 @@ struct Concurrency {
   std::string reason;  // a few words
 };
 
-// How many trainings fill this device (bench/RESULTS.md, "Issue 30: throughput"): on a GPU
+// How many trainings fill this device (docs/history/RESULTS.md, "Issue 30: throughput"): on a GPU
 // eight (an H200 trains 2.1x the slices per minute with 8 or 16 as with one), on a CPU one:
 // PoCL shares one pool of threads among queues, so a second training in the same process
 // gains little (1.1-1.3x on 2 cores) where separate processes of two cores each (MPI ranks,

@@ -51,7 +51,7 @@ struct ExecutionPlan {
   std::size_t grid_bands = 1;
   // Rays per training step when the config leaves it to the plan (training.rays_per_step = 0):
   // a CPU is throughput-bound and gains nothing from bigger batches; a GPU runs small steps at
-  // its launch latency, so 4x the rays cost 1.6x the time and buy 1.6 dB (bench/RESULTS.md).
+  // its launch latency, so 4x the rays cost 1.6x the time and buy 1.6 dB (docs/history/RESULTS.md).
   int rays_per_step = kCpuRaysPerStep;
   std::string reason;  // why these choices, in a few words
 

@@ -1,6 +1,6 @@
-// The scan geometry: one convention for the whole product (README.md, "Geometry convention").
-// Units are millimetres and radians; rotation is about the z axis through the origin, which is
-// the centre of the reconstruction grid.
+// The scan geometry: one convention for the whole product (docs/guide/scans.md, "Geometry
+// convention"). Units are millimetres and radians; rotation is about the z axis through the origin,
+// which is the centre of the reconstruction grid.
 #pragma once
 
 #include <cstddef>

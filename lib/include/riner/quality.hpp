@@ -14,7 +14,7 @@
 //   edges        the 99th percentile of the gradient magnitude inside the disc (Sobel after a
 //                Gaussian of 1 px, so that pixel noise does not pass for edges), of the image and
 //                of the FBP: well below the FBP's, the image is blurred. Fewer specks and rings
-//                can come from blur alone (bench/RESULTS.md), so these read beside it
+//                can come from blur alone (docs/history/RESULTS.md), so these read beside it
 //   lost object  the share of the disc where the FBP clearly sees object and the image shows air
 //                (issue 29): both blurred by a Gaussian of 2 px; the FBP's air level and noise
 //                are the median and MAD of its blurred values where the image reads air (below
@@ -51,7 +51,7 @@ struct CentreDeviation {
 double edge_strength(const Array& image);
 
 // Below this fraction of the FBP's edge strength an image reads as blurred: the shared real scans
-// give 0.92-1.01 at the defaults and 0.40-0.76 after 2000 steps (bench/RESULTS.md).
+// give 0.92-1.01 at the defaults and 0.40-0.76 after 2000 steps (docs/history/RESULTS.md).
 constexpr double kSoftEdgeRatio = 0.8;
 
 CentreDeviation centre_deviation(const Array& image, const Array& fbp, int radius_px = 20,

@@ -1,6 +1,7 @@
 // Settings of a Riner reconstruction (METHOD.md §2): the hash-grid encoding, the MLP, the
 // forward model and the training schedule. Defaults are the measured best trade-off of run time
-// against error (bench/RESULTS.md); the paper's values are reachable through the same fields.
+// against error (docs/history/RESULTS.md); the paper's values are reachable through the same
+// fields.
 #pragma once
 
 #include <algorithm>
@@ -63,7 +64,8 @@ enum class AirFbpCheck { kAuto, kOn, kOff };
 struct TrainingConfig {
   // -1: the scan's (kSteps2d or kSteps3d, filled in by the Reconstructor). 3D has its own
   // because a step there draws its rays over ~100x the detector elements of a slice: the paper's
-  // 3D protocol reaches 37.4 dB at 12 000 steps in under 10 min on 2 cores (bench/RESULTS.md).
+  // 3D protocol reaches 37.4 dB at 12 000 steps in under 10 min on 2 cores
+  // (docs/history/RESULTS.md).
   static constexpr int kScanSteps = -1;
   static constexpr int kSteps2d = 24000;
   static constexpr int kSteps3d = 12000;
@@ -74,7 +76,7 @@ struct TrainingConfig {
   // A slice's steps, when left to the scan (steps -1), grow past kSteps2d until each ray is
   // drawn this often over the run. 10: half the paper-size slice's 21 (24 000 x 160 rays over
   // 360 x 500 rays). A 2048-column Shepp-Logan slice: 31.76 dB and edges 0.84 of the truth's
-  // at 1.3 draws, 38.44 and 0.97 at 10 (bench/RESULTS.md, issue 29 item 2); the 2D scans in
+  // at 1.3 draws, 38.44 and 0.97 at 10 (docs/history/RESULTS.md, issue 29 item 2); the 2D scans in
   // ../shared (9.5-33 draws on a CPU) change by at most 5%. 0: off. 2D only.
   double min_draws_per_ray = 10.0;
   int views_per_step = 40;      // views x elements sampler
@@ -108,8 +110,8 @@ struct TrainingConfig {
   double lambda = 0.01;  // weight of the -beta^2 term
   // alpha0 and beta0 learn at learning_rate times these scales. alpha0 stays at its initial
   // value for alpha_warmup_steps (whichever of alpha and the field learns a ring first keeps
-  // it: bench/RESULTS.md, issue 13). beta0 of an element with no invalid (non-finite) reading
-  // stays put for beta_warmup_steps (-1: the first learning-rate phase): while the image is
+  // it: docs/history/RESULTS.md, issue 13). beta0 of an element with no invalid (non-finite)
+  // reading stays put for beta_warmup_steps (-1: the first learning-rate phase): while the image is
   // still far off, every element's residual is large and beta would switch live elements off,
   // most where rays are longest; an element with invalid readings learns from the start (the
   // readings are the evidence).
@@ -118,7 +120,7 @@ struct TrainingConfig {
   // stripe is the RMS of the element-to-element offsets of the measurement's per-element means
   // (model/stripe_evidence.hpp). Adam moves a parameter by about its rate whatever the
   // gradient, so an alpha as fast as the field on a detector whose offsets are 0.002 learns
-  // the object's edges instead (the halo of bench/RESULTS.md, issue 13). 0 turns it off.
+  // the object's edges instead (the halo of docs/history/RESULTS.md, issue 13). 0 turns it off.
   double alpha_stripe_scale = 0.05;
   // Elements whose readings stay steady while their neighbours on both sides vary (a dead,
   // hot or stuck pixel, row or column; model/stuck_elements.hpp) are taken for dead before
@@ -139,7 +141,7 @@ struct TrainingConfig {
   // is at least level_warmup_noise of their 99th percentile, else 0. On the noisy real scans
   // (4e-3 to 7e-3) the finest levels draw the noise as sharp specks before the coarse ones
   // hold the image; the paper's simulated scans (1e-4) keep their training as it was. Longer
-  // warm-ups (steps / 12) leave over- and undershoots at sharp edges (bench/RESULTS.md).
+  // warm-ups (steps / 12) leave over- and undershoots at sharp edges (docs/history/RESULTS.md).
   int level_warmup_steps = -1;
   double level_warmup_noise = 0.001;
   // Tail averaging (model/tail_average.hpp): the image, alpha and beta come from the mean of the
@@ -171,7 +173,7 @@ struct TrainingConfig {
   // off: 39 of 1100 on a simulated neutron square with 2 dead at 0 (441 and the square's middle
   // with 640 rays per step), exactly the 2 at 20. An element with a non-finite reading (a
   // simulated dead one, zero counts) keeps lambda, so it is still switched off as before
-  // (bench/RESULTS.md, issue 29).
+  // (docs/history/RESULTS.md, issue 29).
   double relative_beta_threshold = 20.0;
   std::uint64_t seed = 0;
 
@@ -204,16 +206,16 @@ struct RingCorrectionConfig {
   ResponseRingSettings response;
   // The gradient correction once more after the response correction (when both are on): the
   // first pass keeps the edges of broad structure, so the narrow rings beside them wait until
-  // the response correction has taken it (bench/RESULTS.md, issue 13).
+  // the response correction has taken it (docs/history/RESULTS.md, issue 13).
   bool gradient_after_response = true;
   // Before all of them, objects centred on the axis that training put into alpha go back into
-  // the image (correct_rings_from_mirrors): a tube's wall, a cylinder's edge (bench/RESULTS.md,
-  // issue 32).
+  // the image (correct_rings_from_mirrors): a tube's wall, a cylinder's edge
+  // (docs/history/RESULTS.md, issue 32).
   bool mirror_reference = true;
   MirrorRingSettings mirror;
   // Parallel-beam volumes: the three above, slice by slice (riner/volume_ring_correction.hpp).
   // Off by default: the 3D field holds few rings; on the simulated parallel-beam head the chain
-  // costs 0.13 dB, and on the real savu_proj3d it raises the ring index (bench/RESULTS.md).
+  // costs 0.13 dB, and on the real savu_proj3d it raises the ring index (docs/history/RESULTS.md).
   bool slice_by_slice = false;
 };
 

@@ -2,8 +2,8 @@
 // response, where the data cannot tell them apart.
 //
 // A ring centred on the rotation axis adds the same amount to every view of one detector
-// element, exactly like a change of that element's response (README, "Rings and the detector
-// response"), so the data fit is the same for (image, alpha) and (image - G, alpha exp(-P G))
+// element, exactly like a change of that element's response (docs/method.md, "Rings and the
+// detector response"), so the data fit is the same for (image, alpha) and (image - G, alpha exp(-P G))
 // for any rotationally symmetric image G with per-element projections P G. Training settles
 // somewhere on that line; these steps pick a better point on it:
 //
@@ -57,7 +57,7 @@ struct AirRingSettings {
   // ...and joined, through such pixels, to the grid's edge. Low-density material inside an
   // object (light wood within its denser growth rings, foam) falls below the fraction when
   // the object's densest parts set the percentile; taken for air it would be "corrected" to
-  // air's level (bench/RESULTS.md, issue 13). Air pockets enclosed by the object are lost to
+  // air's level (docs/history/RESULTS.md, issue 13). Air pockets enclosed by the object are lost to
   // the measurement; the radial-gradient correction sees their rings.
   bool reaches_edge = true;
   // A radius (bins of half a pixel) is measured only when it has this many air pixels.

@@ -26,7 +26,7 @@ struct SlabFbpReport {
 // either side that bilinear sampling takes; count 0 when none.
 RowRange fbp_rows_reached(const Geometry& g, std::size_t first, std::size_t count);
 
-// Host memory FBP of a slab of `slices` slices takes (measured, bench/RESULTS.md "FBP by
+// Host memory FBP of a slab of `slices` slices takes (measured, docs/history/RESULTS.md "FBP by
 // slabs"): a base for the runtime and the kernels, the slab's readings in their copies (read,
 // normalised, filtered) and its voxels.
 std::size_t fbp_slab_bytes(const Geometry& g, std::size_t slices);

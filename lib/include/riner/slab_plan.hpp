@@ -31,14 +31,14 @@ std::vector<Slab> plan_slabs(const Geometry& g, std::size_t slices_per_slab);
 // on the grid (the detector rows moved by as much along the axis).
 Geometry slab_geometry(const Geometry& g, const Slab& slab);
 
-// Host memory a slab of `slices` slices takes to train and check (measured, bench/RESULTS.md
+// Host memory a slab of `slices` slices takes to train and check (measured, docs/history/RESULTS.md
 // "Slabs"): a base for the model and the kernels, and per slice its share of the measurement
 // and of the volume in the copies the training, the ring corrections and the quality check
 // hold at once.
 std::size_t slab_bytes(const Geometry& g, std::size_t slices);
 
 // Memory a slab of `slices` slices takes on a device with its own memory (a GPU; measured,
-// bench/RESULTS.md "device memory"): the model and the training's per-sample caches, and per
+// docs/history/RESULTS.md "device memory"): the model and the training's per-sample caches, and per
 // slice the quality check's FBP (its readings in two copies) and the voxels it evaluates.
 std::size_t slab_device_bytes(const Geometry& g, std::size_t slices);
 // The largest single device buffer of such a slab: one copy of its readings.

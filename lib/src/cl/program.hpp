@@ -70,7 +70,7 @@ class Kernel {
   // The work-group size of launches that name none (Context::launch): kDefaultGroup, or the
   // kernel's largest when smaller. Left to the runtime, the group must divide the global size,
   // and a global size with no small factors (a prime count of parameters) ran in groups of one:
-  // twice the time of a whole training step on PoCL (bench/RESULTS.md, issue 14).
+  // twice the time of a whole training step on PoCL (docs/history/RESULTS.md, issue 14).
   static constexpr std::size_t kDefaultGroup = 64;
   std::size_t default_group(cl_device_id device) const;
 

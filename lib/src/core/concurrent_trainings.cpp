@@ -11,7 +11,8 @@ namespace riner {
 
 namespace {
 
-// Trainings at once on a GPU: an H200 gains 1.8x with 4, 2.1x with 8 or 16 (bench/RESULTS.md).
+// Trainings at once on a GPU: an H200 gains 1.8x with 4, 2.1x with 8 or 16
+// (docs/history/RESULTS.md).
 constexpr int kGpuTrainings = 8;
 
 }  // namespace

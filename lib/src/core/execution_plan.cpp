@@ -85,7 +85,7 @@ ExecutionPlan choose_execution_plan(const DeviceInfo& d, const PlanConfig& c) {
     plan.gradient_slices = 2 * units;
     plan.gradient_group = 64;
     // One owner per level: more bands mean every owner scans every sample again, which cost
-    // more than it parallelised on 16 cores (bench/RESULTS.md).
+    // more than it parallelised on 16 cores (docs/history/RESULTS.md).
     plan.grid_bands = 1;
     plan.float_atomics = FloatAtomics::kCompareExchange;  // not used: the grid is owned
   } else {

@@ -2,7 +2,7 @@
 // the air around it (METHOD.md §2: "skip what a scene doesn't need"), and the image is zero
 // there. Skipping object is the worst thing the tool can do (the image says "nothing here"), so
 // a voxel is skipped only on evidence that holds against the noise, an outlier view and a
-// centre of rotation a few pixels off (issue 29; bench/RESULTS.md):
+// centre of rotation a few pixels off (issue 29; docs/history/RESULTS.md):
 //
 // 1. Readings that certify air (model/air_readings.hpp): within the noise of their element's
 //    offset, as the mean of three neighbouring rays; outlier views certify nothing.

@@ -3,7 +3,7 @@
 // centred on it along the row (what the object leaves is smooth across elements once averaged
 // over views; a ring-causing offset is not), as an RMS over the elements whose readings are
 // all finite. On the paper's simulated detectors (alpha ~ U[0.75, 1.25]) it reads ~0.12; on
-// the shared real scans 0.0015-0.0043 (bench/RESULTS.md, issue 13).
+// the shared real scans 0.0015-0.0043 (docs/history/RESULTS.md, issue 13).
 #pragma once
 
 #include <cstddef>

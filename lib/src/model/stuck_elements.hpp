@@ -2,7 +2,7 @@
 // or hot pixel, row or column of a real detector often reads a steady value (the flat, the
 // dark, saturation) instead of non-finite ones; the data term cannot tell it from an object
 // until beta learns it, and on a 3D detector each pixel's beta sees too few rays for that
-// (bench/RESULTS.md, issue 14: rows stuck at 0 and 2.5 kept beta ~0.6 after 12 000 steps).
+// (docs/history/RESULTS.md, issue 14: rows stuck at 0 and 2.5 kept beta ~0.6 after 12 000 steps).
 //
 // An element is stuck when its readings vary over the views by less than 5% of the variance
 // of both its neighbours on one line through it (left and right, or above and below in 3D; at

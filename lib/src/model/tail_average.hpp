@@ -2,9 +2,10 @@
 // last steps of training instead of the last step's alone. With noisy readings, each step of
 // the L1 data term moves the parameters by about the learning rate whatever the batch, so the
 // last iterate carries the last batches' noise, and the finest levels draw it as isolated
-// specks (bench/RESULTS.md, issue 13). Training itself is unchanged: the engines keep a running
-// sum of snapshots beside the parameters. A run stopped early (a plateau, a callback) averages
-// the snapshots it took; steps past the planned ones give the last step's parameters again.
+// specks (docs/history/RESULTS.md, issue 13). Training itself is unchanged: the engines keep a
+// running sum of snapshots beside the parameters. A run stopped early (a plateau, a callback)
+// averages the snapshots it took; steps past the planned ones give the last step's parameters
+// again.
 #pragma once
 
 namespace riner::model {

@@ -86,7 +86,7 @@ bool ring_slope(const PolarSamples& s, std::size_t r, double flat_fraction, doub
 
 // values minus their running median over 2 half_width + 1 nodes, mirrored at both ends. A
 // feature narrower than half_width goes; a step (the edge of a disc about the axis) stays, where
-// a Gaussian high-pass would leave rings on both sides of it (bench/RESULTS.md, issue 13).
+// a Gaussian high-pass would leave rings on both sides of it (docs/history/RESULTS.md, issue 13).
 std::vector<double> high_pass(const std::vector<double>& values, std::size_t half_width) {
   const auto n = static_cast<std::ptrdiff_t>(values.size());
   std::vector<double> out(values.size());

@@ -20,7 +20,7 @@ constexpr double kSmallestStructure = 1e-4;
 constexpr double kEvenOverOdd = 2.0;
 // Evidence needs an element's mirror this many noise windows away: nearer the axis a
 // detector's or a beam's structure across the centre reads as even (on wood_neutron a plateau
-// 60 elements wide on the axis, bench/RESULTS.md).
+// 60 elements wide on the axis, docs/history/RESULTS.md).
 constexpr double kMirrorGapWindows = 4.0;
 // Elements that could tell but show no object hold the profile's projection near no change,
 // with this weight against the evidence's; a small ridge keeps radii no ray reaches at 0.

@@ -15,7 +15,8 @@ namespace riner {
 namespace {
 
 // Relative weights of the profile's curvature and size in the fit. The curvature keeps the
-// nodes few rays reach (the axis) from taking up what the rest cannot fit (bench/RESULTS.md).
+// nodes few rays reach (the axis) from taking up what the rest cannot fit
+// (docs/history/RESULTS.md).
 constexpr double kCurvatureWeight = 0.1;
 constexpr double kRidgeWeight = 1e-9;
 

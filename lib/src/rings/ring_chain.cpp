@@ -13,7 +13,7 @@ RingChain correct_rings_in_order(const Array& image, const Array& alpha, const G
     slot = std::move(c);
   };
   // First: what training put into alpha that is an object goes back before the others judge
-  // the image's rings (after them, it would undo their rings: bench/RESULTS.md, issue 32).
+  // the image's rings (after them, it would undo their rings: docs/history/RESULTS.md, issue 32).
   if (config.mirror_reference) {
     take(out.mirror,
          correct_rings_from_mirrors(out.image, out.alpha, g, dead_elements, config.mirror));

@@ -60,8 +60,8 @@ Array resample_to_grid(const Array& image, const std::vector<double>& spacing_mm
   const std::size_t nz = rank == 3 ? g.volume_shape[0] : 1;
   const std::size_t ny = g.volume_shape[rank - 2];
   const std::size_t nx = g.volume_shape[rank - 1];
-  // Row 0 at +y (README, "Geometry convention") in both grids: rows map to rows. A 2D image is
-  // one slice.
+  // Row 0 at +y (docs/guide/scans.md, "Geometry convention") in both grids: rows map to rows. A 2D
+  // image is one slice.
   const std::vector<Tap> tz =
       rank == 3 ? axis_taps(nz, g.voxel_mm, sz, spacing_mm[0]) : std::vector<Tap>{{true}};
   const std::vector<Tap> ty = axis_taps(ny, g.voxel_mm, sy, spacing_mm[rank - 2]);

@@ -11,7 +11,7 @@ namespace riner {
 namespace {
 
 // Fitted on `riner fbp --slab-slices 1|4|16` of a 720 x 32 x 1024 stack on PoCL (peaks of
-// 227, 213 and 486 MB; bench/RESULTS.md, "FBP by slabs"): the OpenCL runtime's ~170 MB, the
+// 227, 213 and 486 MB; docs/history/RESULTS.md, "FBP by slabs"): the OpenCL runtime's ~170 MB, the
 // readings as read, normalised and filtered, the slab's voxels on the host and the device.
 constexpr double kReadingCopies = 3.0;
 constexpr double kVoxelCopies = 2.0;

@@ -12,7 +12,7 @@ namespace riner {
 
 namespace {
 
-// Measured with `riner_bench --case=slab_stack` (bench/RESULTS.md, "Issue 30"): at 1024
+// Measured with `riner_bench --case=slab_stack` (docs/history/RESULTS.md, "Issue 30"): at 1024
 // columns x 720 views, a slab's peak resident memory is about 260 MB plus 24 MB per detector
 // row (32 bytes per reading: the readings, their ray segments, the carving's and the quality
 // check's filtered copies); the voxels count for little beside them.
@@ -20,7 +20,7 @@ constexpr double kReadingCopies = 8.0;
 constexpr double kVoxelCopies = 12.0;
 constexpr std::size_t kBaseBytes = std::size_t{260} << 20;  // model, kernels, libraries
 
-// On a device (PoCL's buffers, counted as on a GPU; bench/RESULTS.md "device memory"): the
+// On a device (PoCL's buffers, counted as on a GPU; docs/history/RESULTS.md "device memory"): the
 // model, the per-sample caches and the batch (95-256 MB measured), then per slice the quality
 // check's FBP with its readings in two copies and the voxels (2048 columns x 1440 views: 26.4
 // MB per slice against 32 MB here).

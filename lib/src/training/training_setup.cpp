@@ -16,12 +16,12 @@ namespace {
 // slice raised so that each of its rays is drawn training.min_draws_per_ray times over the run.
 // Scans larger than the paper's draw each ray fewer times at a fixed budget (24 000 steps of
 // 160 rays: a 1024-column ray 5 times, a 2048-column one 1.3) and their images blur; more
-// steps buy more than a bigger batch at the same draws (bench/RESULTS.md, issue 29). Volumes
+// steps buy more than a bigger batch at the same draws (docs/history/RESULTS.md, issue 29). Volumes
 // keep their budget: a 3D field is held by far fewer draws per ray. The draws are counted in
 // batches of at most the CPU plan's 160 rays: a GPU's 640 keeps the CPU's steps and draws each
 // ray four times as often, because at 2048 columns the steps were what counted (10 draws of 640
 // rays: 3.4 dB under the oracle FBP; 40 draws, the same steps as the CPU's: 1.8 dB over it;
-// bench/RESULTS.md, issue 29). Needs rays_per_step resolved (the Reconstructor's execution
+// docs/history/RESULTS.md, issue 29). Needs rays_per_step resolved (the Reconstructor's execution
 // plan); left at 0, the default stays.
 void resolve_steps(TrainingConfig& t, const Geometry& g) {
   const bool left_to_scan = t.steps == TrainingConfig::kScanSteps;
