@@ -191,6 +191,18 @@ int run_reconstruct(int argc, char** argv, int first) {
                     setup.steps_planned, setup.rays_per_step, setup.draws_per_ray_planned);
       console.line(line);
     }
+    if (setup.warm_start) {
+      char line[300];
+      std::snprintf(line, sizeof(line),
+                    "warm start from the '%s' stripe filter (%.1f s): alpha read off the scan "
+                    "(mean |ln alpha| %.3f), the field fitted to its FBP (%d steps, mean |error| "
+                    "%.2g /mm); then %d steps at learning rate %.2g",
+                    setup.warm_start->method.c_str(), setup.warm_start->seconds,
+                    setup.warm_start->mean_abs_log_alpha, setup.warm_start->fit_steps,
+                    setup.warm_start->fit_residual, setup.steps_planned,
+                    reconstructor.config().training.learning_rate);
+      console.line(line);
+    }
     if (setup.air_skipped) {
       char line[240];
       std::snprintf(line, sizeof(line),

@@ -10,6 +10,17 @@ namespace riner::app {
 
 namespace {
 
+// training.warm_start: what the classical start did; null for a cold start.
+nlohmann::json warm_start_json(const std::optional<WarmStartStats>& w) {
+  if (!w) return nullptr;
+  return {{"method", w->method},
+          {"fit_steps", w->fit_steps},
+          {"fit_pixels", w->fit_pixels},
+          {"fit_residual_per_mm", w->fit_residual},
+          {"mean_abs_log_alpha", w->mean_abs_log_alpha},
+          {"seconds", w->seconds}};
+}
+
 // Axial slices of a volume the quality report measures, spread over it.
 constexpr std::size_t kQualitySlices = 16;
 
@@ -158,6 +169,7 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
            {{"steps", stats.level_warmup_steps}, {"relative_noise", stats.relative_noise}}},
           {"tail_average",
            {{"steps", stats.tail_average_steps}, {"snapshots", stats.tail_average_snapshots}}},
+          {"warm_start", warm_start_json(stats.warm_start)},
           {"coverage",
            {{"rays", stats.coverage.rays},
             {"rays_per_element_fewest", stats.coverage.fewest},

@@ -22,6 +22,7 @@ SOURCES = {
     "deeplesion_gpu": "issue30_throughput.jsonl",
     "deeplesion_gpu_h100": "issue12_gpu.jsonl",
     "classical": "issue31_destripe.jsonl",
+    "warm_start": "issue31_warm_start.jsonl",
     "sizes_cpu": "issue29_draws10.jsonl",
     "sizes_gpu": "issue29_sizes_gpu.jsonl",
     "real_trained": "issue29_beta_real.jsonl",
@@ -153,6 +154,7 @@ def deeplesion(root):
                  f"corrections (`{CURRENT_CHAIN}`, replayed)",
                  "**" + f2(replay["psnr"]) + "**", f3(replay["ssim"]), "as above",
                  stamp(replay), command(replay)])
+    rows += schedule_rows(root)
     per = gpu["per_slice"]
     rows.append([f"**riner**, slices {per[0]['scene'][-1]}-{per[-1]['scene'][-1]}",
                  "**" + f2(mean(s["psnr"] for s in per)) + "**",
@@ -180,6 +182,28 @@ def deeplesion(root):
     text = table(["method", "PSNR (dB)", "SSIM", "time per slice", "machine; date; revision",
                   "command"], rows)
     return text, summary
+
+
+def schedule_rows(root):
+    """riner at shorter schedules, cold and warm-started (training.warm_start), one row each."""
+    runs = {}
+    for r in records(root, SOURCES["warm_start"]):
+        if not r.get("scene", "").startswith("deeplesion/slice_"):
+            continue
+        runs.setdefault(r["meta"]["settings"]["options"].get("config", ""), []).append(r)
+    rows = []
+    for config, slices in runs.items():
+        training = json.loads(config).get("training", {}) if config else {}
+        warm = training.get("warm_start", "off")
+        steps = slices[0]["steps"]
+        label = (f"riner warm-started from `{warm}`, {steps} steps" if warm != "off"
+                 else f"riner, {steps} steps")
+        rows.append([f"{label}, {len(slices)} slices",
+                     f2(mean(r["reconstruct"]["psnr"] for r in slices)),
+                     f3(mean(r["reconstruct"]["ssim"] for r in slices)),
+                     seconds(mean(r["seconds"] + r.get("setup_seconds", 0.0) for r in slices)),
+                     stamp(slices[0]), command(slices[0])])
+    return rows
 
 
 def classical_methods(root):

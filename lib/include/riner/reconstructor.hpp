@@ -79,6 +79,16 @@ struct RayCoverage {
   std::size_t elements_under_10 = 0;  // elements with fewer than 10 rays
 };
 
+// What the warm start did (training.warm_start; training/warm_start.hpp).
+struct WarmStartStats {
+  std::string method;               // the stripe filter
+  int fit_steps = 0;                // steps fitting the field to the destriped FBP
+  std::size_t fit_pixels = 0;       // pixels fitted (those training samples)
+  double fit_residual = 0.0;        // mean |field - FBP| over the last fit steps, 1/mm
+  double mean_abs_log_alpha = 0.0;  // mean |ln alpha0| the filter read off the scan
+  double seconds = 0.0;             // filter, FBP and fit together
+};
+
 struct TrainingStats {
   int steps = 0;
   int steps_planned = 0;            // training.steps
@@ -92,6 +102,7 @@ struct TrainingStats {
   std::string engine;
   std::string device;                 // device name, or "CPU reference"
   std::optional<ExecutionPlan> plan;  // how the OpenCL engine shaped the work (none: reference)
+  std::optional<WarmStartStats> warm_start;  // training.warm_start, when it ran
   // Skipping the air (training.skip_air): whether the measurements certified any, the share of
   // the grid still sampled and of the samples kept, and why not when they did not.
   bool air_skipped = false;

@@ -151,6 +151,19 @@ struct TrainingConfig {
   // the last batches' noise as specks; on the paper's simulations the field still sharpens in the
   // last phase and its mean lags (DeepLesion -0.3 dB), so they keep the last iterate.
   int tail_average_steps = -1;
+  // Warm start (training/warm_start.hpp): "off", or a classical stripe filter of
+  // riner/destripe.hpp ("normalise", "sorting", "filtering", "large", "dead", "all"). alpha0
+  // starts from the response the filter read off the scan and the field from a fit of
+  // warm_start_steps steps to the FBP of the destriped scan, so that training begins where a
+  // classical answer ends.
+  // With a warm start, steps -1 is a third of the scan's steps and the learning rate is scaled
+  // by warm_start_lr_scale: the field starts near an answer, and the full rate's first Adam
+  // steps (each parameter moved by about the rate) would throw the fit away. Measured on
+  // DeepLesion slice 0 at 8000 steps: 1e-4 38.20 dB, 2e-4 38.59, 3e-4 38.05, 1e-3 37.98 (cold:
+  // 36.99; docs/history/RESULTS.md, issue 31).
+  std::string warm_start = "off";
+  int warm_start_steps = 500;
+  double warm_start_lr_scale = 0.2;
   // Stop on a plateau instead of at `steps`: in the last learning-rate phase, every
   // plateau_window steps (0: a quarter of the phase), training ends when the mean data loss of
   // the latest window is less than plateau_tolerance (relative) below the window's before.

@@ -166,6 +166,18 @@ void add_training_schedule(Table& t) {
                        "last step's; -1: the last learning-rate phase when the readings are "
                        "noisy (level_warmup_noise), else 0",
                        &C::training, &T::tail_average_steps));
+  t.push_back(string_choice<C>(
+      "training", "warm_start", {"off", "normalise", "sorting", "filtering", "large", "dead", "all"},
+      "2D: start alpha from this classical stripe filter's response and the field from the FBP "
+      "of its destriped scan; off: a cold start",
+      &C::training, &T::warm_start));
+  t.push_back(field<C>("training", "warm_start_steps", closed(1, 1000000),
+                       "warm_start: steps fitting the field to the destriped FBP image",
+                       &C::training, &T::warm_start_steps));
+  t.push_back(field<C>("training", "warm_start_lr_scale", open_closed(0, 1),
+                       "warm_start: the learning rate is scaled by this (and steps -1 is a third "
+                       "of the scan's)",
+                       &C::training, &T::warm_start_lr_scale));
   t.push_back(field<C>("training", "stop_on_plateau", {},
                        "stop in the last learning-rate phase when the loss stops falling",
                        &C::training, &T::stop_on_plateau));

@@ -29,8 +29,7 @@ class OpenclTrainer final : public Trainer {
         device_(std::move(device)),
         ctx_(cl::context_of(device_)),
         plan_(plan),
-        params_(ctx_, std::span<const float>(
-                          model::initial_parameters(setup.layout, setup.config.training.seed))),
+        params_(ctx_, std::span<const float>(setup.initial_parameters())),
         grad_(ctx_, std::vector<float>(setup.layout.total, 0.0f)),
         history_(ctx_, static_cast<std::size_t>(kHistoryBlock) * 2),
         invalid_readings_(ctx_, std::span<const cl_uint>(setup.invalid_readings), CL_MEM_READ_ONLY),

@@ -11,6 +11,7 @@
 #include "riner/error.hpp"
 #include "riner/ring_chain.hpp"
 #include "training/trainer.hpp"
+#include "training/warm_start.hpp"
 
 namespace riner {
 
@@ -28,6 +29,7 @@ struct Reconstructor::Impl {
   // result() at `steps` training steps (it only changes with a step).
   std::optional<ReconstructionResult> result;
   int result_steps = -1;
+  std::optional<WarmStartStats> warm_start;
 
   Impl(Scan scan, RinerConfig config, std::optional<Device> device = std::nullopt)
       : setup(std::move(scan), std::move(config), std::move(device)),
@@ -57,18 +59,33 @@ RinerConfig resolved(RinerConfig config, const std::optional<ExecutionPlan>& pla
   return config;
 }
 
+// training.warm_start: the parameters training starts from, fitted with the engine's own trainer.
+template <typename Impl>
+void start_warm(Impl& impl, const detail::TrainerFactory& make_trainer,
+                std::optional<Device> device) {
+  if (!detail::wants_warm_start(impl.setup)) return;
+  detail::WarmStart warm = detail::warm_start(impl.setup, make_trainer, std::move(device));
+  impl.setup.initial = std::move(warm.parameters);
+  impl.warm_start = warm.stats;
+}
+
 }  // namespace
 
 Reconstructor::Reconstructor(Scan scan, RinerConfig config, std::optional<Device> device) {
   config.validate();
   if (config.engine == Engine::kReference) {
     impl_ = std::make_unique<Impl>(std::move(scan), resolved(std::move(config), std::nullopt));
+    start_warm(*impl_, detail::make_reference_trainer, std::nullopt);
     impl_->trainer = detail::make_reference_trainer(impl_->setup);
     return;
   }
   Device d = device ? *device : Device::open();
   const ExecutionPlan plan = choose_execution_plan(d.info(), config.plan);
   impl_ = std::make_unique<Impl>(std::move(scan), resolved(std::move(config), plan), d);
+  start_warm(
+      *impl_,
+      [&](const detail::TrainingSetup& fit) { return detail::make_opencl_trainer(fit, d, plan); },
+      d);
   impl_->trainer = detail::make_opencl_trainer(impl_->setup, std::move(d), plan);
 }
 
@@ -278,6 +295,7 @@ TrainingStats Reconstructor::stats() const {
                             static_cast<double>(impl_->setup.segments.size());
   s.stopped_on_plateau = impl_->plateaued;
   s.plan = impl_->trainer->plan();
+  s.warm_start = impl_->warm_start;
   const detail::TrainingSetup& setup = impl_->setup;
   s.air_skipped = setup.occupancy.carved;
   s.inside_fraction = setup.occupancy.inside_fraction;

@@ -11,8 +11,7 @@ namespace {
 class ReferenceTrainer final : public Trainer {
  public:
   explicit ReferenceTrainer(const TrainingSetup& setup) : setup_(setup) {
-    const std::vector<float> init =
-        model::initial_parameters(setup.layout, setup.config.training.seed);
+    const std::vector<float> init = setup.initial_parameters();
     params_.assign(init.begin(), init.end());
     m_.assign(params_.size(), 0.0);
     v_.assign(params_.size(), 0.0);

@@ -40,9 +40,15 @@ struct TrainingSetup {
   std::size_t stuck_count = 0;
   model::FactorEvidence factor_evidence;             // 3D, model/factor_evidence.hpp
   AlphaModel alpha_model = AlphaModel::kPerElement;  // as trained (never auto)
+  // The parameters training starts from (training/warm_start.hpp); empty: the layout's random
+  // initial values (model::initial_parameters).
+  std::vector<float> initial;
 
   // device: where the air carving's FBP check runs (the OpenCL engine; default Device::open()).
   TrainingSetup(Scan scan, RinerConfig config, std::optional<Device> device = std::nullopt);
+  TrainingSetup() = default;  // filled by hand (the warm start's image fit)
+  // What both engines start from: `initial`, or the layout's random initial values.
+  std::vector<float> initial_parameters() const;
   double learning_rate(int step) const;
   // Adam settings of a step, for both engines: the schedule for the field, alpha0 and beta0,
   // and the lazy range (training.sparse_adam).

@@ -26,13 +26,18 @@ namespace {
 void resolve_steps(TrainingConfig& t, const Geometry& g) {
   const bool left_to_scan = t.steps == TrainingConfig::kScanSteps;
   t.steps = t.steps_for(g.is_3d());
-  if (!left_to_scan || g.is_3d() || !(t.min_draws_per_ray > 0.0) || t.rays_per_step <= 0 ||
-      t.sampler == Sampler::kViewsTimesElements)
-    return;
-  const double rays = static_cast<double>(g.n_views()) * static_cast<double>(g.n_u);
-  const double batch = std::min(t.rays_per_step, ExecutionPlan::kCpuRaysPerStep);
-  const double wanted = std::ceil(t.min_draws_per_ray * rays / batch);
-  if (wanted > t.steps) t.steps = static_cast<int>(std::min<double>(wanted, 1 << 30));
+  if (left_to_scan && !g.is_3d() && t.min_draws_per_ray > 0.0 && t.rays_per_step > 0 &&
+      t.sampler != Sampler::kViewsTimesElements) {
+    const double rays = static_cast<double>(g.n_views()) * static_cast<double>(g.n_u);
+    const double batch = std::min(t.rays_per_step, ExecutionPlan::kCpuRaysPerStep);
+    const double wanted = std::ceil(t.min_draws_per_ray * rays / batch);
+    if (wanted > t.steps) t.steps = static_cast<int>(std::min<double>(wanted, 1 << 30));
+  }
+  // A warm start's schedule (TrainingConfig::warm_start_lr_scale); 2D only, as the warm start.
+  if (t.warm_start != "off" && !g.is_3d()) {
+    if (left_to_scan) t.steps = (t.steps + 2) / 3;
+    t.learning_rate *= t.warm_start_lr_scale;
+  }
 }
 
 }  // namespace
@@ -114,6 +119,11 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
   for (std::size_t ray = 0; ray < rho.size(); ++ray) {
     if (!std::isfinite(rho[ray])) ++invalid_readings[ray % elements_per_view];
   }
+}
+
+std::vector<float> TrainingSetup::initial_parameters() const {
+  if (!initial.empty()) return initial;
+  return model::initial_parameters(layout, config.training.seed);
 }
 
 double TrainingSetup::learning_rate(int step) const {
