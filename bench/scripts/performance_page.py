@@ -339,6 +339,10 @@ a SOURCE.md each (licence, geometry); they are not part of the product.
 
 {deeplesion}
 
+![PSNR against time per slice: FBP, the classical filters, Riner cold and warm on 2 cores, Riner on a GPU](../bench/figures/deeplesion_psnr_time.png)
+
+(The figure: `bench/scripts/psnr_time_plot.py`, from the same JSON lines.)
+
 ## The classical stripe filters (`riner destripe`), the same slices
 
 {classical}
