@@ -119,30 +119,55 @@ def mean(values):
 # --- DeepLesion, the paper's protocol ----------------------------------------------------------
 
 
-def deeplesion(root):
-    cpu = records(root, SOURCES["deeplesion_cpu"])
-    cpu_slices = [r for r in cpu if r.get("scene", "").startswith("deeplesion/slice_")]
-    classical = records(root, SOURCES["classical"])
-    classical_mean = [r for r in classical if r["scene"] == "mean"][-1]
+def slices_of(records_):
+    """The per-slice records of a DeepLesion run (not its mean)."""
+    return [r for r in records_ if r.get("scene", "").startswith("deeplesion/slice_")]
+
+
+def classical_mean(root):
+    """The classical filters' means over the slices (FBP, each filter, the oracle)."""
+    return [r for r in records(root, SOURCES["classical"]) if r["scene"] == "mean"][-1]
+
+
+def gpu_run(root):
+    """The GPU's DeepLesion run at the defaults, one training at a time, most slices."""
     gpu = [r for r in records(root, SOURCES["deeplesion_gpu"])
            if r["case"] == "throughput" and r.get("workers") == 1
            and "NVIDIA" in r["meta"]["device"] and r["per_slice"][0]["steps"] == 24000]
-    gpu = max(gpu, key=lambda r: r["slices"])
-    h100 = [r for r in records(root, SOURCES["deeplesion_gpu_h100"])
-            if r.get("scene", "").startswith("deeplesion/slice_")][:10]
+    return max(gpu, key=lambda r: r["slices"])
+
+
+def schedule_runs(root):
+    """{config: per-slice records} of the shorter schedules, cold and warm-started."""
+    runs = {}
+    for r in slices_of(records(root, SOURCES["warm_start"])):
+        runs.setdefault(r["meta"]["settings"]["options"].get("config", ""), []).append(r)
+    return runs
+
+
+def warm_method(config):
+    """training.warm_start of a run's --config ("off" for a cold one)."""
+    return (json.loads(config).get("training", {}) if config else {}).get("warm_start", "off")
+
+
+def deeplesion(root):
+    cpu_slices = slices_of(records(root, SOURCES["deeplesion_cpu"]))
+    classical = classical_mean(root)
+    gpu = gpu_run(root)
+    h100 = slices_of(records(root, SOURCES["deeplesion_gpu_h100"]))[:10]
 
     rows = []
-    rows.append(["FBP of the ringed scan", f2(classical_mean["fbp"]["psnr"]),
-                 f3(classical_mean["fbp"]["ssim"]), "< 0.2 s", stamp(classical_mean),
-                 command(classical_mean)])
+    rows.append(["FBP of the ringed scan", f2(classical["fbp"]["psnr"]),
+                 f3(classical["fbp"]["ssim"]), "< 0.2 s", stamp(classical),
+                 command(classical)])
     rows.append(["classical `all` (Vo's combination, the paper's Super) + FBP",
-                 f2(classical_mean["all"]["psnr"]), f3(classical_mean["all"]["ssim"]),
-                 seconds(classical_mean["all"]["seconds"]) + " (filter)", stamp(classical_mean),
-                 command(classical_mean)])
+                 f2(classical["all"]["psnr"]), f3(classical["all"]["ssim"]),
+                 seconds(classical["all"]["seconds"]) + " (filter)", stamp(classical),
+                 command(classical)])
     rows.append(["FBP with a perfect detector (the oracle)",
-                 f2(classical_mean["oracle fbp"]["psnr"]),
-                 f3(classical_mean["oracle fbp"]["ssim"]), "", stamp(classical_mean),
-                 command(classical_mean)])
+                 f2(classical["oracle fbp"]["psnr"]),
+                 f3(classical["oracle fbp"]["ssim"]), "", stamp(classical),
+                 command(classical)])
     rows.append([f"**riner**, {len(cpu_slices)} slices",
                  "**" + f2(mean(r["reconstruct"]["psnr"] for r in cpu_slices)) + "**",
                  f3(mean(r["reconstruct"]["ssim"] for r in cpu_slices)),
@@ -175,9 +200,9 @@ def deeplesion(root):
         "gpu_seconds": mean(s["seconds"] for s in per),
         "gpu_machine": machine(gpu["meta"]),
         "gpu_day": day(gpu["meta"]),
-        "fbp_psnr": classical_mean["fbp"]["psnr"],
-        "oracle_psnr": classical_mean["oracle fbp"]["psnr"],
-        "super_psnr": classical_mean["all"]["psnr"],
+        "fbp_psnr": classical["fbp"]["psnr"],
+        "oracle_psnr": classical["oracle fbp"]["psnr"],
+        "super_psnr": classical["all"]["psnr"],
     }
     text = table(["method", "PSNR (dB)", "SSIM", "time per slice", "machine; date; revision",
                   "command"], rows)
@@ -186,15 +211,9 @@ def deeplesion(root):
 
 def schedule_rows(root):
     """riner at shorter schedules, cold and warm-started (training.warm_start), one row each."""
-    runs = {}
-    for r in records(root, SOURCES["warm_start"]):
-        if not r.get("scene", "").startswith("deeplesion/slice_"):
-            continue
-        runs.setdefault(r["meta"]["settings"]["options"].get("config", ""), []).append(r)
     rows = []
-    for config, slices in runs.items():
-        training = json.loads(config).get("training", {}) if config else {}
-        warm = training.get("warm_start", "off")
+    for config, slices in schedule_runs(root).items():
+        warm = warm_method(config)
         steps = slices[0]["steps"]
         label = (f"riner warm-started from `{warm}`, {steps} steps" if warm != "off"
                  else f"riner, {steps} steps")
@@ -207,7 +226,7 @@ def schedule_rows(root):
 
 
 def classical_methods(root):
-    rec = [r for r in records(root, SOURCES["classical"]) if r["scene"] == "mean"][-1]
+    rec = classical_mean(root)
     order = ["fbp", "normalise", "sorting", "filtering", "large", "dead", "all", "oracle fbp"]
     rows = []
     for name in order:
@@ -254,7 +273,8 @@ def real_scans(root):
     trained = records(root, SOURCES["real_trained"])
     rows = []
     for r in trained:
-        rows.append([scan_name(r["scan"]), f"{r['fbp_ring_index']:.4f} → {r['riner_ring_index']:.4f}",
+        rings = f"{r['fbp_ring_index']:.4f} → {r['riner_ring_index']:.4f}"
+        rows.append([scan_name(r["scan"]), rings,
                      f"{r['fbp_specks_per_10k']:.2f} / {r['riner_specks_per_10k']:.2f}",
                      f2(r["edge_ratio"]), f"{r['lost_object_share'] * 100:.3f}%",
                      seconds(r["seconds"]), stamp(r), command(r)])

@@ -7,7 +7,6 @@ on a GPU.
 
 Reads the files performance_page.py's SOURCES names. Needs Pillow (Debian: python3-pil).
 """
-import json
 import math
 import os
 import statistics
@@ -28,31 +27,22 @@ P_MIN, P_MAX = 16.0, 42.0
 def points():
     """[(series, label, seconds per slice, PSNR)]."""
     out = []
-    classical = [r for r in page.records(ROOT, page.SOURCES["classical"])
-                 if r["scene"] == "mean"][-1]
+    classical = page.classical_mean(ROOT)
     fbp_seconds = classical["fbp"]["seconds"] or 0.17
     out.append(("FBP", "FBP", 0.17, classical["fbp"]["psnr"]))
     for name in ("normalise", "sorting", "filtering", "large", "all"):
         m = classical[name]
         out.append(("classical + FBP", name, m["seconds"] + fbp_seconds, m["psnr"]))
-    runs = {}
-    for r in page.records(ROOT, page.SOURCES["warm_start"]):
-        if r.get("scene", "").startswith("deeplesion/slice_"):
-            runs.setdefault(r["meta"]["settings"]["options"].get("config", ""), []).append(r)
-    for config, slices in runs.items():
-        warm = json.loads(config).get("training", {}).get("warm_start", "off")
+    for config, slices in page.schedule_runs(ROOT).items():
+        warm = page.warm_method(config)
         series = "Riner warm, 2 cores" if warm != "off" else "Riner cold, 2 cores"
         seconds = statistics.fmean(r["seconds"] + r.get("setup_seconds", 0.0) for r in slices)
         psnr = statistics.fmean(r["reconstruct"]["psnr"] for r in slices)
         out.append((series, f"{slices[0]['steps']}", seconds, psnr))
-    cpu = [r for r in page.records(ROOT, page.SOURCES["deeplesion_cpu"])
-           if r.get("scene", "").startswith("deeplesion/slice_")]
+    cpu = page.slices_of(page.records(ROOT, page.SOURCES["deeplesion_cpu"]))
     out.append(("Riner cold, 2 cores", "24000", statistics.fmean(r["seconds"] for r in cpu),
                 statistics.fmean(r["reconstruct"]["psnr"] for r in cpu)))
-    gpu = [r for r in page.records(ROOT, page.SOURCES["deeplesion_gpu"])
-           if r["case"] == "throughput" and r.get("workers") == 1
-           and "NVIDIA" in r["meta"]["device"] and r["per_slice"][0]["steps"] == 24000]
-    per = max(gpu, key=lambda r: r["slices"])["per_slice"]
+    per = page.gpu_run(ROOT)["per_slice"]
     out.append(("Riner, NVIDIA H200", "24000", statistics.fmean(s["seconds"] for s in per),
                 statistics.fmean(s["psnr"] for s in per)))
     oracle = classical["oracle fbp"]["psnr"]

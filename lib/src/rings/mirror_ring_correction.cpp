@@ -42,6 +42,13 @@ double element_at(const std::vector<double>& distance, double x) {
   return static_cast<double>(lo) + (span > 0.0 ? (t - sign * distance[lo]) / span : 0.0);
 }
 
+// Calls f(k) for every element k within `radius` of element e, of n.
+template <typename F>
+void for_each_near(std::size_t e, std::size_t radius, std::size_t n, F f) {
+  const std::size_t last = std::min(n - 1, e + radius);
+  for (std::size_t k = e > radius ? e - radius : 0; k <= last; ++k) f(k);
+}
+
 // -ln(alpha) split about the axis: even = (own + mirror) / 2, odd = (own - mirror) / 2, the
 // mirror interpolated between the two usable elements around distance -d.
 struct MirrorParts {
@@ -77,18 +84,16 @@ MirrorParts mirror_parts(const std::vector<double>& offset, const std::vector<ch
 // The median of |values| over the paired elements within `window` of each paired element.
 std::vector<double> running_median_abs(const std::vector<double>& values,
                                        const std::vector<char>& paired, int window) {
-  const auto n = static_cast<std::ptrdiff_t>(values.size());
-  std::vector<double> out(values.size(), 0.0);
+  const std::size_t n = values.size();
+  std::vector<double> out(n, 0.0);
   std::vector<double> near;
-  for (std::ptrdiff_t e = 0; e < n; ++e) {
-    if (!paired[static_cast<std::size_t>(e)]) continue;
+  for (std::size_t e = 0; e < n; ++e) {
+    if (!paired[e]) continue;
     near.clear();
-    for (std::ptrdiff_t j = std::max<std::ptrdiff_t>(0, e - window);
-         j <= std::min(n - 1, e + window); ++j) {
-      const auto k = static_cast<std::size_t>(j);
+    for_each_near(e, static_cast<std::size_t>(window), n, [&](std::size_t k) {
       if (paired[k]) near.push_back(std::fabs(values[k]));
-    }
-    out[static_cast<std::size_t>(e)] = util::quantile(near, 0.5);
+    });
+    out[e] = util::quantile(near, 0.5);
   }
   return out;
 }
@@ -121,17 +126,15 @@ EvenEvidence even_evidence(const MirrorParts& parts, const MirrorRingSettings& s
   const double level = util::quantile(paired_even, 0.5);
   // Around each element (its grow neighbourhood), the even part's excess and the odd part as
   // root mean squares: one bad element makes both alike, an object only the even one.
-  const auto grow = static_cast<std::ptrdiff_t>(s.grow_elements);
-  const auto near_rms = [&](const std::vector<double>& v, double minus, std::ptrdiff_t e) {
+  const auto grow = static_cast<std::size_t>(s.grow_elements);
+  const auto near_rms = [&](const std::vector<double>& v, double minus, std::size_t e) {
     double sum = 0.0;
     double count = 0.0;
-    for (std::ptrdiff_t j = std::max<std::ptrdiff_t>(0, e - grow);
-         j <= std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(n) - 1, e + grow); ++j) {
-      const auto k = static_cast<std::size_t>(j);
-      if (!parts.paired[k]) continue;
+    for_each_near(e, grow, n, [&](std::size_t k) {
+      if (!parts.paired[k]) return;
       sum += (v[k] - minus) * (v[k] - minus);
       count += 1.0;
-    }
+    });
     return count > 0.0 ? std::sqrt(sum / count) : 0.0;
   };
   std::vector<char> seed(n, 0);
@@ -140,18 +143,15 @@ EvenEvidence even_evidence(const MirrorParts& parts, const MirrorRingSettings& s
     ev.judged[e] = 1;
     const double excess = std::fabs(even[e] - level);
     if (excess <= kSmallestStructure || excess <= s.min_sigmas * noise[e]) continue;
-    const auto at = static_cast<std::ptrdiff_t>(e);
-    if (near_rms(even, level, at) <= kEvenOverOdd * near_rms(odd, 0.0, at)) continue;
+    if (near_rms(even, level, e) <= kEvenOverOdd * near_rms(odd, 0.0, e)) continue;
     seed[e] = 1;
     if (noise[e] > 0.0) ev.largest_sigmas = std::max(ev.largest_sigmas, excess / noise[e]);
   }
-  for (std::ptrdiff_t e = 0; e < static_cast<std::ptrdiff_t>(n); ++e) {
-    if (!seed[static_cast<std::size_t>(e)]) continue;
-    for (std::ptrdiff_t j = std::max<std::ptrdiff_t>(0, e - grow);
-         j <= std::min<std::ptrdiff_t>(static_cast<std::ptrdiff_t>(n) - 1, e + grow); ++j) {
-      const auto k = static_cast<std::size_t>(j);
+  for (std::size_t e = 0; e < n; ++e) {
+    if (!seed[e]) continue;
+    for_each_near(e, grow, n, [&](std::size_t k) {
       if (ev.judged[k]) ev.object[k] = 1;
-    }
+    });
   }
   for (std::size_t e = 0; e < n; ++e) {
     if (!ev.object[e]) continue;

@@ -7,6 +7,7 @@
 #include "riner/error.hpp"
 #include "riner/execution_plan.hpp"
 #include "training/trainer.hpp"
+#include "training/warm_start.hpp"
 
 namespace riner::detail {
 
@@ -33,8 +34,8 @@ void resolve_steps(TrainingConfig& t, const Geometry& g) {
     const double wanted = std::ceil(t.min_draws_per_ray * rays / batch);
     if (wanted > t.steps) t.steps = static_cast<int>(std::min<double>(wanted, 1 << 30));
   }
-  // A warm start's schedule (TrainingConfig::warm_start_lr_scale); 2D only, as the warm start.
-  if (t.warm_start != "off" && !g.is_3d()) {
+  // A warm start's schedule (TrainingConfig::warm_start_lr_scale).
+  if (warm_start_applies(t, g)) {
     if (left_to_scan) t.steps = (t.steps + 2) / 3;
     t.learning_rate *= t.warm_start_lr_scale;
   }

@@ -101,13 +101,16 @@ TrainingSetup image_fit_setup(const TrainingSetup& setup, const Array& image,
 
 }  // namespace
 
+bool warm_start_applies(const TrainingConfig& training, const Geometry& g) {
+  return training.warm_start != "off" && !g.is_3d();
+}
+
 bool wants_warm_start(const TrainingSetup& setup) {
-  if (setup.config.training.warm_start == "off") return false;
-  if (setup.scan.geometry.is_3d()) {
+  const Geometry& g = setup.scan.geometry;
+  if (setup.config.training.warm_start != "off" && g.is_3d()) {
     warn("training.warm_start is for 2D scans for now: this volume starts cold");
-    return false;
   }
-  return true;
+  return warm_start_applies(setup.config.training, g);
 }
 
 WarmStart warm_start(const TrainingSetup& setup, const TrainerFactory& make_trainer,

@@ -25,7 +25,11 @@ struct WarmStart {
   WarmStartStats stats;
 };
 
-// Whether the setup asks for a warm start that applies (2D; in 3D it is skipped with a warning).
+// Whether training.warm_start applies to a scan of geometry g: asked for, and 2D. Both the
+// warm schedule (TrainingSetup's steps and rate) and the start itself follow it.
+bool warm_start_applies(const TrainingConfig& training, const Geometry& g);
+
+// warm_start_applies for the setup; a volume that asks for one is warned that it starts cold.
 bool wants_warm_start(const TrainingSetup& setup);
 
 // make_trainer builds the engine's trainer for the image fit's setup; device: where the filter's
