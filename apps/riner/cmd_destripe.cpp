@@ -28,6 +28,17 @@ double positive_option(const Args& args, const char* name) {
   return x;
 }
 
+// An integer option in [least, most]; `unset` when not given.
+int bounded_option(const Args& args, const char* name, int least, int most, int unset) {
+  if (args.get(name).empty()) return unset;
+  const long n = args.integer(name);
+  if (n < least || n > most) {
+    throw UsageError(std::string("--") + name + " must be " + std::to_string(least) + ".." +
+                     std::to_string(most));
+  }
+  return static_cast<int>(n);
+}
+
 }  // namespace
 
 DestripeOptions destripe_options_from(const Args& args, const std::string& method) {
@@ -36,7 +47,10 @@ DestripeOptions destripe_options_from(const Args& args, const std::string& metho
   options.size = window_option(args, "size");
   options.large_size = window_option(args, "large-size");
   options.snr = positive_option(args, "snr");
-  options.sigma = positive_option(args, "sigma");
+  options.sigma = args.get("sigma").empty() ? 0.0 : positive_option(args, "sigma");
+  options.fit_order = bounded_option(args, "fit-order", 0, 10, options.fit_order);
+  options.levels = bounded_option(args, "levels", 1, 10, 0);
+  options.wavelet_order = bounded_option(args, "wavelet", 1, 12, options.wavelet_order);
   options.engine = engine_from(args);
   options.device = device_from(args, options.engine);
   return options;
@@ -50,21 +64,30 @@ void add_destripe_tuning(Args& args) {
       .option("large-size", "N",
               "the window for large and dead stripes (default 51)", "")
       .option("snr", "X", "how far above the noise a stripe must stand to be detected", "3")
-      .option("sigma", "S", "filtering: the Gaussian low-pass width along the views (bins)", "3");
+      .option("sigma", "S",
+              "the Gaussian's width in frequency bins (default: the method's own): filtering's "
+              "low-pass along the views (3), fitting's across columns (10, smaller is "
+              "stronger), wavelet's high-pass along the views (1, larger is stronger)",
+              "")
+      .option("fit-order", "N", "fitting: the polynomial's order along the views", "2")
+      .option("levels", "N", "wavelet: decomposition levels (default: as many as fit, up to 4)",
+              "")
+      .option("wavelet", "N", "wavelet: Daubechies' order (db N)", "9");
 }
 
 int run_destripe(int argc, char** argv, int first) {
   Args args("destripe",
             "Classical stripe (ring) removal on the sinogram: Vo et al.'s sorting, filtering, "
-            "large-stripe and dead-stripe methods and their combination (all, the paper's "
-            "\"Super\"), or a normalisation of each element's mean. Writes the destriped scan "
+            "fitting, large-stripe and dead-stripe methods and their combination (all, the "
+            "paper's \"Super\"), Münch et al.'s wavelet-Fourier filter (wavelet, the paper's "
+            "\"WaveFFT\"), or a normalisation of each element's mean. Writes the destriped scan "
             "(sino.npy with its geometry.json: a scan riner reads again), stripes.npy (each "
             "element's mean over the views of what was removed, rho) and response.npy "
             "(exp(-stripes): the detector response the filter read, as alpha.npy) into the "
             "output folder; with --reconstruct, also its FBP (image.nii, image.png).");
   add_scan_options(args);
   args.option("out", "DIR", "output folder (created if missing)")
-      .option("method", "NAME", "normalise, sorting, filtering, large, dead or all", "all");
+      .option("method", "NAME", "normalise, sorting, filtering, fitting, wavelet, large, dead or all", "all");
   add_destripe_tuning(args);
   args.flag("reconstruct", "also FBP the destriped scan (image.nii, image.png)")
       .option("filter", "NAME", "FBP filter with --reconstruct: ram-lak, shepp-logan or hann",
@@ -91,10 +114,10 @@ int run_destripe(int argc, char** argv, int first) {
   write_array(out / "response.npy", response);
   char line[300];
   std::snprintf(line, sizeof(line),
-                "destripe (%s, windows %zu and %zu): %zu dead and %zu large-stripe elements "
+                "destripe (%s, windows %zu and %zu, sigma %g): %zu dead and %zu large-stripe elements "
                 "found, %zu non-finite readings interpolated, in %.2f s -> %s",
                 destripe_method_name(options.method), report.size, report.large_size,
-                report.dead.size(), report.large.size(), report.non_finite_replaced, seconds,
+                report.sigma, report.dead.size(), report.large.size(), report.non_finite_replaced, seconds,
                 out.string().c_str());
   console.line(line);
   nlohmann::json summary = {{"out", out.string()},
@@ -102,6 +125,8 @@ int run_destripe(int argc, char** argv, int first) {
                             {"size", report.size},
                             {"large_size", report.large_size},
                             {"snr", options.snr},
+                            {"sigma", report.sigma},
+                            {"wavelet_levels", report.levels},
                             {"dead_elements", report.dead},
                             {"large_stripe_elements", report.large},
                             {"non_finite_replaced", report.non_finite_replaced},

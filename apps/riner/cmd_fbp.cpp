@@ -152,7 +152,7 @@ int run_fbp(int argc, char** argv, int first) {
               "")
       .option("destripe", "METHOD",
               "remove stripes from every sinogram first (riner destripe's methods: normalise, "
-              "sorting, filtering, large, dead, all)",
+              "sorting, filtering, fitting, wavelet, large, dead, all)",
               "");
   add_destripe_tuning(args);
   add_engine_flags(args);

@@ -3,7 +3,9 @@
 // riner/destripe.hpp, and the oracle FBP of the same scan with a perfect detector; PSNR/SSIM
 // against the ground truth and the seconds of each filter.
 //
-//   riner_bench --case=destripe [--first=0] [--last=9] [--json=FILE]
+//   riner_bench --case=destripe [--first=0] [--last=9] [--wavelet=9] [--levels=0]
+//               [--json=FILE]
+// (--wavelet and --levels: the wavelet method's Daubechies order and levels.)
 #include <chrono>
 #include <cstdio>
 
@@ -28,7 +30,8 @@ std::vector<Result> destripe_case(const Options& o) {
   fbp_options.device = device;
   const std::vector<riner::DestripeMethod> methods = {
       riner::DestripeMethod::kNormalise, riner::DestripeMethod::kSorting,
-      riner::DestripeMethod::kFiltering, riner::DestripeMethod::kLarge,
+      riner::DestripeMethod::kFiltering, riner::DestripeMethod::kFitting,
+      riner::DestripeMethod::kWavelet, riner::DestripeMethod::kLarge,
       riner::DestripeMethod::kDead, riner::DestripeMethod::kAll};
   struct Total {
     double psnr = 0.0, ssim = 0.0, seconds = 0.0;
@@ -57,6 +60,8 @@ std::vector<Result> destripe_case(const Options& o) {
     for (riner::DestripeMethod method : methods) {
       riner::DestripeOptions options;
       options.method = method;
+      options.wavelet_order = o.get_int("wavelet", options.wavelet_order);
+      options.levels = o.get_int("levels", options.levels);
       const auto start = std::chrono::steady_clock::now();
       const riner::Array clean = riner::destripe(scan.measurement, scan.geometry, options);
       const double seconds =

@@ -21,7 +21,7 @@ SOURCES = {
     "deeplesion_cpu": "issue29_beta_deeplesion.jsonl",
     "deeplesion_gpu": "issue30_throughput.jsonl",
     "deeplesion_gpu_h100": "issue12_gpu.jsonl",
-    "classical": "issue31_destripe.jsonl",
+    "classical": "issue31_destripe_wavelet.jsonl",
     "warm_start": "issue31_warm_start.jsonl",
     "sizes_cpu": "issue29_draws10.jsonl",
     "sizes_gpu": "issue29_sizes_gpu.jsonl",
@@ -227,7 +227,8 @@ def schedule_rows(root):
 
 def classical_methods(root):
     rec = classical_mean(root)
-    order = ["fbp", "normalise", "sorting", "filtering", "large", "dead", "all", "oracle fbp"]
+    order = ["fbp", "normalise", "sorting", "filtering", "fitting", "wavelet", "large", "dead", "all",
+             "oracle fbp"]
     rows = []
     for name in order:
         m = rec[name]

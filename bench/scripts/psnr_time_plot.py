@@ -30,7 +30,7 @@ def points():
     classical = page.classical_mean(ROOT)
     fbp_seconds = classical["fbp"]["seconds"] or 0.17
     out.append(("FBP", "FBP", 0.17, classical["fbp"]["psnr"]))
-    for name in ("normalise", "sorting", "filtering", "large", "all"):
+    for name in ("normalise", "sorting", "filtering", "fitting", "wavelet", "large", "all"):
         m = classical[name]
         out.append(("classical + FBP", name, m["seconds"] + fbp_seconds, m["psnr"]))
     for config, slices in page.schedule_runs(ROOT).items():

@@ -142,7 +142,7 @@ TEST_SUITE("cli") {
     CHECK(std::fabs(psnr((dir / "direct.nii").string()) - destriped) < 0.01);
     expect_error(riner_cli("destripe " + sim + "/sino.npy --method wavelets --out " + out + "2",
                            dir),
-                 2, "a destripe method is normalise, sorting, filtering, large, dead or all");
+                 2, "a destripe method is normalise, sorting, filtering, fitting, wavelet, large, dead or all");
     expect_error(riner_cli("fbp " + sim + "/sino.npy --destripe all --size 0 --out " +
                                (dir / "x.nii").string(),
                            dir),

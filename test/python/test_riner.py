@@ -101,6 +101,9 @@ def test_destripe_matches_the_cli(cli, tmp_path, fan_scan):
     assert np.array_equal(out["sino"], riner.read_array(tmp_path / "clean" / "sino.npy"))
     assert np.array_equal(out["stripes"], riner.read_array(tmp_path / "clean" / "stripes.npy"))
     assert out["size"] == 21
+    wavelet = riner.destripe(sim["sino"], g, method="wavelet", levels=3, wavelet=5)
+    assert wavelet["sino"].shape == sim["sino"].shape and wavelet["wavelet_levels"] == 3
+    assert wavelet["sigma"] == 1.0  # the method's own width
     with pytest.raises(riner.InputError, match="a destripe method is"):
         riner.destripe(sim["sino"], g, method="wavelets")
 

@@ -72,7 +72,8 @@ TEST_CASE("each method takes most of a ringed sinogram's offsets away and report
   const double before = rms(r.ringed.data, r.clean.data);  // about 0.03
   for (riner::DestripeMethod method :
        {riner::DestripeMethod::kNormalise, riner::DestripeMethod::kSorting,
-        riner::DestripeMethod::kFiltering, riner::DestripeMethod::kAll}) {
+        riner::DestripeMethod::kFiltering, riner::DestripeMethod::kFitting,
+        riner::DestripeMethod::kWavelet, riner::DestripeMethod::kAll}) {
     CAPTURE(riner::destripe_method_name(method));
     riner::DestripeOptions options;
     options.method = method;
@@ -96,7 +97,9 @@ TEST_CASE("each method takes most of a ringed sinogram's offsets away and report
 
 TEST_CASE("a sinogram without stripes comes through nearly as it was") {
   const Ringed r = ringed_sinogram();
-  for (riner::DestripeMethod method : {riner::DestripeMethod::kSorting, riner::DestripeMethod::kAll}) {
+  for (riner::DestripeMethod method :
+       {riner::DestripeMethod::kSorting, riner::DestripeMethod::kFitting,
+        riner::DestripeMethod::kWavelet, riner::DestripeMethod::kAll}) {
     CAPTURE(riner::destripe_method_name(method));
     riner::DestripeOptions options;
     options.method = method;
@@ -166,5 +169,13 @@ TEST_CASE("stripe removal refuses what it cannot work on") {
   riner::DestripeOptions bad;
   bad.snr = 0.0;
   const Ringed r = ringed_sinogram(90, 128);
+  CHECK_THROWS_AS(riner::destripe(r.ringed, r.g, bad), riner::InputError);
+  bad = {};
+  bad.method = riner::DestripeMethod::kWavelet;
+  bad.wavelet_order = 0;
+  CHECK_THROWS_WITH_AS(riner::destripe(r.ringed, r.g, bad), doctest::Contains("Daubechies order"),
+                       riner::InputError);
+  bad = {};
+  bad.sigma = std::nan("");
   CHECK_THROWS_AS(riner::destripe(r.ringed, r.g, bad), riner::InputError);
 }

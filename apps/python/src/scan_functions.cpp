@@ -45,7 +45,7 @@ py::array fbp_of(const py::handle& measurement, const std::string& geometry_json
 // Classical stripe removal (riner/destripe.hpp): the destriped measurement and a report.
 py::dict destripe_of(const py::handle& measurement, const std::string& geometry_json,
                      const std::string& method, std::size_t size, std::size_t large_size,
-                     double snr, double sigma) {
+                     double snr, double sigma, int fit_order, int levels, int wavelet_order) {
   const Scan scan = scan_from(measurement, geometry_json);
   DestripeOptions options;
   options.method = parse_destripe_method(method);
@@ -53,6 +53,9 @@ py::dict destripe_of(const py::handle& measurement, const std::string& geometry_
   options.large_size = large_size;
   options.snr = snr;
   options.sigma = sigma;
+  options.fit_order = fit_order;
+  options.levels = levels;
+  options.wavelet_order = wavelet_order;
   DestripeReport report;
   Array out;
   {
@@ -66,6 +69,8 @@ py::dict destripe_of(const py::handle& measurement, const std::string& geometry_
   result["large_stripe_elements"] = report.large;
   result["size"] = report.size;
   result["large_size"] = report.large_size;
+  result["sigma"] = report.sigma;
+  result["wavelet_levels"] = report.levels;
   result["non_finite_replaced"] = report.non_finite_replaced;
   return result;
 }

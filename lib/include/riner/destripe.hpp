@@ -1,7 +1,8 @@
 // Classical stripe removal on sinograms, the methods ring-removal users already run: Vo, Atwood
-// and Drakopoulos' sorting, filtering, large-stripe and dead-stripe methods and their
-// combination (the paper's "Super"; Optics Express 26, 28396, 2018), and a normalisation of
-// each element's mean over the views in the manner of Rivers (1998). Each works on every
+// and Drakopoulos' sorting, filtering, fitting, large-stripe and dead-stripe methods and their
+// combination (the paper's "Super"; Optics Express 26, 28396, 2018), Münch et al.'s
+// wavelet-Fourier filter (Optics Express 17, 8567, 2009; the paper's "WaveFFT"), and a
+// normalisation of each element's mean over the views in the manner of Rivers (1998). Each works on every
 // detector row's sinogram [views, columns] alone, in riner's measurement domain
 // rho = -ln(I / I0): a response alpha is an offset -ln(alpha) along a column there, and the
 // order-based steps (sorting, medians) are the same in either domain. Seconds where Riner takes
@@ -26,12 +27,15 @@ enum class DestripeMethod {
   kNormalise,  // each column's mean over the views set to its neighbours' median
   kSorting,    // Vo's algorithm 3: each column sorted, a median across columns, unsorted
   kFiltering,  // Vo's algorithm 2: the columns' low-pass part along the views by sorting
+  kFitting,    // Vo's algorithm 1: a polynomial along the views per column, smoothed across
+  kWavelet,    // Münch's wavelet-Fourier filter: the stripes' wavelet band high-passed along views
   kLarge,      // Vo's algorithm 5: large stripes found (algorithm 4) and normalised
   kDead,       // Vo's algorithm 6: dead and fluctuating elements found and interpolated
   kAll,        // dead, then large, then sorting: Vo's remove_all_stripe ("Super")
 };
 
-// "normalise", "sorting", "filtering", "large", "dead", "all"; InputError otherwise.
+// "normalise", "sorting", "filtering", "fitting", "wavelet", "large", "dead", "all";
+// InputError otherwise.
 DestripeMethod parse_destripe_method(std::string_view name);
 const char* destripe_method_name(DestripeMethod method);
 
@@ -44,7 +48,14 @@ struct DestripeOptions {
   // The window for large and dead stripes; 0: the literature's 51.
   std::size_t large_size = 0;
   double snr = 3.0;    // how far above the noise a stripe must stand out to be detected
-  double sigma = 3.0;  // filtering: the Gaussian's width in frequency bins along the views
+  // The Gaussian's width in frequency bins; 0: the literature's for the method. filtering: the
+  // low-pass along the views (3); fitting: the low-pass across columns (10; smaller is
+  // stronger); wavelet: the high-pass along the views of the stripes' band (1; larger is
+  // stronger).
+  double sigma = 0.0;
+  int fit_order = 2;     // fitting: the polynomial's order along the views
+  int levels = 0;        // wavelet: decomposition levels; 0: as many as fit, up to 4
+  int wavelet_order = 9;  // wavelet: Daubechies' order (db9)
   double drop_ratio = 0.1;  // large stripes: share of each sorted column's extremes left out
   // The sorting step (sorting, filtering, all) runs on the device (kernels/stripe_sorting.cl)
   // where a column's views fit its local memory, else on the CPU, as the other steps do;
@@ -61,6 +72,8 @@ struct DestripeReport {
   std::vector<std::size_t> large;  // elements normalised as large stripes
   std::size_t size = 0;            // the windows used
   std::size_t large_size = 0;
+  double sigma = 0.0;              // fitting, filtering, wavelet: the width used
+  int levels = 0;                  // wavelet: the levels used
   std::size_t non_finite_replaced = 0;  // NaN/inf readings interpolated from their neighbours first
 };
 

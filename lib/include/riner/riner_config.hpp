@@ -152,7 +152,8 @@ struct TrainingConfig {
   // last phase and its mean lags (DeepLesion -0.3 dB), so they keep the last iterate.
   int tail_average_steps = -1;
   // Warm start (training/warm_start.hpp): "off", or a classical stripe filter of
-  // riner/destripe.hpp ("normalise", "sorting", "filtering", "large", "dead", "all"). alpha0
+  // riner/destripe.hpp ("normalise", "sorting", "filtering", "fitting", "wavelet", "large",
+  // "dead", "all"). alpha0
   // starts from the response the filter read off the scan and the field from a fit of
   // warm_start_steps steps to the FBP of the destriped scan, so that training begins where a
   // classical answer ends.

@@ -135,4 +135,41 @@ void interpolate_columns(Sinogram& s, const std::vector<bool>& mask) {
   }
 }
 
+namespace {
+
+// The raised-cosine weight of the far end at step j + 1 of a blend of n steps.
+double blend_weight(std::size_t j, std::size_t n) {
+  return 0.5 - 0.5 * std::cos(M_PI * static_cast<double>(j + 1) / static_cast<double>(n + 1));
+}
+
+}  // namespace
+
+Sinogram periodic_extension(const Sinogram& s, std::size_t views, std::size_t columns) {
+  Sinogram out{views, columns, std::vector<double>(views * columns, 0.0)};
+  const std::size_t extra_columns = columns - s.columns, extra_views = views - s.views;
+  for (std::size_t v = 0; v < s.views; ++v) {
+    for (std::size_t c = 0; c < s.columns; ++c) out.at(v, c) = s.at(v, c);
+    const double last = s.at(v, s.columns - 1), first = s.at(v, 0);
+    for (std::size_t j = 0; j < extra_columns; ++j) {
+      const double w = blend_weight(j, extra_columns);
+      out.at(v, s.columns + j) = (1.0 - w) * last + w * first;
+    }
+  }
+  for (std::size_t j = 0; j < extra_views; ++j) {
+    const double w = blend_weight(j, extra_views);
+    for (std::size_t c = 0; c < columns; ++c) {
+      out.at(s.views + j, c) = (1.0 - w) * out.at(s.views - 1, c) + w * out.at(0, c);
+    }
+  }
+  return out;
+}
+
+Sinogram crop(const Sinogram& padded, std::size_t views, std::size_t columns) {
+  Sinogram out{views, columns, std::vector<double>(views * columns)};
+  for (std::size_t v = 0; v < views; ++v) {
+    for (std::size_t c = 0; c < columns; ++c) out.at(v, c) = padded.at(v, c);
+  }
+  return out;
+}
+
 }  // namespace riner::stripes

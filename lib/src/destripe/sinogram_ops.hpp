@@ -40,4 +40,12 @@ std::vector<bool> detect_stripes(const std::vector<double>& values, double snr);
 // columns (held constant beyond the last).
 void interpolate_columns(Sinogram& s, const std::vector<bool>& mask);
 
+// `s` in the top-left corner of a views x columns array (each at least s's), the rest filled so
+// that the array is continuous when wrapped around: past the last column a raised-cosine blend
+// back to the first, then likewise past the last view. A filter in Fourier space then sees no
+// jump at the borders, and a column's offset continues through the padding.
+Sinogram periodic_extension(const Sinogram& s, std::size_t views, std::size_t columns);
+// The top-left views x columns of `padded`.
+Sinogram crop(const Sinogram& padded, std::size_t views, std::size_t columns);
+
 }  // namespace riner::stripes

@@ -167,7 +167,8 @@ void add_training_schedule(Table& t) {
                        "noisy (level_warmup_noise), else 0",
                        &C::training, &T::tail_average_steps));
   t.push_back(string_choice<C>(
-      "training", "warm_start", {"off", "normalise", "sorting", "filtering", "large", "dead", "all"},
+      "training", "warm_start",
+      {"off", "normalise", "sorting", "filtering", "fitting", "wavelet", "large", "dead", "all"},
       "2D: start alpha from this classical stripe filter's response and the field from the FBP "
       "of its destriped scan; off: a cold start",
       &C::training, &T::warm_start));
