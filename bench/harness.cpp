@@ -9,6 +9,7 @@
 #include <ctime>
 #include <filesystem>
 #include <numeric>
+#include <sstream>
 
 namespace riner::bench {
 
@@ -41,6 +42,16 @@ std::string format(const char* fmt, ...) {
   std::vsnprintf(buf, sizeof(buf), fmt, args);
   va_end(args);
   return buf;
+}
+
+std::vector<double> number_list(const std::string& text) {
+  std::vector<double> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    if (!item.empty()) out.push_back(std::stod(item));
+  }
+  return out;
 }
 
 nlohmann::json Stats::to_json() const {

@@ -52,6 +52,9 @@ struct Result {
 // printf into a std::string (for table rows).
 std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 
+// "1.5,3.2,3.2" -> {1.5, 3.2, 3.2}; empty items are skipped (an option's list of numbers).
+std::vector<double> number_list(const std::string& text);
+
 using CaseFn = std::function<std::vector<Result>(const Options&)>;
 
 void register_case(const std::string& name, const std::string& summary, CaseFn fn);

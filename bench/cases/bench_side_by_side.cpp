@@ -9,7 +9,6 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
-#include <sstream>
 
 #include "harness.hpp"
 #include "riner/fbp.hpp"
@@ -112,22 +111,12 @@ double seconds_to(const std::vector<Checkpoint>& curve, double psnr) {
   return std::numeric_limits<double>::quiet_NaN();
 }
 
-std::vector<double> parse_list(const std::string& text) {
-  std::vector<double> out;
-  std::stringstream s(text);
-  std::string item;
-  while (std::getline(s, item, ',')) {
-    if (!item.empty()) out.push_back(std::stod(item));
-  }
-  return out;
-}
-
 std::vector<Result> side_by_side(const Options& o) {
   const int first = o.get_int("first", 0);
   const int last = o.get_int("last", o.size == "tiny" ? first : 9);
   const int every = o.get_int("checkpoint", o.size == "tiny" ? 50 : 250);
   const double reference_budget = o.get_double("reference_seconds", o.size == "tiny" ? 5 : 120);
-  const std::vector<double> targets = parse_list(o.get("targets", "28,30,32,33,34"));
+  const std::vector<double> targets = riner::bench::number_list(o.get("targets", "28,30,32,33,34"));
   const std::string out_dir = o.output_dir("out", "");
   riner::RinerConfig config = riner::bench::config_from(o);
   riner::Device device = riner::Device::open(o.device);

@@ -16,7 +16,6 @@
 
 #include <algorithm>
 #include <cstdio>
-#include <sstream>
 
 #include "harness.hpp"
 #include "riner/fbp.hpp"
@@ -37,14 +36,6 @@ double peak_rss_mb() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   return static_cast<double>(usage.ru_maxrss) / 1024.0;
-}
-
-std::vector<double> spacing_of(const std::string& text) {
-  std::vector<double> spacing;
-  std::stringstream in(text);
-  std::string part;
-  while (std::getline(in, part, ',')) spacing.push_back(std::stod(part));
-  return spacing;
 }
 
 // Central axial, coronal and sagittal slices of each volume, side by side in rows:
@@ -81,7 +72,7 @@ std::vector<Result> volume_case(const Options& o) {
   riner::Device device = riner::Device::open(o.device);
   const riner::Geometry g = riner::preset_geometry("cone3d-paper");
   riner::Array truth = riner::read_array(path).array;
-  if (!spacing.empty()) truth = riner::resample_to_grid(truth, spacing_of(spacing), g);
+  if (!spacing.empty()) truth = riner::resample_to_grid(truth, riner::bench::number_list(spacing), g);
   riner::RingModel model;
   model.seed = static_cast<std::uint64_t>(o.get_int("seed", 1));
   const riner::Projector projector(g, riner::Engine::kOpenCL, device);

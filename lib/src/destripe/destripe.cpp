@@ -82,37 +82,6 @@ void sorting(Sinogram& s, std::size_t size, ops::StripeSortingOp* device = nullp
   s = stripes::unsort_columns(stripes::median_across_columns(sorted.sorted, size), sorted.view);
 }
 
-// Algorithm 2: only each column's slow variation along the views (a Gaussian low-pass, the
-// columns mirrored at both ends) goes through the sorting; the fast part is kept as measured.
-void filtering(Sinogram& s, std::size_t size, double sigma, ops::StripeSortingOp* device) {
-  const std::size_t pad = std::min<std::size_t>(150, s.views / 10);
-  const std::size_t n = s.views + 2 * pad;
-  Sinogram smooth = s;
-  Eigen::FFT<double> fft;
-  std::vector<double> line(n), back;
-  std::vector<std::complex<double>> spectrum;
-  for (std::size_t c = 0; c < s.columns; ++c) {
-    for (std::size_t i = 0; i < n; ++i) {
-      long v = static_cast<long>(i) - static_cast<long>(pad);
-      if (v < 0) v = -v;  // mirrored about the first view ('reflect' without repeating it)
-      if (v >= static_cast<long>(s.views)) v = 2 * static_cast<long>(s.views) - v - 2;
-      line[i] = s.at(static_cast<std::size_t>(std::clamp(v, 0L, static_cast<long>(s.views) - 1)), c);
-    }
-    fft.fwd(spectrum, line);
-    for (std::size_t k = 0; k < n; ++k) {
-      const double f = static_cast<double>(std::min(k, n - k));
-      spectrum[k] *= std::exp(-0.5 * (f / sigma) * (f / sigma));
-    }
-    fft.inv(back, spectrum);
-    for (std::size_t v = 0; v < s.views; ++v) smooth.at(v, c) = back[v + pad];
-  }
-  Sinogram corrected = smooth;
-  sorting(corrected, size, device);
-  for (std::size_t i = 0; i < s.values.size(); ++i) {
-    s.values[i] += corrected.values[i] - smooth.values[i];
-  }
-}
-
 // The padding a Fourier filter of a line of n values gets (algotom's: a tenth, at most 150),
 // at least 16 so that the wrap-around blend is gentle.
 std::size_t fourier_pad(std::size_t n) { return std::clamp<std::size_t>(n / 10, 16, 150); }
@@ -132,6 +101,33 @@ void filter_lines(std::vector<double>& values, std::size_t first, std::size_t li
     for (std::size_t k = 0; k < n; ++k) spectrum[k] *= gain(static_cast<double>(std::min(k, n - k)));
     fft.inv(back, spectrum);
     for (std::size_t i = 0; i < n; ++i) values[start + i * stride] = back[i];
+  }
+}
+
+// Algorithm 2: only each column's slow variation along the views (a Gaussian low-pass, the
+// columns mirrored at both ends) goes through the sorting; the fast part is kept as measured.
+void filtering(Sinogram& s, std::size_t size, double sigma, ops::StripeSortingOp* device) {
+  const std::size_t pad = std::min<std::size_t>(150, s.views / 10);
+  const std::size_t n = s.views + 2 * pad;
+  // Each column mirrored about its first and last views ('reflect' without repeating them).
+  Sinogram padded{n, s.columns, std::vector<double>(n * s.columns)};
+  for (std::size_t i = 0; i < n; ++i) {
+    long v = static_cast<long>(i) - static_cast<long>(pad);
+    if (v < 0) v = -v;
+    if (v >= static_cast<long>(s.views)) v = 2 * static_cast<long>(s.views) - v - 2;
+    const auto from = static_cast<std::size_t>(std::clamp(v, 0L, static_cast<long>(s.views) - 1));
+    for (std::size_t c = 0; c < s.columns; ++c) padded.at(i, c) = s.at(from, c);
+  }
+  filter_lines(padded.values, 0, s.columns, 1, n, s.columns,
+               [&](double f) { return std::exp(-0.5 * (f / sigma) * (f / sigma)); });
+  Sinogram smooth = s;
+  for (std::size_t v = 0; v < s.views; ++v) {
+    for (std::size_t c = 0; c < s.columns; ++c) smooth.at(v, c) = padded.at(v + pad, c);
+  }
+  Sinogram corrected = smooth;
+  sorting(corrected, size, device);
+  for (std::size_t i = 0; i < s.values.size(); ++i) {
+    s.values[i] += corrected.values[i] - smooth.values[i];
   }
 }
 
