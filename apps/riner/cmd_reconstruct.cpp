@@ -135,7 +135,9 @@ int run_reconstruct(int argc, char** argv, int first) {
                   std::to_string(static_cast<int>(TrainingConfig{}.min_draws_per_ray)) +
                   " times, " +
                   std::to_string(TrainingConfig::kSteps3d) +
-                  " for a volume; the learning rate halves every quarter of them)",
+                  " or more for a volume so that each voxel is sampled " +
+                  std::to_string(static_cast<int>(TrainingConfig{}.min_samples_per_voxel)) +
+                  " times; the learning rate halves every quarter of them)",
               "")
       .option("seed", "N", "random seed", "")
       .option("rays-per-step", "N",
@@ -185,10 +187,17 @@ int run_reconstruct(int argc, char** argv, int first) {
         setup.steps_planned >
             config.training.steps_for(reconstructor.scan().geometry.is_3d())) {
       char line[240];
-      std::snprintf(line, sizeof(line),
-                    "%d steps of %d rays, so that each of the slice's rays is drawn %.0f "
-                    "times (training.min_draws_per_ray; --steps N sets the count)",
-                    setup.steps_planned, setup.rays_per_step, setup.draws_per_ray_planned);
+      if (reconstructor.scan().geometry.is_3d()) {
+        std::snprintf(line, sizeof(line),
+                      "%d steps of %d rays, so that each voxel is sampled %.0f times "
+                      "(training.min_samples_per_voxel; --steps N sets the count)",
+                      setup.steps_planned, setup.rays_per_step, setup.samples_per_voxel_planned);
+      } else {
+        std::snprintf(line, sizeof(line),
+                      "%d steps of %d rays, so that each of the slice's rays is drawn %.0f "
+                      "times (training.min_draws_per_ray; --steps N sets the count)",
+                      setup.steps_planned, setup.rays_per_step, setup.draws_per_ray_planned);
+      }
       console.line(line);
     }
     if (setup.warm_start) {

@@ -129,6 +129,7 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
           {"steps_planned", stats.steps_planned},
           {"rays_per_step", stats.rays_per_step},
           {"draws_per_ray_planned", stats.draws_per_ray_planned},
+          {"samples_per_voxel_planned", stats.samples_per_voxel_planned},
           {"stopped_on_plateau", stats.stopped_on_plateau},
           {"seconds", stats.seconds},
           {"samples", stats.samples},

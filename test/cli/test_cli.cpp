@@ -626,7 +626,8 @@ TEST_SUITE("cli") {
     expect_error(riner_cli("reconstruct " + sim + "/sino.npy --set training.steps=-4 --out " +
                                (dir / "s").string(),
                            dir),
-                 2, "config: training.steps must be in -1..10000000 (training steps; -1: the scan's, 24000 in 2D, 12000 in 3D)");
+                 2, "config: training.steps must be in -1..10000000 (training steps; -1: the scan's, "
+           "24000 in 2D and 12000 in 3D or more (min_draws_per_ray, min_samples_per_voxel))");
     expect_error(riner_cli("reconstruct " + sim + "/sino.npy --set training.stepz=4 --out " +
                                (dir / "s").string(),
                            dir),

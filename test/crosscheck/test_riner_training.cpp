@@ -5,6 +5,7 @@
 #include <cmath>
 #include <vector>
 
+#include "model/ray_segments.hpp"
 #include "riner/destripe.hpp"
 #include "riner/error.hpp"
 #include "riner/fbp.hpp"
@@ -272,6 +273,64 @@ TEST_SUITE("riner_training") {
     c.training.steps = riner::TrainingConfig::kScanSteps;
     c.training.sampler = riner::Sampler::kViewsTimesElements;  // its batch is views x elements
     CHECK(riner::Reconstructor(scan, c, riner::test::device()).config().training.steps == 24000);
+  }
+
+  TEST_CASE("a volume short of samples: steps until each voxel is sampled "
+            "min_samples_per_voxel times, the volume's table and rate; else the slice's") {
+    const riner::Geometry g = riner::test::small_cone3d();
+    riner::Array sino(g.measurement_shape());
+    for (std::size_t i = 0; i < sino.size(); ++i) sino.data[i] = 0.1f + 0.01f * (i % 7);
+    const riner::Scan volume{sino, g, 0};
+    riner::RinerConfig c = riner::test::tiny_config();
+    c.training.steps = riner::TrainingConfig::kScanSteps;
+    c.training.learning_rate = riner::TrainingConfig::kScanLearningRate;
+    c.encoding.log2_table_size = riner::EncodingConfig::kScanTable;
+    c.training.rays_per_step = 64;
+    c.training.min_samples_per_voxel = 2000.0;
+    // The rays' mean samples inside the grid, as the trainer steps along them.
+    const std::vector<riner::model::RaySegment> segments =
+        riner::model::ray_segments(g, c.training.sample_spacing * g.voxel_mm,
+                                   c.training.circle_region);
+    double samples = 0.0;
+    for (const riner::model::RaySegment& s : segments) samples += s.count;
+    const double per_step = 64.0 * samples / static_cast<double>(segments.size()) /
+                            static_cast<double>(riner::shape_size(g.volume_shape));
+    const int expected = static_cast<int>(std::ceil(2000.0 / per_step));
+    REQUIRE(expected > riner::TrainingConfig::kSteps3d);
+    const riner::Reconstructor raised(volume, c, riner::test::device());
+    CHECK(raised.config().training.steps == expected);
+    CHECK(raised.stats().samples_per_voxel_planned == doctest::Approx(2000.0).epsilon(1e-3));
+    CHECK(raised.config().encoding.log2_table_size == riner::EncodingConfig::kLog2TableVolume);
+    CHECK(raised.config().training.learning_rate == riner::TrainingConfig::kLearningRateVolume);
+    // An explicit count keeps the volume's table and rate: they follow the scan.
+    c.training.steps = 300;
+    const riner::Reconstructor counted(volume, c, riner::test::device());
+    CHECK(counted.config().training.steps == 300);
+    CHECK(counted.config().encoding.log2_table_size == riner::EncodingConfig::kLog2TableVolume);
+    // Sampled enough at the floor (a thin slab): the floor, the slice's table and rate.
+    c.training.steps = riner::TrainingConfig::kScanSteps;
+    c.training.min_samples_per_voxel = 0.5 * riner::TrainingConfig::kSteps3d * per_step;
+    const riner::Reconstructor enough(volume, c, riner::test::device());
+    CHECK(enough.config().training.steps == riner::TrainingConfig::kSteps3d);
+    CHECK(enough.config().encoding.log2_table_size == riner::EncodingConfig::kLog2TableSlice);
+    CHECK(enough.config().training.learning_rate == riner::TrainingConfig::kLearningRateSlice);
+    c.training.min_samples_per_voxel = 0.0;  // off
+    CHECK(riner::Reconstructor(volume, c, riner::test::device()).config().training.steps ==
+          riner::TrainingConfig::kSteps3d);
+    // Explicit table and rate stay.
+    c.training.min_samples_per_voxel = 2000.0;
+    c.training.learning_rate = 5e-3;
+    c.encoding.log2_table_size = 12;
+    const riner::Reconstructor set(volume, c, riner::test::device());
+    CHECK(set.config().training.learning_rate == 5e-3);
+    CHECK(set.config().encoding.log2_table_size == 12);
+    // A slice's are the slice's.
+    c = riner::test::tiny_config();
+    c.training.learning_rate = riner::TrainingConfig::kScanLearningRate;
+    c.encoding.log2_table_size = riner::EncodingConfig::kScanTable;
+    const riner::Reconstructor slice(riner::test::tiny_problem(3).scan, c, riner::test::device());
+    CHECK(slice.config().encoding.log2_table_size == riner::EncodingConfig::kLog2TableSlice);
+    CHECK(slice.config().training.learning_rate == riner::TrainingConfig::kLearningRateSlice);
   }
 
   TEST_CASE("zero steps leave the initial field; alpha and beta start at 1 and sigmoid(1)") {

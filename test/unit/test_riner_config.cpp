@@ -65,7 +65,8 @@ TEST_SUITE("riner_config") {
     expect(R"({"training": {"steps": "many"}})",
            "c.json: config: training.steps must be an integer");
     expect(R"({"training": {"learning_rate": -1}})",
-           "c.json: config: training.learning_rate must be in (0, 10) (Adam's learning rate)");
+           "c.json: config: training.learning_rate must be in [0, 10) (Adam's learning rate; 0: "
+           "the scan's, 2e-3 for a volume short of samples (min_samples_per_voxel), else 1e-3)");
     expect(R"({"training": {"sampler": "random"}})",
            "c.json: config: training.sampler must be one of uniform, views-x-elements, mixed, even");
     expect(R"({"training": {"ring_lambda": 1}})",
@@ -90,7 +91,8 @@ TEST_SUITE("riner_config") {
            "mixed samplers' rays per step; 0: the execution plan's)");
     // A value beyond an int's range is refused, not wrapped.
     expect(R"({"training": {"steps": 5000000000}})",
-           "c.json: config: training.steps must be in -1..10000000 (training steps; -1: the scan's, 24000 in 2D, 12000 in 3D)");
+           "c.json: config: training.steps must be in -1..10000000 (training steps; -1: the scan's, "
+           "24000 in 2D and 12000 in 3D or more (min_draws_per_ray, min_samples_per_voxel))");
     expect(R"({"training": {"seed": -1}})",
            "c.json: config: training.seed must be in 0..1.84467e+19 (seed of the initial "
            "weights and the sampler)");

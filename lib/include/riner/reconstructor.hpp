@@ -94,6 +94,8 @@ struct TrainingStats {
   int steps_planned = 0;            // training.steps
   int rays_per_step = 0;            // training.rays_per_step as resolved
   double draws_per_ray_planned = 0.0;  // steps_planned x rays_per_step / the scan's rays
+  // steps_planned x rays_per_step x the rays' mean samples inside the grid / the grid's voxels
+  double samples_per_voxel_planned = 0.0;
   bool stopped_on_plateau = false;  // training.stop_on_plateau ended the run early
   double seconds = 0.0;             // wall time inside step()/run()
   double samples = 0.0;             // field evaluations trained on (forward + backward)

@@ -20,11 +20,27 @@ namespace riner {
 // so that the last level reaches finest_resolution; a level is dense while it fits in
 // 2^log2_table_size entries and spatially hashed above that.
 struct EncodingConfig {
+  // 0: the scan's (filled in by the Reconstructor): kLog2TableVolume for a volume short of
+  // samples (training.min_samples_per_voxel), kLog2TableSlice otherwise. Such a volume's step
+  // is held by its table: Adam and the gradient scatter touch a few entries in every cache line
+  // of it, so on a CPU a step costs in proportion to the table (the chest CT at 12 000 steps:
+  // 2^18 100 s, 2^16 41 s, at the same 32.7 dB), and the volume gains from steps, not entries
+  // (docs/history/RESULTS.md, issue 34). A thin slab, sampled enough, keeps the slice's table
+  // (2^16 there: -1.8 dB).
+  static constexpr int kScanTable = 0;
+  static constexpr int kLog2TableSlice = 18;
+  static constexpr int kLog2TableVolume = 16;
   int levels = 8;
   int features = 2;  // per level
-  int log2_table_size = 18;
+  int log2_table_size = kScanTable;
   int base_resolution = 16;
   int finest_resolution = 0;  // 0: the grid's largest side (one vertex per voxel at the top)
+
+  // volume: a volume short of samples (TrainingConfig::min_samples_per_voxel).
+  int log2_table_for(bool volume) const {
+    if (log2_table_size != kScanTable) return log2_table_size;
+    return volume ? kLog2TableVolume : kLog2TableSlice;
+  }
 };
 
 // input (levels * features) -> [width, ReLU] x hidden_layers -> 1, linear output.
@@ -62,10 +78,10 @@ enum class AlphaModel { kAuto, kPerElement, kRowsTimesColumns };
 enum class AirFbpCheck { kAuto, kOn, kOff };
 
 struct TrainingConfig {
-  // -1: the scan's (kSteps2d or kSteps3d, filled in by the Reconstructor). 3D has its own
-  // because a step there draws its rays over ~100x the detector elements of a slice: the paper's
-  // 3D protocol reaches 37.4 dB at 12 000 steps in under 10 min on 2 cores
-  // (docs/history/RESULTS.md).
+  // -1: the scan's (kSteps2d or kSteps3d, filled in by the Reconstructor), raised for a large
+  // slice by min_draws_per_ray and for a volume by min_samples_per_voxel. kSteps3d is the
+  // floor for a slab of a few slices; a whole volume at the paper's 3D protocol gets ~93 000
+  // (docs/history/RESULTS.md, issue 34).
   static constexpr int kScanSteps = -1;
   static constexpr int kSteps2d = 24000;
   static constexpr int kSteps3d = 12000;
@@ -79,6 +95,14 @@ struct TrainingConfig {
   // at 1.3 draws, 38.44 and 0.97 at 10 (docs/history/RESULTS.md, issue 29 item 2); the 2D scans in
   // ../shared (9.5-33 draws on a CPU) change by at most 5%. 0: off. 2D only.
   double min_draws_per_ray = 10.0;
+  // A volume is short of samples when kSteps3d steps (in batches of at most 160 rays) would
+  // sample its grid's voxels fewer than this many times each (the rays' samples inside the
+  // grid, air included). Its steps, when left to the scan (steps -1), then grow until they do,
+  // and it trains with the volume's table and rate (log2_table_size, learning_rate 0). A 3D
+  // field is short of draws, not of entries: the chest CT at the paper's protocol gains 1-2 dB
+  // for each doubling of its steps (docs/history/RESULTS.md, issue 34). A slab of a few slices
+  // is sampled ~1000 times at kSteps3d and trains as before. 0: off (no volume is short).
+  double min_samples_per_voxel = 200.0;
   int views_per_step = 40;      // views x elements sampler
   int elements_per_step = 2;    // views x elements sampler: adjacent elements
   double sample_spacing = 1.5;  // along each ray, in voxels (the paper uses a fixed interval)
@@ -96,7 +120,15 @@ struct TrainingConfig {
   int air_min_views = 3;
   double air_centre_tolerance_px = 0.0;
   AirFbpCheck air_fbp_check = AirFbpCheck::kAuto;
-  double learning_rate = 1e-3;
+  // 0: the scan's (filled in by the Reconstructor): kLearningRateVolume for a volume short of
+  // samples (min_samples_per_voxel), kLearningRateSlice otherwise. Short of samples, the field
+  // is still fitting when a slice's schedule would have it settle (the chest CT at 12 000
+  // steps: 1e-3 32.67 dB, 2e-3 33.53, 3e-3 33.47; at 48 000, 2e-3 36.07, 3e-3 35.59;
+  // docs/history/RESULTS.md, issue 34).
+  static constexpr double kScanLearningRate = 0.0;
+  static constexpr double kLearningRateSlice = 1e-3;
+  static constexpr double kLearningRateVolume = 2e-3;
+  double learning_rate = kScanLearningRate;
   // The rate is multiplied by lr_decay every lr_decay_steps steps; 0: every steps / 4, so the
   // schedule stretches with the budget (--steps 12000 halves every 3000).
   int lr_decay_steps = 0;
@@ -195,6 +227,11 @@ struct TrainingConfig {
   int steps_for(bool is_3d) const {
     if (steps != kScanSteps) return steps;
     return is_3d ? kSteps3d : kSteps2d;
+  }
+  // volume: a volume short of samples (min_samples_per_voxel).
+  double learning_rate_for(bool volume) const {
+    if (learning_rate != kScanLearningRate) return learning_rate;
+    return volume ? kLearningRateVolume : kLearningRateSlice;
   }
   // Needs `steps` resolved (steps_for); the Reconstructor's config always is.
   int decay_interval() const {

@@ -22,7 +22,8 @@ ParameterLayout make_layout(int dims, const EncodingConfig& encoding, const Netw
   l.dims = dims;
   l.levels = encoding.levels;
   l.features = encoding.features;
-  l.table_size = 1u << encoding.log2_table_size;
+  // A config the Reconstructor did not resolve: the slice's table.
+  l.table_size = 1u << encoding.log2_table_for(false);
   l.inputs = encoding.levels * encoding.features;
   l.width = network.width;
   l.hidden_layers = network.hidden_layers;

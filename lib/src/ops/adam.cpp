@@ -53,7 +53,8 @@ void AdamOp::step(const AdamSettings& s, int step, cl::Buffer<float>& params,
     p.n_partials = static_cast<cl_uint>(slices.slices);
   }
   kernel_.set_args(p, params, m_, v_, grad, sliced ? *slices.buffer : no_slices_);
-  context_.launch(kernel_, n_params_);
+  constexpr std::size_t kLanes = 8;  // ADAM_LANES in adam.cl
+  context_.launch(kernel_, (n_params_ + kLanes - 1) / kLanes);
 }
 
 }  // namespace riner::ops

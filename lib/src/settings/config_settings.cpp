@@ -30,8 +30,9 @@ void add_encoding(Table& t) {
       field<C>("encoding", "levels", closed(1, 32), "hash-grid levels", &C::encoding, &E::levels));
   t.push_back(field<C>("encoding", "features", closed(1, 8), "features per level", &C::encoding,
                        &E::features));
-  t.push_back(field<C>("encoding", "log2_table_size", closed(4, 26),
-                       "log2 of each level's table entries (dense while the level fits)",
+  t.push_back(field<C>("encoding", "log2_table_size", closed(0, 26),
+                       "log2 of each level's table entries (dense while the level fits); 0: the "
+                       "scan's, 16 for a volume short of samples (min_samples_per_voxel), else 18",
                        &C::encoding, &E::log2_table_size));
   t.push_back(field<C>("encoding", "base_resolution", closed(2, 65536), "coarsest level's scale",
                        &C::encoding, &E::base_resolution));
@@ -50,8 +51,9 @@ void add_network(Table& t) {
 // How a step samples rays along them.
 void add_training_sampling(Table& t) {
   t.push_back(field<C>("training", "steps", closed(-1, kMaxSteps),
-                       "training steps; -1: the scan's, 24000 in 2D, 12000 in 3D", &C::training,
-                       &T::steps));
+                       "training steps; -1: the scan's, 24000 in 2D and 12000 in 3D or more "
+                       "(min_draws_per_ray, min_samples_per_voxel)",
+                       &C::training, &T::steps));
   t.push_back(enum_choice<C>(
       "training", "sampler",
       {Sampler::kUniform, Sampler::kViewsTimesElements, Sampler::kMixed, Sampler::kEven},
@@ -67,6 +69,11 @@ void add_training_sampling(Table& t) {
                        "2D, steps -1: the steps grow until each ray is drawn this often in "
                        "batches of at most 160 rays (a larger batch keeps those steps); 0: off",
                        &C::training, &T::min_draws_per_ray));
+  t.push_back(field<C>("training", "min_samples_per_voxel", closed_open(0, 1e9),
+                       "3D: a volume whose voxels 12000 steps of at most 160 rays sample fewer times "
+                       "each is short of samples: its steps (-1) grow until they do, its table "
+                       "and rate are the volume's; 0: off",
+                       &C::training, &T::min_samples_per_voxel));
   t.push_back(field<C>("training", "views_per_step", closed(1, 65536),
                        "views x elements sampler: views", &C::training, &T::views_per_step));
   t.push_back(field<C>("training", "elements_per_step", closed(1, 65536),
@@ -107,7 +114,9 @@ void add_training_sampling(Table& t) {
 
 // The optimiser, the schedule and the loss.
 void add_training_schedule(Table& t) {
-  t.push_back(field<C>("training", "learning_rate", open(0, 10), "Adam's learning rate",
+  t.push_back(field<C>("training", "learning_rate", closed_open(0, 10),
+                       "Adam's learning rate; 0: the scan's, 2e-3 for a volume short of samples "
+                       "(min_samples_per_voxel), else 1e-3",
                        &C::training, &T::learning_rate));
   t.push_back(field<C>("training", "lr_decay_steps", closed(0, kMaxSteps),
                        "steps between learning-rate decays; 0: steps / 4", &C::training,

@@ -94,6 +94,8 @@ void RinerConfig::validate() const {
   // What one setting's range cannot say.
   require(encoding.finest_resolution == 0 || encoding.finest_resolution >= encoding.base_resolution,
           "encoding.finest_resolution must be 0 (the grid's size) or >= base_resolution");
+  require(encoding.log2_table_size == 0 || encoding.log2_table_size >= 4,
+          "encoding.log2_table_size must be 0 (the scan's) or >= 4");
   require(network.width % 16 == 0, "network.width must be a multiple of 16");
   const TrainingConfig& t = training;
   require(t.ring_lambda == 0.0 || (draws_block(t.sampler) && t.elements_per_step >= 3),

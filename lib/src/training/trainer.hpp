@@ -31,6 +31,9 @@ struct TrainingSetup {
   std::vector<std::uint32_t> invalid_readings;  // per element: its non-finite measurements
   model::Occupancy occupancy;                   // where the object can be (all, without skip_air)
   double samples_in_grid = 0.0;                 // samples of every ray inside the grid
+  // A volume that TrainingConfig::kSteps3d steps would sample fewer than
+  // training.min_samples_per_voxel times a voxel: more steps, the volume's table and rate.
+  bool short_of_samples = false;
   double samples_kept = 0.0;                    // of those, inside the occupied region
   double stripe_rms = 0.0;                      // model/stripe_evidence.hpp
   double alpha_rate = 1.0;                      // alpha_lr_scale times the stripe evidence's factor

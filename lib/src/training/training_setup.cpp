@@ -13,27 +13,40 @@ namespace riner::detail {
 
 namespace {
 
+// A step's rays as the step rules count them: at most the CPU plan's 160 (the plan's when 0).
+double capped_batch(const TrainingConfig& t) {
+  const int cap = ExecutionPlan::kCpuRaysPerStep;
+  return static_cast<double>(t.rays_per_step > 0 ? std::min(t.rays_per_step, cap) : cap);
+}
+
 // The steps when the config leaves them to the scan (-1): the dimension's default, and for a
 // slice raised so that each of its rays is drawn training.min_draws_per_ray times over the run.
 // Scans larger than the paper's draw each ray fewer times at a fixed budget (24 000 steps of
 // 160 rays: a 1024-column ray 5 times, a 2048-column one 1.3) and their images blur; more
-// steps buy more than a bigger batch at the same draws (docs/history/RESULTS.md, issue 29). Volumes
-// keep their budget: a 3D field is held by far fewer draws per ray. The draws are counted in
-// batches of at most the CPU plan's 160 rays: a GPU's 640 keeps the CPU's steps and draws each
-// ray four times as often, because at 2048 columns the steps were what counted (10 draws of 640
-// rays: 3.4 dB under the oracle FBP; 40 draws, the same steps as the CPU's: 1.8 dB over it;
-// docs/history/RESULTS.md, issue 29). Needs rays_per_step resolved (the Reconstructor's execution
-// plan); left at 0, the default stays.
-void resolve_steps(TrainingConfig& t, const Geometry& g) {
+// steps buy more than a bigger batch at the same draws (docs/history/RESULTS.md, issue 29). A
+// volume short of samples (short_of_samples) gets steps until its voxels are sampled
+// training.min_samples_per_voxel times each: its rays are drawn well under once however long
+// it trains, and what its field lacks is samples per unknown (issue 34).
+// Both count batches of at most the CPU plan's 160 rays: a GPU's 640 keeps the CPU's steps and
+// draws each ray four times as often, because at 2048 columns the steps were what counted (10
+// draws of 640 rays: 3.4 dB under the oracle FBP; 40 draws, the same steps as the CPU's: 1.8 dB
+// over it; docs/history/RESULTS.md, issue 29). Needs rays_per_step resolved (the
+// Reconstructor's execution plan); left at 0, the default stays. The learning rate left to
+// the scan (0) is the volume's for a volume short of samples.
+void resolve_schedule(TrainingConfig& t, const Geometry& g, double samples_per_voxel_step,
+                      bool volume) {
   const bool left_to_scan = t.steps == TrainingConfig::kScanSteps;
   t.steps = t.steps_for(g.is_3d());
-  if (left_to_scan && !g.is_3d() && t.min_draws_per_ray > 0.0 && t.rays_per_step > 0 &&
-      t.sampler != Sampler::kViewsTimesElements) {
+  t.learning_rate = t.learning_rate_for(volume);
+  const bool grows =
+      left_to_scan && t.rays_per_step > 0 && t.sampler != Sampler::kViewsTimesElements;
+  double wanted = 0.0;
+  if (grows && !g.is_3d() && t.min_draws_per_ray > 0.0) {
     const double rays = static_cast<double>(g.n_views()) * static_cast<double>(g.n_u);
-    const double batch = std::min(t.rays_per_step, ExecutionPlan::kCpuRaysPerStep);
-    const double wanted = std::ceil(t.min_draws_per_ray * rays / batch);
-    if (wanted > t.steps) t.steps = static_cast<int>(std::min<double>(wanted, 1 << 30));
+    wanted = std::ceil(t.min_draws_per_ray * rays / capped_batch(t));
   }
+  if (grows && volume) wanted = std::ceil(t.min_samples_per_voxel / samples_per_voxel_step);
+  if (wanted > t.steps) t.steps = static_cast<int>(std::min<double>(wanted, 1 << 30));
   // A warm start's schedule (TrainingConfig::warm_start_lr_scale).
   if (warm_start_applies(t, g)) {
     if (left_to_scan) t.steps = (t.steps + 2) / 3;
@@ -50,12 +63,6 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
   check_scan(scan);
   const Geometry& g = scan.geometry;
   elements_per_view = g.n_u * (g.is_3d() ? g.n_v : 1);
-  resolve_steps(config.training, g);
-  if (config.encoding.finest_resolution == 0) {
-    const std::size_t largest = *std::max_element(g.volume_shape.begin(), g.volume_shape.end());
-    config.encoding.finest_resolution =
-        std::max(config.encoding.base_resolution, static_cast<int>(largest));
-  }
   segments = model::ray_segments(g, config.training.sample_spacing * g.voxel_mm,
                                  config.training.circle_region);
   std::size_t hit = 0;
@@ -64,6 +71,20 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
     throw InputError("no detector ray crosses the reconstruction grid: check the geometry");
   for (const model::RaySegment& segment : segments) samples_in_grid += segment.count;
   samples_kept = samples_in_grid;
+  // The voxels' mean samples per step of the capped batch; short of samples at the 3D floor?
+  const double per_voxel_step = capped_batch(config.training) *
+                                static_cast<double>(samples_in_grid) /
+                                static_cast<double>(segments.size()) /
+                                static_cast<double>(shape_size(g.volume_shape));
+  short_of_samples = g.is_3d() && config.training.min_samples_per_voxel > 0.0 &&
+                     TrainingConfig::kSteps3d * per_voxel_step < config.training.min_samples_per_voxel;
+  resolve_schedule(config.training, g, per_voxel_step, short_of_samples);
+  config.encoding.log2_table_size = config.encoding.log2_table_for(short_of_samples);
+  if (config.encoding.finest_resolution == 0) {
+    const std::size_t largest = *std::max_element(g.volume_shape.begin(), g.volume_shape.end());
+    config.encoding.finest_resolution =
+        std::max(config.encoding.base_resolution, static_cast<int>(largest));
+  }
   noise = model::reading_noise(scan);
   if (config.training.level_warmup_steps < 0) {
     config.training.level_warmup_steps =
