@@ -431,7 +431,7 @@ oracle is FDK with a perfect detector.
 
 The chest against the training budget (`--config='{{"training":{{"steps":N}}}}'`; each row a
 whole run with its own schedule, the same machine, one after another; its speed drifted
-between 2.3 and 3.4 ms a step over them, so read the time column to ±20%):
+between 2.5 and 4.1 ms a step over the session, so read the time column to ±25%):
 
 {volume_curve}
 

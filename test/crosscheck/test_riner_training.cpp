@@ -276,14 +276,13 @@ TEST_SUITE("riner_training") {
   }
 
   TEST_CASE("a volume short of samples: steps until each voxel is sampled "
-            "min_samples_per_voxel times, the volume's table and rate; else the slice's") {
+            "min_samples_per_voxel times, the volume's table; else the slice's") {
     const riner::Geometry g = riner::test::small_cone3d();
     riner::Array sino(g.measurement_shape());
     for (std::size_t i = 0; i < sino.size(); ++i) sino.data[i] = 0.1f + 0.01f * (i % 7);
     const riner::Scan volume{sino, g, 0};
     riner::RinerConfig c = riner::test::tiny_config();
     c.training.steps = riner::TrainingConfig::kScanSteps;
-    c.training.learning_rate = riner::TrainingConfig::kScanLearningRate;
     c.encoding.log2_table_size = riner::EncodingConfig::kScanTable;
     c.training.rays_per_step = 64;
     c.training.min_samples_per_voxel = 2000.0;
@@ -301,36 +300,30 @@ TEST_SUITE("riner_training") {
     CHECK(raised.config().training.steps == expected);
     CHECK(raised.stats().samples_per_voxel_planned == doctest::Approx(2000.0).epsilon(1e-3));
     CHECK(raised.config().encoding.log2_table_size == riner::EncodingConfig::kLog2TableVolume);
-    CHECK(raised.config().training.learning_rate == riner::TrainingConfig::kLearningRateVolume);
-    // An explicit count keeps the volume's table and rate: they follow the scan.
+    // An explicit count keeps the volume's table: it follows the scan.
     c.training.steps = 300;
     const riner::Reconstructor counted(volume, c, riner::test::device());
     CHECK(counted.config().training.steps == 300);
     CHECK(counted.config().encoding.log2_table_size == riner::EncodingConfig::kLog2TableVolume);
-    // Sampled enough at the floor (a thin slab): the floor, the slice's table and rate.
+    // Sampled enough at the floor (a thin slab): the floor, the slice's table.
     c.training.steps = riner::TrainingConfig::kScanSteps;
     c.training.min_samples_per_voxel = 0.5 * riner::TrainingConfig::kSteps3d * per_step;
     const riner::Reconstructor enough(volume, c, riner::test::device());
     CHECK(enough.config().training.steps == riner::TrainingConfig::kSteps3d);
     CHECK(enough.config().encoding.log2_table_size == riner::EncodingConfig::kLog2TableSlice);
-    CHECK(enough.config().training.learning_rate == riner::TrainingConfig::kLearningRateSlice);
     c.training.min_samples_per_voxel = 0.0;  // off
     CHECK(riner::Reconstructor(volume, c, riner::test::device()).config().training.steps ==
           riner::TrainingConfig::kSteps3d);
-    // Explicit table and rate stay.
+    // An explicit table stays.
     c.training.min_samples_per_voxel = 2000.0;
-    c.training.learning_rate = 5e-3;
     c.encoding.log2_table_size = 12;
-    const riner::Reconstructor set(volume, c, riner::test::device());
-    CHECK(set.config().training.learning_rate == 5e-3);
-    CHECK(set.config().encoding.log2_table_size == 12);
+    CHECK(riner::Reconstructor(volume, c, riner::test::device()).config().encoding.log2_table_size ==
+          12);
     // A slice's are the slice's.
     c = riner::test::tiny_config();
-    c.training.learning_rate = riner::TrainingConfig::kScanLearningRate;
     c.encoding.log2_table_size = riner::EncodingConfig::kScanTable;
     const riner::Reconstructor slice(riner::test::tiny_problem(3).scan, c, riner::test::device());
     CHECK(slice.config().encoding.log2_table_size == riner::EncodingConfig::kLog2TableSlice);
-    CHECK(slice.config().training.learning_rate == riner::TrainingConfig::kLearningRateSlice);
   }
 
   TEST_CASE("zero steps leave the initial field; alpha and beta start at 1 and sigmoid(1)") {

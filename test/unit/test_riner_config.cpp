@@ -65,8 +65,7 @@ TEST_SUITE("riner_config") {
     expect(R"({"training": {"steps": "many"}})",
            "c.json: config: training.steps must be an integer");
     expect(R"({"training": {"learning_rate": -1}})",
-           "c.json: config: training.learning_rate must be in [0, 10) (Adam's learning rate; 0: "
-           "the scan's, 2e-3 for a volume short of samples (min_samples_per_voxel), else 1e-3)");
+           "c.json: config: training.learning_rate must be in (0, 10) (Adam's learning rate)");
     expect(R"({"training": {"sampler": "random"}})",
            "c.json: config: training.sampler must be one of uniform, views-x-elements, mixed, even");
     expect(R"({"training": {"ring_lambda": 1}})",

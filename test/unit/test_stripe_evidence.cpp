@@ -58,6 +58,6 @@ TEST_SUITE("stripe evidence") {
     const riner::detail::TrainingSetup off(bump_scan(0.01f), config);
     CHECK(off.alpha_rate == doctest::Approx(0.5));
     CHECK(off.adam_settings(0).alpha_learning_rate ==
-          doctest::Approx(0.5 * off.config.training.learning_rate));
+          doctest::Approx(0.5 * config.training.learning_rate));
   }
 }

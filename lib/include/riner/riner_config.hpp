@@ -98,7 +98,7 @@ struct TrainingConfig {
   // A volume is short of samples when kSteps3d steps (in batches of at most 160 rays) would
   // sample its grid's voxels fewer than this many times each (the rays' samples inside the
   // grid, air included). Its steps, when left to the scan (steps -1), then grow until they do,
-  // and it trains with the volume's table and rate (log2_table_size, learning_rate 0). A 3D
+  // and it trains with the volume's table (log2_table_size 0). A 3D
   // field is short of draws, not of entries: the chest CT at the paper's protocol gains 1-2 dB
   // for each doubling of its steps (docs/history/RESULTS.md, issue 34). A slab of a few slices
   // is sampled ~1000 times at kSteps3d and trains as before. 0: off (no volume is short).
@@ -120,15 +120,7 @@ struct TrainingConfig {
   int air_min_views = 3;
   double air_centre_tolerance_px = 0.0;
   AirFbpCheck air_fbp_check = AirFbpCheck::kAuto;
-  // 0: the scan's (filled in by the Reconstructor): kLearningRateVolume for a volume short of
-  // samples (min_samples_per_voxel), kLearningRateSlice otherwise. Short of samples, the field
-  // is still fitting when a slice's schedule would have it settle (the chest CT at 12 000
-  // steps: 1e-3 32.67 dB, 2e-3 33.53, 3e-3 33.47; at 48 000, 2e-3 36.07, 3e-3 35.59;
-  // docs/history/RESULTS.md, issue 34).
-  static constexpr double kScanLearningRate = 0.0;
-  static constexpr double kLearningRateSlice = 1e-3;
-  static constexpr double kLearningRateVolume = 2e-3;
-  double learning_rate = kScanLearningRate;
+  double learning_rate = 1e-3;
   // The rate is multiplied by lr_decay every lr_decay_steps steps; 0: every steps / 4, so the
   // schedule stretches with the budget (--steps 12000 halves every 3000).
   int lr_decay_steps = 0;
@@ -227,11 +219,6 @@ struct TrainingConfig {
   int steps_for(bool is_3d) const {
     if (steps != kScanSteps) return steps;
     return is_3d ? kSteps3d : kSteps2d;
-  }
-  // volume: a volume short of samples (min_samples_per_voxel).
-  double learning_rate_for(bool volume) const {
-    if (learning_rate != kScanLearningRate) return learning_rate;
-    return volume ? kLearningRateVolume : kLearningRateSlice;
   }
   // Needs `steps` resolved (steps_for); the Reconstructor's config always is.
   int decay_interval() const {

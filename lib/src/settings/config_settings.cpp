@@ -72,7 +72,7 @@ void add_training_sampling(Table& t) {
   t.push_back(field<C>("training", "min_samples_per_voxel", closed_open(0, 1e9),
                        "3D: a volume whose voxels 12000 steps of at most 160 rays sample fewer times "
                        "each is short of samples: its steps (-1) grow until they do, its table "
-                       "and rate are the volume's; 0: off",
+                       "is the volume's; 0: off",
                        &C::training, &T::min_samples_per_voxel));
   t.push_back(field<C>("training", "views_per_step", closed(1, 65536),
                        "views x elements sampler: views", &C::training, &T::views_per_step));
@@ -114,9 +114,7 @@ void add_training_sampling(Table& t) {
 
 // The optimiser, the schedule and the loss.
 void add_training_schedule(Table& t) {
-  t.push_back(field<C>("training", "learning_rate", closed_open(0, 10),
-                       "Adam's learning rate; 0: the scan's, 2e-3 for a volume short of samples "
-                       "(min_samples_per_voxel), else 1e-3",
+  t.push_back(field<C>("training", "learning_rate", open(0, 10), "Adam's learning rate",
                        &C::training, &T::learning_rate));
   t.push_back(field<C>("training", "lr_decay_steps", closed(0, kMaxSteps),
                        "steps between learning-rate decays; 0: steps / 4", &C::training,

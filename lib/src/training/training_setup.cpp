@@ -31,13 +31,11 @@ double capped_batch(const TrainingConfig& t) {
 // draws each ray four times as often, because at 2048 columns the steps were what counted (10
 // draws of 640 rays: 3.4 dB under the oracle FBP; 40 draws, the same steps as the CPU's: 1.8 dB
 // over it; docs/history/RESULTS.md, issue 29). Needs rays_per_step resolved (the
-// Reconstructor's execution plan); left at 0, the default stays. The learning rate left to
-// the scan (0) is the volume's for a volume short of samples.
+// Reconstructor's execution plan); left at 0, the default stays.
 void resolve_schedule(TrainingConfig& t, const Geometry& g, double samples_per_voxel_step,
                       bool volume) {
   const bool left_to_scan = t.steps == TrainingConfig::kScanSteps;
   t.steps = t.steps_for(g.is_3d());
-  t.learning_rate = t.learning_rate_for(volume);
   const bool grows =
       left_to_scan && t.rays_per_step > 0 && t.sampler != Sampler::kViewsTimesElements;
   double wanted = 0.0;
