@@ -44,14 +44,28 @@ std::string format(const char* fmt, ...) {
   return buf;
 }
 
-std::vector<double> number_list(const std::string& text) {
-  std::vector<double> out;
+namespace {
+
+// The comma-separated items of text, each read by parse; empty items are skipped.
+template <typename T, typename Parse>
+std::vector<T> list_of(const std::string& text, Parse parse) {
+  std::vector<T> out;
   std::stringstream in(text);
   std::string item;
   while (std::getline(in, item, ',')) {
-    if (!item.empty()) out.push_back(std::stod(item));
+    if (!item.empty()) out.push_back(parse(item));
   }
   return out;
+}
+
+}  // namespace
+
+std::vector<double> number_list(const std::string& text) {
+  return list_of<double>(text, [](const std::string& item) { return std::stod(item); });
+}
+
+std::vector<int> int_list(const std::string& text) {
+  return list_of<int>(text, [](const std::string& item) { return std::stoi(item); });
 }
 
 nlohmann::json Stats::to_json() const {

@@ -54,6 +54,8 @@ std::string format(const char* fmt, ...) __attribute__((format(printf, 1, 2)));
 
 // "1.5,3.2,3.2" -> {1.5, 3.2, 3.2}; empty items are skipped (an option's list of numbers).
 std::vector<double> number_list(const std::string& text);
+// "160,640" -> {160, 640}, the same for whole numbers.
+std::vector<int> int_list(const std::string& text);
 
 using CaseFn = std::function<std::vector<Result>(const Options&)>;
 

@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <mutex>
-#include <sstream>
 
 #include "harness.hpp"
 #include "riner/concurrent_trainings.hpp"
@@ -19,14 +18,6 @@ namespace {
 using riner::bench::Options;
 using riner::bench::Result;
 
-std::vector<int> parse_list(const std::string& text) {
-  std::vector<int> values;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ',')) values.push_back(std::stoi(item));
-  return values;
-}
-
 std::vector<Result> throughput(const Options& o) {
   const int first = o.get_int("first", 0);
   const int last = o.get_int("last", o.size == "tiny" ? first + 1 : 7);
@@ -34,7 +25,7 @@ std::vector<Result> throughput(const Options& o) {
   const riner::Device device = riner::Device::open(o.device);
   const riner::Concurrency chosen = riner::concurrent_trainings(device.info());
   const std::vector<int> worker_counts =
-      parse_list(o.get("workers", "1," + std::to_string(chosen.trainings)));
+      riner::bench::int_list(o.get("workers", "1," + std::to_string(chosen.trainings)));
   const riner::Projector projector(riner::preset_geometry("fan2d-paper"), riner::Engine::kOpenCL,
                                    device);
   // --copies=N trains the slices N times over: enough trainings to fill a big device.

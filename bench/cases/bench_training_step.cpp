@@ -7,7 +7,6 @@
 
 #include <chrono>
 #include <cmath>
-#include <sstream>
 
 #include "cl/context.hpp"
 #include "cl/device_access.hpp"
@@ -30,16 +29,6 @@ double step_flops_per_sample(const model::ParameterLayout& l) {
       2.0 * (l.inputs * l.width + (l.hidden_layers - 1) * l.width * l.width + l.width);
   return l.levels * corners * (l.dims + 2.0 * l.features) + 3.0 * mlp +
          l.levels * corners * 2.0 * l.features;
-}
-
-std::vector<int> parse_list(const std::string& text) {
-  std::vector<int> out;
-  std::stringstream s(text);
-  std::string item;
-  while (std::getline(s, item, ',')) {
-    if (!item.empty()) out.push_back(std::stoi(item));
-  }
-  return out;
 }
 
 }  // namespace
@@ -123,7 +112,7 @@ std::vector<Result> training_step(const Options& o) {
   std::vector<std::string> plans{plan};
   if (plan == "both") plans = {"cpu", "gpu"};
   if (plan == "auto") plans = {""};
-  return time_training_steps(device, o, plans, parse_list(o.get("rays", "0")), nullptr);
+  return time_training_steps(device, o, plans, int_list(o.get("rays", "0")), nullptr);
 }
 
 }  // namespace

@@ -98,10 +98,10 @@ struct TrainingConfig {
   // A volume is short of samples when kSteps3d steps (in batches of at most 160 rays) would
   // sample its grid's voxels fewer than this many times each (the rays' samples inside the
   // grid, air included). Its steps, when left to the scan (steps -1), then grow until they do,
-  // and it trains with the volume's table (log2_table_size 0). A 3D
-  // field is short of draws, not of entries: the chest CT at the paper's protocol gains 1-2 dB
-  // for each doubling of its steps (docs/history/RESULTS.md, issue 34). A slab of a few slices
-  // is sampled ~1000 times at kSteps3d and trains as before. 0: off (no volume is short).
+  // and it trains with the volume's table (log2_table_size 0). A 3D field is short of draws,
+  // not of entries: the chest CT at the paper's protocol gains 1-2 dB for each doubling of its
+  // steps (docs/history/RESULTS.md, issue 34). A slab of a few slices is sampled ~1000 times at
+  // kSteps3d and trains as before. 0: off (no volume is short).
   double min_samples_per_voxel = 200.0;
   int views_per_step = 40;      // views x elements sampler
   int elements_per_step = 2;    // views x elements sampler: adjacent elements

@@ -293,10 +293,8 @@ TrainingStats Reconstructor::stats() const {
   s.rays_per_step = impl_->setup.config.training.rays_per_step;
   s.draws_per_ray_planned = static_cast<double>(s.steps_planned) * s.rays_per_step /
                             static_cast<double>(impl_->setup.segments.size());
-  s.samples_per_voxel_planned =
-      static_cast<double>(s.steps_planned) * s.rays_per_step * impl_->setup.samples_in_grid /
-      static_cast<double>(impl_->setup.segments.size()) /
-      static_cast<double>(shape_size(impl_->setup.scan.geometry.volume_shape));
+  s.samples_per_voxel_planned = static_cast<double>(s.steps_planned) * s.rays_per_step *
+                                impl_->setup.voxel_samples_per_ray;
   s.stopped_on_plateau = impl_->plateaued;
   s.plan = impl_->trainer->plan();
   s.warm_start = impl_->warm_start;

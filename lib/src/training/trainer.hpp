@@ -31,8 +31,11 @@ struct TrainingSetup {
   std::vector<std::uint32_t> invalid_readings;  // per element: its non-finite measurements
   model::Occupancy occupancy;                   // where the object can be (all, without skip_air)
   double samples_in_grid = 0.0;                 // samples of every ray inside the grid
+  // What one drawn ray adds to each voxel of the grid on average: samples_in_grid / rays /
+  // voxels (x rays per step x steps: the samples per voxel of a run).
+  double voxel_samples_per_ray = 0.0;
   // A volume that TrainingConfig::kSteps3d steps would sample fewer than
-  // training.min_samples_per_voxel times a voxel: more steps, the volume's table and rate.
+  // training.min_samples_per_voxel times a voxel: more steps, the volume's table.
   bool short_of_samples = false;
   double samples_kept = 0.0;                    // of those, inside the occupied region
   double stripe_rms = 0.0;                      // model/stripe_evidence.hpp

@@ -32,8 +32,8 @@ double capped_batch(const TrainingConfig& t) {
 // draws of 640 rays: 3.4 dB under the oracle FBP; 40 draws, the same steps as the CPU's: 1.8 dB
 // over it; docs/history/RESULTS.md, issue 29). Needs rays_per_step resolved (the
 // Reconstructor's execution plan); left at 0, the default stays.
-void resolve_schedule(TrainingConfig& t, const Geometry& g, double samples_per_voxel_step,
-                      bool volume) {
+void resolve_steps(TrainingConfig& t, const Geometry& g, double samples_per_voxel_step,
+                   bool volume) {
   const bool left_to_scan = t.steps == TrainingConfig::kScanSteps;
   t.steps = t.steps_for(g.is_3d());
   const bool grows =
@@ -69,14 +69,13 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
     throw InputError("no detector ray crosses the reconstruction grid: check the geometry");
   for (const model::RaySegment& segment : segments) samples_in_grid += segment.count;
   samples_kept = samples_in_grid;
+  voxel_samples_per_ray = samples_in_grid / static_cast<double>(segments.size()) /
+                          static_cast<double>(shape_size(g.volume_shape));
   // The voxels' mean samples per step of the capped batch; short of samples at the 3D floor?
-  const double per_voxel_step = capped_batch(config.training) *
-                                static_cast<double>(samples_in_grid) /
-                                static_cast<double>(segments.size()) /
-                                static_cast<double>(shape_size(g.volume_shape));
+  const double per_voxel_step = capped_batch(config.training) * voxel_samples_per_ray;
   short_of_samples = g.is_3d() && config.training.min_samples_per_voxel > 0.0 &&
                      TrainingConfig::kSteps3d * per_voxel_step < config.training.min_samples_per_voxel;
-  resolve_schedule(config.training, g, per_voxel_step, short_of_samples);
+  resolve_steps(config.training, g, per_voxel_step, short_of_samples);
   config.encoding.log2_table_size = config.encoding.log2_table_for(short_of_samples);
   if (config.encoding.finest_resolution == 0) {
     const std::size_t largest = *std::max_element(g.volume_shape.begin(), g.volume_shape.end());
