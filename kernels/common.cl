@@ -82,3 +82,11 @@ inline float uniform24(uint h) { return (float)(h >> 8) * (1.0f / 16777216.0f); 
 inline float sample_jitter(uint seed, uint step, uint ray, uint k) {
   return uniform24(hash32(k ^ hash_keys(JITTER_STREAM, seed, step, ray)));
 }
+
+// Index i in [-n, 2n) mirrored into [0, n), repeating the end (d c b a | a b c d | d c b a):
+// scipy's 'reflect', the stripe filters' edge rule.
+inline int mirrored(int i, const int n) {
+  if (i < 0) i = -i - 1;
+  if (i >= n) i = 2 * n - i - 1;
+  return clamp(i, 0, n - 1);
+}

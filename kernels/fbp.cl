@@ -1,15 +1,5 @@
-// fbp.cl: the two device stages of FBP/FDK.
-//   fbp_filter(n_out, n_u, taps, in, out)
-//     one work-item per output sample; out[line][j] = sum_j' taps[j - j' + n_u - 1] *
-//     in[line][j'] (the ramp filter as a linear convolution; taps already hold the spacing).
-//   fbp_filter_fft(n_lines, n_u, n, spectrum, twiddles, in, out, x)
-//     the same convolution by FFT, n log n instead of n_u^2 per line: one work-group per pair of
-//     lines, the second as the imaginary part (the taps are real, so the two convolve apart),
-//     zero-padded to n, a power of two >= 2 n_u - 1 (the circular convolution is then the
-//     linear one), transformed in local memory x[n] by a radix-2 FFT (decimation in frequency:
-//     the spectrum comes out in bit-reversed order), multiplied by the taps' spectrum (given in
-//     that order, 1/n folded in) and transformed back (decimation in time from bit-reversed
-//     order to natural). twiddles[k] = exp(-2 pi i k / n), k < n / 2.
+// fbp.cl: the backprojection stage of FBP/FDK.
+//   (the ramp filter along each detector row is kernels/line_filter.cl)
 //   fbp_backproject_parallel(n_items, first_slice, slice_step, n_selected, g, views,
 //                            view_weights, filtered, volume)
 //     the axial slices first_slice + s * slice_step, s < n_selected (volume[s] holds slice s of
@@ -28,72 +18,8 @@
 //     depend on its height, so they are found once per view for the block of slices, and only
 //     each slice's row per view.
 // Needs common.cl and ray_geometry.cl. No -D constants.
-// Buffers: taps float[2 n_u - 1]; in/out/filtered float[views][rows][n_u]; views float2 (cos,
+// Buffers: filtered float[views][rows][n_u]; views float2 (cos,
 // sin); view_weights float[views]; volume float[selected slices][ny][nx].
-
-__kernel void fbp_filter(const uint n_out, const int n_u, __global const float* taps,
-                         __global const float* in, __global float* out) {
-  const uint gid = get_global_id(0);
-  if (gid >= n_out) return;
-  const int j = gid % n_u;
-  __global const float* line = in + (gid - j);
-  __global const float* h = taps + j + n_u - 1;  // h[-j'] = taps[j - j' + n_u - 1]
-  float sum = 0.0f;
-  for (int k = 0; k < n_u; ++k) sum += h[-k] * line[k];
-  out[gid] = sum;
-}
-
-inline float2 complex_times(const float2 a, const float2 b) {
-  return (float2)(a.x * b.x - a.y * b.y, a.x * b.y + a.y * b.x);
-}
-
-__kernel void fbp_filter_fft(const uint n_lines, const uint n_u, const uint n,
-                             __global const float2* spectrum, __global const float2* twiddles,
-                             __global const float* in, __global float* out, __local float2* x) {
-  const uint first = 2 * get_group_id(0);
-  const uint t = get_local_id(0);
-  const uint threads = get_local_size(0);
-  const int pair = first + 1 < n_lines;
-  __global const float* a = in + first * n_u;
-  __global const float* b = in + (first + 1) * n_u;
-  for (uint i = t; i < n; i += threads) {
-    x[i] = i < n_u ? (float2)(a[i], pair ? b[i] : 0.0f) : (float2)(0.0f, 0.0f);
-  }
-  barrier(CLK_LOCAL_MEM_FENCE);
-  for (uint span = n / 2; span >= 1; span /= 2) {
-    const uint stride = n / (2 * span);
-    for (uint k = t; k < n / 2; k += threads) {
-      const uint pos = k & (span - 1);
-      const uint i = (k - pos) * 2 + pos;
-      const float2 u = x[i];
-      const float2 v = x[i + span];
-      x[i] = u + v;
-      x[i + span] = complex_times(u - v, twiddles[pos * stride]);
-    }
-    barrier(CLK_LOCAL_MEM_FENCE);
-  }
-  for (uint k = t; k < n; k += threads) x[k] = complex_times(x[k], spectrum[k]);
-  barrier(CLK_LOCAL_MEM_FENCE);
-  for (uint span = 1; span < n; span *= 2) {
-    const uint stride = n / (2 * span);
-    for (uint k = t; k < n / 2; k += threads) {
-      const uint pos = k & (span - 1);
-      const uint i = (k - pos) * 2 + pos;
-      const float2 w = twiddles[pos * stride];
-      const float2 u = x[i];
-      const float2 v = complex_times(x[i + span], (float2)(w.x, -w.y));
-      x[i] = u + v;
-      x[i + span] = u - v;
-    }
-    barrier(CLK_LOCAL_MEM_FENCE);
-  }
-  __global float* out_a = out + first * n_u;
-  __global float* out_b = out + (first + 1) * n_u;
-  for (uint i = t; i < n_u; i += threads) {
-    out_a[i] = x[i].x;
-    if (pair) out_b[i] = x[i].y;
-  }
-}
 
 #define kParallelSlices 4
 

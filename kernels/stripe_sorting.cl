@@ -9,7 +9,7 @@
 //     columns around c at rank k, mirrored at the ends (d c b a | a b c d | d c b a).
 //   unsort_columns(views, columns, filtered, order, out)
 //     out[order[k][c]][c] = filtered[k][c].
-// Needs nothing else. No -D constants.
+// Needs common.cl (mirrored). No -D constants.
 
 #define kMostWindow 255
 
@@ -48,13 +48,6 @@ __kernel void sort_columns(const uint views, const uint columns, const uint n,
     sorted[k * columns + c] = keys[k];
     order[k * columns + c] = views_of[k];
   }
-}
-
-// Mirrored index in [0, n) of i in [-n, 2n).
-inline int mirrored(int i, const int n) {
-  if (i < 0) i = -i - 1;
-  if (i >= n) i = 2 * n - i - 1;
-  return clamp(i, 0, n - 1);
 }
 
 __kernel void median_across_columns(const uint views, const uint columns, const uint size,

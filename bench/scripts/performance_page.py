@@ -21,7 +21,7 @@ SOURCES = {
     "deeplesion_cpu": "issue29_beta_deeplesion.jsonl",
     "deeplesion_gpu": "issue30_throughput.jsonl",
     "deeplesion_gpu_h100": "issue12_gpu.jsonl",
-    "classical": "issue31_destripe_wavelet.jsonl",
+    "classical": "issue31_destripe_device.jsonl",
     "warm_start": "issue31_warm_start.jsonl",
     "sizes_cpu": "issue29_draws10.jsonl",
     "sizes_gpu": "issue29_sizes_gpu.jsonl",

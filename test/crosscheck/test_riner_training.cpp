@@ -366,7 +366,8 @@ TEST_SUITE("riner_training") {
       CAPTURE(e);
       const double expected = std::clamp(std::exp(-report.removed.data[e]), 0.05f, 20.0f);
       CHECK(alpha.data[e] == doctest::Approx(expected).epsilon(1e-5));
-      CHECK(reference.trained_alpha().data[e] == alpha.data[e]);
+      // The filter runs on each engine's own path (float on the device, double on the CPU).
+      CHECK(reference.trained_alpha().data[e] == doctest::Approx(alpha.data[e]).epsilon(1e-5));
     }
 
     // The field: the destriped scan's FBP after the fit, far from the random start, on both

@@ -3,14 +3,16 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <functional>
 #include <memory>
-#include <Eigen/Dense>
+#include <optional>
 #include <unsupported/Eigen/FFT>
 
 #include "analytic/fbp_setup.hpp"
 #include "cl/device_access.hpp"
-#include "ops/stripe_sorting.hpp"
+#include "destripe/device_destripe.hpp"
 #include "destripe/sinogram_ops.hpp"
+#include "destripe/stripe_rules.hpp"
 #include "destripe/wavelets.hpp"
 #include "riner/error.hpp"
 
@@ -19,6 +21,7 @@ namespace riner {
 namespace {
 
 using stripes::Sinogram;
+using stripes::StripeSettings;
 
 // The literature's Gaussian widths (algotom's): filtering's low-pass along the views, fitting's
 // across columns, the wavelet filter's high-pass along the views.
@@ -33,12 +36,6 @@ double literature_sigma(DestripeMethod method) {
 // The literature's windows (algotom's remove_all_stripe: 21 and 51).
 constexpr std::size_t kSmallWindow = 21;
 constexpr std::size_t kLargeWindow = 51;
-// Algorithm 6's moving mean along the views.
-constexpr std::size_t kFluctuationWindow = 11;
-// More elements than this share of a row found dead or fluctuating is the object's structure,
-// not the detector's (a noiseless sinogram's columns fluctuate with the edges they cross):
-// algorithm 6 then interpolates nothing.
-constexpr double kMostDeadShare = 0.05;
 
 // The literature's window unless one is given, odd and within the detector. Widening them by
 // the widest stripe the column means show was tried: on a sinogram of smooth blobs 20-25
@@ -59,38 +56,30 @@ std::vector<double> column_means(const Sinogram& s, std::size_t from, std::size_
   return mean;
 }
 
-// Each column's mean over the views moved onto the median of its neighbours' means.
-void normalise(Sinogram& s, std::size_t size) {
-  const std::vector<double> mean = column_means(s, 0, s.views);
-  const std::vector<double> target = stripes::median_filter(mean, size);
+void subtract_column_offsets(Sinogram& s, const std::vector<double>& offset) {
   for (std::size_t v = 0; v < s.views; ++v) {
-    for (std::size_t c = 0; c < s.columns; ++c) s.at(v, c) -= mean[c] - target[c];
+    for (std::size_t c = 0; c < s.columns; ++c) s.at(v, c) -= offset[c];
   }
 }
 
+// Each column's mean over the views moved onto the median of its neighbours' means.
+void normalise(Sinogram& s, std::size_t size) {
+  subtract_column_offsets(s, stripes::normalise_offsets(column_means(s, 0, s.views), size));
+}
+
 // Algorithm 3: a stripe is an offset of one column, which sorting turns into an offset of one
-// column of a smooth image; a median across columns removes it there. On the device when one is
-// given and holds a column (the CPU twin below otherwise).
-void sorting(Sinogram& s, std::size_t size, ops::StripeSortingOp* device = nullptr) {
-  if (device != nullptr) {
-    const std::vector<float> in(s.values.begin(), s.values.end());
-    const std::vector<float> out = device->run(in, size);
-    s.values.assign(out.begin(), out.end());
-    return;
-  }
+// column of a smooth image; a median across columns removes it there.
+void sorting(Sinogram& s, std::size_t size) {
   const stripes::SortedColumns sorted = stripes::sort_columns(s);
   s = stripes::unsort_columns(stripes::median_across_columns(sorted.sorted, size), sorted.view);
 }
 
-// The padding a Fourier filter of a line of n values gets (algotom's: a tenth, at most 150),
-// at least 16 so that the wrap-around blend is gentle.
-std::size_t fourier_pad(std::size_t n) { return std::clamp<std::size_t>(n / 10, 16, 150); }
-
 // Each line `stride` apart in `values` of n values multiplied in Fourier space by
 // gain(min(k, n - k)), the distance of bin k from the zero frequency.
-template <typename Gain>
 void filter_lines(std::vector<double>& values, std::size_t first, std::size_t lines,
-                  std::size_t line_step, std::size_t n, std::size_t stride, Gain gain) {
+                  std::size_t line_step, std::size_t n, std::size_t stride,
+                  const std::function<double(double)>& gain) {
+  const std::vector<double> gains = stripes::line_gains(n, gain);
   Eigen::FFT<double> fft;
   std::vector<double> line(n), back;
   std::vector<std::complex<double>> spectrum;
@@ -98,7 +87,7 @@ void filter_lines(std::vector<double>& values, std::size_t first, std::size_t li
     const std::size_t start = first + l * line_step;
     for (std::size_t i = 0; i < n; ++i) line[i] = values[start + i * stride];
     fft.fwd(spectrum, line);
-    for (std::size_t k = 0; k < n; ++k) spectrum[k] *= gain(static_cast<double>(std::min(k, n - k)));
+    for (std::size_t k = 0; k < n; ++k) spectrum[k] *= gains[k];
     fft.inv(back, spectrum);
     for (std::size_t i = 0; i < n; ++i) values[start + i * stride] = back[i];
   }
@@ -106,9 +95,11 @@ void filter_lines(std::vector<double>& values, std::size_t first, std::size_t li
 
 // Algorithm 2: only each column's slow variation along the views (a Gaussian low-pass, the
 // columns mirrored at both ends) goes through the sorting; the fast part is kept as measured.
-void filtering(Sinogram& s, std::size_t size, double sigma, ops::StripeSortingOp* device) {
-  const std::size_t pad = std::min<std::size_t>(150, s.views / 10);
-  const std::size_t n = s.views + 2 * pad;
+void filtering(Sinogram& s, std::size_t size, double sigma) {
+  const std::size_t pad = stripes::filtering_pad(s.views);
+  const stripes::PaddedLine line = stripes::filtering_line(s.views);
+  const std::size_t n = line.length;
+  sigma *= line.bins_scale;
   // Each column mirrored about its first and last views ('reflect' without repeating them).
   Sinogram padded{n, s.columns, std::vector<double>(n * s.columns)};
   for (std::size_t i = 0; i < n; ++i) {
@@ -119,13 +110,13 @@ void filtering(Sinogram& s, std::size_t size, double sigma, ops::StripeSortingOp
     for (std::size_t c = 0; c < s.columns; ++c) padded.at(i, c) = s.at(from, c);
   }
   filter_lines(padded.values, 0, s.columns, 1, n, s.columns,
-               [&](double f) { return std::exp(-0.5 * (f / sigma) * (f / sigma)); });
+               [&](double f) { return stripes::low_pass_gain(f, sigma); });
   Sinogram smooth = s;
   for (std::size_t v = 0; v < s.views; ++v) {
     for (std::size_t c = 0; c < s.columns; ++c) smooth.at(v, c) = padded.at(v + pad, c);
   }
   Sinogram corrected = smooth;
-  sorting(corrected, size, device);
+  sorting(corrected, size);
   for (std::size_t i = 0; i < s.values.size(); ++i) {
     s.values[i] += corrected.values[i] - smooth.values[i];
   }
@@ -137,23 +128,20 @@ void filtering(Sinogram& s, std::size_t size, double sigma, ops::StripeSortingOp
 // sinograms whose stripes are gains; in rho a response is an offset, and a quotient of fits is
 // unstable where the sinogram reads air (about 0), so the difference is subtracted.
 void fitting(Sinogram& s, int order, double sigma) {
+  const std::vector<double> basis = stripes::polynomial_basis(s.views, order);
   const auto views = static_cast<Eigen::Index>(s.views);
-  const int terms = std::clamp(order, 0, static_cast<int>(s.views) - 1) + 1;
-  Eigen::MatrixXd basis(views, terms);
-  for (Eigen::Index v = 0; v < views; ++v) {
-    const double t = 2.0 * static_cast<double>(v) / static_cast<double>(views - 1) - 1.0;
-    for (int j = 0; j < terms; ++j) basis(v, j) = std::pow(t, j);
-  }
-  const Eigen::MatrixXd q =
-      Eigen::HouseholderQR<Eigen::MatrixXd>(basis).householderQ() * Eigen::MatrixXd::Identity(views, terms);
+  const auto terms = static_cast<Eigen::Index>(basis.size() / s.views);
   using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const Eigen::Map<const RowMajor> q(basis.data(), views, terms);
   const Eigen::Map<const RowMajor> data(s.values.data(), views, static_cast<Eigen::Index>(s.columns));
   const RowMajor fitted = q * (q.transpose() * data);
   Sinogram trend{s.views, s.columns, std::vector<double>(fitted.data(), fitted.data() + fitted.size())};
-  const std::size_t columns = s.columns + fourier_pad(s.columns);
+  const stripes::PaddedLine line = stripes::fitting_line(s.columns);
+  const std::size_t columns = line.length;
+  sigma *= line.bins_scale;
   Sinogram smooth = stripes::periodic_extension(trend, s.views, columns);
   filter_lines(smooth.values, 0, s.views, columns, columns, 1,
-               [&](double k) { return std::exp(-0.5 * (k / sigma) * (k / sigma)); });
+               [&](double k) { return stripes::low_pass_gain(k, sigma); });
   smooth = stripes::crop(smooth, s.views, s.columns);
   for (std::size_t i = 0; i < s.values.size(); ++i) s.values[i] -= trend.values[i] - smooth.values[i];
 }
@@ -176,16 +164,17 @@ int wavelet_levels(int wanted, std::size_t views, std::size_t columns) {
 // (continuous when wrapped, periodic_extension) to a multiple of 2^levels on both sides.
 void wavelet_fft(Sinogram& s, int levels, int order, double sigma) {
   const std::vector<double> low_pass = stripes::daubechies_filter(order);
-  const std::size_t block = std::size_t{1} << levels;
-  const auto round_up = [&](std::size_t n) { return (n + fourier_pad(n) + block - 1) / block * block; };
-  const std::size_t views = round_up(s.views), columns = round_up(s.columns);
+  const stripes::PaddedLine along_views = stripes::wavelet_line(s.views, levels);
+  const std::size_t views = along_views.length;
+  const std::size_t columns = stripes::wavelet_line(s.columns, levels).length;
+  sigma *= along_views.bins_scale;  // the band's lines run along the views
   Sinogram padded = stripes::periodic_extension(s, views, columns);
   for (int l = 0; l < levels; ++l) {
     const std::size_t rows_l = views >> l, columns_l = columns >> l;
     stripes::wavelet_level(padded.values, rows_l, columns_l, columns, low_pass);
     const std::size_t band_rows = rows_l / 2;
     filter_lines(padded.values, columns_l / 2, columns_l - columns_l / 2, 1, band_rows, columns,
-                 [&](double k) { return 1.0 - std::exp(-0.5 * (k / sigma) * (k / sigma)); });
+                 [&](double k) { return stripes::high_pass_gain(k, sigma); });
   }
   for (int l = levels - 1; l >= 0; --l) {
     stripes::inverse_wavelet_level(padded.values, views >> l, columns >> l, columns, low_pass);
@@ -197,32 +186,27 @@ void wavelet_fft(Sinogram& s, int levels, int order, double sigma) {
 // columns (the extremes of each column dropped), every column's offset normalised, and the
 // stripes' columns replaced by the smoothed sorted values.
 std::vector<bool> large_stripes(Sinogram& s, std::size_t size, double snr, double drop_ratio) {
-  const std::size_t drop = static_cast<std::size_t>(
-      0.5 * std::clamp(drop_ratio, 0.0, 0.8) * static_cast<double>(s.views));
+  const std::size_t drop = stripes::large_stripe_drop(s.views, drop_ratio);
   const stripes::SortedColumns sorted = stripes::sort_columns(s);
   const Sinogram smooth = stripes::median_across_columns(sorted.sorted, size);
-  const std::vector<double> level = column_means(sorted.sorted, drop, s.views - drop);
-  const std::vector<double> smooth_level = column_means(smooth, drop, s.views - drop);
-  std::vector<double> offset(s.columns);
-  for (std::size_t c = 0; c < s.columns; ++c) offset[c] = level[c] - smooth_level[c];
-  const std::vector<bool> mask = stripes::detect_stripes(offset, snr);
-  for (std::size_t v = 0; v < s.views; ++v) {
-    for (std::size_t c = 0; c < s.columns; ++c) s.at(v, c) -= offset[c];
-  }
-  const stripes::SortedColumns order = stripes::sort_columns(s);
-  const Sinogram corrected = stripes::unsort_columns(smooth, order.view);
+  const stripes::LargeStripes found =
+      stripes::large_stripe_offsets(column_means(sorted.sorted, drop, s.views - drop),
+                                    column_means(smooth, drop, s.views - drop), snr);
+  subtract_column_offsets(s, found.offset);
+  // A column less its offset ranks its views as before: the first sort's order serves.
+  const Sinogram corrected = stripes::unsort_columns(smooth, sorted.view);
   for (std::size_t v = 0; v < s.views; ++v) {
     for (std::size_t c = 0; c < s.columns; ++c) {
-      if (mask[c]) s.at(v, c) = corrected.at(v, c);
+      if (found.mask[c]) s.at(v, c) = corrected.at(v, c);
     }
   }
-  return mask;
+  return found.mask;
 }
 
 // Algorithm 6: an element that does not follow the scan (dead: too little fluctuation along
 // the views; fluctuating: too much) against its neighbours is interpolated from them.
 std::vector<bool> dead_stripes(Sinogram& s, std::size_t size, double snr) {
-  const long half = static_cast<long>(kFluctuationWindow / 2);
+  const long half = static_cast<long>(stripes::kFluctuationWindow / 2);
   std::vector<double> fluctuation(s.columns, 0.0);
   for (std::size_t c = 0; c < s.columns; ++c) {
     for (std::size_t v = 0; v < s.views; ++v) {
@@ -233,20 +217,28 @@ std::vector<bool> dead_stripes(Sinogram& s, std::size_t size, double snr) {
       fluctuation[c] += std::fabs(s.at(v, c) - mean / static_cast<double>(2 * half + 1));
     }
   }
-  const std::vector<double> background = stripes::median_filter(fluctuation, size);
-  std::vector<double> ratio(s.columns, 1.0);
-  for (std::size_t c = 0; c < s.columns; ++c) {
-    if (background[c] > 0.0) ratio[c] = fluctuation[c] / background[c];
-  }
-  std::vector<bool> mask = stripes::detect_stripes(ratio, snr);
-  for (std::size_t c = 0; c < std::min<std::size_t>(2, s.columns); ++c) {
-    mask[c] = false;
-    mask[s.columns - 1 - c] = false;
-  }
-  const auto found = static_cast<double>(std::count(mask.begin(), mask.end(), true));
-  if (found > kMostDeadShare * static_cast<double>(s.columns)) mask.assign(s.columns, false);
-  stripes::interpolate_columns(s, mask);
+  const std::vector<bool> mask = stripes::dead_columns(fluctuation, size, snr);
+  stripes::interpolate_columns(s, stripes::interpolation_plan(mask));
   return mask;
+}
+
+// `method` on one sinogram on the CPU; the masks of dead and large stripes where it finds them.
+void destripe_on_cpu(DestripeMethod method, const StripeSettings& k, Sinogram& s,
+                     std::vector<bool>& dead, std::vector<bool>& large) {
+  switch (method) {
+    case DestripeMethod::kNormalise: normalise(s, k.size); break;
+    case DestripeMethod::kSorting: sorting(s, k.size); break;
+    case DestripeMethod::kFiltering: filtering(s, k.size, k.sigma); break;
+    case DestripeMethod::kFitting: fitting(s, k.fit_order, k.sigma); break;
+    case DestripeMethod::kWavelet: wavelet_fft(s, k.levels, k.wavelet_order, k.sigma); break;
+    case DestripeMethod::kLarge: large = large_stripes(s, k.large_size, k.snr, k.drop_ratio); break;
+    case DestripeMethod::kDead: dead = dead_stripes(s, k.large_size, k.snr); break;
+    case DestripeMethod::kAll:
+      dead = dead_stripes(s, k.large_size, k.snr);
+      large = large_stripes(s, k.large_size, k.snr, k.drop_ratio);
+      sorting(s, k.size);
+      break;
+  }
 }
 
 }  // namespace
@@ -301,31 +293,37 @@ Array destripe(const Array& measurement, const Geometry& g, const DestripeOption
     throw InputError("destripe: the wavelet levels must be 1..10, or 0 for as many as fit (got " +
                      std::to_string(options.levels) + ")");
   }
-  const std::size_t size = window(options.size, kSmallWindow, columns);
-  const std::size_t large_size = window(options.large_size, kLargeWindow, columns);
-  // The device outlives the op that holds its context.
+  StripeSettings settings;
+  settings.size = window(options.size, kSmallWindow, columns);
+  settings.large_size = window(options.large_size, kLargeWindow, columns);
+  settings.snr = options.snr;
+  settings.sigma = options.sigma > 0.0 ? options.sigma : literature_sigma(options.method);
+  settings.fit_order = options.fit_order;
+  settings.levels = options.method == DestripeMethod::kWavelet
+                        ? wavelet_levels(options.levels, views, columns)
+                        : 0;
+  settings.wavelet_order = options.wavelet_order;
+  settings.drop_ratio = options.drop_ratio;
+  // Every per-reading step on the device where it holds a column for the sorting step; the
+  // device outlives the steps that hold its context.
   std::optional<Device> opened;
-  std::unique_ptr<ops::StripeSortingOp> device;
-  const bool sorts = options.method == DestripeMethod::kSorting ||
-                     options.method == DestripeMethod::kFiltering ||
-                     options.method == DestripeMethod::kAll;
-  if (options.engine == Engine::kOpenCL && sorts) {
+  std::unique_ptr<stripes::DeviceDestripe> device;
+  if (options.engine == Engine::kOpenCL) {
     opened = options.device ? *options.device : Device::open();
     cl::Context& context = cl::context_of(*opened);
-    if (ops::StripeSortingOp::supported(context, views, size)) {
-      device = std::make_unique<ops::StripeSortingOp>(context, views, columns);
+    if (stripes::DeviceDestripe::supported(context, views, settings)) {
+      device = std::make_unique<stripes::DeviceDestripe>(context, options.method, settings, views,
+                                                         columns);
     }
   }
   Array out = measurement;
   DestripeReport local;
   local.non_finite_replaced = analytic::repair_non_finite(out, columns);
   local.removed = Array({rows, columns});
-  local.size = size;
-  local.large_size = large_size;
-  local.sigma = options.sigma > 0.0 ? options.sigma : literature_sigma(options.method);
-  local.levels = options.method == DestripeMethod::kWavelet
-                     ? wavelet_levels(options.levels, views, columns)
-                     : 0;
+  local.size = settings.size;
+  local.large_size = settings.large_size;
+  local.sigma = settings.sigma;
+  local.levels = settings.levels;
   for (std::size_t r = 0; r < rows; ++r) {
     Sinogram s{views, columns, std::vector<double>(views * columns)};
     for (std::size_t v = 0; v < views; ++v) {
@@ -333,23 +331,10 @@ Array destripe(const Array& measurement, const Geometry& g, const DestripeOption
     }
     const Sinogram before = s;
     std::vector<bool> dead, large;
-    switch (options.method) {
-      case DestripeMethod::kNormalise: normalise(s, size); break;
-      case DestripeMethod::kSorting: sorting(s, size, device.get()); break;
-      case DestripeMethod::kFiltering: filtering(s, size, local.sigma, device.get()); break;
-      case DestripeMethod::kFitting: fitting(s, options.fit_order, local.sigma); break;
-      case DestripeMethod::kWavelet:
-        wavelet_fft(s, local.levels, options.wavelet_order, local.sigma);
-        break;
-      case DestripeMethod::kLarge:
-        large = large_stripes(s, large_size, options.snr, options.drop_ratio);
-        break;
-      case DestripeMethod::kDead: dead = dead_stripes(s, large_size, options.snr); break;
-      case DestripeMethod::kAll:
-        dead = dead_stripes(s, large_size, options.snr);
-        large = large_stripes(s, large_size, options.snr, options.drop_ratio);
-        sorting(s, size, device.get());
-        break;
+    if (device) {
+      device->run(s, dead, large);
+    } else {
+      destripe_on_cpu(options.method, settings, s, dead, large);
     }
     for (std::size_t c = 0; c < columns; ++c) {
       if (c < dead.size() && dead[c]) local.dead.push_back(r * columns + c);

@@ -112,25 +112,40 @@ std::vector<bool> detect_stripes(const std::vector<double>& values, double snr) 
   return grown;
 }
 
-void interpolate_columns(Sinogram& s, const std::vector<bool>& mask) {
+ColumnInterpolation interpolation_plan(const std::vector<bool>& mask) {
+  const std::size_t columns = mask.size();
+  ColumnInterpolation plan{std::vector<std::size_t>(columns), std::vector<std::size_t>(columns),
+                           std::vector<double>(columns, -1.0)};
   std::vector<std::size_t> kept;
-  for (std::size_t c = 0; c < s.columns; ++c) {
+  for (std::size_t c = 0; c < columns; ++c) {
+    plan.left[c] = plan.right[c] = c;
     if (!mask[c]) kept.push_back(c);
   }
-  if (kept.empty() || kept.size() == s.columns) return;
-  for (std::size_t c = 0; c < s.columns; ++c) {
+  if (kept.empty() || kept.size() == columns) return plan;
+  for (std::size_t c = 0; c < columns; ++c) {
     if (!mask[c]) continue;
     const auto next = std::lower_bound(kept.begin(), kept.end(), c);
+    if (next == kept.begin()) {
+      plan.left[c] = plan.right[c] = *next;
+      plan.weight[c] = 0.0;
+    } else if (next == kept.end()) {
+      plan.left[c] = plan.right[c] = kept.back();
+      plan.weight[c] = 0.0;
+    } else {
+      plan.left[c] = *(next - 1);
+      plan.right[c] = *next;
+      plan.weight[c] = static_cast<double>(c - plan.left[c]) / static_cast<double>(*next - plan.left[c]);
+    }
+  }
+  return plan;
+}
+
+void interpolate_columns(Sinogram& s, const ColumnInterpolation& plan) {
+  for (std::size_t c = 0; c < s.columns; ++c) {
+    const double t = plan.weight[c];
+    if (t < 0.0) continue;
     for (std::size_t v = 0; v < s.views; ++v) {
-      if (next == kept.begin()) {
-        s.at(v, c) = s.at(v, *next);
-      } else if (next == kept.end()) {
-        s.at(v, c) = s.at(v, kept.back());
-      } else {
-        const std::size_t a = *(next - 1), b = *next;
-        const double t = static_cast<double>(c - a) / static_cast<double>(b - a);
-        s.at(v, c) = (1.0 - t) * s.at(v, a) + t * s.at(v, b);
-      }
+      s.at(v, c) = (1.0 - t) * s.at(v, plan.left[c]) + t * s.at(v, plan.right[c]);
     }
   }
 }

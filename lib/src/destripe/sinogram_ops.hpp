@@ -37,8 +37,14 @@ std::vector<double> median_filter(const std::vector<double>& values, std::size_t
 std::vector<bool> detect_stripes(const std::vector<double>& values, double snr);
 
 // Masked columns replaced, view by view, by linear interpolation between the nearest unmasked
-// columns (held constant beyond the last).
-void interpolate_columns(Sinogram& s, const std::vector<bool>& mask);
+// columns (held constant beyond the last): column c becomes (1 - weight) left + weight right;
+// weight < 0 for the columns kept (all of them when none or every one is masked).
+struct ColumnInterpolation {
+  std::vector<std::size_t> left, right;
+  std::vector<double> weight;
+};
+ColumnInterpolation interpolation_plan(const std::vector<bool>& mask);
+void interpolate_columns(Sinogram& s, const ColumnInterpolation& plan);
 
 // `s` in the top-left corner of a views x columns array (each at least s's), the rest filled so
 // that the array is continuous when wrapped around: past the last column a raised-cosine blend

@@ -9,15 +9,6 @@ namespace riner::stripes {
 
 namespace {
 
-// The high-pass filter of an orthogonal pair: g[n] = (-1)^n h[L - 1 - n].
-std::vector<double> high_pass_of(const std::vector<double>& h) {
-  std::vector<double> g(h.size());
-  for (std::size_t n = 0; n < h.size(); ++n) {
-    g[n] = (n % 2 == 0 ? 1.0 : -1.0) * h[h.size() - 1 - n];
-  }
-  return g;
-}
-
 // One periodised analysis step of a line of n (even) values `stride` apart: the n/2
 // approximation coefficients, then the n/2 details, written back over the line.
 void analyse_line(double* line, std::size_t n, std::size_t stride, const std::vector<double>& h,
@@ -51,6 +42,14 @@ void synthesise_line(double* line, std::size_t n, std::size_t stride,
 }
 
 }  // namespace
+
+std::vector<double> wavelet_high_pass(const std::vector<double>& low_pass) {
+  std::vector<double> g(low_pass.size());
+  for (std::size_t n = 0; n < low_pass.size(); ++n) {
+    g[n] = (n % 2 == 0 ? 1.0 : -1.0) * low_pass[low_pass.size() - 1 - n];
+  }
+  return g;
+}
 
 std::vector<double> daubechies_filter(int order) {
   if (order < 1 || order > 12) throw std::invalid_argument("Daubechies order must be 1..12");
@@ -100,7 +99,7 @@ std::vector<double> daubechies_filter(int order) {
 
 void wavelet_level(std::vector<double>& values, std::size_t rows, std::size_t columns,
                    std::size_t stride, const std::vector<double>& low_pass) {
-  const std::vector<double> g = high_pass_of(low_pass);
+  const std::vector<double> g = wavelet_high_pass(low_pass);
   std::vector<double> scratch;
   for (std::size_t r = 0; r < rows; ++r) {
     analyse_line(values.data() + r * stride, columns, 1, low_pass, g, scratch);
@@ -112,7 +111,7 @@ void wavelet_level(std::vector<double>& values, std::size_t rows, std::size_t co
 
 void inverse_wavelet_level(std::vector<double>& values, std::size_t rows, std::size_t columns,
                            std::size_t stride, const std::vector<double>& low_pass) {
-  const std::vector<double> g = high_pass_of(low_pass);
+  const std::vector<double> g = wavelet_high_pass(low_pass);
   std::vector<double> scratch;
   for (std::size_t c = 0; c < columns; ++c) {
     synthesise_line(values.data() + c, rows, stride, low_pass, g, scratch);

@@ -13,6 +13,8 @@ namespace riner::stripes {
 // (db1 is Haar): 2 * order taps, summing to sqrt(2), orthonormal to its shifts by 2. order in
 // [1, 12] (beyond, the factorisation loses digits: db15 is orthonormal to only 1e-8).
 std::vector<double> daubechies_filter(int order);
+// The high-pass filter of the orthogonal pair of `low_pass`: g[n] = (-1)^n h[L - 1 - n].
+std::vector<double> wavelet_high_pass(const std::vector<double>& low_pass);
 
 // One level of the periodised transform of the 2D array `values` [rows][columns] (row-major,
 // `stride` values between rows), in place on its top-left rows x columns block (both even):

@@ -33,7 +33,7 @@ StripeSortingOp::StripeSortingOp(cl::Context& context, std::size_t views, std::s
       views_(static_cast<cl_uint>(views)),
       columns_(static_cast<cl_uint>(columns)),
       padded_(static_cast<cl_uint>(power_of_two_at_least(views))),
-      program_(context.program({"stripe_sorting"})),
+      program_(context.program({"common", "stripe_sorting"})),
       sort_(*program_, "sort_columns"),
       median_(*program_, "median_across_columns"),
       unsort_(*program_, "unsort_columns"),
@@ -49,23 +49,39 @@ StripeSortingOp::StripeSortingOp(cl::Context& context, std::size_t views, std::s
 }
 
 std::vector<float> StripeSortingOp::run(const std::vector<float>& sinogram, std::size_t size) {
-  const std::size_t n = static_cast<std::size_t>(views_) * columns_;
-  if (sinogram.size() != n || size % 2 == 0 || size > kMostWindow) {
-    throw Error("stripe sorting: size mismatch or an even or too wide window");
-  }
+  if (sinogram.size() != in_.size()) throw Error("stripe sorting: size mismatch");
   in_.write(std::span<const float>(sinogram));
-  const std::size_t group = std::min({kSortGroup, static_cast<std::size_t>(padded_) / 2 + 1,
-                                      sort_.max_work_group_size(context_.device())});
-  sort_.set_args(views_, columns_, padded_, in_, sorted_, order_,
-                 cl::LocalMemory{padded_ * sizeof(float)}, cl::LocalMemory{padded_ * sizeof(cl_uint)});
-  context_.launch(sort_, cl::Range(std::size_t{columns_} * group), cl::Range(group));
-  median_.set_args(views_, columns_, static_cast<cl_uint>(size), sorted_, filtered_);
-  context_.launch(median_, n);
-  unsort_.set_args(views_, columns_, filtered_, order_, out_);
-  context_.launch(unsort_, n);
-  std::vector<float> out(n);
+  apply(in_, out_, size);
+  std::vector<float> out(sinogram.size());
   out_.read(std::span<float>(out));
   return out;
+}
+
+void StripeSortingOp::apply(const cl::Buffer<float>& in, cl::Buffer<float>& out, std::size_t size) {
+  sort(in);
+  median(size);
+  unsort(out);
+}
+
+void StripeSortingOp::sort(const cl::Buffer<float>& in) {
+  if (in.size() != sorted_.size()) throw Error("stripe sorting: size mismatch");
+  const std::size_t group = std::min({kSortGroup, static_cast<std::size_t>(padded_) / 2 + 1,
+                                      sort_.max_work_group_size(context_.device())});
+  sort_.set_args(views_, columns_, padded_, in, sorted_, order_,
+                 cl::LocalMemory{padded_ * sizeof(float)}, cl::LocalMemory{padded_ * sizeof(cl_uint)});
+  context_.launch(sort_, cl::Range(std::size_t{columns_} * group), cl::Range(group));
+}
+
+void StripeSortingOp::median(std::size_t size) {
+  if (size % 2 == 0 || size > kMostWindow) throw Error("stripe sorting: an even or too wide window");
+  median_.set_args(views_, columns_, static_cast<cl_uint>(size), sorted_, filtered_);
+  context_.launch(median_, sorted_.size());
+}
+
+void StripeSortingOp::unsort(cl::Buffer<float>& out) {
+  if (out.size() != sorted_.size()) throw Error("stripe sorting: size mismatch");
+  unsort_.set_args(views_, columns_, filtered_, order_, out);
+  context_.launch(unsort_, sorted_.size());
 }
 
 }  // namespace riner::ops

@@ -21,6 +21,17 @@ class StripeSortingOp {
   // The sinogram [views][columns] with every column's sorted readings replaced by their median
   // across `size` neighbouring columns at the same rank.
   std::vector<float> run(const std::vector<float>& sinogram, std::size_t size);
+  // The same on device buffers [views][columns] (in and out may be one buffer).
+  void apply(const cl::Buffer<float>& in, cl::Buffer<float>& out, std::size_t size);
+
+  // The three steps apart, for large-stripe removal: sort() ranks in's columns (sorted(),
+  // and the views they came from); median() fills filtered() from sorted(); unsort() puts
+  // filtered() back in the views of the last sort().
+  void sort(const cl::Buffer<float>& in);
+  void median(std::size_t size);
+  void unsort(cl::Buffer<float>& out);
+  const cl::Buffer<float>& sorted() const { return sorted_; }
+  const cl::Buffer<float>& filtered() const { return filtered_; }
 
  private:
   cl::Context& context_;

@@ -1,0 +1,119 @@
+#include "destripe/stripe_rules.hpp"
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+
+#include "destripe/sinogram_ops.hpp"
+
+namespace riner::stripes {
+
+namespace {
+
+// More elements than this share of a row found dead or fluctuating is the object's structure,
+// not the detector's (a noiseless sinogram's columns fluctuate with the edges they cross):
+// algorithm 6 then interpolates nothing.
+constexpr double kMostDeadShare = 0.05;
+
+}  // namespace
+
+std::size_t fft_friendly(std::size_t n) {
+  for (std::size_t m = std::max<std::size_t>(n, 1);; ++m) {
+    std::size_t rest = m;
+    for (const std::size_t p : {2, 3, 5}) {
+      while (rest % p == 0) rest /= p;
+    }
+    if (rest == 1) return m;
+  }
+}
+
+namespace {
+
+PaddedLine padded_line(std::size_t nominal, std::size_t length) {
+  return {length, static_cast<double>(length) / static_cast<double>(nominal)};
+}
+
+}  // namespace
+
+std::size_t filtering_pad(std::size_t views) { return std::min<std::size_t>(150, views / 10); }
+
+PaddedLine filtering_line(std::size_t views) {
+  const std::size_t nominal = views + 2 * filtering_pad(views);
+  return padded_line(nominal, fft_friendly(nominal));
+}
+
+std::size_t fourier_pad(std::size_t n) { return std::clamp<std::size_t>(n / 10, 16, 150); }
+
+PaddedLine fitting_line(std::size_t columns) {
+  const std::size_t nominal = columns + fourier_pad(columns);
+  return padded_line(nominal, fft_friendly(nominal));
+}
+
+PaddedLine wavelet_line(std::size_t n, int levels) {
+  const std::size_t block = std::size_t{1} << levels;
+  const std::size_t blocks = (n + fourier_pad(n) + block - 1) / block;
+  return padded_line(blocks * block, fft_friendly(blocks) * block);
+}
+
+double low_pass_gain(double k, double sigma) { return std::exp(-0.5 * (k / sigma) * (k / sigma)); }
+
+double high_pass_gain(double k, double sigma) { return 1.0 - low_pass_gain(k, sigma); }
+
+std::vector<double> line_gains(std::size_t n, const std::function<double(double)>& gain) {
+  std::vector<double> out(n);
+  for (std::size_t k = 0; k < n; ++k) out[k] = gain(static_cast<double>(std::min(k, n - k)));
+  return out;
+}
+
+std::vector<double> polynomial_basis(std::size_t views, int order) {
+  const auto n = static_cast<Eigen::Index>(views);
+  const int terms = std::clamp(order, 0, static_cast<int>(views) - 1) + 1;
+  Eigen::MatrixXd powers(n, terms);
+  for (Eigen::Index v = 0; v < n; ++v) {
+    const double t = 2.0 * static_cast<double>(v) / static_cast<double>(n - 1) - 1.0;
+    for (int j = 0; j < terms; ++j) powers(v, j) = std::pow(t, j);
+  }
+  using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const RowMajor q = Eigen::HouseholderQR<Eigen::MatrixXd>(powers).householderQ() *
+                     Eigen::MatrixXd::Identity(n, terms);
+  return {q.data(), q.data() + q.size()};
+}
+
+std::vector<double> normalise_offsets(const std::vector<double>& mean, std::size_t size) {
+  const std::vector<double> target = median_filter(mean, size);
+  std::vector<double> offset(mean.size());
+  for (std::size_t c = 0; c < mean.size(); ++c) offset[c] = mean[c] - target[c];
+  return offset;
+}
+
+LargeStripes large_stripe_offsets(const std::vector<double>& level,
+                                  const std::vector<double>& smooth_level, double snr) {
+  LargeStripes out;
+  out.offset.resize(level.size());
+  for (std::size_t c = 0; c < level.size(); ++c) out.offset[c] = level[c] - smooth_level[c];
+  out.mask = detect_stripes(out.offset, snr);
+  return out;
+}
+
+std::size_t large_stripe_drop(std::size_t views, double drop_ratio) {
+  return static_cast<std::size_t>(0.5 * std::clamp(drop_ratio, 0.0, 0.8) * static_cast<double>(views));
+}
+
+std::vector<bool> dead_columns(const std::vector<double>& fluctuation, std::size_t size, double snr) {
+  const std::size_t columns = fluctuation.size();
+  const std::vector<double> background = median_filter(fluctuation, size);
+  std::vector<double> ratio(columns, 1.0);
+  for (std::size_t c = 0; c < columns; ++c) {
+    if (background[c] > 0.0) ratio[c] = fluctuation[c] / background[c];
+  }
+  std::vector<bool> mask = detect_stripes(ratio, snr);
+  for (std::size_t c = 0; c < std::min<std::size_t>(2, columns); ++c) {
+    mask[c] = false;
+    mask[columns - 1 - c] = false;
+  }
+  const auto found = static_cast<double>(std::count(mask.begin(), mask.end(), true));
+  if (found > kMostDeadShare * static_cast<double>(columns)) mask.assign(columns, false);
+  return mask;
+}
+
+}  // namespace riner::stripes
