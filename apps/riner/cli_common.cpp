@@ -60,4 +60,36 @@ std::vector<std::string> split_commas(const std::string& list) {
   return items;
 }
 
+void print_quality_doubts(Console& console, const QualityReport& q) {
+  char line[200];
+  if (q.centre.sigmas > 1.0) {
+    std::snprintf(line, sizeof(line),
+                  "note: near the rotation axis the image departs from FBP's broad profile by "
+                  "%.1f times FBP's own noise there (a disc or dip rings can hide)",
+                  q.centre.sigmas);
+    console.line(line);
+  }
+  if (q.specks_per_10k > q.fbp_specks_per_10k) {
+    std::snprintf(line, sizeof(line),
+                  "note: %.1f isolated specks per 10^4 pixels against FBP's %.1f", q.specks_per_10k,
+                  q.fbp_specks_per_10k);
+    console.line(line);
+  }
+  if (q.lost.share > kLostObjectShare) {
+    std::snprintf(line, sizeof(line),
+                  "note: %.2f%% of the field (%zu pixels) shows air where FBP clearly sees "
+                  "object: look there before trusting the image",
+                  100.0 * q.lost.share, q.lost.pixels);
+    console.line(line);
+  }
+  if (q.edge_strength < kSoftEdgeRatio * q.fbp_edge_strength) {
+    std::snprintf(line, sizeof(line),
+                  "note: edges at %.0f%% of FBP's strength (99th percentile of the gradient): "
+                  "the image may be blurred",
+                  100.0 * q.edge_strength / q.fbp_edge_strength);
+    console.line(line);
+  }
+}
+
+
 }  // namespace riner::app

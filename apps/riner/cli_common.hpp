@@ -12,6 +12,7 @@
 #include "riner/device.hpp"
 #include "riner/engine.hpp"
 #include "riner/geometry.hpp"
+#include "riner/quality.hpp"
 
 namespace riner::app {
 
@@ -45,5 +46,9 @@ class Console {
 };
 
 nlohmann::json metrics_json(double psnr, double ssim, double mae, double rmse, double data_range);
+
+// Where the quality report (against the FBP of the same scan) has doubts, a console note each:
+// the centre, specks, lost object, soft edges.
+void print_quality_doubts(Console& console, const QualityReport& q);
 
 }  // namespace riner::app

@@ -58,6 +58,8 @@ nlohmann::json volume_ring_summary(const std::optional<VolumeRingCorrection>& ri
           {"note", rings->note}};
 }
 
+}  // namespace
+
 nlohmann::json quality_summary(const QualityCheck& check) {
   const QualityReport& q = check.image;
   nlohmann::json out = {{"fbp_noise_per_mm", q.noise},
@@ -84,8 +86,6 @@ nlohmann::json quality_summary(const QualityCheck& check) {
   }
   return out;
 }
-
-}  // namespace
 
 QualityCheck check_quality(const Reconstructor& r, const ReconstructionResult& result,
                            const std::optional<Device>& device) {

@@ -31,6 +31,8 @@ struct QualityCheck {
 
 QualityCheck check_quality(const Reconstructor& r, const ReconstructionResult& result,
                            const std::optional<Device>& device);
+// summary.json's "quality".
+nlohmann::json quality_summary(const QualityCheck& check);
 
 // Every field of summary.json that the reconstruction itself decides (the caller adds where
 // the outputs went, the flat field and the centre).

@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cli/cli_run.hpp"
+#include "riner/quality.hpp"
 #include "riner/io.hpp"
 #include "support/fixture.hpp"
 
@@ -124,6 +125,11 @@ TEST_SUITE("cli") {
     const auto summary = nlohmann::json::parse(run.out);
     CHECK(summary["method"] == "all");
     CHECK(summary["non_finite_replaced"] == 720);  // the two dead elements' readings, interpolated
+    // The quality report against the scan's own FBP: fewer rings (0.054 -> 0.008), and little
+    // set to air (6 pixels at this seed: under the share the console notes).
+    const auto& quality = summary["quality"];
+    CHECK(quality["ring_index"].get<double>() < quality["fbp_ring_index"].get<double>() / 3.0);
+    CHECK(quality["lost_object"]["share"].get<double>() < riner::kLostObjectShare);
     for (const char* f : {"sino.npy", "geometry.json", "stripes.npy", "response.npy",
                           "image.nii", "image.png", "summary.json"}) {
       CHECK(std::filesystem::exists(std::filesystem::path(out) / f));
