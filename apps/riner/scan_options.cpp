@@ -83,9 +83,9 @@ std::optional<CentreEstimate> check_centre(const LoadedScan& loaded, const Conso
   if (loaded.centre) return std::nullopt;
   const Geometry& g = loaded.scan.geometry;
   if (!centre_search_covers(g)) {
-    console.line("note: the rotation axis lies outside the detector's central half (half "
-                 "acquisition?): the centre finders search there only, so the geometry's offset "
-                 "is not checked");
+    console.line("note: the rotation axis lies outside the detector's central half and the "
+                 "views cover less than a full turn: the centre finders search the central half "
+                 "only, so the geometry's offset is not checked");
     return std::nullopt;
   }
   std::optional<CentreEstimate> e;
@@ -101,7 +101,9 @@ std::optional<CentreEstimate> check_centre(const LoadedScan& loaded, const Conso
                   "note: the scan's own %s the rotation axis at offset %.2f px, the "
                   "geometry at %.2f: a wrong axis doubles edges and leaves arcs (pass "
                   "--offset-px auto, or check the geometry)",
-                  e->method == "conjugate rays" ? "conjugate rays put" : "sinogram puts",
+                  e->method == "conjugate rays"                 ? "conjugate rays put"
+                  : e->method.rfind("view pairs", 0) == 0 ? "view pairs put"
+                                                          : "sinogram puts",
                   e->offset_px,
                   given);
     console.line(line);

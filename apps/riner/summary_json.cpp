@@ -206,6 +206,7 @@ nlohmann::json centre_json(const CentreEstimate& e) {
   return {{"offset_px", e.offset_px},
           {"axis_column", e.axis_column},
           {"method", e.method},
+          {"half_acquisition", e.half_acquisition},
           {"sinogram_offset_px", maybe(e.sinogram_offset_px)},
           {"view_pairs_offset_px", maybe(e.pairs_offset_px)},
           {"spread_px", e.spread_px},

@@ -114,6 +114,40 @@ TEST_SUITE("centre") {
     CHECK(std::fabs(e.offset_px - 3.4) < 0.15);
   }
 
+  TEST_CASE("a half acquisition (a full turn, the axis near one end): found within 0.5 px") {
+    // 60 elements, the axis 12 columns from either end: a view and its opposite share 25
+    // columns; the object reaches past the nearer end.
+    riner::Geometry g = with_angles(riner::test::make_geometry(riner::GeometryType::kParallel2d,
+                                                               120, 60, 1, {61, 67}, 1.0, 1.0,
+                                                               2.0 * M_PI),
+                                    120, 2.0 * M_PI, false);
+    std::mt19937 rng(3);
+    std::normal_distribution<double> noise(0.0, 1.0);
+    for (double offset : {17.5, -16.7}) {
+      CAPTURE(offset);
+      riner::Scan scan = scan_with_offset(g, offset);
+      double top = 0.0;
+      for (float v : scan.measurement.data) top = std::max(top, static_cast<double>(v));
+      for (float& v : scan.measurement.data) v += static_cast<float>(0.005 * top * noise(rng));
+      const riner::CentreEstimate e = riner::estimate_centre(scan);
+      CHECK(e.half_acquisition);
+      CHECK(e.method == "view pairs, half acquisition");
+      CHECK(std::fabs(e.offset_px - offset) < 0.5);
+      CHECK(e.spread_px < 1.0);
+      CHECK(std::isnan(e.sinogram_offset_px));
+    }
+    // The same detector centred: the central answer stands.
+    const riner::CentreEstimate centred = riner::estimate_centre(scan_with_offset(g, 1.3));
+    CHECK_FALSE(centred.half_acquisition);
+    CHECK(centred.method == "sinogram");
+    CHECK(std::fabs(centred.offset_px - 1.3) < 0.1);
+    CHECK(riner::centre_search_covers([&] {
+      riner::Geometry far = g;
+      far.offset_u = 17.5;
+      return far;
+    }()));
+  }
+
   TEST_CASE(
       "neither a half-turn nor a view pair, or a divergent beam: InputError saying what to do") {
     const riner::Geometry short_scan =

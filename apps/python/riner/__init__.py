@@ -157,7 +157,8 @@ def _scan(sino, geometry_spec, flat, dark, center_spec):
 
 def center(sino, geometry, flat=None, dark=None):
     """The centre of rotation a parallel-beam scan's own views point to (mirrored views half
-    a turn apart): a dict with offset_px (riner's), axis_column (tomopy's center), spread_px."""
+    a turn apart): a dict with offset_px (riner's), axis_column (tomopy's center), spread_px,
+    method, and half_acquisition (a full turn whose axis lies near one end of the detector)."""
     sino, geometry_json, _ = _scan(sino, geometry, flat, dark, None)
     return json.loads(_riner.center(sino, geometry_json))
 

@@ -24,7 +24,9 @@ struct CentreEstimate {
   // View pairs half a turn apart that were compared (conjugate rays: the ray pairs).
   std::size_t pairs = 0;
   std::size_t rows = 0;   // detector rows compared (1 in 2D)
-  std::string method;     // "sinogram" or "view pairs": which gave offset_px
+  std::string method;     // "sinogram", "view pairs" or "view pairs, half acquisition"
+  // A full turn whose axis lies beyond the central search, near one end of the detector.
+  bool half_acquisition = false;
   // Each method's own answer (NaN where it has none): the cross-check.
   double sinogram_offset_px = 0.0;
   double pairs_offset_px = 0.0;
@@ -41,11 +43,15 @@ struct CentreEstimate {
 CentreEstimate estimate_centre(const Scan& scan);
 
 // A parallel beam's centre finders search offsets within this share of the detector's width
-// either way of its middle (a half acquisition's axis lies beyond).
+// either way of its middle. Over a full turn the view pairs also search beyond, up to where a
+// view and its opposite share a twentieth of the detector (16 columns at least): a half
+// acquisition's axis, taken where it matches far better than the central best, relative to the
+// spread of the readings compared.
 constexpr double kCentreSearchShare = 0.25;
 
 // Whether estimate_centre searches where the geometry puts the axis: a divergent beam's search
-// follows the geometry's offset, a parallel beam's stays within kCentreSearchShare.
+// follows the geometry's offset, a parallel beam's covers the detector over a full turn and
+// stays within kCentreSearchShare otherwise.
 bool centre_search_covers(const Geometry& g);
 
 }  // namespace riner

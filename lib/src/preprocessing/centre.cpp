@@ -5,6 +5,7 @@
 #include <limits>
 #include <optional>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "preprocessing/centre_conjugate.hpp"
@@ -167,6 +168,73 @@ double best_axis(std::span<const LinePair> lines, std::size_t n_u, double* width
   return best;
 }
 
+// A half acquisition's axis (a full turn, the axis near one end of the detector: the two
+// halves of the turn see the two sides of the object, and a view and its opposite overlap only
+// in the few columns around the axis). The absolute mismatch cannot look there: a few columns
+// of air beside the detector's end match their mirror image as well as the true axis's whole
+// overlap does. Relative to the spread of the readings compared, air matches at about 1 (noise
+// against noise) and the true axis near 0.
+double relative_cost_at(std::span<const LinePair> lines, std::size_t n, double axis) {
+  double d2 = 0.0, count = 0.0, sa = 0.0, saa = 0.0, sb = 0.0, sbb = 0.0;
+  for (const LinePair& p : lines) {
+    for (std::size_t j = 0; j < n; ++j) {
+      const double x = 2.0 * axis - static_cast<double>(j);
+      if (x < 0.0 || x > static_cast<double>(n - 1)) continue;
+      const auto k = static_cast<std::size_t>(x);
+      const double t = x - static_cast<double>(k);
+      const float va = p.first[j], b0 = p.opposite[k], b1 = p.opposite[std::min(k + 1, n - 1)];
+      if (!std::isfinite(va) || !std::isfinite(b0) || !std::isfinite(b1)) continue;
+      const double vb = (1.0 - t) * b0 + t * b1;
+      d2 += (va - vb) * (va - vb);
+      sa += va;
+      saa += static_cast<double>(va) * va;
+      sb += vb;
+      sbb += vb * vb;
+      count += 1.0;
+    }
+  }
+  if (count < 2.0) return std::numeric_limits<double>::infinity();
+  const double spread = saa - sa * sa / count + sbb - sb * sb / count;
+  return spread > 0.0 ? d2 / spread : std::numeric_limits<double>::infinity();
+}
+
+// The columns a view and its opposite must share for an axis near an end to count: a
+// twentieth of the detector, at least 16.
+std::size_t least_overlap(std::size_t n_u) { return std::max<std::size_t>(16, n_u / 20); }
+
+// The best axis beyond the central search (kCentreSearchShare either way of the middle), in
+// the outer parts where the pair still overlaps by least_overlap columns, by the relative
+// mismatch: the axis and its relative cost; nullopt where nothing is searched.
+std::optional<std::pair<double, double>> best_outer_axis(std::span<const LinePair> lines,
+                                                         std::size_t n_u) {
+  const double n = static_cast<double>(n_u);
+  const double centre = 0.5 * (n - 1.0);
+  const double reach = 0.5 * static_cast<double>(least_overlap(n_u) - 1);
+  auto cost = [&](double a) { return relative_cost_at(lines, n_u, a); };
+  double best = 0.0, best_cost = std::numeric_limits<double>::infinity();
+  auto consider = [&](double a) {
+    const double c = cost(a);
+    if (c < best_cost) {
+      best_cost = c;
+      best = a;
+    }
+  };
+  for (double a = reach; a < centre - kCentreSearchShare * n; a += kCoarseStepPx) consider(a);
+  for (double a = n - 1.0 - reach; a > centre + kCentreSearchShare * n; a -= kCoarseStepPx) consider(a);
+  if (!std::isfinite(best_cost)) return std::nullopt;
+  const double coarse = best;
+  for (double a = coarse - kCoarseStepPx; a <= coarse + kCoarseStepPx + 1e-9; a += kFineStepPx) {
+    if (a >= reach && a <= n - 1.0 - reach) consider(a);
+  }
+  return std::pair{best, best_cost};
+}
+
+// An outer axis is taken over the central one only when it matches this much better,
+// relatively: a centred scan's outer overlap is mostly air (relative cost about 1, its true
+// axis a few hundredths); a half acquisition's central search pairs different parts of the
+// object (about 1 or more), its true axis a few hundredths.
+constexpr double kOuterAxisAdvantage = 0.25;
+
 }  // namespace
 
 namespace {
@@ -186,6 +254,13 @@ std::optional<CentreEstimate> from_view_pairs(const Scan& scan) {
   double width = 0.0;
   const std::vector<LinePair> lines = line_pairs(scan, pairs, rows);
   e.axis_column = best_axis(lines, g.n_u, &width);
+  if (covers_full_turn(g)) {
+    const std::optional<std::pair<double, double>> outer = best_outer_axis(lines, g.n_u);
+    if (outer && outer->second < kOuterAxisAdvantage * relative_cost_at(lines, g.n_u, e.axis_column)) {
+      e.axis_column = outer->first;
+      e.half_acquisition = true;
+    }
+  }
   e.offset_px = 0.5 * (static_cast<double>(g.n_u) - 1.0) - e.axis_column;
   if (pairs.size() == 1) {
     e.spread_px = width;
@@ -193,7 +268,9 @@ std::optional<CentreEstimate> from_view_pairs(const Scan& scan) {
     double sum2 = 0.0;
     for (std::size_t p = 0; p < pairs.size(); ++p) {
       const std::span<const LinePair> one(lines.data() + p * rows.size(), rows.size());
-      const double a = best_axis(one, g.n_u);
+      const std::optional<std::pair<double, double>> outer =
+          e.half_acquisition ? best_outer_axis(one, g.n_u) : std::nullopt;
+      const double a = outer ? outer->first : best_axis(one, g.n_u);
       sum2 += (a - e.axis_column) * (a - e.axis_column);
     }
     e.spread_px = std::sqrt(sum2 / static_cast<double>(pairs.size()));
@@ -231,8 +308,8 @@ Scan midplane_fan(const Scan& cone) {
 }  // namespace
 
 bool centre_search_covers(const Geometry& g) {
-  return g.is_divergent() ||
-         std::fabs(g.offset_u) <= kCentreSearchShare * static_cast<double>(g.n_u);
+  if (g.is_divergent() || covers_full_turn(g)) return true;
+  return std::fabs(g.offset_u) <= kCentreSearchShare * static_cast<double>(g.n_u);
 }
 
 CentreEstimate estimate_centre(const Scan& scan) {
@@ -266,9 +343,10 @@ CentreEstimate estimate_centre(const Scan& scan) {
   }
   CentreEstimate e = pairs ? *pairs : CentreEstimate{};
   e.pairs_offset_px = pairs ? pairs->offset_px : kNaN;
-  e.method = "view pairs";
+  e.method = e.half_acquisition ? "view pairs, half acquisition" : "view pairs";
   e.sinogram_offset_px = kNaN;
-  if (sinogram) {
+  // The sinogram's search is the central one: a half acquisition's axis is the pairs'.
+  if (sinogram && !e.half_acquisition) {
     e.method = "sinogram";
     e.axis_column = sinogram->axis_column;
     e.offset_px = 0.5 * (static_cast<double>(g.n_u) - 1.0) - e.axis_column;

@@ -216,8 +216,10 @@ std::string centre_line(const CentreEstimate& e) {
   }
   std::snprintf(line, sizeof(line),
                 "centre of rotation: offset %.2f px (axis at column %.2f), spread %.2f px over "
-                "%zu view pair(s) x %zu row(s)",
-                e.offset_px, e.axis_column, e.spread_px, e.pairs, e.rows);
+                "%zu view pair(s) x %zu row(s)%s",
+                e.offset_px, e.axis_column, e.spread_px, e.pairs, e.rows,
+                e.half_acquisition ? "; a half acquisition: the axis near one end of the detector"
+                                   : "");
   return line;
 }
 
