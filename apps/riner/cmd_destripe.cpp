@@ -117,7 +117,7 @@ int run_destripe(int argc, char** argv, int first) {
   char line[300];
   std::snprintf(line, sizeof(line),
                 "destripe (%s, windows %zu and %zu, sigma %g): %zu dead and %zu large-stripe elements "
-                "found, %zu non-finite readings interpolated, in %.2f s -> %s",
+                "found, %zu non-finite or absurd readings interpolated, in %.2f s -> %s",
                 destripe_method_name(options.method), report.size, report.large_size,
                 report.sigma, report.dead.size(), report.large.size(), report.non_finite_replaced, seconds,
                 out.string().c_str());

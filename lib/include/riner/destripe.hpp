@@ -74,7 +74,8 @@ struct DestripeReport {
   std::size_t large_size = 0;
   double sigma = 0.0;              // fitting, filtering, wavelet: the width used
   int levels = 0;                  // wavelet: the levels used
-  std::size_t non_finite_replaced = 0;  // NaN/inf readings interpolated from their neighbours first
+  // NaN/inf readings, and absurd ones (beyond 1e20), interpolated from their neighbours first.
+  std::size_t non_finite_replaced = 0;
 };
 
 // The destriped measurement, shaped as `measurement` ([views, columns] or [views, rows,

@@ -17,7 +17,7 @@ std::size_t repair_non_finite(Array& measurement, std::size_t n_u) {
     float* p = measurement.ptr() + line * n_u;
     long previous = -1;  // last finite index
     for (std::size_t j = 0; j <= n_u; ++j) {
-      if (j < n_u && !std::isfinite(p[j])) continue;
+      if (j < n_u && !(std::fabs(p[j]) <= kLargestReading)) continue;  // NaN fails it too
       // Fill the gap (previous, j) from its finite ends.
       for (std::size_t k = static_cast<std::size_t>(previous + 1); k < j; ++k) {
         float value = 0.0f;

@@ -1,6 +1,7 @@
 #include "destripe/device_destripe.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "destripe/wavelets.hpp"
 #include "riner/error.hpp"
@@ -104,6 +105,11 @@ void DeviceDestripe::run(Sinogram& s, std::vector<bool>& dead, std::vector<bool>
 
 std::vector<double> DeviceDestripe::read_columns(const cl::Buffer<float>& buffer) {
   const std::vector<float> values = buffer.read();
+  // The decisions sort these: a NaN would break the ordering (repair_non_finite's bound on the
+  // readings keeps the sums finite).
+  for (std::size_t c = 0; c < columns_; ++c) {
+    if (!std::isfinite(values[c])) throw Error("device destripe: a column's summary is not finite");
+  }
   return {values.begin(), values.begin() + static_cast<long>(columns_)};
 }
 
