@@ -101,7 +101,7 @@ std::optional<CentreEstimate> check_centre(const LoadedScan& loaded, const Conso
                   "note: the scan's own %s the rotation axis at offset %.2f px, the "
                   "geometry at %.2f: a wrong axis doubles edges and leaves arcs (pass "
                   "--offset-px auto, or check the geometry)",
-                  e->method == "conjugate rays"                 ? "conjugate rays put"
+                  e->method.rfind("conjugate rays", 0) == 0 ? "conjugate rays put"
                   : e->method.rfind("view pairs", 0) == 0 ? "view pairs put"
                                                           : "sinogram puts",
                   e->offset_px,

@@ -183,6 +183,23 @@ TEST_SUITE("centre") {
     CHECK(std::fabs(riner::estimate_centre(scan_with_offset(closed, 1.6)).offset_px - 1.6) < 0.15);
   }
 
+  TEST_CASE("a fan beam's half acquisition: the axis near one end from conjugate rays") {
+    // 64 elements, the axis 12 from either end; only the rays around it have conjugates on
+    // the detector.
+    const riner::Geometry g =
+        riner::test::make_geometry(riner::GeometryType::kFan2d, 180, 64, 1, {64, 64}, 1.5, 1.0);
+    for (const double offset : {19.5, -18.3}) {
+      CAPTURE(offset);
+      const riner::CentreEstimate e = riner::estimate_centre(scan_with_offset(g, offset));
+      CHECK(e.half_acquisition);
+      CHECK(e.method == "conjugate rays, half acquisition");
+      CHECK(std::fabs(e.offset_px - offset) < 0.5);
+    }
+    const riner::CentreEstimate centred = riner::estimate_centre(scan_with_offset(g, 2.2));
+    CHECK_FALSE(centred.half_acquisition);
+    CHECK(std::fabs(centred.offset_px - 2.2) < 0.15);
+  }
+
   TEST_CASE("a cone beam over a full turn: the offset from the fan through the source's plane") {
     const riner::Geometry cone = with_angles(riner::test::small_cone3d(), 120, 2.0 * M_PI, false);
     for (const double offset : {2.2, -3.4}) {

@@ -38,8 +38,9 @@ struct CentreEstimate {
 // views). Non-finite readings are left out (pairs) or interpolated along the row (sinogram).
 // InputError for a divergent beam or a scan where neither works.
 // Fan beam (2D) over a full turn: from conjugate rays (method "conjugate rays",
-// preprocessing/centre_conjugate.hpp), within 32 px of the geometry's offset; a cone beam
-// likewise from the fan of its rays through the source's plane.
+// preprocessing/centre_conjugate.hpp), within 32 px of the geometry's offset, or a half
+// acquisition's beyond the detector's central half ("conjugate rays, half acquisition"); a cone
+// beam likewise from the fan of its rays through the source's plane.
 CentreEstimate estimate_centre(const Scan& scan);
 
 // A parallel beam's centre finders search offsets within this share of the detector's width

@@ -328,7 +328,8 @@ CentreEstimate estimate_centre(const Scan& scan) {
     e.axis_column = 0.5 * (static_cast<double>(g.n_u) - 1.0) - e.offset_px;
     e.rows = 1;
     e.pairs = axis->rays;
-    e.method = "conjugate rays";
+    e.half_acquisition = axis->half_acquisition;
+    e.method = axis->half_acquisition ? "conjugate rays, half acquisition" : "conjugate rays";
     e.sinogram_offset_px = kNaN;
     e.pairs_offset_px = kNaN;
     return e;

@@ -3,8 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
+#include <utility>
 #include <vector>
 
+#include "riner/centre.hpp"
 #include "riner/rays.hpp"
 
 namespace riner::preprocessing {
@@ -68,6 +71,9 @@ std::optional<Turn> full_turn(const Geometry& g) {
 struct Cost {
   double mean = std::numeric_limits<double>::infinity();
   std::size_t rays = 0;
+  // The mismatch over the spread of the readings compared (both sides about their means): about
+  // 1 where noise meets noise (air), near 0 at the scan's offset where the pairs hold object.
+  double relative = std::numeric_limits<double>::infinity();
 };
 
 Cost conjugate_cost(const Scan& scan, const Turn& turn, double offset_px, RaySample sample) {
@@ -76,7 +82,7 @@ Cost conjugate_cost(const Scan& scan, const Turn& turn, double offset_px, RaySam
   const std::size_t n_u = g.n_u;
   const std::size_t view_step = std::max<std::size_t>(1, turn.views / sample.views);
   const std::size_t element_step = std::max<std::size_t>(1, n_u / sample.elements);
-  double sum = 0.0;
+  double sum = 0.0, s_here = 0.0, ss_here = 0.0, s_there = 0.0, ss_there = 0.0;
   std::size_t rays = 0;
   for (std::size_t v = 0; v < turn.views; v += view_step) {
     for (std::size_t e = 0; e < n_u; e += element_step) {
@@ -102,11 +108,49 @@ Cost conjugate_cost(const Scan& scan, const Turn& turn, double offset_px, RaySam
       const double there = (1.0 - w) * a + w * b;
       if (!std::isfinite(there)) continue;
       sum += (here - there) * (here - there);
+      s_here += here;
+      ss_here += here * here;
+      s_there += there;
+      ss_there += there * there;
       ++rays;
     }
   }
-  return {rays ? sum / static_cast<double>(rays) : std::numeric_limits<double>::infinity(), rays};
+  Cost cost;
+  cost.rays = rays;
+  if (rays == 0) return cost;
+  const auto n = static_cast<double>(rays);
+  cost.mean = sum / n;
+  const double spread = ss_here - s_here * s_here / n + ss_there - s_there * s_there / n;
+  if (spread > 0.0 && rays >= 2) cost.relative = sum / spread;
+  return cost;
 }
+
+// The offsets a half acquisition's axis can have: beyond the detector's central half
+// (kCentreSearchShare either way), up to where a ray's conjugate still lands on the detector
+// for a twentieth of its elements (16 at least) around the axis. Every 2 px on a sixth of the
+// rays by the relative cost (4 px missed a 64-element detector's axis); the best and that
+// cost.
+std::optional<std::pair<double, double>> outer_offset(const Scan& scan, const Turn& turn) {
+  const Geometry& g = scan.geometry;
+  const double n = static_cast<double>(g.n_u);
+  const double reach = 0.5 * std::max(16.0, n / 20.0);
+  const double inner = kCentreSearchShare * n, outer = 0.5 * (n - 1.0) - reach;
+  constexpr double kCoarseStep = 2.0;
+  std::optional<std::pair<double, double>> best;
+  for (double magnitude = inner; magnitude <= outer; magnitude += kCoarseStep) {
+    for (const double offset : {magnitude, -magnitude}) {
+      const Cost cost = conjugate_cost(scan, turn, offset, kCoarse);
+      if (std::isfinite(cost.relative) && (!best || cost.relative < best->second)) {
+        best = std::pair{offset, cost.relative};
+      }
+    }
+  }
+  return best;
+}
+
+// An outer offset is taken over the search around the geometry's only where it matches this
+// much better, relatively (as the view pairs of a parallel beam: riner/centre.hpp).
+constexpr double kOuterAdvantage = 0.25;
 
 }  // namespace
 
@@ -139,6 +183,21 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, double search_px) 
       coarse_best = coarse_at[k];
     }
   }
+  // A half acquisition's axis beyond the detector's central half: where its conjugates meet
+  // far better than at the best offset around the geometry's, relatively, the fine search
+  // goes there, and every offset around it counts (its few pairs are all the scan has).
+  bool half_acquisition = false;
+  if (std::fabs(g.offset_u) < kCentreSearchShare * static_cast<double>(g.n_u)) {
+    const std::optional<std::pair<double, double>> far = outer_offset(scan, *turn);
+    const double central = std::isfinite(coarse_least)
+                               ? conjugate_cost(scan, *turn, coarse_best, kCoarse).relative
+                               : std::numeric_limits<double>::infinity();
+    if (far && far->second < kOuterAdvantage * central) {
+      coarse_best = far->first;
+      coarse_least = far->second;
+      half_acquisition = true;
+    }
+  }
   if (!std::isfinite(coarse_least)) return std::nullopt;
   std::vector<double> offsets, costs;
   std::vector<Cost> fine;
@@ -149,7 +208,11 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, double search_px) 
     most_fine = std::max(most_fine, fine.back().rays);
   }
   for (const Cost& c : fine) {
-    costs.push_back(enough(c, most_fine) ? c.mean : std::numeric_limits<double>::infinity());
+    if (half_acquisition) {
+      costs.push_back(c.relative);
+    } else {
+      costs.push_back(enough(c, most_fine) ? c.mean : std::numeric_limits<double>::infinity());
+    }
   }
   const auto best =
       static_cast<std::size_t>(std::min_element(costs.begin(), costs.end()) - costs.begin());
@@ -157,6 +220,7 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, double search_px) 
   ConjugateAxis out;
   out.offset_px = offsets[best];
   out.rays = fine[best].rays;
+  out.half_acquisition = half_acquisition;
   if (best > 0 && best + 1 < costs.size()) {
     const double c0 = costs[best - 1], c1 = costs[best], c2 = costs[best + 1];
     const double curvature = c0 - 2.0 * c1 + c2;

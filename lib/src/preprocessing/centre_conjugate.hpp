@@ -19,11 +19,15 @@ namespace riner::preprocessing {
 struct ConjugateAxis {
   double offset_px = 0.0;  // the detector offset (geometry's u) that puts the axis there
   std::size_t rays = 0;    // ray pairs compared at the best offset of the half-pixel grid
+  bool half_acquisition = false;  // found beyond the detector's central half
 };
 
-// Fan beam (2D). Searches the geometry's offset +- search_px. nullopt when the views do not
-// cover a full turn less two steps, evenly spaced (within 10% of the step), or the detector is
-// under 8 elements.
+// Fan beam (2D). Searches the geometry's offset +- search_px; where the geometry puts the axis
+// in the detector's central half, also the offsets beyond it (a half acquisition: the axis near
+// one end, only the rays around it have conjugates on the detector), by the mismatch relative
+// to the spread of the readings compared, taken where that is under a quarter of the best
+// around the geometry's offset. nullopt when the views do not cover a full turn less two steps,
+// evenly spaced (within 10% of the step), or the detector is under 8 elements.
 std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, double search_px = 32.0);
 
 }  // namespace riner::preprocessing

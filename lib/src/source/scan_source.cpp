@@ -207,11 +207,13 @@ std::string centre_line(const CentreEstimate& e) {
     }
     return out;
   }
-  if (e.method == "conjugate rays") {
+  if (e.method.rfind("conjugate rays", 0) == 0) {
     std::snprintf(line, sizeof(line),
                   "centre of rotation: offset %.2f px (axis at column %.2f) from %zu conjugate "
-                  "ray pairs of the full turn",
-                  e.offset_px, e.axis_column, e.pairs);
+                  "ray pairs of the full turn%s",
+                  e.offset_px, e.axis_column, e.pairs,
+                  e.half_acquisition ? "; a half acquisition: the axis near one end of the detector"
+                                     : "");
     return line;
   }
   std::snprintf(line, sizeof(line),
