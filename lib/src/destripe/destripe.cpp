@@ -311,7 +311,7 @@ Array destripe(const Array& measurement, const Geometry& g, const DestripeOption
   if (options.engine == Engine::kOpenCL) {
     opened = options.device ? *options.device : Device::open();
     cl::Context& context = cl::context_of(*opened);
-    if (stripes::DeviceDestripe::supported(context, views, settings)) {
+    if (stripes::DeviceDestripe::supported(context, options.method, views, settings)) {
       device = std::make_unique<stripes::DeviceDestripe>(context, options.method, settings, views,
                                                          columns);
     }

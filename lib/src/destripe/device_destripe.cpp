@@ -19,10 +19,10 @@ std::vector<float> to_float(const std::vector<double>& v) { return {v.begin(), v
 
 }  // namespace
 
-bool DeviceDestripe::supported(const cl::Context& context, std::size_t views,
-                               const StripeSettings& settings) {
-  return ops::StripeSortingOp::supported(context, views, settings.size) &&
-         ops::StripeSortingOp::supported(context, views, settings.large_size);
+bool DeviceDestripe::supported(const cl::Context& context, DestripeMethod method,
+                               std::size_t views, const StripeSettings& settings) {
+  return !sorts(method) || (ops::StripeSortingOp::supported(context, views, settings.size) &&
+                            ops::StripeSortingOp::supported(context, views, settings.large_size));
 }
 
 DeviceDestripe::DeviceDestripe(cl::Context& context, DestripeMethod method,

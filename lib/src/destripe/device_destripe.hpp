@@ -20,9 +20,10 @@ namespace riner::stripes {
 
 class DeviceDestripe {
  public:
-  // Whether the device holds a column of `views` readings in local memory for the sorting
-  // step, at the settings' windows.
-  static bool supported(const cl::Context& context, std::size_t views, const StripeSettings& settings);
+  // Whether the device can run `method`: for the methods that sort, whether it holds a column
+  // of `views` readings in local memory, at the settings' windows.
+  static bool supported(const cl::Context& context, DestripeMethod method, std::size_t views,
+                        const StripeSettings& settings);
 
   // Buffers and filters for sinograms of views x columns.
   DeviceDestripe(cl::Context& context, DestripeMethod method, const StripeSettings& settings,
