@@ -106,14 +106,14 @@ int run_simulate(int argc, char** argv, int first) {
               "tube-wall (a tube whose wall is centred on the axis: object rings), or an "
               "image/volume file on the grid",
               "shepp-logan")
-      .option("geometry", "PRESET|FILE",
-              "fan2d-paper, cone3d-paper, parallel3d, or a geometry JSON", "fan2d-paper")
-      .option("out", "DIR", "output folder (created if missing)")
-      .option("seed", "N", "random seed (responses and noise)", "0")
       .option("phantom-spacing-mm", "Z,Y,X|file",
               "resample the image onto the geometry's grid from this voxel size (mm per axis, "
               "array order; 'file': the file's own); default: the image is on the grid",
               "")
+      .option("geometry", "PRESET|FILE",
+              "fan2d-paper, cone3d-paper, parallel3d, or a geometry JSON", "fan2d-paper")
+      .option("out", "DIR", "output folder (created if missing)")
+      .option("seed", "N", "random seed (responses and noise)", "0")
       .option("mu-unit", "mm|cm", "unit of the image's values (DeepLesion: cm)", "mm")
       .option("mu-scale", "MU", "Shepp-Logan: 1/mm per head unit (brain = 0.2 units)", "0.1")
       .option("photons", "I0", "incident photons per ray; 0 disables noise", "1e7")
