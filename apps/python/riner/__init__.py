@@ -172,17 +172,20 @@ def fbp(sino, geometry, flat=None, dark=None, center=None, filter="ram-lak", dev
 
 
 def destripe(sino, geometry, flat=None, dark=None, center=None, method="all", size=0,
-             large_size=0, snr=3.0, sigma=0.0, fit_order=2, levels=0, wavelet=9):
+             large_size=0, snr=3.0, sigma=0.0, fit_order=2, levels=0, wavelet=9, device=None,
+             engine="opencl"):
     """Classical stripe removal on the sinogram, as `riner destripe`: method "normalise",
     "sorting", "filtering", "fitting", "wavelet" (Münch et al.'s wavelet-Fourier filter),
     "large", "dead" or "all" (Vo et al.'s combination); size and large_size 0 for the
     literature's 21 and 51, sigma 0 for the method's own width, levels 0 for as many as fit
     (up to 4), wavelet the Daubechies order. Returns a dict: sino (the destriped measurement),
     stripes (each element's mean removed, rho; exp(-stripes) reads as alpha), dead_elements,
-    large_stripe_elements, size, large_size, sigma, wavelet_levels, non_finite_replaced."""
+    large_stripe_elements, size, large_size, sigma, wavelet_levels, non_finite_replaced.
+    engine "opencl" runs every step as a kernel on device (None: the first GPU, else the first
+    device), "reference" on the CPU twins."""
     sino, geometry_json, _ = _scan(sino, geometry, flat, dark, center)
     return _riner.destripe(sino, geometry_json, method, size, large_size, snr, sigma,
-                           fit_order, levels, wavelet)
+                           fit_order, levels, wavelet, engine, _device(device))
 
 
 def simulate(image=None, geometry="fan2d-paper", seed=0, photons=1e7, nonideal_fraction=0.75,

@@ -45,9 +45,11 @@ py::array fbp_of(const py::handle& measurement, const std::string& geometry_json
 // Classical stripe removal (riner/destripe.hpp): the destriped measurement and a report.
 py::dict destripe_of(const py::handle& measurement, const std::string& geometry_json,
                      const std::string& method, std::size_t size, std::size_t large_size,
-                     double snr, double sigma, int fit_order, int levels, int wavelet_order) {
+                     double snr, double sigma, int fit_order, int levels, int wavelet_order,
+                     const std::string& engine, const std::string& device) {
   const Scan scan = scan_from(measurement, geometry_json);
   DestripeOptions options;
+  options.engine = parse_engine(engine);
   options.method = parse_destripe_method(method);
   options.size = size;
   options.large_size = large_size;
@@ -60,6 +62,7 @@ py::dict destripe_of(const py::handle& measurement, const std::string& geometry_
   Array out;
   {
     py::gil_scoped_release release;
+    options.device = device_for(options.engine, device);
     out = destripe(scan.measurement, scan.geometry, options, &report);
   }
   py::dict result;
