@@ -92,4 +92,27 @@ void print_quality_doubts(Console& console, const QualityReport& q) {
 }
 
 
+namespace {
+
+// The share of a detector's elements found as large stripes beyond which the console doubts it.
+constexpr double kLargeStripeShareNoted = 0.1;
+
+}  // namespace
+
+void note_large_stripes(Console& console, const DestripeReport& report) {
+  const std::size_t elements = report.removed.size();
+  if (static_cast<double>(report.large.size()) <= kLargeStripeShareNoted * static_cast<double>(elements)) {
+    return;
+  }
+  char line[400];
+  std::snprintf(line, sizeof(line),
+                "note: %zu of %zu elements (%.0f%%) were found as large stripes, more than a "
+                "detector has: the object's structure read as stripes, replaced by smoothed "
+                "values; check the image (riner destripe --reconstruct reports lost object), or "
+                "use the method sorting, filtering or normalise",
+                report.large.size(), elements,
+                100.0 * static_cast<double>(report.large.size()) / static_cast<double>(elements));
+  console.line(line);
+}
+
 }  // namespace riner::app

@@ -9,6 +9,7 @@
 
 #include "cli_args.hpp"
 #include "riner/array.hpp"
+#include "riner/destripe.hpp"
 #include "riner/device.hpp"
 #include "riner/engine.hpp"
 #include "riner/geometry.hpp"
@@ -50,5 +51,10 @@ nlohmann::json metrics_json(double psnr, double ssim, double mae, double rmse, d
 // Where the quality report (against the FBP of the same scan) has doubts, a console note each:
 // the centre, specks, lost object, soft edges.
 void print_quality_doubts(Console& console, const QualityReport& q);
+
+// A note when classical stripe removal found over a tenth of the detector as large stripes: Vo's
+// detection reading the object's structure (neutron360: 149 of 503 elements, 785 pixels of
+// object set to air; docs/guide/destripe.md), with what to try instead.
+void note_large_stripes(Console& console, const DestripeReport& report);
 
 }  // namespace riner::app

@@ -15,13 +15,6 @@ namespace riner::app {
 
 namespace {
 
-// The share of a detector's elements found as large stripes beyond which the console doubts it.
-constexpr double kLargeStripeShareNoted = 0.1;
-
-}  // namespace
-
-namespace {
-
 std::size_t window_option(const Args& args, const char* name) {
   if (args.get(name).empty()) return 0;
   const long n = args.integer(name);
@@ -129,20 +122,7 @@ int run_destripe(int argc, char** argv, int first) {
                 report.sigma, report.dead.size(), report.large.size(), report.non_finite_replaced, seconds,
                 out.string().c_str());
   console.line(line);
-  // Vo's large-stripe detection reads a dense object's edges as stripes: on neutron360 it flags
-  // 148 of 503 elements and replacing them sets 785 pixels of object to air
-  // (docs/guide/destripe.md); no detector has stripes over a tenth of its elements.
-  const std::size_t elements = report.removed.size();
-  if (static_cast<double>(report.large.size()) > kLargeStripeShareNoted * static_cast<double>(elements)) {
-    std::snprintf(line, sizeof(line),
-                  "note: %zu of %zu elements (%.0f%%) were found as large stripes, more than a "
-                  "detector has: the object's structure read as stripes, replaced by smoothed "
-                  "values; check the image (--reconstruct reports lost object), or use --method "
-                  "sorting, filtering or normalise",
-                  report.large.size(), elements,
-                  100.0 * static_cast<double>(report.large.size()) / static_cast<double>(elements));
-    console.line(line);
-  }
+  note_large_stripes(console, report);
   nlohmann::json summary = {{"out", out.string()},
                             {"method", destripe_method_name(options.method)},
                             {"size", report.size},

@@ -185,6 +185,7 @@ int run_fbp(int argc, char** argv, int first) {
     console.line("destripe (" + std::string(destripe_method_name(stripes->method)) + "): " +
                  std::to_string(destripe_report.dead.size()) + " dead and " +
                  std::to_string(destripe_report.large.size()) + " large-stripe elements found");
+    note_large_stripes(console, destripe_report);
   }
   FbpReport report;
   const auto start = std::chrono::steady_clock::now();
