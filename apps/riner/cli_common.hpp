@@ -52,9 +52,9 @@ nlohmann::json metrics_json(double psnr, double ssim, double mae, double rmse, d
 // the centre, specks, lost object, soft edges.
 void print_quality_doubts(Console& console, const QualityReport& q);
 
-// A note when classical stripe removal found over a tenth of the detector as large stripes: Vo's
-// detection reading the object's structure (neutron360: 149 of 503 elements, 785 pixels of
-// object set to air; docs/guide/destripe.md), with what to try instead.
+// A note when classical stripe removal found over a tenth of the detector as large stripes: the
+// detection reading the object's structure (Vo's rule alone on neutron360: 149 of 503 elements,
+// 785 pixels of object set to air; docs/guide/destripe.md), with what to try instead.
 void note_large_stripes(Console& console, const DestripeReport& report);
 
 }  // namespace riner::app

@@ -29,7 +29,8 @@ enum class DestripeMethod {
   kFiltering,  // Vo's algorithm 2: the columns' low-pass part along the views by sorting
   kFitting,    // Vo's algorithm 1: a polynomial along the views per column, smoothed across
   kWavelet,    // Münch's wavelet-Fourier filter: the stripes' wavelet band high-passed along views
-  kLarge,      // Vo's algorithm 5: large stripes found (algorithm 4) and normalised
+  kLarge,      // Vo's algorithm 5: large stripes found (algorithm 4, and whole columns only)
+               // and normalised
   kDead,       // Vo's algorithm 6: dead and fluctuating elements found and interpolated
   kAll,        // dead, then large, then sorting: Vo's remove_all_stripe ("Super")
 };

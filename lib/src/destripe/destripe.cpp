@@ -189,9 +189,17 @@ std::vector<bool> large_stripes(Sinogram& s, std::size_t size, double snr, doubl
   const std::size_t drop = stripes::large_stripe_drop(s.views, drop_ratio);
   const stripes::SortedColumns sorted = stripes::sort_columns(s);
   const Sinogram smooth = stripes::median_across_columns(sorted.sorted, size);
+  std::vector<std::vector<double>> quarters;
+  for (int q = 0; q < 4; ++q) {
+    const auto [first, last] = stripes::rank_quarter(s.views, drop, q);
+    const std::vector<double> a = column_means(sorted.sorted, first, last);
+    const std::vector<double> b = column_means(smooth, first, last);
+    quarters.emplace_back(a.size());
+    for (std::size_t c = 0; c < a.size(); ++c) quarters.back()[c] = a[c] - b[c];
+  }
   const stripes::LargeStripes found =
       stripes::large_stripe_offsets(column_means(sorted.sorted, drop, s.views - drop),
-                                    column_means(smooth, drop, s.views - drop), snr);
+                                    column_means(smooth, drop, s.views - drop), snr, quarters);
   subtract_column_offsets(s, found.offset);
   // A column less its offset ranks its views as before: the first sort's order serves.
   const Sinogram corrected = stripes::unsort_columns(smooth, sorted.view);

@@ -170,8 +170,17 @@ std::vector<bool> DeviceDestripe::large_stripes() {
   sorting_->median(settings_.large_size);
   steps_.column_means(views_, columns_, drop, views_ - drop, sorting_->sorted(), column_a_);
   steps_.column_means(views_, columns_, drop, views_ - drop, sorting_->filtered(), column_b_);
-  const LargeStripes found =
-      large_stripe_offsets(read_columns(column_a_), read_columns(column_b_), settings_.snr);
+  const std::vector<double> level = read_columns(column_a_), smooth_level = read_columns(column_b_);
+  std::vector<std::vector<double>> quarters;
+  for (int q = 0; q < 4; ++q) {
+    const auto [first, last] = rank_quarter(views_, drop, q);
+    steps_.column_means(views_, columns_, first, last, sorting_->sorted(), column_a_);
+    steps_.column_means(views_, columns_, first, last, sorting_->filtered(), column_b_);
+    const std::vector<double> a = read_columns(column_a_), b = read_columns(column_b_);
+    quarters.emplace_back(a.size());
+    for (std::size_t c = 0; c < a.size(); ++c) quarters.back()[c] = a[c] - b[c];
+  }
+  const LargeStripes found = large_stripe_offsets(level, smooth_level, settings_.snr, quarters);
   write_columns(column_a_, found.offset);
   steps_.subtract_column_offsets(columns_, column_a_, values_);
   if (std::find(found.mask.begin(), found.mask.end(), true) == found.mask.end()) return found.mask;

@@ -73,7 +73,8 @@ Sinogram median_across_columns(const Sinogram& s, std::size_t size) {
   return out;
 }
 
-std::vector<bool> detect_stripes(const std::vector<double>& values, double snr) {
+std::vector<bool> detect_stripes(const std::vector<double>& values, double snr,
+                                 const std::vector<bool>* allowed) {
   const std::size_t n = values.size();
   std::vector<bool> mask(n, false);
   if (n < 8) return mask;
@@ -102,6 +103,9 @@ std::vector<bool> detect_stripes(const std::vector<double>& values, double snr) 
   if (std::fabs(intercept - sorted.front()) / noise >= snr) {
     const double lower = intercept - 0.5 * snr * noise;
     for (std::size_t i = 0; i < n; ++i) mask[i] = mask[i] || values[i] <= lower;
+  }
+  if (allowed != nullptr) {
+    for (std::size_t i = 0; i < n; ++i) mask[i] = mask[i] && (*allowed)[i];
   }
   std::vector<bool> grown = mask;
   for (std::size_t i = 0; i < n; ++i) {

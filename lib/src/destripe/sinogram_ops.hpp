@@ -34,7 +34,9 @@ std::vector<double> median_filter(const std::vector<double>& values, std::size_t
 
 // Vo's algorithm 4: the elements of `values` (about 1 or 0 where there is no stripe) that stand
 // out of the noise of their sorted profile by `snr`, then grown by one on each side.
-std::vector<bool> detect_stripes(const std::vector<double>& values, double snr);
+// Where `allowed` is given, only its elements may stand out (before the growth).
+std::vector<bool> detect_stripes(const std::vector<double>& values, double snr,
+                                 const std::vector<bool>* allowed = nullptr);
 
 // Masked columns replaced, view by view, by linear interpolation between the nearest unmasked
 // columns (held constant beyond the last): column c becomes (1 - weight) left + weight right;

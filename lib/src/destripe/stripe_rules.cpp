@@ -87,12 +87,25 @@ std::vector<double> normalise_offsets(const std::vector<double>& mean, std::size
 }
 
 LargeStripes large_stripe_offsets(const std::vector<double>& level,
-                                  const std::vector<double>& smooth_level, double snr) {
+                                  const std::vector<double>& smooth_level, double snr,
+                                  const std::vector<std::vector<double>>& quarters) {
   LargeStripes out;
   out.offset.resize(level.size());
-  for (std::size_t c = 0; c < level.size(); ++c) out.offset[c] = level[c] - smooth_level[c];
-  out.mask = detect_stripes(out.offset, snr);
+  std::vector<bool> whole_column(level.size(), true);
+  for (std::size_t c = 0; c < level.size(); ++c) {
+    out.offset[c] = level[c] - smooth_level[c];
+    for (const std::vector<double>& q : quarters) {
+      whole_column[c] = whole_column[c] && q[c] * out.offset[c] >= 0.5 * out.offset[c] * out.offset[c];
+    }
+  }
+  out.mask = detect_stripes(out.offset, snr, &whole_column);
   return out;
+}
+
+std::pair<std::size_t, std::size_t> rank_quarter(std::size_t views, std::size_t drop, int q) {
+  const std::size_t ranks = views - 2 * drop;
+  return {drop + ranks * static_cast<std::size_t>(q) / 4,
+          drop + ranks * static_cast<std::size_t>(q + 1) / 4};
 }
 
 std::size_t large_stripe_drop(std::size_t views, double drop_ratio) {

@@ -6,6 +6,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <utility>
 #include <vector>
 
 namespace riner::stripes {
@@ -68,8 +69,16 @@ struct LargeStripes {
   std::vector<double> offset;
   std::vector<bool> mask;
 };
+// `quarters`: each quarter of the trimmed ranks' level minus smoothed level, per column (four
+// vectors). A detector's stripe shifts a column's whole sorted profile, so every quarter carries
+// its offset; an object's edge shifts some ranks only (a dense rod's top quarter, its air
+// none), and such a column is no stripe: only columns whose every quarter carries at least
+// half the offset, with its sign, may stand out.
 LargeStripes large_stripe_offsets(const std::vector<double>& level,
-                                  const std::vector<double>& smooth_level, double snr);
+                                  const std::vector<double>& smooth_level, double snr,
+                                  const std::vector<std::vector<double>>& quarters);
+// The ranks [first, last) of quarter q (0..3) of the trimmed ranks [drop, views - drop).
+std::pair<std::size_t, std::size_t> rank_quarter(std::size_t views, std::size_t drop, int q);
 // The share of each sorted column's extremes large-stripe removal leaves out, as views per end.
 std::size_t large_stripe_drop(std::size_t views, double drop_ratio);
 
