@@ -10,6 +10,9 @@
 #include <random>
 #include <string>
 
+#include "cl/buffer.hpp"
+#include "cl/device_access.hpp"
+#include "ops/line_filter.hpp"
 #include "riner/destripe.hpp"
 #include "support/fixture.hpp"
 #include "support/geometries.hpp"
@@ -125,6 +128,57 @@ TEST_SUITE("destripe_device") {
     (void)riner::destripe(sinogram(120, 90, false, 5), g, options, &report);
     CHECK(std::find(report.dead.begin(), report.dead.end(), std::size_t{23}) != report.dead.end());
     CHECK(std::find(report.large.begin(), report.large.end(), std::size_t{11}) != report.large.end());
+  }
+
+  TEST_CASE("the line filter on strided lines (columns of a block), by FFT and directly") {
+    // A GPU with little local memory takes the direct path for long lines (many views): both
+    // paths on the layouts the stripe filters use, against the circular convolution in double.
+    riner::cl::Context& ctx = riner::cl::context_of(riner::test::device());
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> value(-1.0f, 2.0f);
+    const std::size_t rows = 37, width = 23;  // the array; lines are a block's columns
+    std::vector<float> in(rows * width);
+    for (float& v : in) v = value(rng);
+    struct Layout {
+      std::size_t n, lines, first, line_step, stride;
+    };
+    for (const Layout l : {Layout{37, 23, 0, 1, 23}, Layout{16, 9, 5 * 23 + 3, 1, 23},
+                           Layout{23, 37, 0, 23, 1}, Layout{10, 4, 2 * 23 + 11, 23, 1}}) {
+      CAPTURE(l.n);
+      CAPTURE(l.first);
+      CAPTURE(l.stride);
+      std::vector<double> gain(l.n);
+      for (std::size_t k = 0; k < l.n; ++k) {
+        const double f = static_cast<double>(std::min(k, l.n - k));
+        gain[k] = 1.0 - std::exp(-0.5 * f * f / 4.0);
+      }
+      const std::vector<double> taps = riner::ops::circular_filter_taps(gain);
+      // The circular convolution out[i] = sum_j in[j] h[(i - j) mod n], h = taps[d + n - 1].
+      std::vector<float> expected = in;
+      for (std::size_t line = 0; line < l.lines; ++line) {
+        const std::size_t start = l.first + line * l.line_step;
+        for (std::size_t i = 0; i < l.n; ++i) {
+          double sum = 0.0;
+          for (std::size_t j = 0; j < l.n; ++j) {
+            sum += taps[i - j + l.n - 1] * in[start + j * l.stride];
+          }
+          expected[start + i * l.stride] = static_cast<float>(sum);
+        }
+      }
+      riner::ops::LineFilterOp op(ctx, l.n, taps);
+      CHECK(op.by_fft());  // PoCL's local memory holds these lines
+      for (int pass = 0; pass < 2; ++pass) {
+        CAPTURE(pass);
+        if (pass == 1) op.use_direct();
+        const riner::cl::Buffer<float> d_in(ctx, std::span<const float>(in));
+        riner::cl::Buffer<float> d_out(ctx, std::span<const float>(in));  // outside the lines: kept
+        op.run(d_in, d_out, riner::ops::LineLayout{l.lines, l.first, l.line_step, l.stride});
+        const std::vector<float> out = d_out.read();
+        float worst = 0.0f;
+        for (std::size_t i = 0; i < out.size(); ++i) worst = std::max(worst, std::fabs(out[i] - expected[i]));
+        CHECK(worst < 2e-5f);
+      }
+    }
   }
 
   TEST_CASE("every method on a tiny sinogram (the oclgrind tier)") {
