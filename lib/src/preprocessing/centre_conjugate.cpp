@@ -22,6 +22,8 @@ struct RaySample {
 };
 constexpr RaySample kFine{};
 constexpr RaySample kCoarse{60, 256};
+// The half-acquisition search beyond the detector's central half: a wide range, fewer rays.
+constexpr RaySample kOuter{30, 128};
 
 // The reading at fractional element u of a view, linear between elements; NaN off the detector
 // or next to a non-finite reading.
@@ -127,8 +129,8 @@ Cost conjugate_cost(const Scan& scan, const Turn& turn, double offset_px, RaySam
 
 // The offsets a half acquisition's axis can have: beyond the detector's central half
 // (kCentreSearchShare either way), up to where a ray's conjugate still lands on the detector
-// for a twentieth of its elements (16 at least) around the axis. Every 2 px on a sixth of the
-// rays by the relative cost (4 px missed a 64-element detector's axis); the best and that
+// for a twentieth of its elements (16 at least) around the axis. Every 2 px on 30 views by 128
+// elements by the relative cost (4 px missed a 64-element detector's axis); the best and that
 // cost.
 std::optional<std::pair<double, double>> outer_offset(const Scan& scan, const Turn& turn) {
   const Geometry& g = scan.geometry;
@@ -139,7 +141,7 @@ std::optional<std::pair<double, double>> outer_offset(const Scan& scan, const Tu
   std::optional<std::pair<double, double>> best;
   for (double magnitude = inner; magnitude <= outer; magnitude += kCoarseStep) {
     for (const double offset : {magnitude, -magnitude}) {
-      const Cost cost = conjugate_cost(scan, turn, offset, kCoarse);
+      const Cost cost = conjugate_cost(scan, turn, offset, kOuter);
       if (std::isfinite(cost.relative) && (!best || cost.relative < best->second)) {
         best = std::pair{offset, cost.relative};
       }
@@ -190,7 +192,7 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, double search_px) 
   if (std::fabs(g.offset_u) < kCentreSearchShare * static_cast<double>(g.n_u)) {
     const std::optional<std::pair<double, double>> far = outer_offset(scan, *turn);
     const double central = std::isfinite(coarse_least)
-                               ? conjugate_cost(scan, *turn, coarse_best, kCoarse).relative
+                               ? conjugate_cost(scan, *turn, coarse_best, kOuter).relative
                                : std::numeric_limits<double>::infinity();
     if (far && far->second < kOuterAdvantage * central) {
       coarse_best = far->first;
