@@ -1,5 +1,7 @@
 #include "scenes.hpp"
 
+#include <algorithm>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -78,10 +80,11 @@ RinerConfig config_from(const Options& o) {
   return config;
 }
 
-nlohmann::json detector_accuracy(const Array& alpha, const Array& beta, const SimulatedScan& sim) {
+nlohmann::json detector_accuracy(const Array& alpha, const Array& beta, const SimulatedScan& sim,
+                                 const std::vector<std::size_t>& reported_dead) {
   const Geometry& g = sim.scan.geometry;
   double alpha_error = 0.0;
-  int live = 0, live_off = 0, dead_crossing = 0, dead_flagged = 0;
+  int live = 0, live_off = 0, dead_crossing = 0, dead_flagged = 0, dead_flagged_by_beta = 0;
   nlohmann::json dead = nlohmann::json::array();
   for (std::size_t e = 0; e < alpha.size(); ++e) {
     if (sim.alpha.data[e] > 0.0f) {
@@ -93,10 +96,13 @@ nlohmann::json detector_accuracy(const Array& alpha, const Array& beta, const Si
     double clean_mean = 0.0;
     for (std::size_t v = 0; v < g.n_views(); ++v) clean_mean += sim.clean(v, e);
     clean_mean /= static_cast<double>(g.n_views());
-    const bool flagged = beta.data[e] < 0.5f;
+    const bool by_beta = beta.data[e] < 0.5f;
+    const bool flagged =
+        by_beta || std::find(reported_dead.begin(), reported_dead.end(), e) != reported_dead.end();
     if (clean_mean >= 0.1) {
       ++dead_crossing;
       dead_flagged += flagged;
+      dead_flagged_by_beta += by_beta;
     }
     dead.push_back(
         {{"element", e}, {"beta", beta.data[e]}, {"flagged", flagged}, {"clean_mean", clean_mean}});
@@ -104,6 +110,7 @@ nlohmann::json detector_accuracy(const Array& alpha, const Array& beta, const Si
   return {{"alpha_mae_live", live > 0 ? alpha_error / live : 0.0},
           {"dead_crossing", dead_crossing},
           {"dead_flagged", dead_flagged},
+          {"dead_flagged_by_beta", dead_flagged_by_beta},
           {"live_switched_off", live_off},
           {"dead", dead}};
 }

@@ -30,8 +30,12 @@ RingScene paper_scene(const Options& o, int index, const Projector& projector);
 RinerConfig config_from(const Options& o);
 
 // How well alpha and beta match the truth: mean |alpha err| over live elements, dead elements
-// flagged (beta < 0.5) among those whose rays cross the object (clean column mean >= 0.1,
-// elsewhere flagging is moot), live elements switched off, and each dead element's details.
-nlohmann::json detector_accuracy(const Array& alpha, const Array& beta, const SimulatedScan& sim);
+// flagged among those whose rays cross the object (clean column mean >= 0.1, elsewhere flagging
+// is moot), live elements switched off, and each dead element's details. Flagged: beta < 0.5,
+// or in `reported_dead` (Reconstructor::dead_elements(): also the elements whose readings are
+// invalid, which a volume's few rays per pixel leave at beta 0.8-1; "dead_flagged_by_beta"
+// counts beta alone).
+nlohmann::json detector_accuracy(const Array& alpha, const Array& beta, const SimulatedScan& sim,
+                                 const std::vector<std::size_t>& reported_dead = {});
 
 }  // namespace riner::bench

@@ -84,7 +84,7 @@ std::vector<Result> riner_deeplesion(const Options& o) {
       riner::write_png(png_dir + "/deeplesion_slice" + std::to_string(slice) + ".png", panel,
                        riner::Window{0.0f, 0.035f});
     }
-    nlohmann::json fields = riner::bench::detector_accuracy(result.alpha, r.beta(), scene.sim);
+    nlohmann::json fields = riner::bench::detector_accuracy(result.alpha, r.beta(), scene.sim, r.dead_elements());
     fields.update({{"scene", scene.name},
                    {"slice", slice},
                    {"psnr", m.psnr},
