@@ -4,8 +4,10 @@
 // against the ground truth and the seconds of each filter.
 //
 //   riner_bench --case=destripe [--first=0] [--last=9] [--wavelet=9] [--levels=0]
-//               [--json=FILE]
-// (--wavelet and --levels: the wavelet method's Daubechies order and levels.)
+//               [--window=21] [--large_window=51] [--json=FILE]
+// (--wavelet and --levels: the wavelet method's Daubechies order and levels; --window and
+// --large_window: the median windows, 0 for the literature's 21 and 51; --size is the
+// harness's own.)
 //
 // And on a real scan, where there is no ground truth: each method's FBP against the scan's own
 // FBP through the quality report (ring index, specks, edge strength, lost object), with a PNG
@@ -43,6 +45,8 @@ riner::DestripeOptions method_options(const Options& o, riner::DestripeMethod me
   options.method = method;
   options.wavelet_order = o.get_int("wavelet", options.wavelet_order);
   options.levels = o.get_int("levels", options.levels);
+  options.size = static_cast<std::size_t>(o.get_int("window", 0));
+  options.large_size = static_cast<std::size_t>(o.get_int("large_window", 0));
   options.device = device;
   return options;
 }
