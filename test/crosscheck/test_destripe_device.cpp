@@ -14,6 +14,7 @@
 #include "cl/device_access.hpp"
 #include "ops/line_filter.hpp"
 #include "riner/destripe.hpp"
+#include "support/compare.hpp"
 #include "support/fixture.hpp"
 #include "support/geometries.hpp"
 
@@ -45,22 +46,6 @@ riner::Array sinogram(std::size_t views, std::size_t columns, bool ties, std::ui
   return a;
 }
 
-struct Difference {
-  std::size_t differ = 0;
-  float worst = 0.0f;
-};
-
-Difference compare(const riner::Array& a, const riner::Array& b) {
-  REQUIRE(a.data.size() == b.data.size());
-  Difference d;
-  for (std::size_t i = 0; i < a.data.size(); ++i) {
-    const float e = std::fabs(a.data[i] - b.data[i]);
-    d.differ += e > 0.0f;
-    d.worst = std::max(d.worst, e);
-  }
-  return d;
-}
-
 void check_method(riner::DestripeMethod method, std::size_t views, std::size_t columns,
                   std::size_t size, bool ties) {
   const std::string name = riner::destripe_method_name(method);
@@ -89,18 +74,20 @@ void check_method(riner::DestripeMethod method, std::size_t views, std::size_t c
   options.engine = riner::Engine::kOpenCL;
   options.device = riner::test::device();
   const riner::Array on_device = riner::destripe(in, g, options, &device);
-  const Difference d = compare(on_device, reference);
+  REQUIRE(on_device.data.size() == reference.data.size());
+  const riner::test::ErrorStats d = riner::test::compare(on_device.data, reference.data);
+  CHECK(d.non_finite == 0);
   CHECK(device.dead == cpu.dead);
   CHECK(device.large == cpu.large);
   if (method == riner::DestripeMethod::kSorting) {
-    CHECK(d.differ == 0);  // the same readings picked and put back in the same views
+    CHECK(d.max_abs == 0.0);  // the same readings picked and put back in the same views
   } else {
     // float on the device, double on the CPU, on readings of about 1: a few float epsilons
     // through each sum, FFT or wavelet level.
-    CHECK(d.worst < 2e-5f);
+    CHECK(d.max_abs < 2e-5);
   }
-  const Difference removed = compare(device.removed, cpu.removed);
-  CHECK(removed.worst < 2e-5f);
+  REQUIRE(device.removed.data.size() == cpu.removed.data.size());
+  CHECK(riner::test::compare(device.removed.data, cpu.removed.data).max_abs < 2e-5);
 }
 
 }  // namespace
@@ -173,10 +160,9 @@ TEST_SUITE("destripe_device") {
         const riner::cl::Buffer<float> d_in(ctx, std::span<const float>(in));
         riner::cl::Buffer<float> d_out(ctx, std::span<const float>(in));  // outside the lines: kept
         op.run(d_in, d_out, riner::ops::LineLayout{l.lines, l.first, l.line_step, l.stride});
-        const std::vector<float> out = d_out.read();
-        float worst = 0.0f;
-        for (std::size_t i = 0; i < out.size(); ++i) worst = std::max(worst, std::fabs(out[i] - expected[i]));
-        CHECK(worst < 2e-5f);
+        const riner::test::ErrorStats stats = riner::test::compare(d_out.read(), expected);
+        CHECK(stats.non_finite == 0);
+        CHECK(stats.max_abs < 2e-5);
       }
     }
   }

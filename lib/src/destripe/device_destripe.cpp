@@ -36,7 +36,6 @@ DeviceDestripe::DeviceDestripe(cl::Context& context, DestripeMethod method,
       steps_(context),
       values_(context, views * columns),
       work_(context, views * columns),
-      work2_(context, views * columns),
       column_a_(context, columns),
       column_b_(context, columns) {
   if (sorts(method)) sorting_ = std::make_unique<ops::StripeSortingOp>(context, views, columns);
@@ -47,6 +46,7 @@ DeviceDestripe::DeviceDestripe(cl::Context& context, DestripeMethod method,
     const std::size_t n = wide_views_;
     padded_ = cl::Buffer<float>(context, n * columns);
     padded2_ = cl::Buffer<float>(context, n * columns);
+    work2_ = cl::Buffer<float>(context, views * columns);
     const double sigma = settings.sigma * line.bins_scale;
     filter_ = std::make_unique<ops::LineFilterOp>(
         context, n, ops::circular_filter_taps(line_gains(n, [&](double k) { return low_pass_gain(k, sigma); })));

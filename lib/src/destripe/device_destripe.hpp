@@ -48,10 +48,11 @@ class DeviceDestripe {
   std::size_t views_, columns_;
   ops::StripeStepsOp steps_;
   std::unique_ptr<ops::StripeSortingOp> sorting_;
-  cl::Buffer<float> values_, work_, work2_, column_a_, column_b_;
-  // filtering: the padded columns and their low-pass; fitting: the basis, its coefficients,
-  // and the trend's extension and its low-pass; wavelet: the padded array and its scratch.
-  cl::Buffer<float> padded_, padded2_, basis_, coefficients_, low_pass_, high_pass_;
+  cl::Buffer<float> values_, work_, column_a_, column_b_;
+  // filtering: the padded columns and their low-pass, and the sorted smooth part (work2_);
+  // fitting: the basis, its coefficients, and the trend's extension and its low-pass; wavelet:
+  // the padded array and its scratch.
+  cl::Buffer<float> work2_, padded_, padded2_, basis_, coefficients_, low_pass_, high_pass_;
   std::size_t pad_ = 0, terms_ = 0, wide_views_ = 0, wide_columns_ = 0;
   std::unique_ptr<ops::LineFilterOp> filter_;
   std::vector<std::unique_ptr<ops::LineFilterOp>> band_filters_;  // wavelet: one per level

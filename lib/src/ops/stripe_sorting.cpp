@@ -37,24 +37,13 @@ StripeSortingOp::StripeSortingOp(cl::Context& context, std::size_t views, std::s
       sort_(*program_, "sort_columns"),
       median_(*program_, "median_across_columns"),
       unsort_(*program_, "unsort_columns"),
-      in_(context, views * columns),
       sorted_(context, views * columns),
       filtered_(context, views * columns),
-      out_(context, views * columns),
       order_(context, views * columns) {
   if (!supported(context, views, 1)) {
     throw Error("stripe sorting: a column of " + std::to_string(views) +
                 " views does not fit the device's local memory");
   }
-}
-
-std::vector<float> StripeSortingOp::run(const std::vector<float>& sinogram, std::size_t size) {
-  if (sinogram.size() != in_.size()) throw Error("stripe sorting: size mismatch");
-  in_.write(std::span<const float>(sinogram));
-  apply(in_, out_, size);
-  std::vector<float> out(sinogram.size());
-  out_.read(std::span<float>(out));
-  return out;
 }
 
 void StripeSortingOp::apply(const cl::Buffer<float>& in, cl::Buffer<float>& out, std::size_t size) {

@@ -3,7 +3,6 @@
 #pragma once
 
 #include <memory>
-#include <vector>
 
 #include "cl/buffer.hpp"
 #include "cl/context.hpp"
@@ -18,10 +17,8 @@ class StripeSortingOp {
   StripeSortingOp(cl::Context& context, std::size_t views, std::size_t columns);
   static bool supported(const cl::Context& context, std::size_t views, std::size_t size);
 
-  // The sinogram [views][columns] with every column's sorted readings replaced by their median
-  // across `size` neighbouring columns at the same rank.
-  std::vector<float> run(const std::vector<float>& sinogram, std::size_t size);
-  // The same on device buffers [views][columns] (in and out may be one buffer).
+  // out [views][columns]: in with every column's sorted readings replaced by their median
+  // across `size` neighbouring columns at the same rank (in and out may be one buffer).
   void apply(const cl::Buffer<float>& in, cl::Buffer<float>& out, std::size_t size);
 
   // The three steps apart, for large-stripe removal: sort() ranks in's columns (sorted(),
@@ -38,7 +35,7 @@ class StripeSortingOp {
   cl_uint views_, columns_, padded_;
   std::shared_ptr<const cl::Program> program_;
   cl::Kernel sort_, median_, unsort_;
-  cl::Buffer<float> in_, sorted_, filtered_, out_;
+  cl::Buffer<float> sorted_, filtered_;
   cl::Buffer<cl_uint> order_;
 };
 

@@ -10,6 +10,7 @@
 
 #include "preprocessing/centre_conjugate.hpp"
 #include "preprocessing/centre_sinogram.hpp"
+#include "preprocessing/mismatch_sums.hpp"
 #include "riner/error.hpp"
 #include "riner/rays.hpp"
 
@@ -106,11 +107,10 @@ std::vector<LinePair> line_pairs(const Scan& s, const std::vector<ViewPair>& pai
   return out;
 }
 
-// Mean squared difference between line a and line b mirrored about column `axis`
-// (a[j] against b[2 axis - j], linearly interpolated), over the columns both see; the
-// sums accumulate into sum and count.
-void mirror_mismatch(const float* a, const float* b, std::size_t n, double axis, double& sum,
-                     double& count) {
+// Every column j where line a and line b mirrored about column `axis` both see: visit(a[j],
+// b[2 axis - j] linearly interpolated), finite readings only.
+template <typename Visit>
+void for_each_mirrored(const float* a, const float* b, std::size_t n, double axis, Visit visit) {
   for (std::size_t j = 0; j < n; ++j) {
     const double x = 2.0 * axis - static_cast<double>(j);
     if (x < 0.0 || x > static_cast<double>(n - 1)) continue;
@@ -120,17 +120,24 @@ void mirror_mismatch(const float* a, const float* b, std::size_t n, double axis,
     const float b0 = b[k];
     const float b1 = b[std::min(k + 1, n - 1)];
     if (!std::isfinite(va) || !std::isfinite(b0) || !std::isfinite(b1)) continue;
-    const double d = va - ((1.0 - t) * b0 + t * b1);
-    sum += d * d;
-    count += 1.0;
+    visit(va, (1.0 - t) * b0 + t * b1);
   }
 }
 
-// The cost of a candidate axis over the given line pairs.
+// The mismatch sums of a candidate axis over the given line pairs.
+preprocessing::MismatchSums mismatch_at(std::span<const LinePair> lines, std::size_t n,
+                                        double axis) {
+  preprocessing::MismatchSums sums;
+  for (const LinePair& p : lines) {
+    for_each_mirrored(p.first, p.opposite.data(), n, axis,
+                      [&](double a, double b) { sums.add(a, b); });
+  }
+  return sums;
+}
+
+// The cost of a candidate axis: the mean squared difference of the mirrored pairs.
 double cost_at(std::span<const LinePair> lines, std::size_t n, double axis) {
-  double sum = 0.0, count = 0.0;
-  for (const LinePair& p : lines) mirror_mismatch(p.first, p.opposite.data(), n, axis, sum, count);
-  return count > 0.0 ? sum / count : std::numeric_limits<double>::infinity();
+  return mismatch_at(lines, n, axis).mean();
 }
 
 // The best axis: a coarse scan over the central half of the detector (the pair must overlap
@@ -175,27 +182,7 @@ double best_axis(std::span<const LinePair> lines, std::size_t n_u, double* width
 // overlap does. Relative to the spread of the readings compared, air matches at about 1 (noise
 // against noise) and the true axis near 0.
 double relative_cost_at(std::span<const LinePair> lines, std::size_t n, double axis) {
-  double d2 = 0.0, count = 0.0, sa = 0.0, saa = 0.0, sb = 0.0, sbb = 0.0;
-  for (const LinePair& p : lines) {
-    for (std::size_t j = 0; j < n; ++j) {
-      const double x = 2.0 * axis - static_cast<double>(j);
-      if (x < 0.0 || x > static_cast<double>(n - 1)) continue;
-      const auto k = static_cast<std::size_t>(x);
-      const double t = x - static_cast<double>(k);
-      const float va = p.first[j], b0 = p.opposite[k], b1 = p.opposite[std::min(k + 1, n - 1)];
-      if (!std::isfinite(va) || !std::isfinite(b0) || !std::isfinite(b1)) continue;
-      const double vb = (1.0 - t) * b0 + t * b1;
-      d2 += (va - vb) * (va - vb);
-      sa += va;
-      saa += static_cast<double>(va) * va;
-      sb += vb;
-      sbb += vb * vb;
-      count += 1.0;
-    }
-  }
-  if (count < 2.0) return std::numeric_limits<double>::infinity();
-  const double spread = saa - sa * sa / count + sbb - sb * sb / count;
-  return spread > 0.0 ? d2 / spread : std::numeric_limits<double>::infinity();
+  return mismatch_at(lines, n, axis).relative();
 }
 
 // The columns a view and its opposite must share for an axis near an end to count: a

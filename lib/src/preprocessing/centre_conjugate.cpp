@@ -1,4 +1,5 @@
 #include "preprocessing/centre_conjugate.hpp"
+#include "preprocessing/mismatch_sums.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -73,9 +74,7 @@ std::optional<Turn> full_turn(const Geometry& g) {
 struct Cost {
   double mean = std::numeric_limits<double>::infinity();
   std::size_t rays = 0;
-  // The mismatch over the spread of the readings compared (both sides about their means): about
-  // 1 where noise meets noise (air), near 0 at the scan's offset where the pairs hold object.
-  double relative = std::numeric_limits<double>::infinity();
+  double relative = std::numeric_limits<double>::infinity();  // MismatchSums::relative
 };
 
 Cost conjugate_cost(const Scan& scan, const Turn& turn, double offset_px, RaySample sample) {
@@ -84,8 +83,7 @@ Cost conjugate_cost(const Scan& scan, const Turn& turn, double offset_px, RaySam
   const std::size_t n_u = g.n_u;
   const std::size_t view_step = std::max<std::size_t>(1, turn.views / sample.views);
   const std::size_t element_step = std::max<std::size_t>(1, n_u / sample.elements);
-  double sum = 0.0, s_here = 0.0, ss_here = 0.0, s_there = 0.0, ss_there = 0.0;
-  std::size_t rays = 0;
+  MismatchSums sums;
   for (std::size_t v = 0; v < turn.views; v += view_step) {
     for (std::size_t e = 0; e < n_u; e += element_step) {
       const double here = scan.measurement.data[v * n_u + e];
@@ -109,22 +107,10 @@ Cost conjugate_cost(const Scan& scan, const Turn& turn, double offset_px, RaySam
       const double b = reading_at(scan.measurement, v1, project_to_detector(g, v1, nearest).u, n_u);
       const double there = (1.0 - w) * a + w * b;
       if (!std::isfinite(there)) continue;
-      sum += (here - there) * (here - there);
-      s_here += here;
-      ss_here += here * here;
-      s_there += there;
-      ss_there += there * there;
-      ++rays;
+      sums.add(here, there);
     }
   }
-  Cost cost;
-  cost.rays = rays;
-  if (rays == 0) return cost;
-  const auto n = static_cast<double>(rays);
-  cost.mean = sum / n;
-  const double spread = ss_here - s_here * s_here / n + ss_there - s_there * s_there / n;
-  if (spread > 0.0 && rays >= 2) cost.relative = sum / spread;
-  return cost;
+  return {sums.mean(), sums.pairs, sums.relative()};
 }
 
 // The offsets a half acquisition's axis can have: beyond the detector's central half
