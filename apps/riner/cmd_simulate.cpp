@@ -82,6 +82,11 @@ RingModel model_from(const Args& args) {
   m.dead_elements = static_cast<std::size_t>(dead);
   m.dead_rows = static_cast<std::size_t>(rows);
   m.dead_columns = static_cast<std::size_t>(columns);
+  const long partial = args.integer("partial");
+  const long partial_dead = args.integer("partial-dead");
+  if (partial < 0 || partial_dead < 0) throw UsageError("partial counts must be >= 0");
+  m.partial_elements = static_cast<std::size_t>(partial);
+  m.partial_dead_elements = static_cast<std::size_t>(partial_dead);
   const std::string pattern = args.get("response-pattern");
   if (pattern == "rows-x-columns") {
     m.pattern = ResponsePattern::kRowsTimesColumns;
@@ -127,6 +132,11 @@ int run_simulate(int argc, char** argv, int first) {
       .option("dead", "N", "dead elements (alpha = 0)", "2")
       .option("dead-rows", "N", "3D: whole dead detector rows", "0")
       .option("dead-columns", "N", "3D: whole dead detector columns", "0")
+      .option("partial", "N",
+              "2D: elements whose response changes part-way (partial rings; alpha.npy is then "
+              "per view)",
+              "0")
+      .option("partial-dead", "N", "2D: elements that die part-way", "0")
       .option("supersample", "S", "built-in phantoms' raster: S^d points averaged per voxel", "4")
       .option("projector", "NAME", "exact (analytic, built-in phantoms only) or joseph", "exact");
   add_engine_flags(args);
@@ -179,10 +189,8 @@ int run_simulate(int argc, char** argv, int first) {
   write_png(out / "ground_truth.png", sim.ground_truth);
   write_png(out / "sino.png", sim.scan.measurement);
 
-  std::vector<std::size_t> dead;
-  for (std::size_t e = 0; e < sim.alpha.size(); ++e) {
-    if (sim.alpha.data[e] == 0.0f) dead.push_back(e);
-  }
+  const std::size_t elements = g.n_u * (g.is_3d() ? g.n_v : 1);
+  const std::vector<std::size_t> dead = dead_in_every_view(sim.alpha, elements);
   nlohmann::json summary = {{"phantom", args.get("phantom")},
                             {"geometry", geometry_type_name(g.type)},
                             {"measurement_shape", sim.scan.measurement.shape},
@@ -193,6 +201,8 @@ int run_simulate(int argc, char** argv, int first) {
                             {"alpha_range", {model.alpha_min, model.alpha_max}},
                             {"response_pattern", args.get("response-pattern")},
                             {"dead_elements", dead},
+                            {"partial_elements", model.partial_elements},
+                            {"dead_part_way", dead_part_way(sim.alpha, elements)},
                             {"non_finite_measurements", stats.non_finite()},
                             {"max_line_integral", max_line},
                             {"out", out.string()}};

@@ -82,6 +82,17 @@ def test_simulate_matches_the_cli_bit_for_bit(cli, tmp_path):
     assert (sim["alpha"] == 0).sum() == 2
 
 
+def test_simulate_partial_rings_matches_the_cli(cli, tmp_path):
+    sim = riner.simulate(None, "fan2d-paper", seed=2, partial=3, partial_dead=1)
+    subprocess.run([cli, "simulate", "--geometry", "fan2d-paper", "--seed", "2", "--partial", "3",
+                    "--partial-dead", "1", "--out", str(tmp_path), "--quiet"], check=True)
+    assert sim["alpha"].shape == (360, 500)
+    assert np.array_equal(sim["alpha"], riner.read_array(tmp_path / "alpha.npy"))
+    assert np.array_equal(sim["sino"], riner.read_array(tmp_path / "sino.npy"))
+    changing = [e for e in range(500) if np.any(np.diff(sim["alpha"][:, e]))]
+    assert len(changing) == 4
+
+
 def test_fbp_matches_the_cli(cli, tmp_path, fan_scan):
     sim, g = fan_scan
     riner.write_array(tmp_path / "sino.npy", sim["sino"])

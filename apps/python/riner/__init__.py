@@ -191,12 +191,14 @@ def destripe(sino, geometry, flat=None, dark=None, center=None, method="all", si
 def simulate(image=None, geometry="fan2d-paper", seed=0, photons=1e7, nonideal_fraction=0.75,
              alpha_min=0.75, alpha_max=1.25, dead=2, dead_rows=0, dead_columns=0,
              mu_unit="mm", mu_scale=0.1, projector="exact", device=None, engine="opencl",
-             response_pattern="per-element"):
+             response_pattern="per-element", partial=0, partial_dead=0):
     """A ring-corrupted scan by the paper's protocol (METHOD.md §4) of `image` (on the
     geometry's grid; mu_unit "cm" for DeepLesion's 1/cm) or, when None, of the built-in
     Shepp-Logan phantom. response_pattern "rows-x-columns" (3D) draws alpha as row x column
-    factors, as `riner simulate --response-pattern` does. Returns a dict: sino, clean, alpha
-    (0 = dead), ground_truth, geometry."""
+    factors, as `riner simulate --response-pattern` does; partial and partial_dead (2D) make
+    that many elements change their response or die part-way (partial rings; alpha is then
+    [views, columns]), as `riner simulate --partial/--partial-dead` do. Returns a dict: sino,
+    clean, alpha (0 = dead), ground_truth, geometry."""
     if mu_unit not in ("mm", "cm"):
         raise InputError(f"mu_unit must be mm or cm (got {mu_unit!r})")
     if image is not None:
@@ -206,7 +208,8 @@ def simulate(image=None, geometry="fan2d-paper", seed=0, photons=1e7, nonideal_f
     geometry_json = _geometry_json(geometry)
     out = _riner.simulate(image, geometry_json, mu_scale, seed, photons, nonideal_fraction,
                           alpha_min, alpha_max, dead, dead_rows, dead_columns, projector,
-                          engine, _device(device), response_pattern)
+                          engine, _device(device), response_pattern, int(partial),
+                          int(partial_dead))
     out["geometry"] = json.loads(geometry_json)
     return out
 

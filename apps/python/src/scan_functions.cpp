@@ -135,7 +135,7 @@ void bind_scan_functions(py::module_& m) {
            std::uint64_t seed, double photons, double nonideal_fraction, double alpha_min,
            double alpha_max, std::size_t dead, std::size_t dead_rows, std::size_t dead_columns,
            const std::string& projector, const std::string& engine, const std::string& device,
-           const std::string& response_pattern) {
+           const std::string& response_pattern, std::size_t partial, std::size_t partial_dead) {
           RingModel model;
           if (response_pattern == "rows-x-columns") {
             model.pattern = ResponsePattern::kRowsTimesColumns;
@@ -151,6 +151,8 @@ void bind_scan_functions(py::module_& m) {
           model.dead_elements = dead;
           model.dead_rows = dead_rows;
           model.dead_columns = dead_columns;
+          model.partial_elements = partial;
+          model.partial_dead_elements = partial_dead;
           return simulate_scan(image, geometry_json, mu_scale, model, projector, engine, device);
         });
   m.def("center", [](const py::handle& measurement, const std::string& geometry_json) {

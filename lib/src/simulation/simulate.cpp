@@ -1,5 +1,6 @@
 #include "riner/simulate.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numeric>
 
@@ -35,6 +36,46 @@ std::vector<std::size_t> iota(std::size_t n) {
   return v;
 }
 
+// A response for an element that changes part-way: U[alpha_min, alpha_max], redrawn until it
+// is at least kPartialChange (in log) from the old one.
+constexpr double kPartialChange = 0.15;
+
+double changed_response(double old, const RingModel& model, sim::Random& rng) {
+  for (int attempt = 0; attempt < 64; ++attempt) {
+    const double a = model.alpha_min + (model.alpha_max - model.alpha_min) * rng.uniform();
+    if (std::fabs(std::log(a / old)) >= kPartialChange) return a;
+  }
+  return old * std::exp(old < std::sqrt(model.alpha_min * model.alpha_max) ? kPartialChange
+                                                                           : -kPartialChange);
+}
+
+// Per-element responses `alpha` [n_u] made per view [n_views, n_u]: partial elements change
+// from a view in the middle three fifths of the scan on.
+Array with_partial_responses(const Array& alpha, const Geometry& g, const RingModel& model,
+                             const std::vector<std::size_t>& live, sim::Random& rng) {
+  if (g.is_3d()) throw InputError("responses that change part-way need a 2D scan for now");
+  const std::size_t views = g.n_views();
+  if (model.partial_elements + model.partial_dead_elements > live.size()) {
+    throw InputError("more partial elements than live detector elements");
+  }
+  Array out({views, g.n_u});
+  for (std::size_t v = 0; v < views; ++v) {
+    std::copy(alpha.data.begin(), alpha.data.end(),
+              out.data.begin() + static_cast<std::ptrdiff_t>(v * g.n_u));
+  }
+  const std::vector<std::size_t> chosen =
+      choose(live, model.partial_elements + model.partial_dead_elements, rng);
+  for (std::size_t i = 0; i < chosen.size(); ++i) {
+    const std::size_t e = chosen[i];
+    const auto from = static_cast<std::size_t>(
+        std::floor(static_cast<double>(views) * (0.2 + 0.6 * rng.uniform())));
+    const double after =
+        i < model.partial_elements ? changed_response(alpha.data[e], model, rng) : 0.0;
+    for (std::size_t v = from; v < views; ++v) out.data[v * g.n_u + e] = static_cast<float>(after);
+  }
+  return out;
+}
+
 }  // namespace
 
 void RingModel::validate() const {
@@ -45,6 +86,38 @@ void RingModel::validate() const {
     throw InputError("the response range must satisfy 0 < alpha_min <= alpha_max");
   }
   if (!(photons >= 0.0) || !std::isfinite(photons)) throw InputError("photons must be >= 0");
+}
+
+std::vector<std::size_t> dead_in_every_view(const Array& alpha, std::size_t elements) {
+  std::vector<std::size_t> dead;
+  for (std::size_t e = 0; e < elements; ++e) {
+    bool all = true;
+    for (std::size_t i = e; i < alpha.size() && all; i += elements) all = alpha.data[i] == 0.0f;
+    if (all) dead.push_back(e);
+  }
+  return dead;
+}
+
+std::vector<std::size_t> dead_part_way(const Array& alpha, std::size_t elements) {
+  std::vector<std::size_t> out;
+  for (std::size_t e = 0; e < elements; ++e) {
+    std::size_t zeros = 0;
+    std::size_t views = 0;
+    for (std::size_t i = e; i < alpha.size(); i += elements, ++views)
+      zeros += alpha.data[i] == 0.0f;
+    if (zeros > 0 && zeros < views) out.push_back(e);
+  }
+  return out;
+}
+
+std::vector<std::size_t> response_change_views(const Array& alpha, std::size_t e) {
+  std::vector<std::size_t> views;
+  if (alpha.rank() != 2) return views;
+  const std::size_t elements = alpha.shape[1];
+  for (std::size_t v = 1; v < alpha.shape[0]; ++v) {
+    if (alpha.data[v * elements + e] != alpha.data[(v - 1) * elements + e]) views.push_back(v);
+  }
+  return views;
 }
 
 Array draw_responses(const Geometry& g, const RingModel& model) {
@@ -104,7 +177,8 @@ Array draw_responses(const Geometry& g, const RingModel& model) {
     alpha.data[e] =
         static_cast<float>(model.alpha_min + (model.alpha_max - model.alpha_min) * rng.uniform());
   }
-  return alpha;
+  if (model.partial_elements + model.partial_dead_elements == 0) return alpha;
+  return with_partial_responses(alpha, g, model, live, rng);
 }
 
 Array corrupt_measurement(const Array& clean, const Array& alpha, const RingModel& model) {
@@ -114,6 +188,7 @@ Array corrupt_measurement(const Array& clean, const Array& alpha, const RingMode
   }
   sim::Random rng(stream_seed(model.seed, 2));
   Array out(clean.shape);
+  // Per element (repeated for every view) or per view and element.
   const std::size_t per_view = alpha.size();
   for (std::size_t r = 0; r < clean.size(); ++r) {
     const double p = clean.data[r];
