@@ -35,7 +35,7 @@ bool uses_deeplesion(const Options& o) {
   return false;
 }
 
-RingScene paper_scene(const Options& o, int index, const Projector& projector) {
+RingScene paper_scene(const Options& o, int index, const Projector& projector, RingModel model) {
   RingScene scene;
   Array truth;
   if (uses_deeplesion(o)) {
@@ -49,7 +49,6 @@ RingScene paper_scene(const Options& o, int index, const Projector& projector) {
     truth = rasterize(shepp_logan(projector.geometry(), 0.02), projector.geometry(), 4);
     scene.name = "shepp-logan/seed_" + std::to_string(index);
   }
-  RingModel model;
   model.seed = static_cast<std::uint64_t>(index + o.get_int("seed-offset", 0));
   if (model.seed != static_cast<std::uint64_t>(index)) {
     scene.name += " (seed " + std::to_string(model.seed) + ")";

@@ -23,8 +23,10 @@ struct RingScene {
 bool uses_deeplesion(const Options& o);
 // Scene `index` (a slice index, also the ring seed) in the fan2d-paper geometry. --seed-offset=N
 // adds N to the seed: the same slices with other responses, dead elements and noise (a check
-// of settings chosen on the default seeds).
-RingScene paper_scene(const Options& o, int index, const Projector& projector);
+// of settings chosen on the default seeds). `model`: the paper's ring model unless given (its
+// seed is replaced as above).
+RingScene paper_scene(const Options& o, int index, const Projector& projector,
+                      RingModel model = {});
 
 // The defaults, then --config=FILE|JSON, then --steps, then --engine.
 RinerConfig config_from(const Options& o);

@@ -9,15 +9,19 @@
 //   riner_step_forward(p, batch, levels, params, mu_dx, cache)
 //     sample i of batch ray b (batch_ray_of): mu_dx[i] = mu * dx at the sample; its features
 //     and activations into the cache (sample_cache.cl).
-//   riner_step_loss(p, batch, mu_dx, params, invalid_readings, grad, sums, d_sums,
-//                   ray_grads, history, scratch)
+//   riner_step_loss(p, batch, mu_dx, params, invalid_readings, response_slots, grad, sums,
+//                   d_sums, ray_grads, history, scratch)
 //     one work-group of any size (the plan's): work-items take rays b = lid, lid + size, ...:
 //     sums[b] = sum of mu dx over the ray's samples (in sample order), the ray's loss
 //     (ray_sum.cl), d_sums[b] and its alpha0/beta0 gradients; then elements i = lid, ...
 //     of the batch's distinct elements: their rays' gradients in ascending ray order plus the
 //     -lambda beta^2 term into grad (each element's entries are written by one work-item:
-//     deterministic, no atomics). history[2 * slot] = data term, [2 * slot + 1] = penalties,
-//     summed by a fixed tree. When relative_beta_threshold > 0, lambda is raised to
+//     deterministic, no atomics). A reading's alpha0 and beta0 are its response slot's
+//     (response_slot: the element's, or for an element whose response changes part-way its
+//     segment's, lib/src/model/response_map.hpp); an element's slots take their rays' gradients
+//     and a penalty each when the batch holds one of their rays; invalid_readings is per
+//     response slot. history[2 * p.history_slot] = data term, [2 * p.history_slot + 1] =
+//     penalties, summed by a fixed tree. When relative_beta_threshold > 0, lambda is raised to
 //     data_weight relative_beta_threshold max(m, 1e-3) / 2 where that is larger, m the batch's
 //     median ray mismatch, for elements whose readings are all finite (an element with a
 //     non-finite reading keeps lambda) (scratch float[n_batch]). When hold_valid_beta != 0,
@@ -69,6 +73,16 @@ __kernel void riner_step_forward(const StepParams p, __global const uint* batch,
     RINER_UNROLL
     for (int j = 0; j < MLP_WIDTH; ++j) cache[(CACHE_ACT(h) + j) * stride + i] = act[h][j];
   }
+}
+
+#define RESPONSE_VIEW_TABLE 0x80000000u
+
+// The response slot of a reading (lib/src/model/response_map.hpp lays the table out).
+RINER_INLINE uint response_slot(__global const uint* slots, uint ray, uint elements_per_view) {
+  const uint s = slots[ray % elements_per_view];
+  if (!(s & RESPONSE_VIEW_TABLE)) return s;
+  const uint o = s & ~RESPONSE_VIEW_TABLE;
+  return slots[o + 1 + slots[o] + ray / elements_per_view];
 }
 
 // The k-th smallest of values[0 .. n) (Hoare's selection; reorders values).
@@ -144,7 +158,8 @@ RINER_INLINE float ring_prior(const StepParams* p, __global const float* sums,
 
 __kernel void riner_step_loss(const StepParams p, __global const uint* batch,
                               __global const float* mu_dx, __global const float* params,
-                              __global const uint* invalid_readings, __global float* grad,
+                              __global const uint* invalid_readings,
+                              __global const uint* response_slots, __global float* grad,
                               __global float* sums, __global float* d_sums,
                               __global float2* ray_grads, __global float* history,
                               __global float* scratch, __local float* reduce) {
@@ -162,8 +177,8 @@ __kernel void riner_step_loss(const StepParams p, __global const uint* batch,
     if (lid == 0) {
       for (uint b = 0; b < p.n_batch; ++b) {
         const uint ray = batch[p.rays_at + b];
-        scratch[b] = ray_mismatch(sums[b], params[p.alpha_offset + ray % p.elements_per_view],
-                                  batch_rho(batch, &p, b));
+        const uint slot = response_slot(response_slots, ray, p.elements_per_view);
+        scratch[b] = ray_mismatch(sums[b], params[p.alpha_offset + slot], batch_rho(batch, &p, b));
       }
       reduce[0] = select_kth(scratch, p.n_batch, (p.n_batch - 1) / 2);
     }
@@ -174,12 +189,11 @@ __kernel void riner_step_loss(const StepParams p, __global const uint* batch,
   }
   float data = 0.0f;
   for (uint b = lid; b < p.n_batch; b += size) {
-    const uint ray = batch[p.rays_at + b];
-    const uint e = ray % p.elements_per_view;
+    const uint slot = response_slot(response_slots, batch[p.rays_at + b], p.elements_per_view);
     float d_sum;
     float d_alpha0;
     float d_beta0;
-    data += ray_loss(sums[b], params[p.alpha_offset + e], params[p.beta_offset + e],
+    data += ray_loss(sums[b], params[p.alpha_offset + slot], params[p.beta_offset + slot],
                      batch_rho(batch, &p, b), as_float(batch[p.weights_at + b]), &d_sum, &d_alpha0,
                      &d_beta0);
     d_sums[b] = d_sum;
@@ -192,13 +206,32 @@ __kernel void riner_step_loss(const StepParams p, __global const uint* batch,
   __global const uint* element_rays = starts + p.n_elements + 1;
   for (uint i = lid; i < p.n_elements; i += size) {
     const uint e = batch[p.elements_at + i];
-    float2 g = (float2)(0.0f);
-    for (uint j = starts[i]; j < starts[i + 1]; ++j) g += ray_grads[element_rays[j]];
-    float d_beta0;
-    const float weight = invalid_readings[e] != 0 ? p.lambda : penalty_weight;
-    penalty += beta_penalty(params[p.beta_offset + e], weight, &d_beta0);
-    grad[p.alpha_offset + e] += g.x;
-    if (!p.hold_valid_beta || invalid_readings[e] != 0) grad[p.beta_offset + e] += g.y + d_beta0;
+    const uint entry = response_slots[e];
+    const uint changing = entry & RESPONSE_VIEW_TABLE;
+    const uint o = entry & ~RESPONSE_VIEW_TABLE;
+    const uint n_slots = changing ? response_slots[o] : 1;
+    for (uint k = 0; k < n_slots; ++k) {
+      const uint slot = changing ? response_slots[o + 1 + k] : entry;
+      float2 g = (float2)(0.0f);
+      uint rays = 0;
+      for (uint j = starts[i]; j < starts[i + 1]; ++j) {
+        const uint b = element_rays[j];
+        if (changing &&
+            response_slot(response_slots, batch[p.rays_at + b], p.elements_per_view) != slot) {
+          continue;
+        }
+        g += ray_grads[b];
+        ++rays;
+      }
+      if (rays == 0) continue;
+      float d_beta0;
+      const float weight = invalid_readings[slot] != 0 ? p.lambda : penalty_weight;
+      penalty += beta_penalty(params[p.beta_offset + slot], weight, &d_beta0);
+      grad[p.alpha_offset + slot] += g.x;
+      if (!p.hold_valid_beta || invalid_readings[slot] != 0) {
+        grad[p.beta_offset + slot] += g.y + d_beta0;
+      }
+    }
   }
   data = group_sum(data, reduce);
   penalty = group_sum(penalty, reduce);

@@ -180,6 +180,15 @@ int run_reconstruct(int argc, char** argv, int first) {
                     reconstructor.config().training.learning_rate);
       console.line(line);
     }
+    const std::vector<ChangingElement> changing = reconstructor.changing_elements();
+    if (!changing.empty()) {
+      const auto dies = std::count_if(changing.begin(), changing.end(),
+                                      [](const ChangingElement& c) { return c.dies; });
+      console.line("partial rings: " + std::to_string(changing.size() - dies) +
+                   " element(s) change response part-way and " + std::to_string(dies) +
+                   " die part-way: alpha and beta per segment of views (summary.json "
+                   "changing_elements, alpha_by_view.npy)");
+    }
     if (setup.air_skipped) {
       char line[240];
       std::snprintf(line, sizeof(line),
@@ -231,7 +240,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   nlohmann::json summary = {{"image", image_path.string()}};
   summary.update(run_summary(reconstructor, result, quality));
   const std::vector<std::size_t> dead = summary["dead_elements"];
-  write_detector_outputs(out, alpha, reconstructor.beta(), dead);
+  write_detector_outputs(out, alpha, reconstructor.beta(), dead, result.alpha_by_view);
   write_history(out / "loss.csv", reconstructor.history());
   write_text(out / "config.json", reconstructor.config().to_json());  // as resolved for the device
 

@@ -8,9 +8,10 @@
 namespace riner::app {
 
 void write_detector_outputs(const std::filesystem::path& dir, const Array& alpha, const Array& beta,
-                            const std::vector<std::size_t>& dead) {
+                            const std::vector<std::size_t>& dead, const Array& alpha_by_view) {
   write_array(dir / "alpha.npy", alpha);
   write_array(dir / "beta.npy", beta);
+  if (alpha_by_view.size() > 0) write_array(dir / "alpha_by_view.npy", alpha_by_view);
   if (alpha.rank() == 1) {
     LinePlot plot;
     plot.title = "estimated detector response alpha (blue) and mask beta (orange)";

@@ -138,6 +138,7 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
           {"non_finite_measurements", stats.non_finite},
           {"dead_elements", dead},
           {"dead_element_reasons", dead_elements_json(dead_report)},
+          {"changing_elements", changing_elements_json(r.changing_elements())},
           {"engine", stats.engine},
           {"device", stats.device},
           {"plan", stats.plan ? nlohmann::json::parse(stats.plan->to_json()) : nlohmann::json()},
@@ -197,6 +198,19 @@ nlohmann::json dead_elements_json(const std::vector<DeadElement>& dead) {
                    {"reason", d.reason},
                    {"beta", d.beta},
                    {"invalid_readings", d.invalid_readings}});
+  }
+  return out;
+}
+
+nlohmann::json changing_elements_json(const std::vector<ChangingElement>& changing) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const ChangingElement& c : changing) {
+    nlohmann::json segments = nlohmann::json::array();
+    for (const ResponseSegment& s : c.segments) {
+      segments.push_back(
+          {{"first_view", s.first_view}, {"views", s.views}, {"alpha", s.alpha}, {"beta", s.beta}});
+    }
+    out.push_back({{"element", c.element}, {"dies", c.dies}, {"segments", segments}});
   }
   return out;
 }

@@ -41,6 +41,8 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
 
 // summary.json's account of each dead element: index, reason, beta, invalid readings.
 nlohmann::json dead_elements_json(const std::vector<DeadElement>& dead);
+// Each element whose response changes or that dies part-way, with its segments of views.
+nlohmann::json changing_elements_json(const std::vector<ChangingElement>& changing);
 nlohmann::json flat_field_json(const FlatFieldReport& report);
 nlohmann::json centre_json(const CentreEstimate& estimate);
 

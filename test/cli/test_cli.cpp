@@ -107,6 +107,36 @@ TEST_SUITE("cli") {
           riner::test::read_bytes(out + "2/sino.npy"));
   }
 
+  TEST_CASE("partial rings: simulate --partial, reconstruct writes alpha by view and the segments") {
+    // test/support/partial_scan.hpp's scan, from the CLI: 5 elements change, 2 die part-way.
+    riner::test::TempDir dir;
+    riner::test::write_bytes(dir / "g.json", R"({"type": "parallel2d",
+      "detector": {"count": 128, "pitch_mm": 1.0}, "volume": {"shape": [96, 96], "voxel_mm": 1.0},
+      "angles": {"count": 240, "range_rad": 3.141592653589793, "start_rad": 0.1}})");
+    const std::string sim = (dir / "sim").string();
+    REQUIRE(riner_cli("simulate --quiet --geometry " + (dir / "g.json").string() +
+                          " --partial 5 --partial-dead 2 --seed 6 --out " + sim,
+                      dir)
+                .code == 0);
+    CHECK(riner::read_array(sim + "/alpha.npy").array.shape == std::vector<std::size_t>{240, 128});
+    const auto simulated = nlohmann::json::parse(riner::test::read_bytes(sim + "/simulation.json"));
+    CHECK(simulated["dead_part_way"].size() == 2);
+    CHECK(simulated["dead_elements"].size() == 2);
+    const std::string out = (dir / "r").string();
+    const Run run = riner_cli("reconstruct " + sim + "/sino.npy --set training.steps=50 --out " +
+                                  out,
+                              dir);
+    REQUIRE(run.code == 0);
+    CHECK(run.out.find("partial rings: 5 element(s) change response part-way and 2 die") !=
+          std::string::npos);
+    CHECK(riner::read_array(out + "/alpha_by_view.npy").array.shape ==
+          std::vector<std::size_t>{240, 128});
+    CHECK(riner::read_array(out + "/alpha.npy").array.shape == std::vector<std::size_t>{128});
+    const auto summary = nlohmann::json::parse(riner::test::read_bytes(out + "/summary.json"));
+    REQUIRE(summary["changing_elements"].size() == 7);
+    CHECK(summary["changing_elements"][0]["segments"].size() == 2);
+  }
+
   TEST_CASE("destripe: a ringed scan's FBP gains, the scan and its stripes are written") {
     riner::test::TempDir dir;
     const std::string sim = (dir / "sim").string();

@@ -4,6 +4,7 @@
 // parameter's gradient, the losses.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -34,6 +35,8 @@ struct Scenario {
   bool hold_valid_beta = false;
   bool coarse_to_fine = false;
   int hidden_layers = 1;
+  bool changing_responses = false;  // a few elements' responses change or die part-way
+  int rays_per_step = 40;
 };
 
 std::vector<Scenario> scenarios() {
@@ -49,6 +52,13 @@ std::vector<Scenario> scenarios() {
   mixed.coarse_to_fine = true;
   mixed.hidden_layers = 2;
   s.push_back(mixed);
+  Scenario changing{"fan 2D, responses changing and dying part-way, relative beta, beta held",
+                    riner::test::small_fan2d()};
+  changing.changing_responses = true;
+  changing.relative_beta_threshold = 4.0;
+  changing.hold_valid_beta = true;
+  changing.rays_per_step = 400;  // ~4 rays per element: every segment of 40, 45 and 50 is read
+  s.push_back(changing);
   Scenario cone{"cone 3D, uniform rays, jitter, hashed levels", riner::test::small_cone3d()};
   cone.jitter = true;
   s.push_back(cone);
@@ -58,17 +68,20 @@ std::vector<Scenario> scenarios() {
 // A step's fixed inputs on the device, and its loss history.
 struct DeviceInputs {
   riner::cl::Buffer<cl_uint> invalid;
+  riner::cl::Buffer<cl_uint> responses;
   riner::cl::Buffer<float> params;
   riner::cl::Buffer<float> history;
 
-  DeviceInputs(const std::vector<std::uint32_t>& inv, const std::vector<float>& p)
+  DeviceInputs(const std::vector<std::uint32_t>& inv, const std::vector<float>& p,
+               const riner::model::ResponseMap& map)
       : invalid(ctx(), std::span<const cl_uint>(inv)),
+        responses(ctx(), std::span<const cl_uint>(map.table())),
         params(ctx(), std::span<const float>(p)),
         history(ctx(), 2) {}
 
   void step(riner::ops::RinerStepOp& op, const riner::ops::StepParams& p,
             const riner::cl::Buffer<cl_uint>& words, riner::cl::Buffer<float>& grad) {
-    op.step(p, words, {&invalid}, params, grad, history);
+    op.step(p, words, {&invalid, &responses}, params, grad, history);
   }
 };
 
@@ -92,22 +105,32 @@ std::vector<double> section(const std::vector<double>& v, std::size_t first, std
 }  // namespace
 
 TEST_SUITE("riner_step") {
-  TEST_CASE("each plan's step matches ref::riner_step on random parameters and batches") {
+  // Every plan's step against the twin on the scenarios with (or without) changing responses.
+  void check_steps(bool changing_responses) {
     std::mt19937_64 rng(riner::test::seed() + 71);
     for (const Scenario& sc : scenarios()) {
+      if (sc.changing_responses != changing_responses) continue;
       const riner::Geometry& g = sc.geometry;
       riner::RinerConfig c;
       c.encoding = {5, 2, g.is_3d() ? 10 : 14, 4, 48};  // 3D: hashed fine levels
       c.network = {16, sc.hidden_layers};
       riner::TrainingConfig& t = c.training;
       t.sampler = sc.sampler;
-      t.rays_per_step = 40;
+      t.rays_per_step = sc.rays_per_step;
       t.views_per_step = 6;
       t.elements_per_step = 5;
       t.jitter = sc.jitter;
       const std::size_t per_view = g.n_u * (g.is_3d() ? g.n_v : 1);
+      const std::size_t views = g.n_views();
+      // Element 40 changes once, 45 twice, 50 dies half-way (its readings +inf from there on).
+      std::vector<riner::model::ResponseChange> changes;
+      if (sc.changing_responses) {
+        changes = {
+            {40, {views / 3}, false}, {45, {views / 4, views / 2}, false}, {50, {views / 2}, true}};
+      }
+      const riner::model::ResponseMap map(per_view, views, changes);
       const riner::model::ParameterLayout l =
-          riner::model::make_layout(g.is_3d() ? 3 : 2, c.encoding, c.network, per_view);
+          riner::model::make_layout(g.is_3d() ? 3 : 2, c.encoding, c.network, map.slots());
       const std::vector<riner::model::RaySegment> segments =
           riner::model::ray_segments(g, 1.3 * g.voxel_mm, false);
       // Parameters away from the initial ones, so every layer matters.
@@ -115,24 +138,31 @@ TEST_SUITE("riner_step") {
       std::uniform_real_distribution<float> grid(-0.2f, 0.2f), response(0.8f, 1.2f),
           logit(-1.0f, 2.0f), measured(0.0f, 2.0f);
       for (std::size_t i = 0; i < l.grid_params; ++i) params[i] = grid(rng);
-      for (std::size_t e = 0; e < per_view; ++e) {
-        params[l.alpha_offset + e] = response(rng);
-        params[l.beta_offset + e] = logit(rng);
+      for (std::size_t slot = 0; slot < map.slots(); ++slot) {
+        params[l.alpha_offset + slot] = response(rng);
+        params[l.beta_offset + slot] = logit(rng);
       }
-      std::vector<float> rho(g.n_views() * per_view);
+      std::vector<float> rho(views * per_view);
       for (float& v : rho) v = measured(rng);
-      std::vector<std::uint32_t> invalid(per_view, 0);
       for (std::size_t e = 3; e < per_view; e += 17) {  // a few elements with +inf readings
-        invalid[e] = static_cast<std::uint32_t>(g.n_views());
-        for (std::size_t v = 0; v < g.n_views(); ++v) rho[v * per_view + e] = INFINITY;
+        for (std::size_t v = 0; v < views; ++v) rho[v * per_view + e] = INFINITY;
+      }
+      if (sc.changing_responses) {
+        for (std::size_t v = views / 2; v < views; ++v) rho[v * per_view + 50] = INFINITY;
+      }
+      std::vector<std::uint32_t> invalid(map.slots(), 0);
+      for (std::size_t ray = 0; ray < rho.size(); ++ray) {
+        if (std::isinf(rho[ray])) ++invalid[map.slot(ray % per_view, ray / per_view)];
       }
       std::vector<float> level_weights(static_cast<std::size_t>(l.levels), 1.0f);
       if (sc.coarse_to_fine) level_weights.back() = 0.3f;
 
-      DeviceInputs device(invalid, params);
+      DeviceInputs device(invalid, params, map);
       const std::vector<double> params_d(params.begin(), params.end());
       const riner::model::BatchSampler sampler(g, t);
 
+      // The steps read every changing segment's slot (else the case would test nothing).
+      std::vector<std::uint8_t> read(map.slots() - per_view, 0);
       for (const char* kind : {"cpu", "gpu"}) {
         riner::PlanConfig pc;
         pc.kind = kind;
@@ -178,7 +208,10 @@ TEST_SUITE("riner_step") {
           in.level_weights = level_weights;
           in.hold_valid_beta = sc.hold_valid_beta;
           in.invalid_readings = &invalid;
+          in.responses = sc.changing_responses ? &map : nullptr;
           const riner::ref::StepResult want = riner::ref::riner_step(in, batch, params_d);
+          for (std::size_t slot = per_view; slot < map.slots(); ++slot)
+            read[slot - per_view] |= want.grad[l.alpha_offset + slot] != 0.0;
 
           // float32 sums of ~100 samples against double: a few ulps of the sum.
           const std::size_t n = batch.rays.size();
@@ -211,7 +244,17 @@ TEST_SUITE("riner_step") {
           }
         }
       }
+      CHECK(std::count(read.begin(), read.end(), 1) == static_cast<long>(read.size()));
     }
+  }
+
+  TEST_CASE("each plan's step matches ref::riner_step on random parameters and batches") {
+    check_steps(false);
+  }
+
+  // Also under oclgrind (test/CMakeLists.txt, oclgrind_response_slots).
+  TEST_CASE("each plan's step matches ref::riner_step with responses changing part-way") {
+    check_steps(true);
   }
 
   TEST_CASE("the cpu plan's step is bit-identical run to run") {
@@ -227,7 +270,7 @@ TEST_SUITE("riner_step") {
     for (std::size_t i = 0; i < l.grid_params; ++i) params[i] = u(rng);
     std::vector<float> rho(g.n_views() * g.n_u, 0.5f);
     std::vector<std::uint32_t> invalid(g.n_u, 0);
-    DeviceInputs device(invalid, params);
+    DeviceInputs device(invalid, params, riner::model::ResponseMap(g.n_u));
     c.training.rays_per_step = 200;
     const riner::model::BatchSampler sampler(g, c.training);
     riner::PlanConfig pc;

@@ -49,6 +49,10 @@ struct ReconstructionResult {
   Array field_image;
   Array image;
   Array alpha;
+  // 2D, when some element's response changes part-way (training.partial_responses): each
+  // view's response per element, [n_views, n_u], the corrections' change to alpha included;
+  // otherwise empty.
+  Array alpha_by_view;
   std::optional<RingCorrection> air_rings;
   std::optional<RingCorrection> gradient_rings;
   std::optional<RingCorrection> response_rings;
@@ -67,6 +71,22 @@ struct DeadElement {
   std::size_t invalid_readings = 0;  // non-finite readings, of one per view
   std::string reason;  // "no finite reading", "stuck: steady while its neighbours vary" or
                        // "beta below 0.5"
+};
+
+// Part of the views over which an element's response is one alpha and one beta.
+struct ResponseSegment {
+  std::size_t first_view = 0;
+  std::size_t views = 0;
+  double alpha = 1.0;  // as trained
+  double beta = 1.0;
+};
+
+// An element whose response changes part-way through the scan, or that dies part-way
+// (training.partial_responses, model/response_changes.hpp), and its segments in view order.
+struct ChangingElement {
+  std::size_t element = 0;
+  bool dies = false;  // the segments are bounded by runs of non-finite readings
+  std::vector<ResponseSegment> segments;
 };
 
 // How the training's rays covered the detector: an element's (pixel's, in 3D) alpha and beta
@@ -172,8 +192,15 @@ class Reconstructor {
   // [n_v, n_u] in 3D). In 2D, after the ring corrections config.rings turns on, which change
   // the image and alpha together and keep the data fit.
   Array image() const;
+  // An element whose response changes part-way: the geometric mean of its live segments'
+  // (beta >= kDeadBelowBeta) by their views; alpha_by_view() has each view's.
   Array alpha() const;
-  Array beta() const;  // sigmoid(beta0) per element; < kDeadBelowBeta marks an element as dead
+  // sigmoid(beta0) per element (its largest segment's where it changes); < kDeadBelowBeta marks
+  // an element as dead.
+  Array beta() const;
+  // ReconstructionResult::alpha_by_view, and the elements it is about.
+  Array alpha_by_view() const;
+  std::vector<ChangingElement> changing_elements() const;
   static constexpr float kDeadBelowBeta = 0.5f;
   // The dead elements: beta < kDeadBelowBeta, or no finite reading at all (where the rays miss
   // the object, training has no reason to switch such an element off), with the reason.
@@ -194,6 +221,8 @@ class Reconstructor {
 
  private:
   ReconstructionResult evaluate_result() const;
+  void evaluate_rings(ReconstructionResult& r) const;
+  Array responses_by_view(const Array& trained, const Array& corrected) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -150,6 +150,13 @@ struct TrainingConfig {
   // hot or stuck pixel, row or column; model/stuck_elements.hpp) are taken for dead before
   // training: their readings count as invalid, like non-finite ones.
   bool stuck_elements = true;
+  // Partial rings (2D): elements whose response changes part-way through the scan (a jump of
+  // their reading against their neighbours', held for views / 12 views or more, at least
+  // partial_response_sigmas times the noise) or that die part-way (a run of non-finite
+  // readings) get an alpha0 and a beta0 per segment of views instead of one
+  // (model/response_changes.hpp). A scan without such evidence trains exactly as before.
+  bool partial_responses = true;
+  double partial_response_sigmas = 12.0;
   AlphaModel alpha_model = AlphaModel::kAuto;
   // Auto: rows x columns when the factors explain at least this fraction of the stripe
   // pattern's energy (model/factor_evidence.hpp).

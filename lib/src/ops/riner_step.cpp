@@ -87,8 +87,9 @@ void RinerStepOp::step(StepParams p, const cl::Buffer<cl_uint>& batch, const Ste
     forward_.set_args(p, batch, levels_, params, mu_dx_, cache_);
     context_.launch(forward_, samples, plan_.sample_group);
   }
-  loss_.set_args(p, batch, mu_dx_, params, *scan.invalid_readings, grad, sums_, d_sums_, ray_grads_,
-                 history, scratch_, cl::LocalMemory{plan_.loss_group * sizeof(float)});
+  loss_.set_args(p, batch, mu_dx_, params, *scan.invalid_readings, *scan.response_slots, grad,
+                 sums_, d_sums_, ray_grads_, history, scratch_,
+                 cl::LocalMemory{plan_.loss_group * sizeof(float)});
   context_.launch(loss_, plan_.loss_group, plan_.loss_group);
   slices_ = 0;
   if (samples == 0) return;

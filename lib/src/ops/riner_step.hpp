@@ -65,7 +65,8 @@ void set_batch_shape(const model::PackedBatch& batch, StepParams& p);
 
 // The scan-wide inputs of every step (the rays' segments and readings come in the batch).
 struct StepScan {
-  const cl::Buffer<cl_uint>* invalid_readings;  // per element: its non-finite readings
+  const cl::Buffer<cl_uint>* invalid_readings;  // per response slot: its non-finite readings
+  const cl::Buffer<cl_uint>* response_slots;    // model/response_map.hpp's table
 };
 
 class RinerStepOp {

@@ -69,8 +69,8 @@ double penalty_weight(const StepInputs& in, const model::Batch& batch,
   std::vector<double> mismatch(n);
   for (std::size_t b = 0; b < n; ++b) {
     const std::uint32_t ray = batch.rays[b];
-    mismatch[b] = ray_mismatch(sums[b], params[l.alpha_offset + ray % in.elements_per_view],
-                               (*in.measurement)[ray]);
+    mismatch[b] =
+        ray_mismatch(sums[b], params[l.alpha_offset + in.slot(ray)], (*in.measurement)[ray]);
   }
   std::nth_element(mismatch.begin(), mismatch.begin() + static_cast<long>((n - 1) / 2),
                    mismatch.end());
@@ -87,28 +87,40 @@ void losses(const StepInputs& in, const model::Batch& batch, const std::vector<d
   const std::size_t n = batch.rays.size();
   result.d_sums.assign(n, 0.0);
   const double weight = penalty_weight(in, batch, params, result.sums);
-  const auto beta_learns = [&](std::size_t e) {
-    return !in.hold_valid_beta || (*in.invalid_readings)[e] != 0;
+  const auto beta_learns = [&](std::size_t slot) {
+    return !in.hold_valid_beta || (*in.invalid_readings)[slot] != 0;
   };
+  std::vector<std::uint8_t> touched(l.elements, 0);
   for (std::size_t b = 0; b < n; ++b) {
     const std::uint32_t ray = batch.rays[b];
-    const std::size_t e = ray % in.elements_per_view;
+    const std::size_t slot = in.slot(ray);
+    touched[slot] = 1;
     const RayLoss rl =
-        ray_loss(result.sums[b], params[l.alpha_offset + e], params[l.beta_offset + e],
+        ray_loss(result.sums[b], params[l.alpha_offset + slot], params[l.beta_offset + slot],
                  (*in.measurement)[ray], batch.weights[b]);
     result.data_loss += rl.loss;
     result.d_sums[b] = rl.d_sum;
     if (with_gradient) {
-      result.grad[l.alpha_offset + e] += rl.d_alpha0;
-      if (beta_learns(e)) result.grad[l.beta_offset + e] += rl.d_beta0;
+      result.grad[l.alpha_offset + slot] += rl.d_alpha0;
+      if (beta_learns(slot)) result.grad[l.beta_offset + slot] += rl.d_beta0;
     }
   }
+  // A penalty per slot the batch reads, element by element and each element's in view order.
   for (std::uint32_t e : batch.elements) {
-    double d_beta0 = 0.0;
-    const double w =
-        in.invalid_readings && (*in.invalid_readings)[e] != 0 ? in.lambda : weight;
-    result.penalty += beta_penalty(params[l.beta_offset + e], w, &d_beta0);
-    if (with_gradient && beta_learns(e)) result.grad[l.beta_offset + e] += d_beta0;
+    std::vector<std::size_t> slots{e};
+    if (in.responses) {
+      slots.clear();
+      for (const model::ResponseMap::Segment& s : in.responses->segments(e))
+        slots.push_back(s.slot);
+    }
+    for (std::size_t slot : slots) {
+      if (!touched[slot]) continue;
+      double d_beta0 = 0.0;
+      const double w =
+          in.invalid_readings && (*in.invalid_readings)[slot] != 0 ? in.lambda : weight;
+      result.penalty += beta_penalty(params[l.beta_offset + slot], w, &d_beta0);
+      if (with_gradient && beta_learns(slot)) result.grad[l.beta_offset + slot] += d_beta0;
+    }
   }
   result.penalty += ring_prior(batch, result.sums, in.ring_lambda, &result.d_sums);
 }

@@ -9,6 +9,7 @@
 #include "model/batch_sampler.hpp"
 #include "model/parameter_layout.hpp"
 #include "model/ray_segments.hpp"
+#include "model/response_map.hpp"
 
 namespace riner::ref {
 
@@ -28,7 +29,14 @@ struct StepInputs {
   // Beta warm-up (riner_step.cl): while hold_valid_beta, beta0 of every element with no
   // invalid reading (invalid_readings[e] == 0) gets no gradient.
   bool hold_valid_beta = false;
-  const std::vector<std::uint32_t>* invalid_readings = nullptr;
+  const std::vector<std::uint32_t>* invalid_readings = nullptr;  // per response slot
+  // Which alpha0/beta0 each reading uses (null: its element's, as ResponseMap(elements)).
+  const model::ResponseMap* responses = nullptr;
+
+  std::size_t slot(std::uint32_t ray) const {
+    const std::size_t e = ray % elements_per_view;
+    return responses ? responses->slot(e, ray / elements_per_view) : e;
+  }
 };
 
 struct StepResult {

@@ -142,6 +142,13 @@ void add_training_schedule(Table& t) {
                        "elements steady over the views while their neighbours vary are dead "
                        "before training",
                        &C::training, &T::stuck_elements));
+  t.push_back(field<C>("training", "partial_responses", {},
+                       "2D: alpha and beta per segment of views for elements whose response "
+                       "changes or that die part-way (partial rings)",
+                       &C::training, &T::partial_responses));
+  t.push_back(field<C>("training", "partial_response_sigmas", closed(3, 1000),
+                       "partial_responses: a change must jump this many noise sigmas", &C::training,
+                       &T::partial_response_sigmas));
   t.push_back(enum_choice<C>(
       "training", "alpha_model",
       {AlphaModel::kAuto, AlphaModel::kPerElement, AlphaModel::kRowsTimesColumns}, alpha_model_name,

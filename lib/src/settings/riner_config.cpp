@@ -204,6 +204,7 @@ RinerConfig RinerConfig::paper() {
   c.training.level_warmup_steps = 0;
   c.training.tail_average_steps = 0;  // the paper's result is the last step's
   c.training.stuck_elements = false;
+  c.training.partial_responses = false;
   c.training.alpha_model = AlphaModel::kPerElement;
   c.training.skip_air = false;  // riner's additions, not the paper's
   c.rings.air_reference = false;

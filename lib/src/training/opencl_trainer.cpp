@@ -22,6 +22,12 @@ namespace {
 constexpr int kHistoryBlock = 256;   // steps between reads of the loss history
 constexpr int kUploadsInFlight = 3;  // steps the host may prepare ahead of the device
 
+// The setup's response table (one slot per element when the setup left it empty).
+std::vector<cl_uint> response_table(const TrainingSetup& setup) {
+  if (setup.responses.elements() == setup.elements_per_view) return setup.responses.table();
+  return model::ResponseMap(setup.elements_per_view).table();
+}
+
 class OpenclTrainer final : public Trainer {
  public:
   OpenclTrainer(const TrainingSetup& setup, Device device, const ExecutionPlan& plan)
@@ -33,6 +39,7 @@ class OpenclTrainer final : public Trainer {
         grad_(ctx_, std::vector<float>(setup.layout.total, 0.0f)),
         history_(ctx_, static_cast<std::size_t>(kHistoryBlock) * 2),
         invalid_readings_(ctx_, std::span<const cl_uint>(setup.invalid_readings), CL_MEM_READ_ONLY),
+        response_slots_(ctx_, std::span<const cl_uint>(response_table(setup)), CL_MEM_READ_ONLY),
         level_weights_(ctx_, static_cast<std::size_t>(setup.layout.levels)),
         uploads_(ctx_, kUploadsInFlight),
         step_op_(ctx_, setup.layout, plan_,
@@ -65,7 +72,7 @@ class OpenclTrainer final : public Trainer {
     p.block_views = batch.block_views;
     p.block_elements = batch.block_elements;
     const cl::Buffer<cl_uint>& words = uploads_.upload(packed_.words);
-    step_op_.step(p, words, {&invalid_readings_}, params_, grad_, history_);
+    step_op_.step(p, words, {&invalid_readings_, &response_slots_}, params_, grad_, history_);
     if (factors_) factors_->gradient(params_, grad_);
     const model::AdamSettings adam = setup_.adam_settings(index);
     adam_.step(adam, index + 1, params_, grad_,
@@ -139,6 +146,7 @@ class OpenclTrainer final : public Trainer {
   cl::Buffer<float> grad_;
   cl::Buffer<float> history_;
   cl::Buffer<cl_uint> invalid_readings_;
+  cl::Buffer<cl_uint> response_slots_;  // model/response_map.hpp's table
   cl::Buffer<float> level_weights_;
   cl::UploadRing<cl_uint> uploads_;
   model::PackedBatch packed_;

@@ -184,7 +184,16 @@ ReconstructionResult Reconstructor::evaluate_result() const {
   r.field_image = field_image();
   r.image = r.field_image;
   r.alpha = trained_alpha();
-  if (!corrects_rings(c, g)) return r;
+  const Array trained = r.alpha;
+  evaluate_rings(r);
+  r.alpha_by_view = responses_by_view(trained, r.alpha);
+  return r;
+}
+
+void Reconstructor::evaluate_rings(ReconstructionResult& r) const {
+  const RinerConfig& c = impl_->setup.config;
+  const Geometry& g = impl_->setup.scan.geometry;
+  if (!corrects_rings(c, g)) return;
   if (g.is_3d()) {
     r.volume_rings = correct_rings_per_slice(r.image, r.alpha, g, dead_elements(), c.rings);
     r.image = r.volume_rings->image;
@@ -203,7 +212,43 @@ ReconstructionResult Reconstructor::evaluate_result() const {
   // sampled region, that would paint the ring into the skipped air. No second ramp: the field's
   // already has one.
   model::fade_into_skipped_air(impl_->setup.occupancy, g.volume_shape, 0, r.image.data);
-  return r;
+}
+
+Array Reconstructor::responses_by_view(const Array& trained, const Array& corrected) const {
+  const model::ResponseMap& map = impl_->setup.responses;
+  if (!map.varies()) return Array();
+  const model::ParameterLayout& l = impl_->setup.layout;
+  const std::vector<float> p = impl_->trainer->parameters();
+  const std::size_t views = impl_->setup.scan.geometry.n_views();
+  const std::size_t elements = impl_->setup.elements_per_view;
+  Array out({views, elements});
+  for (std::size_t v = 0; v < views; ++v) {
+    for (std::size_t e = 0; e < elements; ++e) {
+      const float a = std::max(p[l.alpha_offset + map.slot(e, v)], 1e-8f);
+      out.data[v * elements + e] = a * corrected.data[e] / trained.data[e];
+    }
+  }
+  return out;
+}
+
+Array Reconstructor::alpha_by_view() const { return result().alpha_by_view; }
+
+std::vector<ChangingElement> Reconstructor::changing_elements() const {
+  const model::ResponseMap& map = impl_->setup.responses;
+  std::vector<ChangingElement> out;
+  if (!map.varies()) return out;
+  const model::ParameterLayout& l = impl_->setup.layout;
+  const std::vector<float> p = impl_->trainer->parameters();
+  for (const model::ResponseChange& c : impl_->setup.response_changes) {
+    ChangingElement element{c.element, c.dies, {}};
+    for (const model::ResponseMap::Segment& s : map.segments(c.element)) {
+      element.segments.push_back({s.first_view, s.views,
+                                  std::max(p[l.alpha_offset + s.slot], 1e-8f),
+                                  1.0 / (1.0 + std::exp(-p[l.beta_offset + s.slot]))});
+    }
+    out.push_back(std::move(element));
+  }
+  return out;
 }
 
 Array Reconstructor::image() const { return result().image; }
@@ -220,7 +265,20 @@ Array Reconstructor::trained_alpha() const {
   const std::vector<float> p = impl_->trainer->parameters();
   const Geometry& g = impl_->setup.scan.geometry;
   Array out(g.is_3d() ? std::vector<std::size_t>{g.n_v, g.n_u} : std::vector<std::size_t>{g.n_u});
-  for (std::size_t e = 0; e < l.elements; ++e) out.data[e] = std::max(p[l.alpha_offset + e], 1e-8f);
+  for (std::size_t e = 0; e < out.size(); ++e) out.data[e] = std::max(p[l.alpha_offset + e], 1e-8f);
+  for (const ChangingElement& c : changing_elements()) {
+    // The live segments' geometric mean by their views (all of them where none lives).
+    double log_sum = 0.0, views = 0.0, all_log = 0.0, all_views = 0.0;
+    for (const ResponseSegment& s : c.segments) {
+      all_log += std::log(s.alpha) * static_cast<double>(s.views);
+      all_views += static_cast<double>(s.views);
+      if (s.beta < kDeadBelowBeta) continue;
+      log_sum += std::log(s.alpha) * static_cast<double>(s.views);
+      views += static_cast<double>(s.views);
+    }
+    out.data[c.element] =
+        static_cast<float>(views > 0 ? std::exp(log_sum / views) : std::exp(all_log / all_views));
+  }
   return out;
 }
 
@@ -229,15 +287,21 @@ Array Reconstructor::beta() const {
   const std::vector<float> p = impl_->trainer->parameters();
   const Geometry& g = impl_->setup.scan.geometry;
   Array out(g.is_3d() ? std::vector<std::size_t>{g.n_v, g.n_u} : std::vector<std::size_t>{g.n_u});
-  for (std::size_t e = 0; e < l.elements; ++e) {
-    out.data[e] = 1.0f / (1.0f + std::exp(-p[l.beta_offset + e]));
+  for (std::size_t slot = 0; slot < l.elements; ++slot) {
+    const std::size_t e = impl_->setup.responses.element_of(slot);
+    const float b = 1.0f / (1.0f + std::exp(-p[l.beta_offset + slot]));
+    out.data[e] = slot == e ? b : std::max(out.data[e], b);
   }
   return out;
 }
 
 std::vector<DeadElement> Reconstructor::dead_element_report() const {
   const Array b = beta();
-  const std::vector<std::uint32_t>& invalid = impl_->setup.invalid_readings;
+  // Per element (the slots of a changing element summed).
+  std::vector<std::uint32_t> invalid(b.size(), 0);
+  for (std::size_t slot = 0; slot < impl_->setup.invalid_readings.size(); ++slot) {
+    invalid[impl_->setup.responses.element_of(slot)] += impl_->setup.invalid_readings[slot];
+  }
   const std::size_t views = impl_->setup.scan.geometry.n_views();
   std::vector<DeadElement> dead;
   const std::vector<std::uint8_t>& stuck = impl_->setup.stuck;

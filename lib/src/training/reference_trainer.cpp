@@ -27,6 +27,7 @@ class ReferenceTrainer final : public Trainer {
     inputs_.relative_beta_threshold = setup_.config.training.relative_beta_threshold;
     inputs_.data_weight = setup_.config.training.data_weight;
     inputs_.invalid_readings = &setup_.invalid_readings;
+    inputs_.responses = setup_.responses.varies() ? &setup_.responses : nullptr;
   }
 
   void step(int index, const model::Batch& batch) override {

@@ -13,6 +13,7 @@
 #include "model/occupancy.hpp"
 #include "model/parameter_layout.hpp"
 #include "model/ray_segments.hpp"
+#include "model/response_map.hpp"
 #include "model/tail_average.hpp"
 #include "riner/device.hpp"
 #include "riner/execution_plan.hpp"
@@ -28,7 +29,11 @@ struct TrainingSetup {
   std::vector<model::RaySegment> segments;
   std::size_t elements_per_view = 0;
   std::uint32_t seed = 0;
-  std::vector<std::uint32_t> invalid_readings;  // per element: its non-finite measurements
+  std::vector<std::uint32_t> invalid_readings;  // per response slot: its non-finite measurements
+  // Which alpha0/beta0 each reading uses: one per element, or per segment of views for the
+  // elements whose response changes part-way (training.partial_responses).
+  model::ResponseMap responses;
+  std::vector<model::ResponseChange> response_changes;
   model::Occupancy occupancy;                   // where the object can be (all, without skip_air)
   double samples_in_grid = 0.0;                 // samples of every ray inside the grid
   // What one drawn ray adds to each voxel of the grid on average: samples_in_grid / rays /

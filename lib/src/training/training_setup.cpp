@@ -2,6 +2,7 @@
 #include <cmath>
 
 #include "model/factor_evidence.hpp"
+#include "model/response_changes.hpp"
 #include "model/stripe_evidence.hpp"
 #include "model/stuck_elements.hpp"
 #include "riner/error.hpp"
@@ -119,7 +120,13 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
       alpha_model = AlphaModel::kRowsTimesColumns;
     }
   }
-  layout = model::make_layout(g.is_3d() ? 3 : 2, config.encoding, config.network, elements_per_view,
+  responses = model::ResponseMap(elements_per_view);
+  if (config.training.partial_responses && !g.is_3d()) {
+    response_changes =
+        model::find_response_changes(scan.measurement, {config.training.partial_response_sigmas});
+    responses = model::ResponseMap(elements_per_view, g.n_views(), response_changes);
+  }
+  layout = model::make_layout(g.is_3d() ? 3 : 2, config.encoding, config.network, responses.slots(),
                               alpha_model == AlphaModel::kRowsTimesColumns ? g.n_v : 0);
   occupancy.inside.assign(shape_size(g.volume_shape), 1);
   if (config.training.skip_air) {
@@ -133,10 +140,12 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
     alpha_rate *= std::min(1.0, stripe_rms / config.training.alpha_stripe_scale);
   }
   seed = static_cast<std::uint32_t>(config.training.seed ^ (config.training.seed >> 32));
-  invalid_readings.assign(elements_per_view, 0);
+  invalid_readings.assign(responses.slots(), 0);
   const std::vector<float>& rho = scan.measurement.data;
   for (std::size_t ray = 0; ray < rho.size(); ++ray) {
-    if (!std::isfinite(rho[ray])) ++invalid_readings[ray % elements_per_view];
+    if (!std::isfinite(rho[ray])) {
+      ++invalid_readings[responses.slot(ray % elements_per_view, ray / elements_per_view)];
+    }
   }
 }
 

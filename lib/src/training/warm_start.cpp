@@ -94,6 +94,7 @@ TrainingSetup image_fit_setup(const TrainingSetup& setup, const Array& image,
                                   pixels.size());
   fit.seed = setup.seed;
   fit.invalid_readings.assign(pixels.size(), 0);
+  fit.responses = model::ResponseMap(pixels.size());
   fit.tail_average = {0, t.steps};
   fit.alpha_rate = 0.0;
   return fit;
@@ -136,11 +137,12 @@ WarmStart warm_start(const TrainingSetup& setup, const TrainerFactory& make_trai
   std::copy(fitted.begin(), fitted.begin() + static_cast<std::ptrdiff_t>(l.alpha_offset),
             out.parameters.begin());
   double log_alpha = 0.0;
-  for (std::size_t e = 0; e < l.elements; ++e) {
+  for (std::size_t slot = 0; slot < l.elements; ++slot) {
+    const std::size_t e = setup.responses.element_of(slot);
     const double alpha = std::clamp(std::exp(-static_cast<double>(answer.removed.data[e])),
                                     kAlphaMin, kAlphaMax);
-    out.parameters[l.alpha_offset + e] = static_cast<float>(alpha);
-    log_alpha += std::abs(std::log(alpha));
+    out.parameters[l.alpha_offset + slot] = static_cast<float>(alpha);
+    if (slot == e) log_alpha += std::abs(std::log(alpha));
   }
 
   WarmStartStats& s = out.stats;
@@ -155,7 +157,8 @@ WarmStart warm_start(const TrainingSetup& setup, const TrainerFactory& make_trai
   }
   const double beta = 1.0 / (1.0 + std::exp(-1.0));
   s.fit_residual /= static_cast<double>(tail) * fit.config.training.data_weight * beta;
-  s.mean_abs_log_alpha = log_alpha / static_cast<double>(std::max<std::size_t>(1, l.elements));
+  s.mean_abs_log_alpha =
+      log_alpha / static_cast<double>(std::max<std::size_t>(1, setup.elements_per_view));
   s.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return out;
 }
