@@ -133,10 +133,10 @@ int run_simulate(int argc, char** argv, int first) {
       .option("dead-rows", "N", "3D: whole dead detector rows", "0")
       .option("dead-columns", "N", "3D: whole dead detector columns", "0")
       .option("partial", "N",
-              "2D: elements whose response changes part-way (partial rings; alpha.npy is then "
-              "per view)",
+              "elements (pixels) whose response changes part-way (partial rings; alpha.npy is "
+              "then per view)",
               "0")
-      .option("partial-dead", "N", "2D: elements that die part-way", "0")
+      .option("partial-dead", "N", "elements (pixels) that die part-way", "0")
       .option("supersample", "S", "built-in phantoms' raster: S^d points averaged per voxel", "4")
       .option("projector", "NAME", "exact (analytic, built-in phantoms only) or joseph", "exact");
   add_engine_flags(args);

@@ -48,11 +48,14 @@ struct Detection {
 Detection score(const riner::Reconstructor& r, const riner::Array& alpha) {
   Detection d;
   const std::vector<riner::ChangingElement> found = r.changing_elements();
+  const riner::Geometry& g = r.scan().geometry;
   const std::size_t elements = alpha.shape[1];
   int segments = 0;
-  for (std::size_t e = 0; e < elements; ++e) d.changing += !riner::response_change_views(alpha, e).empty();
+  for (std::size_t e = 0; e < elements; ++e) {
+    d.changing += !riner::response_change_views(alpha, g, e).empty();
+  }
   for (const riner::ChangingElement& c : found) {
-    const std::vector<std::size_t> truth = riner::response_change_views(alpha, c.element);
+    const std::vector<std::size_t> truth = riner::response_change_views(alpha, g, c.element);
     if (truth.empty()) {
       ++d.extra;
       continue;

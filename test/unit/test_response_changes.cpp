@@ -9,6 +9,7 @@
 
 #include "model/response_changes.hpp"
 #include "model/response_map.hpp"
+#include "support/geometries.hpp"
 #include "support/partial_scan.hpp"
 #include "training/trainer.hpp"
 
@@ -48,7 +49,8 @@ TEST_SUITE("response changes") {
     const auto found = riner::model::find_response_changes(s.scan.measurement, {});
     std::size_t changing = 0;
     for (std::size_t e = 0; e < s.alpha.shape[1]; ++e) {
-      const std::vector<std::size_t> truth = riner::response_change_views(s.alpha, e);
+      const std::vector<std::size_t> truth =
+          riner::response_change_views(s.alpha, s.scan.geometry, e);
       if (truth.empty()) continue;
       ++changing;
       CAPTURE(e);
@@ -73,6 +75,36 @@ TEST_SUITE("response changes") {
     const riner::Array exact =
         riner::exact_projections(riner::shepp_logan(clean.geometry, 0.1), clean.geometry);
     CHECK(riner::model::find_response_changes(exact, {}).empty());
+  }
+
+  TEST_CASE("3D: each detector row's changes, at their views, as pixels of the detector") {
+    const riner::Geometry g = riner::test::make_geometry(riner::GeometryType::kParallel3d, 240, 96,
+                                                         6, {6, 64, 64}, 1.0, 1.0, M_PI);
+    const riner::Array clean = riner::exact_projections(riner::shepp_logan(g, 0.1), g);
+    riner::RingModel model;
+    model.seed = 3;
+    model.partial_elements = 8;
+    model.partial_dead_elements = 2;
+    const riner::Array alpha = riner::draw_responses(g, model);
+    REQUIRE(alpha.shape == std::vector<std::size_t>{240, 6, 96});
+    const riner::Array rho = riner::corrupt_measurement(clean, alpha, model);
+    const auto found = riner::model::find_response_changes(rho, {});
+    std::size_t changing = 0, at_their_view = 0;
+    for (std::size_t e = 0; e < 6 * 96; ++e) {
+      const std::vector<std::size_t> truth = riner::response_change_views(alpha, g, e);
+      const auto it =
+          std::find_if(found.begin(), found.end(), [&](const auto& c) { return c.element == e; });
+      CAPTURE(e);
+      if (truth.empty()) {
+        CHECK(it == found.end());  // nothing found that did not change
+        continue;
+      }
+      ++changing;
+      at_their_view += it != found.end() && it->starts == truth;
+    }
+    MESSAGE(at_their_view << " of " << changing << " changing pixels found at their view");
+    CHECK(changing == 10);
+    CHECK(at_their_view >= 9);
   }
 
   TEST_CASE("training gives each changing element a slot per segment, off by the setting") {

@@ -195,9 +195,9 @@ def simulate(image=None, geometry="fan2d-paper", seed=0, photons=1e7, nonideal_f
     """A ring-corrupted scan by the paper's protocol (METHOD.md §4) of `image` (on the
     geometry's grid; mu_unit "cm" for DeepLesion's 1/cm) or, when None, of the built-in
     Shepp-Logan phantom. response_pattern "rows-x-columns" (3D) draws alpha as row x column
-    factors, as `riner simulate --response-pattern` does; partial and partial_dead (2D) make
+    factors, as `riner simulate --response-pattern` does; partial and partial_dead make
     that many elements change their response or die part-way (partial rings; alpha is then
-    [views, columns]), as `riner simulate --partial/--partial-dead` do. Returns a dict: sino,
+    per view), as `riner simulate --partial/--partial-dead` do. Returns a dict: sino,
     clean, alpha (0 = dead), ground_truth, geometry."""
     if mu_unit not in ("mm", "cm"):
         raise InputError(f"mu_unit must be mm or cm (got {mu_unit!r})")

@@ -49,9 +49,9 @@ struct ReconstructionResult {
   Array field_image;
   Array image;
   Array alpha;
-  // 2D, when some element's response changes part-way (training.partial_responses): each
-  // view's response per element, [n_views, n_u], the corrections' change to alpha included;
-  // otherwise empty.
+  // When some element's response changes part-way (training.partial_responses): each view's
+  // response per element, [n_views, n_u] ([n_views, n_v, n_u] in 3D), the corrections' change
+  // to alpha included; otherwise empty.
   Array alpha_by_view;
   std::optional<RingCorrection> air_rings;
   std::optional<RingCorrection> gradient_rings;

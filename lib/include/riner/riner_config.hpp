@@ -150,11 +150,12 @@ struct TrainingConfig {
   // hot or stuck pixel, row or column; model/stuck_elements.hpp) are taken for dead before
   // training: their readings count as invalid, like non-finite ones.
   bool stuck_elements = true;
-  // Partial rings (2D): elements whose response changes part-way through the scan (a jump of
+  // Partial rings: elements (pixels) whose response changes part-way through the scan (a jump of
   // their reading against their neighbours', held for views / 12 views or more, at least
   // partial_response_sigmas times the noise) or that die part-way (a run of non-finite
   // readings) get an alpha0 and a beta0 per segment of views instead of one
-  // (model/response_changes.hpp). A scan without such evidence trains exactly as before.
+  // (model/response_changes.hpp; in 3D each detector row's sinogram on its own, and not with
+  // alpha by rows x columns). A scan without such evidence trains exactly as before.
   bool partial_responses = true;
   double partial_response_sigmas = 12.0;
   AlphaModel alpha_model = AlphaModel::kAuto;

@@ -28,10 +28,10 @@ struct RingModel {
   std::size_t dead_elements = 2;  // alpha = 0: the whole column reads +inf
   std::size_t dead_rows = 0;      // 3D: whole detector rows dead
   std::size_t dead_columns = 0;   // 3D: whole detector columns dead
-  // Partial rings (2D): elements whose response changes part-way through the scan, from a view
-  // drawn in the middle three fifths on, to a new value ~ U[alpha_min, alpha_max] at least 15%
-  // (in log) from the old; and elements that die part-way (alpha 0 from such a view on). With
-  // either, the responses are per view: [n_views, n_u].
+  // Partial rings: elements (pixels) whose response changes part-way through the scan, from a
+  // view drawn in the middle three fifths on, to a new value ~ U[alpha_min, alpha_max] at least
+  // 15% (in log) from the old; and elements that die part-way (alpha 0 from such a view on).
+  // With either, the responses are per view: [n_views, n_u] ([n_views, n_v, n_u] in 3D).
   std::size_t partial_elements = 0;
   std::size_t partial_dead_elements = 0;
   double photons = 1e7;           // I0; 0 = no noise (rho = p - ln alpha exactly)
@@ -43,8 +43,8 @@ struct RingModel {
 // True responses: alpha per element, [n_u] in 2D and [n_v, n_u] in 3D; 0 marks dead elements.
 // Exactly round(nonideal_fraction * n) elements get U[alpha_min, alpha_max]; exactly
 // dead_elements (plus whole rows/columns) get 0; the rest get 1. Dead elements are chosen
-// first, then the non-ideal ones among the others. With partial elements (2D only), the
-// responses per view, [n_views, n_u]: partial_elements live elements, then
+// first, then the non-ideal ones among the others. With partial elements, the responses per
+// view ([n_views, n_u], [n_views, n_v, n_u]): partial_elements live elements, then
 // partial_dead_elements others, change from a drawn view on.
 Array draw_responses(const Geometry& g, const RingModel& model);
 
@@ -57,9 +57,10 @@ Array corrupt_measurement(const Array& clean, const Array& alpha, const RingMode
 // view (dead), and those that read 0 in some views only (dead part-way).
 std::vector<std::size_t> dead_in_every_view(const Array& alpha, std::size_t elements);
 std::vector<std::size_t> dead_part_way(const Array& alpha, std::size_t elements);
-// The views where element e's response in a 2D scan's `alpha` ([n_views, elements]) differs from
-// the view before (none for responses per element, [elements]).
-std::vector<std::size_t> response_change_views(const Array& alpha, std::size_t e);
+// The views where element e's response in `alpha` (per view: n_views x the detector's elements)
+// differs from the view before; none for responses per element.
+std::vector<std::size_t> response_change_views(const Array& alpha, const Geometry& g,
+                                               std::size_t e);
 
 struct SimulatedScan {
   Scan scan;           // the ring-corrupted, noisy measurement and its geometry

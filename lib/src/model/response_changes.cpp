@@ -100,8 +100,30 @@ std::size_t response_change_min_views(std::size_t views) {
 
 std::vector<ResponseChange> find_response_changes(const Array& rho_array,
                                                   const ResponseChangeSettings& settings) {
-  if (rho_array.rank() != 2)
-    throw Error("find_response_changes needs a [views, elements] sinogram");
+  if (rho_array.rank() == 3) {
+    // Each detector row on its own: neighbours are the row's (a row's sinogram is a slice's).
+    const std::size_t views = rho_array.shape[0];
+    const std::size_t rows = rho_array.shape[1];
+    const std::size_t columns = rho_array.shape[2];
+    std::vector<ResponseChange> out;
+    Array row({views, columns});
+    for (std::size_t r = 0; r < rows; ++r) {
+      for (std::size_t v = 0; v < views; ++v) {
+        const auto from =
+            rho_array.data.begin() + static_cast<std::ptrdiff_t>((v * rows + r) * columns);
+        std::copy(from, from + static_cast<std::ptrdiff_t>(columns),
+                  row.data.begin() + static_cast<std::ptrdiff_t>(v * columns));
+      }
+      for (ResponseChange& c : find_response_changes(row, settings)) {
+        c.element += r * columns;
+        out.push_back(std::move(c));
+      }
+    }
+    return out;
+  }
+  if (rho_array.rank() != 2) {
+    throw Error("find_response_changes needs a [views, elements] or [views, rows, columns] scan");
+  }
   const std::size_t views = rho_array.shape[0];
   const std::size_t elements = rho_array.shape[1];
   const std::size_t big = response_change_min_views(views);         // M

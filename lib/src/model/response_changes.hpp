@@ -44,7 +44,8 @@ struct ResponseChangeSettings {
   double spike_sigmas = 12.0;
 };
 
-// rho: [views, elements] (a 2D sinogram; non-finite readings allowed). Elements in order.
+// rho: [views, elements] (a 2D sinogram) or [views, rows, columns] (each detector row's
+// sinogram on its own; elements row-major); non-finite readings allowed. Elements in order.
 std::vector<ResponseChange> find_response_changes(const Array& rho,
                                                   const ResponseChangeSettings& settings);
 

@@ -143,7 +143,7 @@ void add_training_schedule(Table& t) {
                        "before training",
                        &C::training, &T::stuck_elements));
   t.push_back(field<C>("training", "partial_responses", {},
-                       "2D: alpha and beta per segment of views for elements whose response "
+                       "alpha and beta per segment of views for elements whose response "
                        "changes or that die part-way (partial rings)",
                        &C::training, &T::partial_responses));
   t.push_back(field<C>("training", "partial_response_sigmas", closed(3, 1000),

@@ -49,19 +49,21 @@ double changed_response(double old, const RingModel& model, sim::Random& rng) {
                                                                            : -kPartialChange);
 }
 
-// Per-element responses `alpha` [n_u] made per view [n_views, n_u]: partial elements change
-// from a view in the middle three fifths of the scan on.
+// Per-element responses `alpha` ([n_u], [n_v, n_u] in 3D) made per view ([n_views, n_u],
+// [n_views, n_v, n_u]): partial elements change from a view in the middle three fifths of the
+// scan on.
 Array with_partial_responses(const Array& alpha, const Geometry& g, const RingModel& model,
                              const std::vector<std::size_t>& live, sim::Random& rng) {
-  if (g.is_3d()) throw InputError("responses that change part-way need a 2D scan for now");
   const std::size_t views = g.n_views();
+  const std::size_t n = alpha.size();
   if (model.partial_elements + model.partial_dead_elements > live.size()) {
     throw InputError("more partial elements than live detector elements");
   }
-  Array out({views, g.n_u});
+  Array out(g.is_3d() ? std::vector<std::size_t>{views, g.n_v, g.n_u}
+                      : std::vector<std::size_t>{views, g.n_u});
   for (std::size_t v = 0; v < views; ++v) {
     std::copy(alpha.data.begin(), alpha.data.end(),
-              out.data.begin() + static_cast<std::ptrdiff_t>(v * g.n_u));
+              out.data.begin() + static_cast<std::ptrdiff_t>(v * n));
   }
   const std::vector<std::size_t> chosen =
       choose(live, model.partial_elements + model.partial_dead_elements, rng);
@@ -71,7 +73,7 @@ Array with_partial_responses(const Array& alpha, const Geometry& g, const RingMo
         std::floor(static_cast<double>(views) * (0.2 + 0.6 * rng.uniform())));
     const double after =
         i < model.partial_elements ? changed_response(alpha.data[e], model, rng) : 0.0;
-    for (std::size_t v = from; v < views; ++v) out.data[v * g.n_u + e] = static_cast<float>(after);
+    for (std::size_t v = from; v < views; ++v) out.data[v * n + e] = static_cast<float>(after);
   }
   return out;
 }
@@ -110,11 +112,12 @@ std::vector<std::size_t> dead_part_way(const Array& alpha, std::size_t elements)
   return out;
 }
 
-std::vector<std::size_t> response_change_views(const Array& alpha, std::size_t e) {
+std::vector<std::size_t> response_change_views(const Array& alpha, const Geometry& g,
+                                               std::size_t e) {
   std::vector<std::size_t> views;
-  if (alpha.rank() != 2) return views;
-  const std::size_t elements = alpha.shape[1];
-  for (std::size_t v = 1; v < alpha.shape[0]; ++v) {
+  const std::size_t elements = g.n_u * (g.is_3d() ? g.n_v : 1);
+  if (alpha.size() != g.n_views() * elements) return views;
+  for (std::size_t v = 1; v < g.n_views(); ++v) {
     if (alpha.data[v * elements + e] != alpha.data[(v - 1) * elements + e]) views.push_back(v);
   }
   return views;
@@ -129,6 +132,10 @@ Array draw_responses(const Geometry& g, const RingModel& model) {
   }
   if (!g.is_3d() && model.pattern == ResponsePattern::kRowsTimesColumns) {
     throw InputError("responses by rows x columns need a 3D detector");
+  }
+  if (model.partial_elements + model.partial_dead_elements > 0 &&
+      model.pattern == ResponsePattern::kRowsTimesColumns) {
+    throw InputError("responses that change part-way are per element, not by rows x columns");
   }
   if (model.dead_rows > rows || model.dead_columns > g.n_u || model.dead_elements > n) {
     throw InputError("more dead rows, columns or elements than the detector has");

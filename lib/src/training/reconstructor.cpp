@@ -178,8 +178,6 @@ ReconstructionResult Reconstructor::result() const {
 }
 
 ReconstructionResult Reconstructor::evaluate_result() const {
-  const RinerConfig& c = impl_->setup.config;
-  const Geometry& g = impl_->setup.scan.geometry;
   ReconstructionResult r;
   r.field_image = field_image();
   r.image = r.field_image;
@@ -221,7 +219,9 @@ Array Reconstructor::responses_by_view(const Array& trained, const Array& correc
   const std::vector<float> p = impl_->trainer->parameters();
   const std::size_t views = impl_->setup.scan.geometry.n_views();
   const std::size_t elements = impl_->setup.elements_per_view;
-  Array out({views, elements});
+  const Geometry& g = impl_->setup.scan.geometry;
+  Array out(g.is_3d() ? std::vector<std::size_t>{views, g.n_v, g.n_u}
+                      : std::vector<std::size_t>{views, elements});
   for (std::size_t v = 0; v < views; ++v) {
     for (std::size_t e = 0; e < elements; ++e) {
       const float a = std::max(p[l.alpha_offset + map.slot(e, v)], 1e-8f);

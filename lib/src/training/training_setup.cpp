@@ -121,7 +121,7 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
     }
   }
   responses = model::ResponseMap(elements_per_view);
-  if (config.training.partial_responses && !g.is_3d()) {
+  if (config.training.partial_responses && alpha_model != AlphaModel::kRowsTimesColumns) {
     response_changes =
         model::find_response_changes(scan.measurement, {config.training.partial_response_sigmas});
     responses = model::ResponseMap(elements_per_view, g.n_views(), response_changes);
