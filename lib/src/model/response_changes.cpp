@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "riner/error.hpp"
+#include "util/parallel.hpp"
 
 namespace riner::model {
 
@@ -42,30 +43,46 @@ double robust_sigma(const std::vector<double>& x, std::size_t begin, std::size_t
   return kMadToSigma * median_of(scratch);
 }
 
+// The median of v[0, n), n <= 2 kNeighbours (insertion sort: a handful of values, once per
+// reading).
+double median_of_few(double* v, int n) {
+  for (int i = 1; i < n; ++i) {
+    const double x = v[i];
+    int j = i;
+    for (; j > 0 && v[j - 1] > x; --j) v[j] = v[j - 1];
+    v[j] = x;
+  }
+  return n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
 // a[v][e] minus the median of its finite neighbours e +- 1..kNeighbours in the same row
-// (mirrored at the ends); NaN where a is not finite or has no finite neighbour.
+// (mirrored at the ends); NaN where a is not finite or has no finite neighbour. Rows in
+// parallel.
 std::vector<double> minus_neighbours(const std::vector<double>& a, std::size_t rows,
                                      std::size_t columns) {
   std::vector<double> out(a.size(), NAN);
-  std::vector<double> around;
   const auto n = static_cast<long>(columns);
-  for (std::size_t r = 0; r < rows; ++r) {
-    const double* row = a.data() + r * columns;
-    for (long c = 0; c < n; ++c) {
-      if (!std::isfinite(row[c])) continue;
-      around.clear();
-      for (long j = -kNeighbours; j <= kNeighbours; ++j) {
-        if (j == 0) continue;
-        long i = c + j;
-        if (i < 0) i = -i;
-        if (i >= n) i = 2 * (n - 1) - i;
-        if (i < 0 || i >= n) continue;
-        if (std::isfinite(row[i])) around.push_back(row[i]);
+  util::parallel_for(rows, [&](std::size_t first, std::size_t last) {
+    double around[2 * kNeighbours];
+    for (std::size_t r = first; r < last; ++r) {
+      const double* row = a.data() + r * columns;
+      for (long c = 0; c < n; ++c) {
+        if (!std::isfinite(row[c])) continue;
+        int count = 0;
+        for (long j = -kNeighbours; j <= kNeighbours; ++j) {
+          if (j == 0) continue;
+          long i = c + j;
+          if (i < 0) i = -i;
+          if (i >= n) i = 2 * (n - 1) - i;
+          if (i < 0 || i >= n) continue;
+          if (std::isfinite(row[i])) around[count++] = row[i];
+        }
+        if (count > 0) {
+          out[r * columns + static_cast<std::size_t>(c)] = row[c] - median_of_few(around, count);
+        }
       }
-      if (!around.empty())
-        out[r * columns + static_cast<std::size_t>(c)] = row[c] - median_of(around);
     }
-  }
+  });
   return out;
 }
 
