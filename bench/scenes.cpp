@@ -57,6 +57,20 @@ RingScene paper_scene(const Options& o, int index, const Projector& projector, R
   return scene;
 }
 
+Geometry parallel_half_turn(double offset_px) {
+  Geometry g;
+  g.type = GeometryType::kParallel2d;
+  g.n_u = 367;
+  g.pitch_u = 1.0;
+  g.offset_u = offset_px;
+  g.voxel_mm = 1.0;
+  g.volume_shape = {256, 256};
+  g.uniform_angles = UniformAngles{360, 0.0, M_PI};
+  g.angles = uniform_angles(*g.uniform_angles);
+  g.validate();
+  return g;
+}
+
 RinerConfig config_from(const Options& o) {
   RinerConfig config;
   const std::string c = o.get("config", "");

@@ -28,6 +28,10 @@ bool uses_deeplesion(const Options& o);
 RingScene paper_scene(const Options& o, int index, const Projector& projector,
                       RingModel model = {});
 
+// A synchrotron-like 2D parallel beam: 360 views over 180 degrees, 367 elements of 1 mm (wide
+// enough for the 256 x 256 grid's diagonal), the axis offset_px from the detector's centre.
+Geometry parallel_half_turn(double offset_px = 0.0);
+
 // The defaults, then --config=FILE|JSON, then --steps, then --engine.
 RinerConfig config_from(const Options& o);
 

@@ -22,21 +22,6 @@ namespace {
 using riner::bench::Options;
 using riner::bench::Result;
 
-// bench/partial_rings_geometry.json: 360 views over 180 degrees, 367 elements of 1 mm.
-riner::Geometry parallel_half_turn() {
-  riner::Geometry g;
-  g.type = riner::GeometryType::kParallel2d;
-  g.n_u = 367;
-  g.pitch_u = 1.0;
-  g.voxel_mm = 1.0;
-  g.volume_shape = {256, 256};
-  g.uniform_angles = riner::UniformAngles{360, 0.0, M_PI};
-  g.angles = riner::uniform_angles(*g.uniform_angles);
-  g.validate();
-  return g;
-}
-
-
 struct Detection {
   int changing = 0;              // elements whose true response changes
   int found = 0;                 // of those, found at their true view
@@ -79,7 +64,9 @@ std::vector<Result> partial_rings(const Options& o) {
   const int last = o.get_int("last", o.size == "tiny" ? first : 9);
   const std::string png_dir = o.output_dir("png", "");
   riner::Device device = riner::Device::open(o.device);
-  const riner::Projector projector(parallel_half_turn(), riner::Engine::kOpenCL, device);
+  // bench/partial_rings_geometry.json
+  const riner::Projector projector(riner::bench::parallel_half_turn(), riner::Engine::kOpenCL,
+                                   device);
   riner::RingModel model;
   model.partial_elements = static_cast<std::size_t>(o.get_int("partial", 12));
   model.partial_dead_elements = static_cast<std::size_t>(o.get_int("partial_dead", 4));

@@ -108,15 +108,7 @@ std::vector<Result> riner_deeplesion(const Options& o) {
 
 // A parallel-beam Shepp-Logan ring scan (180 degrees, off-centre axis).
 std::vector<Result> riner_parallel_shepp_logan(const Options& o) {
-  riner::Geometry g;
-  g.type = riner::GeometryType::kParallel2d;
-  g.n_u = 367;
-  g.pitch_u = 1.0;
-  g.offset_u = 3.5;
-  g.voxel_mm = 1.0;
-  g.volume_shape = {256, 256};
-  g.uniform_angles = riner::UniformAngles{360, 0.0, M_PI};
-  g.angles = riner::uniform_angles(*g.uniform_angles);
+  const riner::Geometry g = riner::bench::parallel_half_turn(3.5);
   const riner::Phantom phantom = riner::shepp_logan(g);
   const riner::Array truth = riner::rasterize(phantom, g, 4);
   riner::RingModel model;

@@ -222,7 +222,6 @@ class Reconstructor {
  private:
   ReconstructionResult evaluate_result() const;
   void evaluate_rings(ReconstructionResult& r) const;
-  Array responses_by_view(const Array& trained, const Array& corrected) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -5,6 +5,7 @@
 
 #include "riner/error.hpp"
 #include "util/parallel.hpp"
+#include "util/robust_statistics.hpp"
 
 namespace riner::model {
 
@@ -17,7 +18,6 @@ constexpr int kNeighbours = 3;  // each side, for the neighbours' median
 constexpr double kStepSigmas = 3.0;
 constexpr double kIsolation = 8.0;   // the jump against either neighbour's within one view
 constexpr double kSharpness = 0.25;  // the jump's views before and after, against the jump
-constexpr double kMadToSigma = 1.4826;
 
 double median_of(std::vector<double>& v) {
   if (v.empty()) return NAN;
@@ -40,7 +40,7 @@ double robust_sigma(const std::vector<double>& x, std::size_t begin, std::size_t
                     std::vector<double>& scratch) {
   const double m = median_range(x, begin, end, scratch);
   for (double& v : scratch) v = std::fabs(v - m);
-  return kMadToSigma * median_of(scratch);
+  return util::kMadToSigma * median_of(scratch);
 }
 
 // The median of v[0, n), n <= 2 kNeighbours (insertion sort: a handful of values, once per
@@ -159,7 +159,7 @@ std::vector<ResponseChange> find_response_changes(const Array& rho_array,
   for (double j : jump) {
     if (std::isfinite(j)) scratch.push_back(std::fabs(j));
   }
-  const double noise = kMadToSigma * median_of(scratch);
+  const double noise = util::kMadToSigma * median_of(scratch);
   if (!(noise > 0.0)) return out;
 
   // The largest |jump| of e's neighbours (e +- 1) within one view of j. Not e +- 2: an edge of
@@ -229,7 +229,7 @@ std::vector<ResponseChange> find_response_changes(const Array& rho_array,
       for (std::size_t i = lo; i < hi; ++i) {
         if (i != j) scratch.push_back(std::fabs(g[i]));
       }
-      const double local = std::max(kMadToSigma * median_of(scratch), noise);
+      const double local = std::max(util::kMadToSigma * median_of(scratch), noise);
       if (a < settings.spike_sigmas * local || a < kIsolation * neighbours_jump(j, e)) continue;
       // Between two views: an edge of the object crossing the element slowly spreads its jump
       // over several.

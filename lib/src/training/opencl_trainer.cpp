@@ -22,10 +22,12 @@ namespace {
 constexpr int kHistoryBlock = 256;   // steps between reads of the loss history
 constexpr int kUploadsInFlight = 3;  // steps the host may prepare ahead of the device
 
-// The setup's response table (one slot per element when the setup left it empty).
-std::vector<cl_uint> response_table(const TrainingSetup& setup) {
-  if (setup.responses.elements() == setup.elements_per_view) return setup.responses.table();
-  return model::ResponseMap(setup.elements_per_view).table();
+// The setup's response table, which the step kernel indexes by every element of a view.
+const std::vector<cl_uint>& response_table(const TrainingSetup& setup) {
+  if (setup.responses.elements() != setup.elements_per_view) {
+    throw Error("training setup: its response map does not cover the detector's elements");
+  }
+  return setup.responses.table();
 }
 
 class OpenclTrainer final : public Trainer {

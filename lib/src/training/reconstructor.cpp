@@ -177,14 +177,80 @@ ReconstructionResult Reconstructor::result() const {
   return *impl_->result;
 }
 
+namespace {
+
+// The changing elements' segments with their trained alpha and beta (parameters p).
+std::vector<ChangingElement> changing_elements_of(const detail::TrainingSetup& setup,
+                                                  const std::vector<float>& p) {
+  const model::ResponseMap& map = setup.responses;
+  const model::ParameterLayout& l = setup.layout;
+  std::vector<ChangingElement> out;
+  for (const model::ResponseChange& c : setup.response_changes) {
+    ChangingElement element{c.element, c.dies, {}};
+    for (const model::ResponseMap::Segment& s : map.segments(c.element)) {
+      element.segments.push_back({s.first_view, s.views,
+                                  std::max(p[l.alpha_offset + s.slot], 1e-8f),
+                                  1.0 / (1.0 + std::exp(-p[l.beta_offset + s.slot]))});
+    }
+    out.push_back(std::move(element));
+  }
+  return out;
+}
+
+// max(alpha0, 1e-8) per element; a changing element's is its live segments' geometric mean by
+// their views (all of them where none lives).
+Array alpha_per_element(const detail::TrainingSetup& setup, const std::vector<float>& p) {
+  const model::ParameterLayout& l = setup.layout;
+  const Geometry& g = setup.scan.geometry;
+  Array out(g.is_3d() ? std::vector<std::size_t>{g.n_v, g.n_u} : std::vector<std::size_t>{g.n_u});
+  for (std::size_t e = 0; e < out.size(); ++e) out.data[e] = std::max(p[l.alpha_offset + e], 1e-8f);
+  for (const ChangingElement& c : changing_elements_of(setup, p)) {
+    double log_sum = 0.0, views = 0.0, all_log = 0.0, all_views = 0.0;
+    for (const ResponseSegment& s : c.segments) {
+      all_log += std::log(s.alpha) * static_cast<double>(s.views);
+      all_views += static_cast<double>(s.views);
+      if (s.beta < Reconstructor::kDeadBelowBeta) continue;
+      log_sum += std::log(s.alpha) * static_cast<double>(s.views);
+      views += static_cast<double>(s.views);
+    }
+    out.data[c.element] =
+        static_cast<float>(views > 0 ? std::exp(log_sum / views) : std::exp(all_log / all_views));
+  }
+  return out;
+}
+
+// ReconstructionResult::alpha_by_view: each view's slot, scaled by what the ring corrections did
+// to its element (trained -> corrected); empty when no element changes.
+Array responses_by_view(const detail::TrainingSetup& setup, const std::vector<float>& p,
+                        const Array& trained, const Array& corrected) {
+  const model::ResponseMap& map = setup.responses;
+  if (!map.varies()) return Array();
+  const model::ParameterLayout& l = setup.layout;
+  const Geometry& g = setup.scan.geometry;
+  const std::size_t views = g.n_views();
+  const std::size_t elements = setup.elements_per_view;
+  Array out(g.is_3d() ? std::vector<std::size_t>{views, g.n_v, g.n_u}
+                      : std::vector<std::size_t>{views, elements});
+  for (std::size_t v = 0; v < views; ++v) {
+    for (std::size_t e = 0; e < elements; ++e) {
+      const float a = std::max(p[l.alpha_offset + map.slot(e, v)], 1e-8f);
+      out.data[v * elements + e] = a * corrected.data[e] / trained.data[e];
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
 ReconstructionResult Reconstructor::evaluate_result() const {
   ReconstructionResult r;
   r.field_image = field_image();
   r.image = r.field_image;
-  r.alpha = trained_alpha();
+  const std::vector<float> p = impl_->trainer->parameters();
+  r.alpha = alpha_per_element(impl_->setup, p);
   const Array trained = r.alpha;
   evaluate_rings(r);
-  r.alpha_by_view = responses_by_view(trained, r.alpha);
+  r.alpha_by_view = responses_by_view(impl_->setup, p, trained, r.alpha);
   return r;
 }
 
@@ -212,43 +278,11 @@ void Reconstructor::evaluate_rings(ReconstructionResult& r) const {
   model::fade_into_skipped_air(impl_->setup.occupancy, g.volume_shape, 0, r.image.data);
 }
 
-Array Reconstructor::responses_by_view(const Array& trained, const Array& corrected) const {
-  const model::ResponseMap& map = impl_->setup.responses;
-  if (!map.varies()) return Array();
-  const model::ParameterLayout& l = impl_->setup.layout;
-  const std::vector<float> p = impl_->trainer->parameters();
-  const std::size_t views = impl_->setup.scan.geometry.n_views();
-  const std::size_t elements = impl_->setup.elements_per_view;
-  const Geometry& g = impl_->setup.scan.geometry;
-  Array out(g.is_3d() ? std::vector<std::size_t>{views, g.n_v, g.n_u}
-                      : std::vector<std::size_t>{views, elements});
-  for (std::size_t v = 0; v < views; ++v) {
-    for (std::size_t e = 0; e < elements; ++e) {
-      const float a = std::max(p[l.alpha_offset + map.slot(e, v)], 1e-8f);
-      out.data[v * elements + e] = a * corrected.data[e] / trained.data[e];
-    }
-  }
-  return out;
-}
-
 Array Reconstructor::alpha_by_view() const { return result().alpha_by_view; }
 
 std::vector<ChangingElement> Reconstructor::changing_elements() const {
-  const model::ResponseMap& map = impl_->setup.responses;
-  std::vector<ChangingElement> out;
-  if (!map.varies()) return out;
-  const model::ParameterLayout& l = impl_->setup.layout;
-  const std::vector<float> p = impl_->trainer->parameters();
-  for (const model::ResponseChange& c : impl_->setup.response_changes) {
-    ChangingElement element{c.element, c.dies, {}};
-    for (const model::ResponseMap::Segment& s : map.segments(c.element)) {
-      element.segments.push_back({s.first_view, s.views,
-                                  std::max(p[l.alpha_offset + s.slot], 1e-8f),
-                                  1.0 / (1.0 + std::exp(-p[l.beta_offset + s.slot]))});
-    }
-    out.push_back(std::move(element));
-  }
-  return out;
+  if (!impl_->setup.responses.varies()) return {};
+  return changing_elements_of(impl_->setup, impl_->trainer->parameters());
 }
 
 Array Reconstructor::image() const { return result().image; }
@@ -261,25 +295,7 @@ Array Reconstructor::alpha() const {
 }
 
 Array Reconstructor::trained_alpha() const {
-  const model::ParameterLayout& l = impl_->setup.layout;
-  const std::vector<float> p = impl_->trainer->parameters();
-  const Geometry& g = impl_->setup.scan.geometry;
-  Array out(g.is_3d() ? std::vector<std::size_t>{g.n_v, g.n_u} : std::vector<std::size_t>{g.n_u});
-  for (std::size_t e = 0; e < out.size(); ++e) out.data[e] = std::max(p[l.alpha_offset + e], 1e-8f);
-  for (const ChangingElement& c : changing_elements()) {
-    // The live segments' geometric mean by their views (all of them where none lives).
-    double log_sum = 0.0, views = 0.0, all_log = 0.0, all_views = 0.0;
-    for (const ResponseSegment& s : c.segments) {
-      all_log += std::log(s.alpha) * static_cast<double>(s.views);
-      all_views += static_cast<double>(s.views);
-      if (s.beta < kDeadBelowBeta) continue;
-      log_sum += std::log(s.alpha) * static_cast<double>(s.views);
-      views += static_cast<double>(s.views);
-    }
-    out.data[c.element] =
-        static_cast<float>(views > 0 ? std::exp(log_sum / views) : std::exp(all_log / all_views));
-  }
-  return out;
+  return alpha_per_element(impl_->setup, impl_->trainer->parameters());
 }
 
 Array Reconstructor::beta() const {
