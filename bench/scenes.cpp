@@ -128,4 +128,17 @@ nlohmann::json detector_accuracy(const Array& alpha, const Array& beta, const Si
           {"dead", dead}};
 }
 
+void write_panel_png(const std::string& path, const std::vector<const Array*>& images,
+                     const Window& window) {
+  const std::size_t ny = images.front()->shape[0];
+  const std::size_t nx = images.front()->shape[1];
+  Array panel({ny, images.size() * nx});
+  for (std::size_t i = 0; i < ny; ++i) {
+    for (std::size_t p = 0; p < images.size(); ++p) {
+      for (std::size_t k = 0; k < nx; ++k) panel(i, p * nx + k) = (*images[p])(i, k);
+    }
+  }
+  write_png(path, panel, window);
+}
+
 }  // namespace riner::bench

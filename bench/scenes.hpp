@@ -7,6 +7,7 @@
 #include <string>
 
 #include "harness.hpp"
+#include "riner/io.hpp"
 #include "riner/projector.hpp"
 #include "riner/riner_config.hpp"
 #include "riner/simulate.hpp"
@@ -43,5 +44,9 @@ RinerConfig config_from(const Options& o);
 // counts beta alone).
 nlohmann::json detector_accuracy(const Array& alpha, const Array& beta, const SimulatedScan& sim,
                                  const std::vector<std::size_t>& reported_dead = {});
+
+// Images of one shape side by side in one PNG (a figure: truth | FBP | riner ...).
+void write_panel_png(const std::string& path, const std::vector<const Array*>& images,
+                     const Window& window);
 
 }  // namespace riner::bench

@@ -116,16 +116,9 @@ std::vector<Result> partial_rings(const Options& o) {
     }
     if (!png_dir.empty()) {
       // truth | FBP | Riner, partial_responses off | on
-      const std::size_t n = truth.shape[0];
-      riner::Array panel({n, 4 * n});
-      const riner::Array* columns[] = {&truth, &fbp_image, &images[0], &images[1]};
-      for (std::size_t i = 0; i < n; ++i) {
-        for (std::size_t p = 0; p < 4; ++p) {
-          for (std::size_t k = 0; k < n; ++k) panel(i, p * n + k) = (*columns[p])(i, k);
-        }
-      }
-      riner::write_png(png_dir + "/partial_rings_slice" + std::to_string(slice) + ".png", panel,
-                       riner::Window{0.0f, 0.035f});
+      riner::bench::write_panel_png(
+          png_dir + "/partial_rings_slice" + std::to_string(slice) + ".png",
+          {&truth, &fbp_image, &images[0], &images[1]}, riner::Window{0.0f, 0.035f});
     }
     results.push_back({"partial_rings", fields});
   }

@@ -22,10 +22,30 @@ constexpr double kEvenOverOdd = 2.0;
 // detector's or a beam's structure across the centre reads as even (on wood_neutron a plateau
 // 60 elements wide on the axis, docs/history/RESULTS.md).
 constexpr double kMirrorGapWindows = 4.0;
-// Elements that could tell but show no object hold the profile's projection near no change,
-// with this weight against the evidence's; a small ridge keeps radii no ray reaches at 0.
+// The profile: nodes every half pixel of radius (an object's edge is sharp; the tangent rays'
+// cusps place it to a fraction of an element), solved only within this many pixels of the
+// radius of an element that shows an object, 0 elsewhere.
+constexpr double kNodeStepPx = 0.5;
+constexpr double kObjectMarginPx = 4.0;
+// The fit's elements: those whose ray passes within this many pixels of an object element's
+// (its cusp and flanks, which carry the object's shape) count fully; the other judged elements
+// hold the profile's projection near no change with kHoldWeight (a real detector's broad even
+// structure, a beam profile say, is no object: with full weight there the HTC disc's rim came
+// out sharper than its edge, 3 speck pixels became 15).
+constexpr double kEvidenceReachPx = 8.0;
 constexpr double kHoldWeight = 0.1;
-constexpr double kRidgeWeight = 1e-3;
+// The detector's own even part is noise as large as its odd part, which a profile with a node
+// per element would copy into the image as fine rings. So the profile's total variation is
+// penalised, by the largest weight (of those tried) that leaves the weighted residual within
+// this fraction of the noise (EvenEvidence::noise): a profile with about a node per element
+// absorbs part of the noise, so the honest residual is below it (0.8: the tube-wall phantom at
+// detectors of +-5% and +-25%, docs/history/RESULTS.md, issue 32).
+constexpr double kResidualToNoise = 0.8;
+constexpr double kSmallestVariationWeight = 1e-4;
+constexpr int kVariationWeightsTried = 9;  // half decades up to 1
+constexpr int kReweightingRounds = 60;
+// |profile step| below this (1/mm) counts as this in the total variation's reweighting.
+constexpr double kVariationFloor = 1e-5;
 
 // The fractional element whose ray lies at distance x from the axis (distances run monotonically
 // across the detector), or -1 when x is beyond the detector.
@@ -103,9 +123,12 @@ std::vector<double> running_median_abs(const std::vector<double>& values,
 struct EvenEvidence {
   std::vector<char> judged;  // paired with a mirror far enough away to tell
   std::vector<char> object;
-  std::vector<double> target;  // -ln(alpha) the profile's projection should take away
+  std::vector<double> target;  // every judged element's even part above the level
   std::size_t count = 0;
   double largest_sigmas = 0.0;
+  // The detector's noise in the even part: the odd part's robust spread over the judged
+  // elements, or the even part's own element-to-element roughness where that is larger.
+  double noise = 0.0;
 };
 
 EvenEvidence even_evidence(const MirrorParts& parts, const MirrorRingSettings& s) {
@@ -153,41 +176,117 @@ EvenEvidence even_evidence(const MirrorParts& parts, const MirrorRingSettings& s
       if (ev.judged[k]) ev.object[k] = 1;
     });
   }
+  std::vector<double> odd_judged;
   for (std::size_t e = 0; e < n; ++e) {
-    if (!ev.object[e]) continue;
-    ev.target[e] = even[e] - level;
-    ++ev.count;
+    if (ev.object[e]) ++ev.count;
+    if (!ev.judged[e]) continue;
+    // Unsmoothed: the cusps of an object's projection at its tangent rays place its edges.
+    ev.target[e] = parts.even[e] - level;
+    odd_judged.push_back(std::fabs(parts.odd[e]));
+  }
+  if (!odd_judged.empty()) ev.noise = util::kMadToSigma * util::quantile(odd_judged, 0.5);
+  // The even part's own roughness from element to element, which no object's projection has
+  // (it is smooth but at a few cusps, which the median passes over): a detector whose structure
+  // is even (modules laid out symmetrically about the axis) is noise of that size to the fit.
+  std::vector<double> curvature;
+  for (std::size_t e = 1; e + 1 < n; ++e) {
+    if (ev.judged[e - 1] && ev.judged[e] && ev.judged[e + 1]) {
+      curvature.push_back(std::fabs(parts.even[e - 1] - 2.0 * parts.even[e] + parts.even[e + 1]));
+    }
+  }
+  if (!curvature.empty()) {
+    // A second difference of white noise has sqrt(6) times its spread.
+    const double rough = util::kMadToSigma * util::quantile(curvature, 0.5) / std::sqrt(6.0);
+    ev.noise = std::max(ev.noise, rough);
   }
   return ev;
 }
 
-// Weighted least squares of the profile's projections against the target: weight 1 where the
-// evidence is, kHoldWeight (target 0) on the other judged elements, 0 on the rest (no evidence
-// either way: their alpha takes whatever the profile projects there). Returns the
-// image's gain per solved node; `weights` gets every element's projection weights on them.
-Eigen::VectorXd fit_gain(const EvenEvidence& ev, const Geometry& g, double step_mm,
-                         std::size_t nodes, Eigen::Index solved, Eigen::MatrixXd& weights,
-                         std::size_t& measured) {
+// Whether `radius` lies within `reach` of the ray distance of an element that shows an object.
+bool near_object(const EvenEvidence& ev, const std::vector<double>& distance, double radius,
+                 double reach) {
+  for (std::size_t e = 0; e < ev.object.size(); ++e) {
+    if (ev.object[e] && std::fabs(std::fabs(distance[e]) - radius) <= reach) return true;
+  }
+  return false;
+}
+
+// Least squares of `a` (the used nodes' projections, rows weighted) against `target`, plus
+// `weight` times the profile's total variation (reweighted least squares).
+Eigen::VectorXd fit_with_variation(const Eigen::MatrixXd& a, const Eigen::VectorXd& target,
+                                   double weight) {
+  const Eigen::Index k = a.cols();
+  const Eigen::MatrixXd normal = a.transpose() * a;
+  const Eigen::VectorXd rhs = a.transpose() * target;
+  const double scale = normal.trace() / static_cast<double>(k);
+  Eigen::MatrixXd diff = Eigen::MatrixXd::Zero(k - 1, k);
+  for (Eigen::Index i = 0; i + 1 < k; ++i) {
+    diff(i, i) = -1.0;
+    diff(i, i + 1) = 1.0;
+  }
+  const Eigen::MatrixXd ridge = 1e-6 * scale * Eigen::MatrixXd::Identity(k, k);
+  Eigen::VectorXd g = (normal + 1e3 * ridge).ldlt().solve(rhs);
+  for (int round = 0; round < kReweightingRounds; ++round) {
+    const Eigen::VectorXd reweight =
+        (diff * g).array().abs().max(kVariationFloor).inverse().matrix();
+    const Eigen::MatrixXd penalty = diff.transpose() * reweight.asDiagonal() * diff;
+    g = (normal + weight * scale * penalty + ridge).ldlt().solve(rhs);
+  }
+  return g;
+}
+
+// The profile (its gain to the image per solved node) and every element's projection weights
+// on the solved nodes; `used`: how many nodes it may use.
+Eigen::VectorXd fit_gain(const EvenEvidence& ev, const Geometry& g,
+                         const std::vector<double>& distance, double step_mm, std::size_t nodes,
+                         Eigen::Index solved, Eigen::MatrixXd& weights, std::size_t& used) {
   const auto n = static_cast<Eigen::Index>(g.n_u);
   weights.resize(n, solved);
-  Eigen::VectorXd w = Eigen::VectorXd::Zero(n);
-  Eigen::VectorXd target = Eigen::VectorXd::Zero(n);
-  Eigen::VectorXd object = Eigen::VectorXd::Zero(n);
   for (Eigen::Index e = 0; e < n; ++e) {
-    const auto i = static_cast<std::size_t>(e);
-    const std::vector<double> row = rings::ring_projection_weights(nodes, step_mm, g, i);
+    const std::vector<double> row =
+        rings::ring_projection_weights(nodes, step_mm, g, static_cast<std::size_t>(e));
     for (Eigen::Index k = 0; k < solved; ++k) weights(e, k) = row[static_cast<std::size_t>(k)];
-    w[e] = ev.object[i] ? 1.0 : ev.judged[i] ? kHoldWeight : 0.0;
-    target[e] = ev.target[i];
-    object[e] = ev.object[i] ? 1.0 : 0.0;
   }
-  const Eigen::MatrixXd weighted = w.asDiagonal() * weights;
-  // Radii some object element's ray reaches.
-  measured = static_cast<std::size_t>(((weights.transpose() * object).array() > 0.0).count());
-  Eigen::MatrixXd normal = weighted.transpose() * weighted;
-  const double scale = normal.trace() / static_cast<double>(solved);
-  normal.diagonal().array() += kRidgeWeight * scale;
-  return normal.ldlt().solve(weighted.transpose() * w.asDiagonal() * target);
+  std::vector<Eigen::Index> at;
+  for (Eigen::Index k = 0; k < solved; ++k) {
+    const double radius = static_cast<double>(k) * step_mm;
+    if (near_object(ev, distance, radius, kObjectMarginPx * g.voxel_mm)) at.push_back(k);
+  }
+  used = at.size();
+  Eigen::VectorXd gain = Eigen::VectorXd::Zero(solved);
+  if (at.size() < 2) return gain;
+  // Rows: the judged elements whose rays reach a used node (the others see no profile).
+  std::vector<Eigen::Index> rows;
+  for (Eigen::Index e = 0; e < n; ++e) {
+    if (!ev.judged[static_cast<std::size_t>(e)]) continue;
+    bool reaches = false;
+    for (Eigen::Index k : at) reaches = reaches || weights(e, k) > 0.0;
+    if (reaches) rows.push_back(e);
+  }
+  if (rows.empty()) return gain;
+  const auto m = static_cast<Eigen::Index>(rows.size());
+  Eigen::MatrixXd a(m, static_cast<Eigen::Index>(at.size()));
+  Eigen::VectorXd target(m);
+  for (Eigen::Index r = 0; r < m; ++r) {
+    const auto e = static_cast<std::size_t>(rows[static_cast<std::size_t>(r)]);
+    const bool full =
+        near_object(ev, distance, std::fabs(distance[e]), kEvidenceReachPx * g.voxel_mm);
+    const double w = full ? 1.0 : kHoldWeight;
+    for (std::size_t k = 0; k < at.size(); ++k) {
+      a(r, static_cast<Eigen::Index>(k)) = w * weights(rows[static_cast<std::size_t>(r)], at[k]);
+    }
+    target[r] = full ? ev.target[e] : 0.0;
+  }
+  const double allowed = kResidualToNoise * ev.noise * std::sqrt(static_cast<double>(m));
+  Eigen::VectorXd best;
+  for (int i = 0; i < kVariationWeightsTried; ++i) {
+    const double weight = kSmallestVariationWeight * std::pow(10.0, 0.5 * i);
+    Eigen::VectorXd fit = fit_with_variation(a, target, weight);
+    if (best.size() > 0 && (a * fit - target).norm() > allowed) break;
+    best = std::move(fit);
+  }
+  for (std::size_t k = 0; k < at.size(); ++k) gain[at[k]] = best[static_cast<Eigen::Index>(k)];
+  return gain;
 }
 
 }  // namespace
@@ -202,18 +301,19 @@ RingCorrection correct_rings_from_mirrors(const Array& image, const Array& alpha
   RingCorrection out = rings::unchanged(image, alpha, geometry.voxel_mm);
   if (!rings::all_finite(image) || geometry.n_u < 2) return out;
   const rings::ResponseOffsets offsets = rings::response_offsets(alpha, dead_elements);
-  const MirrorParts parts =
-      mirror_parts(offsets.offset, offsets.usable, column_ray_distances(geometry));
+  const std::vector<double> distance = column_ray_distances(geometry);
+  const MirrorParts parts = mirror_parts(offsets.offset, offsets.usable, distance);
   const EvenEvidence evidence = even_evidence(parts, settings);
   out.elements_moved = evidence.count;
   out.largest_even_sigmas = evidence.largest_sigmas;
   if (evidence.count == 0) return out;
 
-  const rings::ProfileNodes at = rings::profile_nodes(image);
+  out.radius_step_mm = kNodeStepPx * geometry.voxel_mm;
+  const rings::ProfileNodes at = rings::profile_nodes(image, kNodeStepPx);
   if (at.solved < 3) return out;
   Eigen::MatrixXd weights;
-  const Eigen::VectorXd gain = fit_gain(evidence, geometry, out.radius_step_mm, at.nodes, at.solved,
-                                        weights, out.measured_radii);
+  const Eigen::VectorXd gain = fit_gain(evidence, geometry, distance, out.radius_step_mm, at.nodes,
+                                        at.solved, weights, out.measured_radii);
   if (out.measured_radii == 0) return out;
   rings::move_gain_into_image(out, image, geometry, gain, weights, at.nodes,
                               settings.max_mean_response_change);

@@ -115,12 +115,12 @@ ResponseOffsets response_offsets(const Array& alpha, const std::vector<std::size
   return r;
 }
 
-ProfileNodes profile_nodes(const Array& image) {
+ProfileNodes profile_nodes(const Array& image, double step_px) {
   const auto ny = static_cast<double>(image.shape[0]);
   const auto nx = static_cast<double>(image.shape[1]);
   ProfileNodes p;
-  p.nodes = static_cast<std::size_t>(std::ceil(0.5 * std::hypot(nx - 1.0, ny - 1.0))) + 2;
-  p.solved = static_cast<Eigen::Index>(0.5 * (std::min(nx, ny) - 1.0));
+  p.nodes = static_cast<std::size_t>(std::ceil(0.5 * std::hypot(nx - 1.0, ny - 1.0) / step_px)) + 2;
+  p.solved = static_cast<Eigen::Index>(0.5 * (std::min(nx, ny) - 1.0) / step_px);
   return p;
 }
 

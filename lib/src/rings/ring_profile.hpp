@@ -48,14 +48,14 @@ struct ResponseOffsets {
 void check_dead_elements(const char* what, const std::vector<std::size_t>& dead, std::size_t n_u);
 ResponseOffsets response_offsets(const Array& alpha, const std::vector<std::size_t>& dead);
 
-// A profile's nodes for an image: one per pixel of radius out to the farthest pixel, plus a
-// spare; `solved` of them lie inside the grid's inscribed circle, beyond which the grid's
-// corners cut a ring differently in every view (no longer a per-element offset).
+// A profile's nodes for an image: one every `step_px` pixels of radius out to the farthest
+// pixel, plus a spare; `solved` of them lie inside the grid's inscribed circle, beyond which the
+// grid's corners cut a ring differently in every view (no longer a per-element offset).
 struct ProfileNodes {
   std::size_t nodes = 0;
   Eigen::Index solved = 0;
 };
-ProfileNodes profile_nodes(const Array& image);
+ProfileNodes profile_nodes(const Array& image, double step_px = 1.0);
 
 // The image gains `gain` (per solved node; `weights`: every element's projection weights on
 // them): out.profile = -gain, folded into alpha (fold_into_alpha) and, when that is applied,
