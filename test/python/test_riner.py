@@ -93,6 +93,17 @@ def test_simulate_partial_rings_matches_the_cli(cli, tmp_path):
     assert len(changing) == 4
 
 
+def test_reconstruct_returns_each_views_response_when_some_change_part_way():
+    sim = riner.simulate(None, "fan2d-paper", seed=2, partial=3, partial_dead=1)
+    r = riner.reconstruct(sim["sino"], "fan2d-paper", steps=20, quality=False)
+    found = {c["element"] for c in r.summary["changing_elements"]}
+    truth = {e for e in range(500) if np.any(np.diff(sim["alpha"][:, e]))}
+    assert found and found <= truth
+    assert r.alpha_by_view.shape == (360, 500) and r.alpha_by_view.dtype == np.float32
+    for e in found:  # a changing element's response steps where the simulation's does
+        assert np.any(np.diff(r.alpha_by_view[:, e]))
+
+
 def test_fbp_matches_the_cli(cli, tmp_path, fan_scan):
     sim, g = fan_scan
     riner.write_array(tmp_path / "sino.npy", sim["sino"])
@@ -157,6 +168,7 @@ def test_reconstruct_returns_image_alpha_beta_summary(fan_scan):
     r = riner.reconstruct(sim["sino"], g, steps=300, seed=1)
     image, alpha, beta, summary, field = r
     assert image.shape == (64, 64) and field.shape == (64, 64)
+    assert r.alpha_by_view is None  # no element changes part-way
     assert alpha.shape == (96,) and beta.shape == (96,)
     assert summary["steps"] == 300
     # The two dead elements of the simulation are reported dead.
@@ -345,3 +357,11 @@ def test_load_scan_interpolates_flats_before_and_after_a_drifting_beam(tmp_path)
     assert np.array_equal(sino_json, sino, equal_nan=True)
     with pytest.raises(riner.InputError, match="flat_after needs flat"):
         riner.load_scan(tmp_path / "raw.npy", flat_after=tmp_path / "after.npy")
+    # And from arrays: flat_field, fbp and reconstruct take the second series as flat_after.
+    rho, report = riner.flat_field(raw, before, flat_after=after)
+    assert np.array_equal(rho, sino, equal_nan=True) and report["flat_series"] == 2
+    assert np.array_equal(riner.fbp(raw, g, flat=before, flat_after=after), riner.fbp(sino, g))
+    r = riner.reconstruct(raw, g, flat=before, flat_after=after, steps=5, quality=False)
+    assert r.summary["flat_field"]["flat_series"] == 2
+    with pytest.raises(riner.InputError, match="flat_after needs flat"):
+        riner.fbp(raw, g, flat_after=after)

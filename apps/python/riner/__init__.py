@@ -121,21 +121,26 @@ def _device(device):
     return "" if device is None else str(device)
 
 
-def flat_field(projections, flat, dark=None):
+def flat_field(projections, flat, dark=None, flat_after=None):
     """rho = -ln((I - D) / (F - D)) with F and D the per-pixel means of the flat and dark frames
-    (one frame or a stack); invalid readings become NaN. Returns (rho, report dict)."""
+    (one frame or a stack); invalid readings become NaN. flat_after: flats taken after the scan
+    (a drifting beam): each view's F is interpolated between the two series by its place in the
+    scan. Returns (rho, report dict)."""
     rho, report = _riner.flat_field(_array(projections), _array(flat),
-                                    None if dark is None else _array(dark))
+                                    None if dark is None else _array(dark),
+                                    None if flat_after is None else _array(flat_after))
     return rho, json.loads(report)
 
 
-def _scan(sino, geometry_spec, flat, dark, center_spec):
+def _scan(sino, geometry_spec, flat, dark, center_spec, flat_after=None):
     """The normalised measurement, the geometry JSON and what was done to get them."""
     notes = {"flat_field": None, "centre": None}
     if flat is not None:
-        sino, notes["flat_field"] = flat_field(sino, flat, dark)
+        sino, notes["flat_field"] = flat_field(sino, flat, dark, flat_after)
     elif dark is not None:
         raise InputError("dark needs flat")
+    elif flat_after is not None:
+        raise InputError("flat_after needs flat")
     else:
         sino = _array(sino)
     geometry_json = _geometry_json(geometry_spec)
@@ -155,25 +160,26 @@ def _scan(sino, geometry_spec, flat, dark, center_spec):
     return sino, geometry_json, notes
 
 
-def center(sino, geometry, flat=None, dark=None):
+def center(sino, geometry, flat=None, dark=None, flat_after=None):
     """The centre of rotation a parallel-beam scan's own views point to (mirrored views half
     a turn apart): a dict with offset_px (riner's), axis_column (tomopy's center), spread_px,
     method, and half_acquisition (a full turn whose axis lies near one end of the detector)."""
-    sino, geometry_json, _ = _scan(sino, geometry, flat, dark, None)
+    sino, geometry_json, _ = _scan(sino, geometry, flat, dark, None, flat_after)
     return json.loads(_riner.center(sino, geometry_json))
 
 
 def fbp(sino, geometry, flat=None, dark=None, center=None, filter="ram-lak", device=None,
-        engine="opencl"):
+        engine="opencl", flat_after=None):
     """FBP (parallel, fan), FDK (cone) or slice-wise FBP (parallel 3D) of a scan, mu in 1/mm.
-    center: the axis column, or "auto" to estimate it (parallel beam)."""
-    sino, geometry_json, _ = _scan(sino, geometry, flat, dark, center)
+    center: the axis column, or "auto" to estimate it (parallel beam); flat_after: as
+    flat_field's."""
+    sino, geometry_json, _ = _scan(sino, geometry, flat, dark, center, flat_after)
     return _riner.fbp(sino, geometry_json, filter, engine, _device(device))
 
 
 def destripe(sino, geometry, flat=None, dark=None, center=None, method="all", size=0,
              large_size=0, snr=3.0, sigma=0.0, fit_order=2, levels=0, wavelet=9, device=None,
-             engine="opencl"):
+             engine="opencl", flat_after=None):
     """Classical stripe removal on the sinogram, as `riner destripe`: method "normalise",
     "sorting", "filtering", "fitting", "wavelet" (Münch et al.'s wavelet-Fourier filter),
     "large", "dead" or "all" (Vo et al.'s combination); size and large_size 0 for the
@@ -182,8 +188,8 @@ def destripe(sino, geometry, flat=None, dark=None, center=None, method="all", si
     stripes (each element's mean removed, rho; exp(-stripes) reads as alpha), dead_elements,
     large_stripe_elements, size, large_size, sigma, wavelet_levels, non_finite_replaced.
     engine "opencl" runs every step as a kernel on device (None: the first GPU, else the first
-    device), "reference" on the CPU twins."""
-    sino, geometry_json, _ = _scan(sino, geometry, flat, dark, center)
+    device), "reference" on the CPU twins. flat_after: as flat_field's."""
+    sino, geometry_json, _ = _scan(sino, geometry, flat, dark, center, flat_after)
     return _riner.destripe(sino, geometry_json, method, size, large_size, snr, sigma,
                            fit_order, levels, wavelet, engine, _device(device))
 
@@ -214,12 +220,24 @@ def simulate(image=None, geometry="fan2d-paper", seed=0, photons=1e7, nonideal_f
     return out
 
 
-class Reconstruction(NamedTuple):
+class _ReconstructionTuple(NamedTuple):
     image: object    # mu in 1/mm on the geometry's grid, rings corrected
     alpha: object    # the detector's estimated response per element ([columns] or [rows, columns])
     beta: object     # validity per element; < 0.5 marks a dead element
     summary: dict    # what `riner reconstruct` writes to summary.json
     field: object    # the trained field before the ring corrections
+
+
+class Reconstruction(_ReconstructionTuple):
+    """(image, alpha, beta, summary, field), and alpha_by_view: each view's response ([views,
+    columns] or [views, rows, columns]) when some element changes or dies part-way through the
+    scan (summary["changing_elements"]), else None. An attribute, not a sixth item, so that
+    code unpacking five items keeps working."""
+
+    def __new__(cls, image, alpha, beta, summary, field, alpha_by_view=None):
+        self = super().__new__(cls, image, alpha, beta, summary, field)
+        self.alpha_by_view = alpha_by_view
+        return self
 
 
 def _settings_list(kwargs):
@@ -241,10 +259,12 @@ def _settings_list(kwargs):
 
 def reconstruct(sino, geometry, flat=None, dark=None, center=None, config=None, settings=None,
                 progress=None, progress_every=200, quality=True, device=None, engine="opencl",
-                **short_settings):
-    """Riner on a scan: returns Reconstruction(image, alpha, beta, summary, field).
+                flat_after=None, **short_settings):
+    """Riner on a scan: returns Reconstruction(image, alpha, beta, summary, field), with
+    .alpha_by_view (each view's response when some change part-way, else None).
 
-    sino: the log-normalised measurement, or raw intensities when flat (and dark) are given.
+    sino: the log-normalised measurement, or raw intensities when flat (and dark) are given;
+    flat_after: flats taken after the scan (a drifting beam), as flat_field's.
     geometry: a dict, a JSON path or a preset name. center: the axis column, or "auto".
     config: a settings dict or JSON file as `riner reconstruct --config` takes; settings: a
     dict {"training.steps": 12000, ...}; keyword arguments name settings by their last part
@@ -253,7 +273,7 @@ def reconstruct(sino, geometry, flat=None, dark=None, center=None, config=None, 
     returning False stops training early. quality: the no-reference quality report against
     FBP in the summary. Ctrl-C stops training and raises KeyboardInterrupt.
     """
-    sino, geometry_json, notes = _scan(sino, geometry, flat, dark, center)
+    sino, geometry_json, notes = _scan(sino, geometry, flat, dark, center, flat_after)
     if config is None:
         config_json = ""
     elif isinstance(config, dict):
@@ -262,12 +282,12 @@ def reconstruct(sino, geometry, flat=None, dark=None, center=None, config=None, 
         with open(config, encoding="utf-8") as f:
             config_json = f.read()
     pairs = _settings_list(dict(settings or {}, **short_settings))
-    image, alpha, beta, summary, field = _riner.reconstruct(
+    image, alpha, beta, summary, field, alpha_by_view = _riner.reconstruct(
         sino, geometry_json, config_json, pairs, engine, _device(device), progress,
         int(progress_every), bool(quality))
     summary = json.loads(summary)
     summary.update(notes)
-    return Reconstruction(image, alpha, beta, summary, field)
+    return Reconstruction(image, alpha, beta, summary, field, alpha_by_view)
 
 
 def load_scan(path, geometry=None, flat=None, dark=None, row=None, center=None,

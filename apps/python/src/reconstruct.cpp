@@ -110,9 +110,11 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
     if (!quality) json["quality"] = nullptr;
     summary = json.dump();
   }
+  py::object alpha_by_view = py::none();
+  if (result.alpha_by_view.size() > 0) alpha_by_view = to_numpy(std::move(result.alpha_by_view));
   return py::make_tuple(to_numpy(std::move(result.image)), to_numpy(std::move(result.alpha)),
-                        to_numpy(std::move(beta)), summary,
-                        to_numpy(std::move(result.field_image)));
+                        to_numpy(std::move(beta)), summary, to_numpy(std::move(result.field_image)),
+                        alpha_by_view);
 }
 
 }  // namespace

@@ -165,15 +165,19 @@ void bind_scan_functions(py::module_& m) {
     return app::centre_json(estimate).dump();
   });
   // Raw intensities, flats and darks (None: D = 0) -> rho and the report's JSON.
-  m.def("flat_field", [](const py::handle& raw, const py::handle& flats, const py::object& darks) {
+  // flats_after (None: one series): flats taken after the scan, each view's flat interpolated.
+  m.def("flat_field", [](const py::handle& raw, const py::handle& flats, const py::object& darks,
+                         const py::object& flats_after) {
     const Array projections = to_array(raw, "projections");
     const Array flat = to_array(flats, "flat");
     const Array dark = darks.is_none() ? Array() : to_array(darks, "dark");
+    const Array after = flats_after.is_none() ? Array() : to_array(flats_after, "flat_after");
     FlatFieldReport report;
     Array rho;
     {
       py::gil_scoped_release release;
-      rho = flat_field_normalise(projections, flat, dark, &report);
+      const FlatStack stack = flats_before_after(flat, after, projections.shape);
+      rho = flat_field_normalise(projections, stack.frames, dark, &report, stack.positions);
     }
     return py::make_tuple(to_numpy(std::move(rho)), app::flat_field_json(report).dump());
   });
