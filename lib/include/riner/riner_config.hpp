@@ -151,7 +151,8 @@ struct TrainingConfig {
   // training: their readings count as invalid, like non-finite ones.
   bool stuck_elements = true;
   // Partial rings: elements (pixels) whose response changes part-way through the scan (a jump of
-  // their reading against their neighbours', held for views / 12 views or more, at least
+  // their reading against their neighbours', held for views / 12 views (near the scan's ends,
+  // what is left of them), at least
   // partial_response_sigmas times the noise) or that die part-way (a run of non-finite
   // readings) get an alpha0 and a beta0 per segment of views instead of one
   // (model/response_changes.hpp; in 3D each detector row's sinogram on its own, and not with

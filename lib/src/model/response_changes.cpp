@@ -222,7 +222,9 @@ std::vector<ResponseChange> find_response_changes(const Array& rho_array,
     for (std::size_t j = 0; j + 1 < views; ++j) {
       const double a = std::fabs(g[j]);
       const std::size_t k = j + 1;
-      if (a <= settings.spike_sigmas * noise || k < big || k + big > views) continue;
+      // Near the scan's ends the step needs its windows of m views; the hold is checked over
+      // what is left, at least m.
+      if (a <= settings.spike_sigmas * noise || k < small || k + small > views) continue;
       const std::size_t lo = j >= around ? j - around : 0;
       const std::size_t hi = std::min(views - 1, j + around);
       scratch.clear();
@@ -245,8 +247,9 @@ std::vector<ResponseChange> find_response_changes(const Array& rho_array,
       if ((d > 0) != (g[j] > 0) || std::fabs(d) < 0.5 * a || std::fabs(d) < kStepSigmas * spread) {
         continue;
       }
+      const std::size_t reach = std::min({big, k, views - k});
       const double held =
-          median_range(x, k, k + big, scratch) - median_range(x, k - big, k, scratch);
+          median_range(x, k, k + reach, scratch) - median_range(x, k - reach, k, scratch);
       if ((held > 0) != (d > 0) || std::fabs(held) < 0.5 * std::fabs(d)) continue;
       found.emplace_back(k, d);
     }
