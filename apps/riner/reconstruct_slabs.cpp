@@ -335,6 +335,10 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
 
   // The whole scan's outputs from the slabs' files (this run's and earlier runs').
   std::vector<std::size_t> dead;
+  // Partial rings: each changing element with the detector rows it stands for (a 2D slice's
+  // column stands for its slab's rows; a 3D slab's pixel for its own row).
+  nlohmann::json changing = nlohmann::json::array();
+  std::size_t dying = 0;
   for (const Slab& s : run.slabs()) {
     const nlohmann::json& summary = run.manifest()["slabs"][s.index]["summary"];
     if (!summary.is_object() || !summary.contains("dead_elements")) continue;
@@ -345,6 +349,15 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
         continue;
       }
       for (std::size_t r = 0; r < s.rows.count; ++r) dead.push_back((s.rows.first + r) * g.n_u + e);
+    }
+    for (const nlohmann::json& c : summary.value("changing_elements", nlohmann::json::array())) {
+      const auto e = c["element"].get<std::size_t>();
+      const std::size_t first_row = by_column ? s.rows.first : s.rows.first + e / g.n_u;
+      changing.push_back({{"rows", {first_row, by_column ? s.rows.count : 1}},
+                          {"column", by_column ? e : e % g.n_u},
+                          {"dies", c["dies"]},
+                          {"segments", c["segments"]}});
+      dying += c["dies"].get<bool>() ? 1 : 0;
     }
   }
   write_detector_outputs(out, run.alpha(), run.beta(), dead);
@@ -390,11 +403,18 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
                          : 0.0},
       {"training_seconds", training_wall},
       {"dead_elements", dead.size()},
+      {"changing_elements", changing},
       {"centre",
        run.source().centre() ? centre_json(*run.source().centre()) : nlohmann::json(nullptr)},
       {"wall_seconds", wall},
       {"per_slab", run.manifest()["slabs"]}};
   write_text(out / "summary.json", summary.dump(1) + "\n");
+  if (!changing.empty()) {
+    console.line("partial rings: " + std::to_string(changing.size() - dying) +
+                 " element(s) change response part-way and " + std::to_string(dying) +
+                 " die part-way, each trained with alpha and beta per segment of views "
+                 "(summary.json changing_elements: rows, column, segments)");
+  }
   console.line("reconstructed " + shape_string(g.volume_shape) + " in " +
                std::to_string(run.slabs().size()) + " slabs in " + format_duration(wall) + " (" +
                std::to_string(dead.size()) + " elements flagged dead) -> " +

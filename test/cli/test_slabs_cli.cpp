@@ -317,6 +317,43 @@ TEST_SUITE("cli") {
     CHECK(run.err.find("--slices-2d trains each slice alone") != std::string::npos);
   }
 
+  TEST_CASE("a stack's partial rings: each slice's changing elements by row in the run's summary") {
+    // 240 views of a 64 x 3 detector, 12 pixels changing and 3 dying part-way (riner simulate
+    // --partial on a volume), each row trained as its 2D slice.
+    riner::test::TempDir dir;
+    riner::test::write_bytes(dir / "g.json", R"({"type": "parallel3d",
+        "detector": {"count": [64, 3], "pitch_mm": [1.0, 1.0]},
+        "angles": {"count": 240, "range_rad": 3.141592653589793},
+        "volume": {"shape": [3, 48, 48], "voxel_mm": 1.0}})");
+    Run run = riner_cli("simulate --quiet --seed 2 --partial 12 --partial-dead 3 --geometry " +
+                            (dir / "g.json").string() + " --out " + (dir / "sim").string(),
+                        dir);
+    REQUIRE(run.code == 0);
+    run = riner_cli("reconstruct " + (dir / "sim" / "sino.npy").string() +
+                        " --slices-2d --steps 20 --out " + (dir / "out").string(),
+                    dir);
+    CAPTURE(run.err);
+    REQUIRE(run.code == 0);
+    const nlohmann::json summary =
+        nlohmann::json::parse(riner::test::read_bytes(dir / "out" / "summary.json"));
+    const nlohmann::json& changing = summary["changing_elements"];
+    MESSAGE(changing.size() << " changing elements found of 15");
+    REQUIRE(changing.size() >= 5);
+    CHECK(run.out.find("partial rings: ") != std::string::npos);
+    const riner::Array alpha = riner::read_array(dir / "sim" / "alpha.npy").array;  // [240, 3, 64]
+    for (const nlohmann::json& c : changing) {
+      const auto row = c["rows"][0].get<std::size_t>();
+      const auto column = c["column"].get<std::size_t>();
+      CAPTURE(row);
+      CAPTURE(column);
+      CHECK(c["rows"][1] == 1);
+      // Found where the simulation changes that pixel's response, at its view.
+      const auto first = c["segments"][1]["first_view"].get<std::size_t>();
+      CHECK(alpha.data[(first * 3 + row) * 64 + column] !=
+            alpha.data[((first - 1) * 3 + row) * 64 + column]);
+    }
+  }
+
   TEST_CASE("slices of 256 x 256 or more train alone in 2D by default; --field-3d keeps 3D slabs") {
     riner::test::TempDir dir;
     riner::test::write_bytes(dir / "g.json", R"({"type": "parallel3d",
