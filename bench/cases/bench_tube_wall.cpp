@@ -11,14 +11,17 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include "harness.hpp"
+#include "metrics/radial_profile.hpp"
 #include "riner/fbp.hpp"
 #include "riner/io.hpp"
 #include "riner/metrics.hpp"
 #include "riner/phantom.hpp"
 #include "riner/reconstructor.hpp"
 #include "riner/simulate.hpp"
+#include "rings/radial.hpp"
 #include "scenes.hpp"
 
 namespace {
@@ -26,48 +29,41 @@ namespace {
 using riner::bench::Options;
 using riner::bench::Result;
 
-// Angular means per whole pixel of radius about the grid's centre, over the pixels farther than
-// 3 px from every off-centre part of the phantom.
+// Angular means per whole pixel of radius about the grid's centre (metrics::radial_means, as
+// the ring index reads them), over the pixels farther than 3 px from every off-centre part of
+// the phantom.
 class RadialProfile {
  public:
-  RadialProfile(const riner::Phantom& phantom, const riner::Geometry& g) {
+  RadialProfile(const riner::Phantom& phantom, const riner::Geometry& g)
+      : radii_(g.volume_shape[0], g.volume_shape[1], 1.0) {
     const std::size_t ny = g.volume_shape[0];
     const std::size_t nx = g.volume_shape[1];
-    const double cx = 0.5 * (static_cast<double>(nx) - 1.0);
-    const double cy = 0.5 * (static_cast<double>(ny) - 1.0);
-    bin_.assign(ny * nx, -1);
+    off_centre_.assign(ny * nx, 0);
     for (std::size_t i = 0; i < ny; ++i) {
       for (std::size_t k = 0; k < nx; ++k) {
-        // World x along columns, y along rows, as voxel_centre places them.
         const riner::Vec3 c =
             riner::voxel_centre(g, static_cast<double>(k), static_cast<double>(i));
-        bool concentric = true;
         for (const riner::Ellipsoid& e : phantom.ellipsoids) {
           if (std::hypot(e.centre.x, e.centre.y) < 1e-9) continue;
           const double reach = e.semi_axes.x + 3.0 * g.voxel_mm;
-          concentric = concentric && std::hypot(c.x - e.centre.x, c.y - e.centre.y) > reach;
+          if (std::hypot(c.x - e.centre.x, c.y - e.centre.y) <= reach) off_centre_[i * nx + k] = 1;
         }
-        if (!concentric) continue;
-        const double r = std::hypot(static_cast<double>(k) - cx, static_cast<double>(i) - cy);
-        bin_[i * nx + k] = static_cast<int>(std::lround(r));
       }
     }
   }
   std::vector<double> of(const riner::Array& image) const {
-    const int bins = *std::max_element(bin_.begin(), bin_.end()) + 1;
-    std::vector<double> sum(static_cast<std::size_t>(bins), 0.0);
-    std::vector<double> count(sum.size(), 0.0);
-    for (std::size_t p = 0; p < bin_.size(); ++p) {
-      if (bin_[p] < 0) continue;
-      sum[static_cast<std::size_t>(bin_[p])] += image.data[p];
-      count[static_cast<std::size_t>(bin_[p])] += 1.0;
+    riner::Array concentric = image;
+    for (std::size_t p = 0; p < image.size(); ++p) {
+      if (off_centre_[p]) concentric.data[p] = std::numeric_limits<float>::quiet_NaN();
     }
-    for (std::size_t b = 0; b < sum.size(); ++b) sum[b] /= std::max(count[b], 1.0);
-    return sum;
+    std::vector<double> mean, count;
+    riner::metrics::radial_means(concentric, radii_.nearest_nodes(), mean, count);
+    return mean;
   }
 
  private:
-  std::vector<int> bin_;
+  riner::rings::PixelRadii radii_;
+  std::vector<char> off_centre_;
 };
 
 struct WallError {

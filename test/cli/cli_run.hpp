@@ -36,19 +36,27 @@ inline Run riner_cli(const std::string& arguments, const TempDir& dir) {
   return run;
 }
 
-// A small parallel-beam stack (36 views, 30 x 20 detector, 20 x 24 x 24 volume) simulated into
-// dir/sim, its geometry in dir/g3.json; returns dir/sim.
-inline std::string simulate_small_parallel3d(const TempDir& dir) {
-  write_bytes(dir / "g3.json", R"({"type": "parallel3d",
-      "detector": {"count": [30, 20], "pitch_mm": [1.0, 1.0]},
-      "angles": {"count": 36, "range_rad": 3.141592653589793},
-      "volume": {"shape": [20, 24, 24], "voxel_mm": 1.0}})");
+// `geometry_json` written as dir/geometry_file and `riner simulate --quiet OPTIONS` of it into
+// dir/sim; returns dir/sim.
+inline std::string simulate_geometry(const TempDir& dir, const std::string& geometry_file,
+                                     const std::string& geometry_json, const std::string& options) {
+  write_bytes(dir / geometry_file, geometry_json);
   const std::string sim = (dir / "sim").string();
-  REQUIRE(riner_cli("simulate --quiet --seed 3 --geometry " + (dir / "g3.json").string() +
-                        " --out " + sim,
+  REQUIRE(riner_cli("simulate --quiet " + options + " --geometry " +
+                        (dir / geometry_file).string() + " --out " + sim,
                     dir)
               .code == 0);
   return sim;
+}
+
+// A small parallel-beam stack (36 views, 30 x 20 detector, 20 x 24 x 24 volume) simulated into
+// dir/sim, its geometry in dir/g3.json; returns dir/sim.
+inline std::string simulate_small_parallel3d(const TempDir& dir) {
+  return simulate_geometry(dir, "g3.json", R"({"type": "parallel3d",
+      "detector": {"count": [30, 20], "pitch_mm": [1.0, 1.0]},
+      "angles": {"count": 36, "range_rad": 3.141592653589793},
+      "volume": {"shape": [20, 24, 24], "voxel_mm": 1.0}})",
+                           "--seed 3");
 }
 
 }  // namespace riner::test

@@ -321,17 +321,14 @@ TEST_SUITE("cli") {
     // 240 views of a 64 x 3 detector, 12 pixels changing and 3 dying part-way (riner simulate
     // --partial on a volume), each row trained as its 2D slice.
     riner::test::TempDir dir;
-    riner::test::write_bytes(dir / "g.json", R"({"type": "parallel3d",
+    riner::test::simulate_geometry(dir, "g.json", R"({"type": "parallel3d",
         "detector": {"count": [64, 3], "pitch_mm": [1.0, 1.0]},
         "angles": {"count": 240, "range_rad": 3.141592653589793},
-        "volume": {"shape": [3, 48, 48], "voxel_mm": 1.0}})");
-    Run run = riner_cli("simulate --quiet --seed 2 --partial 12 --partial-dead 3 --geometry " +
-                            (dir / "g.json").string() + " --out " + (dir / "sim").string(),
-                        dir);
-    REQUIRE(run.code == 0);
-    run = riner_cli("reconstruct " + (dir / "sim" / "sino.npy").string() +
-                        " --slices-2d --steps 20 --out " + (dir / "out").string(),
-                    dir);
+        "volume": {"shape": [3, 48, 48], "voxel_mm": 1.0}})",
+                                   "--seed 2 --partial 12 --partial-dead 3");
+    const Run run = riner_cli("reconstruct " + (dir / "sim" / "sino.npy").string() +
+                                  " --slices-2d --steps 20 --out " + (dir / "out").string(),
+                              dir);
     CAPTURE(run.err);
     REQUIRE(run.code == 0);
     const nlohmann::json summary =
@@ -356,14 +353,11 @@ TEST_SUITE("cli") {
 
   TEST_CASE("slices of 256 x 256 or more train alone in 2D by default; --field-3d keeps 3D slabs") {
     riner::test::TempDir dir;
-    riner::test::write_bytes(dir / "g.json", R"({"type": "parallel3d",
+    riner::test::simulate_geometry(dir, "g.json", R"({"type": "parallel3d",
         "detector": {"count": [260, 2], "pitch_mm": [1.0, 1.0]},
         "angles": {"count": 12, "range_rad": 3.141592653589793},
-        "volume": {"shape": [2, 256, 256], "voxel_mm": 1.0}})");
-    REQUIRE(riner_cli("simulate --quiet --seed 2 --geometry " + (dir / "g.json").string() +
-                          " --out " + (dir / "sim").string(),
-                      dir)
-                .code == 0);
+        "volume": {"shape": [2, 256, 256], "voxel_mm": 1.0}})",
+                                   "--seed 2");
     const std::string scan = (dir / "sim" / "sino.npy").string();
     const std::string settings = " --steps 20 --quiet --out ";
     Run run = riner_cli("reconstruct " + scan + settings + (dir / "default").string(), dir);

@@ -202,13 +202,19 @@ EvenEvidence even_evidence(const MirrorParts& parts, const MirrorRingSettings& s
   return ev;
 }
 
-// Whether `radius` lies within `reach` of the ray distance of an element that shows an object.
-bool near_object(const EvenEvidence& ev, const std::vector<double>& distance, double radius,
-                 double reach) {
+// The distances from the axis of the rays of the elements that show an object.
+std::vector<double> object_radii(const EvenEvidence& ev, const std::vector<double>& distance) {
+  std::vector<double> radii;
   for (std::size_t e = 0; e < ev.object.size(); ++e) {
-    if (ev.object[e] && std::fabs(std::fabs(distance[e]) - radius) <= reach) return true;
+    if (ev.object[e]) radii.push_back(std::fabs(distance[e]));
   }
-  return false;
+  return radii;
+}
+
+// Whether `radius` lies within `reach` of one of `radii`.
+bool within_reach(const std::vector<double>& radii, double radius, double reach) {
+  return std::any_of(radii.begin(), radii.end(),
+                     [&](double r) { return std::fabs(r - radius) <= reach; });
 }
 
 // Least squares of `a` (the used nodes' projections, rows weighted) against `target`, plus
@@ -247,10 +253,11 @@ Eigen::VectorXd fit_gain(const EvenEvidence& ev, const Geometry& g,
         rings::ring_projection_weights(nodes, step_mm, g, static_cast<std::size_t>(e));
     for (Eigen::Index k = 0; k < solved; ++k) weights(e, k) = row[static_cast<std::size_t>(k)];
   }
+  const std::vector<double> objects = object_radii(ev, distance);
   std::vector<Eigen::Index> at;
   for (Eigen::Index k = 0; k < solved; ++k) {
     const double radius = static_cast<double>(k) * step_mm;
-    if (near_object(ev, distance, radius, kObjectMarginPx * g.voxel_mm)) at.push_back(k);
+    if (within_reach(objects, radius, kObjectMarginPx * g.voxel_mm)) at.push_back(k);
   }
   used = at.size();
   Eigen::VectorXd gain = Eigen::VectorXd::Zero(solved);
@@ -269,8 +276,7 @@ Eigen::VectorXd fit_gain(const EvenEvidence& ev, const Geometry& g,
   Eigen::VectorXd target(m);
   for (Eigen::Index r = 0; r < m; ++r) {
     const auto e = static_cast<std::size_t>(rows[static_cast<std::size_t>(r)]);
-    const bool full =
-        near_object(ev, distance, std::fabs(distance[e]), kEvidenceReachPx * g.voxel_mm);
+    const bool full = within_reach(objects, std::fabs(distance[e]), kEvidenceReachPx * g.voxel_mm);
     const double w = full ? 1.0 : kHoldWeight;
     for (std::size_t k = 0; k < at.size(); ++k) {
       a(r, static_cast<Eigen::Index>(k)) = w * weights(rows[static_cast<std::size_t>(r)], at[k]);
