@@ -64,8 +64,9 @@ riner::Array replay(const std::string& order, const Saved& s,
     }
     image = std::move(r.image);
     alpha = std::move(r.alpha);
+    // As riner::correct_rings_in_order: the skipped air back to 0 before the next step.
+    for (std::size_t p = 0; p < image.size(); ++p) image.data[p] *= s.keep.data[p];
   }
-  for (std::size_t p = 0; p < image.size(); ++p) image.data[p] *= s.keep.data[p];
   return image;
 }
 

@@ -16,24 +16,15 @@
 #include "riner/rays.hpp"
 #include "riner/ring_correction.hpp"
 #include "support/geometries.hpp"
+#include "support/painted.hpp"
 
 namespace {
+
+using riner::test::painted;
 
 // A 128 x 128 grid of 1 mm seen by a fan beam with margin.
 riner::Geometry ring_geometry() {
   return riner::test::make_geometry(riner::GeometryType::kFan2d, 32, 181, 1, {128, 128}, 1.5, 1.0);
-}
-
-// The 128 x 128 grid with value(voxel centre) at every pixel.
-template <class Value>
-riner::Array painted(const riner::Geometry& g, const Value& value) {
-  riner::Array image(g.volume_shape);
-  for (std::size_t i = 0; i < 128; ++i) {
-    for (std::size_t k = 0; k < 128; ++k) {
-      image(i, k) = value(riner::voxel_centre(g, static_cast<double>(k), static_cast<double>(i)));
-    }
-  }
-  return image;
 }
 
 riner::Array sum_of(const riner::Array& a, const riner::Array& b) {

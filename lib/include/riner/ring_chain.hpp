@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <vector>
 
@@ -25,9 +26,14 @@ struct RingChain {
   std::optional<RingCorrection> mirror;
 };
 
-// 2D geometry; `dead_elements` as correct_rings_from_response takes them.
+// 2D geometry; `dead_elements` as correct_rings_from_response takes them. `sampled`: per pixel
+// (C order), 0 where training skipped the pixel as air and the image holds 0, or empty (all
+// sampled). Each correction subtracts its profile along whole circles; it is taken back out of
+// the skipped air before the next correction reads the image, which would otherwise take that
+// paint for a ring and move it into the object's outline (the HTC disc: a 0.002/mm halo).
 RingChain correct_rings_in_order(const Array& image, const Array& alpha, const Geometry& geometry,
                                  const std::vector<std::size_t>& dead_elements,
-                                 const RingCorrectionConfig& config);
+                                 const RingCorrectionConfig& config,
+                                 const std::vector<std::uint8_t>& sampled = {});
 
 }  // namespace riner

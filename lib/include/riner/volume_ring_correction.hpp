@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -43,11 +44,12 @@ std::vector<long> rows_of_slices(const Geometry& geometry);
 // `volume` on the 3D geometry's grid, `alpha` per detector pixel ([n_v, n_u]); `dead_elements`
 // are flat indices into alpha (their alpha is not a response). Runs the corrections `config`
 // turns on, in the 2D order, on every slice that has a row; returns the input with a note for
-// a cone beam or when no slice has a row. Throws InputError for a 2D geometry or mismatched
-// shapes.
+// a cone beam or when no slice has a row. `sampled`: per voxel, as correct_rings_in_order takes
+// it per pixel, or empty. Throws InputError for a 2D geometry or mismatched shapes.
 VolumeRingCorrection correct_rings_per_slice(const Array& volume, const Array& alpha,
                                              const Geometry& geometry,
                                              const std::vector<std::size_t>& dead_elements,
-                                             const RingCorrectionConfig& config);
+                                             const RingCorrectionConfig& config,
+                                             const std::vector<std::uint8_t>& sampled = {});
 
 }  // namespace riner

@@ -1,15 +1,28 @@
 #include "riner/ring_chain.hpp"
 
+#include <string>
+
+#include "riner/error.hpp"
+
 namespace riner {
 
 RingChain correct_rings_in_order(const Array& image, const Array& alpha, const Geometry& g,
                                  const std::vector<std::size_t>& dead_elements,
-                                 const RingCorrectionConfig& config) {
+                                 const RingCorrectionConfig& config,
+                                 const std::vector<std::uint8_t>& sampled) {
+  if (!sampled.empty() && sampled.size() != image.size()) {
+    throw InputError("ring corrections: the sampled-pixel mask has " +
+                     std::to_string(sampled.size()) + " values for an image of " +
+                     std::to_string(image.size()));
+  }
   RingChain out{image, alpha, std::nullopt, std::nullopt, std::nullopt, std::nullopt,
                 std::nullopt};
-  const auto take = [&out](std::optional<RingCorrection>& slot, RingCorrection c) {
+  const auto take = [&out, &sampled](std::optional<RingCorrection>& slot, RingCorrection c) {
     out.image = c.image;
     out.alpha = c.alpha;
+    for (std::size_t p = 0; p < sampled.size(); ++p) {
+      if (!sampled[p]) out.image.data[p] = 0.0f;
+    }
     slot = std::move(c);
   };
   // First: what training put into alpha that is an object goes back before the others judge

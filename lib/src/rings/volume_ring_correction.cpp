@@ -35,7 +35,8 @@ std::vector<long> rows_of_slices(const Geometry& g) {
 VolumeRingCorrection correct_rings_per_slice(const Array& volume, const Array& alpha,
                                              const Geometry& g,
                                              const std::vector<std::size_t>& dead_elements,
-                                             const RingCorrectionConfig& config) {
+                                             const RingCorrectionConfig& config,
+                                             const std::vector<std::uint8_t>& sampled) {
   if (!g.is_3d()) throw InputError("per-slice ring correction: only 3D geometries");
   if (volume.shape != g.volume_shape) {
     throw InputError("per-slice ring correction: volume shape " + shape_string(volume.shape) +
@@ -45,6 +46,11 @@ VolumeRingCorrection correct_rings_per_slice(const Array& volume, const Array& a
   if (alpha.size() != pixels) {
     throw InputError("per-slice ring correction: alpha has " + std::to_string(alpha.size()) +
                      " values for " + std::to_string(pixels) + " detector pixels");
+  }
+  if (!sampled.empty() && sampled.size() != volume.size()) {
+    throw InputError("per-slice ring correction: the sampled-voxel mask has " +
+                     std::to_string(sampled.size()) + " values for a volume of " +
+                     std::to_string(volume.size()));
   }
   VolumeRingCorrection out;
   out.image = volume;
@@ -76,8 +82,13 @@ VolumeRingCorrection correct_rings_per_slice(const Array& volume, const Array& a
     Array response({g.n_u});
     std::copy_n(alpha.data.begin() + static_cast<std::ptrdiff_t>(row * g.n_u), g.n_u,
                 response.data.begin());
+    std::vector<std::uint8_t> slice_sampled;
+    if (!sampled.empty()) {
+      const auto first = sampled.begin() + static_cast<std::ptrdiff_t>(s * ny * nx);
+      slice_sampled.assign(first, first + static_cast<std::ptrdiff_t>(ny * nx));
+    }
     const RingChain chain =
-        correct_rings_in_order(image, response, slice_g, dead_by_row[row], config);
+        correct_rings_in_order(image, response, slice_g, dead_by_row[row], config, slice_sampled);
     out.air_applied += chain.air && chain.air->applied;
     out.gradient_applied += chain.gradient && chain.gradient->applied;
     out.response_applied += chain.response && chain.response->applied;

@@ -258,12 +258,17 @@ void Reconstructor::evaluate_rings(ReconstructionResult& r) const {
   const RinerConfig& c = impl_->setup.config;
   const Geometry& g = impl_->setup.scan.geometry;
   if (!corrects_rings(c, g)) return;
+  const model::Occupancy& occupancy = impl_->setup.occupancy;
+  const std::vector<std::uint8_t> sampled =
+      occupancy.carved ? occupancy.inside : std::vector<std::uint8_t>{};
   if (g.is_3d()) {
-    r.volume_rings = correct_rings_per_slice(r.image, r.alpha, g, dead_elements(), c.rings);
+    r.volume_rings =
+        correct_rings_per_slice(r.image, r.alpha, g, dead_elements(), c.rings, sampled);
     r.image = r.volume_rings->image;
     r.alpha = r.volume_rings->alpha;
   } else {
-    RingChain chain = correct_rings_in_order(r.image, r.alpha, g, dead_elements(), c.rings);
+    RingChain chain =
+        correct_rings_in_order(r.image, r.alpha, g, dead_elements(), c.rings, sampled);
     r.image = std::move(chain.image);
     r.alpha = std::move(chain.alpha);
     r.air_rings = std::move(chain.air);
@@ -272,10 +277,6 @@ void Reconstructor::evaluate_rings(ReconstructionResult& r) const {
     r.gradient_after_response_rings = std::move(chain.gradient_after_response);
     r.mirror_rings = std::move(chain.mirror);
   }
-  // Each correction subtracts its profile along whole circles; where a circle leaves the
-  // sampled region, that would paint the ring into the skipped air. No second ramp: the field's
-  // already has one.
-  model::fade_into_skipped_air(impl_->setup.occupancy, g.volume_shape, 0, r.image.data);
 }
 
 Array Reconstructor::alpha_by_view() const { return result().alpha_by_view; }
