@@ -27,7 +27,7 @@ SOURCES = {
     "sizes_cpu": "issue29_draws10.jsonl",
     "sizes_gpu": "issue29_sizes_gpu.jsonl",
     "real_trained": "issue29_beta_real.jsonl",
-    "real_chain": "issue29_skipped_air_chain.jsonl",
+    "real_chain": "issue29_gradient_centre.jsonl",
     "throughput": "issue30_throughput.jsonl",
     "steps_gpu": "issue12_gpu_ops.jsonl",
     "volumes": "issue34_volume_defaults.jsonl",

@@ -319,6 +319,24 @@ TEST_SUITE("ring_correction") {
     CHECK(largest < 2e-5);  // 0.1% of the ellipse's 0.02/mm
   }
 
+  TEST_CASE("gradient: an edge through the axis is no ring: the centre keeps its values") {
+    // The tooth's case (docs/history/RESULTS.md, issue 29): an edge of 0.008/mm runs through the
+    // axis. The circle of radius 0 is the edge's midpoint; the flattest points of the next circle
+    // were its air side, and the profile put a dot of half the step at the centre.
+    const riner::Geometry g = ring_geometry();
+    const riner::Array image =
+        sum_of(phantom(g, false), painted(g, [](const riner::Vec3& c) {
+                 return c.x > 0.3 * c.y && std::hypot(c.x, c.y) < 15.0 ? 0.008f : 0.0f;
+               }));
+    riner::Array alpha({g.n_u}, 1.0f);
+    const riner::RingCorrection c = riner::correct_rings_from_gradient(image, alpha, g);
+    double centre = 0.0;
+    for (std::size_t p = 0; p < 3; ++p) centre = std::max(centre, std::fabs(c.profile[p]));
+    MESSAGE("largest profile value within 2 px of the axis " << centre);
+    // Measured 0; 0.004 (half the step) when the first slope took the flattest half.
+    CHECK(centre < 4e-4);
+  }
+
   TEST_CASE("gradient: a round object centred on the axis is an object, not a ring") {
     // A cylinder of 0.02/mm, 30 mm in radius, with an insert: its edge is a step on every
     // circle, and the running median keeps steps.

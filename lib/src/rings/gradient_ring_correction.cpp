@@ -6,6 +6,7 @@
 #include "rings/radial.hpp"
 #include "rings/ring_profile.hpp"
 #include "rings/ring_settings.hpp"
+#include "util/robust_statistics.hpp"
 
 namespace riner {
 
@@ -13,6 +14,14 @@ namespace {
 
 // A circle with fewer usable points than this (near the grid's corners) is not measured.
 constexpr std::size_t kMinPoints = 32;
+// A slope counts as a ring only where it stands this many of its standard errors from 0 (the
+// median's, over the independent pixels of the circle's flattest half, about pi r of them):
+// below, it is the object's own pixels (near the axis, where a circle holds a few of them, an
+// edge crossing it makes its changes two-sided), which the running sum would paint in as rings:
+// the tooth's centre got a dark dot of -0.0011/mm, a third of the value there. 0.5: the smallest
+// of 0.25-3 that removed it; DeepLesion -0.003 dB (docs/history/RESULTS.md, issue 29).
+constexpr double kSlopeStandardErrors = 0.5;
+constexpr double kMedianStandardError = 1.2533;  // times sigma / sqrt(n), for normal noise
 
 // The image sampled on circles about the rotation axis (the grid's centre): one row of
 // `angles` bilinear samples per radius of whole pixels; NaN where a sample leaves the grid.
@@ -54,7 +63,8 @@ PolarSamples sample_circles(const Array& image) {
 }
 
 // The ring's slope from radius r to r + 1: the median change over the circle's flattest
-// points. False when too few points lie inside the grid.
+// points, 0 where that is within kSlopeStandardErrors of 0. False when too few points lie
+// inside the grid.
 bool ring_slope(const PolarSamples& s, std::size_t r, double flat_fraction, double& slope) {
   std::vector<float> change;
   std::vector<float> along;  // how much the image changes along the circle at that point
@@ -81,6 +91,14 @@ bool ring_slope(const PolarSamples& s, std::size_t r, double flat_fraction, doub
   const auto mid = flat.begin() + static_cast<std::ptrdiff_t>(flat.size() / 2);
   std::nth_element(flat.begin(), mid, flat.end());
   slope = *mid;
+  std::vector<double> deviation(flat.size());
+  for (std::size_t j = 0; j < flat.size(); ++j) deviation[j] = std::fabs(flat[j] - slope);
+  const double sigma = util::kMadToSigma * util::quantile(deviation, 0.5);
+  const double independent =
+      std::min(static_cast<double>(flat.size()), M_PI * std::max(static_cast<double>(r), 0.5));
+  if (std::fabs(slope) <
+      kSlopeStandardErrors * kMedianStandardError * sigma / std::sqrt(independent))
+    slope = 0.0;
   return true;
 }
 
@@ -122,7 +140,10 @@ RingCorrection correct_rings_from_gradient(const Array& image, const Array& alph
   std::vector<double> ring(circles.radii, 0.0);
   for (std::size_t r = 0; r + 1 < circles.radii; ++r) {
     double slope = 0.0;
-    if (ring_slope(circles, r, settings.flat_fraction, slope)) ++out.measured_radii;
+    // The circle of radius 0 is one point, flat by definition: the flattest points would be one
+    // side of any edge through the axis, and the axis would get a dot of half the edge's step.
+    const double fraction = r == 0 ? 1.0 : settings.flat_fraction;
+    if (ring_slope(circles, r, fraction, slope)) ++out.measured_radii;
     ring[r + 1] = ring[r] + slope;
   }
   if (out.measured_radii == 0) return out;
