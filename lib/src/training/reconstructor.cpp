@@ -259,8 +259,8 @@ void Reconstructor::evaluate_rings(ReconstructionResult& r) const {
   const Geometry& g = impl_->setup.scan.geometry;
   if (!corrects_rings(c, g)) return;
   const model::Occupancy& occupancy = impl_->setup.occupancy;
-  const std::vector<std::uint8_t> sampled =
-      occupancy.carved ? occupancy.inside : std::vector<std::uint8_t>{};
+  const std::vector<std::uint8_t> everything;  // not carved: every voxel sampled
+  const std::vector<std::uint8_t>& sampled = occupancy.carved ? occupancy.inside : everything;
   if (g.is_3d()) {
     r.volume_rings =
         correct_rings_per_slice(r.image, r.alpha, g, dead_elements(), c.rings, sampled);
