@@ -11,6 +11,8 @@
 #include <numeric>
 #include <sstream>
 
+#include "riner/cores.hpp"
+
 namespace riner::bench {
 
 Stats Stats::of(std::vector<double> s) {
@@ -133,7 +135,7 @@ nlohmann::json metadata(const DeviceInfo& device, const Options& options) {
   return {{"date", date},
           {"git", revision},
           {"host", host},
-          {"cores", sysconf(_SC_NPROCESSORS_ONLN)},
+          {"cores", riner::usable_cores()},
           {"device", device.full_name()},
           {"driver", device.driver_version},
           {"settings",

@@ -6,6 +6,7 @@
 
 #include "detector_outputs.hpp"
 #include "progress.hpp"
+#include "riner/cores.hpp"
 #include "riner/error.hpp"
 #include "riner/io.hpp"
 #include "riner/slab_ranks.hpp"
@@ -142,7 +143,7 @@ namespace {
 std::optional<Device> rank_device(const Args& args, Engine engine, const SlabRanks& ranks) {
   if (engine != Engine::kOpenCL) return std::nullopt;
   if (ranks.local_size() <= 1 || !args.get("device").empty()) return device_from(args, engine);
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const unsigned cores = usable_cores();
   const std::string share = std::to_string(std::max(1u, cores / ranks.local_size()));
   setenv("POCL_MAX_PTHREAD_COUNT", share.c_str(), 0);
   std::vector<int> gpus;
@@ -191,10 +192,9 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   // are the same for any number of ranks.
   RinerConfig config = settings;
   if (device && device->info().type == "CPU" && config.plan.gradient_slices <= 0) {
-    config.plan.gradient_slices =
-        2 * static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    config.plan.gradient_slices = 2 * static_cast<int>(machine_cores());
   }
-  const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
+  const unsigned cores = usable_cores();
   int processes = 1;
   if (ranks.size() == 1 && joined.empty()) {
     const std::size_t limit = options.limit();

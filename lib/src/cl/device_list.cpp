@@ -6,6 +6,7 @@
 #include <string>
 
 #include "cl/check.hpp"
+#include "riner/cores.hpp"
 
 namespace riner::cl {
 
@@ -99,6 +100,7 @@ DeviceInfo query_device_info(cl_device_id device) {
 }
 
 std::vector<DeviceEntry> enumerate_devices() {
+  fit_opencl_threads_to_usable_cores();
   cl_uint n_platforms = 0;
   cl_int status = clGetPlatformIDs(0, nullptr, &n_platforms);
   // The ICD loader reports "no platform" as an error; for us it is an empty list.

@@ -5,11 +5,13 @@
 #include <mutex>
 #include <thread>
 
+#include "riner/cores.hpp"
+
 namespace riner::util {
 
 std::size_t worker_count() {
   static const std::size_t count = [] {
-    std::size_t n = std::max(1u, std::thread::hardware_concurrency());
+    std::size_t n = usable_cores();
     if (const char* env = std::getenv("RINER_THREADS"); env != nullptr && *env != '\0') {
       n = static_cast<std::size_t>(std::max(1L, std::strtol(env, nullptr, 10)));
     }

@@ -1,0 +1,35 @@
+#include "riner/cores.hpp"
+
+#include <sched.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <string>
+#include <thread>
+
+namespace riner {
+
+unsigned machine_cores() { return std::max(1u, std::thread::hardware_concurrency()); }
+
+unsigned usable_cores() {
+  cpu_set_t mask;
+  CPU_ZERO(&mask);
+  if (sched_getaffinity(0, sizeof(mask), &mask) != 0) return machine_cores();
+  const int count = CPU_COUNT(&mask);
+  return count > 0 ? static_cast<unsigned>(count) : machine_cores();
+}
+
+void fit_opencl_threads_to_usable_cores() {
+  const auto chosen = [](const char* name) {
+    const char* value = std::getenv(name);
+    return value != nullptr && *value != '\0';
+  };
+  if (chosen("POCL_MAX_PTHREAD_COUNT") || chosen("POCL_CPU_MAX_CU_NUM")) return;
+  const unsigned usable = usable_cores();
+  if (usable >= machine_cores()) return;
+  const std::string count = std::to_string(usable);
+  setenv("POCL_MAX_PTHREAD_COUNT", count.c_str(), 0);
+  setenv("POCL_CPU_MAX_CU_NUM", count.c_str(), 0);
+}
+
+}  // namespace riner
