@@ -53,8 +53,9 @@ void AdamOp::step(const AdamSettings& s, int step, cl::Buffer<float>& params,
     p.n_partials = static_cast<cl_uint>(slices.slices);
   }
   kernel_.set_args(p, params, m_, v_, grad, sliced ? *slices.buffer : no_slices_);
-  constexpr std::size_t kLanes = 8;  // ADAM_LANES in adam.cl
-  context_.launch(kernel_, (n_params_ + kLanes - 1) / kLanes);
+  // Groups of ADAM_LANES (adam.cl) parameters, then one work-item per parameter with partials.
+  constexpr std::size_t kLanes = 8;
+  context_.launch(kernel_, (n_params_ + kLanes - 1) / kLanes + (sliced ? slices.count : 0));
 }
 
 }  // namespace riner::ops
