@@ -29,6 +29,8 @@ SOURCES = {
     "real_trained": "issue29_beta_real.jsonl",
     "real_chain": "issue29_gradient_centre.jsonl",
     "throughput": "issue30_throughput.jsonl",
+    "cores": "issue30_cores16.jsonl",
+    "gpu_slow_step": "issue30_gpu_loss_median.jsonl",
     "steps_gpu": "issue12_gpu_ops.jsonl",
     "volumes": "issue34_volume_defaults.jsonl",
     "partial_rings": "issue32_partial_rings.jsonl",
@@ -192,6 +194,7 @@ def deeplesion(root):
                  f3(mean(s["ssim"] for s in per)), seconds(mean(s["seconds"] for s in per)),
                  stamp(gpu), command(gpu, ["--workers=1"]) if "workers" not in
                  gpu["meta"]["settings"]["options"] else command(gpu)])
+    rows += gpu_slow_step_rows(root)
     rows.append([f"riner, {len(h100)} slices, the engine of issue 12 (uniform sampler)",
                  f2(mean(r[ISSUE12_RESULT]["psnr"] for r in h100)),
                  f3(mean(r[ISSUE12_RESULT]["ssim"] for r in h100)),
@@ -206,6 +209,7 @@ def deeplesion(root):
         "gpu_seconds": mean(s["seconds"] for s in per),
         "gpu_machine": machine(gpu["meta"]),
         "gpu_day": day(gpu["meta"]),
+        "gpu_git": gpu["meta"].get("git", "?").replace("-dirty", ""),
         "fbp_psnr": classical["fbp"]["psnr"],
         "oracle_psnr": classical["oracle fbp"]["psnr"],
         "super_psnr": classical["all"]["psnr"],
@@ -213,6 +217,26 @@ def deeplesion(root):
     text = table(["method", "PSNR (dB)", "SSIM", "time per slice", "machine; date; revision",
                   "command"], rows)
     return text, summary
+
+
+def gpu_slow_step_rows(root):
+    """The GPU at a revision whose step ran its median and Adam's partial sums on one work-item
+    each (fixed the same day, not yet measured on a GPU)."""
+    rows = []
+    for r in records(root, SOURCES["gpu_slow_step"]):
+        if r["case"] != "throughput":
+            continue
+        per = r["per_slice"]
+        config = r["meta"]["settings"]["options"].get("config", "")
+        warm = warm_method(config)
+        steps = per[0]["steps"]
+        label = (f"riner warm-started from `{warm}`, {steps} steps" if warm != "off"
+                 else "riner" + (f", `{config}`" if config else ""))
+        rows.append([f"{label}, slices {per[0]['scene'][-1]}-{per[-1]['scene'][-1]} (a slow "
+                     "step: see below)", f2(mean(x["psnr"] for x in per)),
+                     f3(mean(x["ssim"] for x in per)), seconds(mean(x["seconds"] for x in per)),
+                     stamp(r), command(r)])
+    return rows
 
 
 def schedule_rows(root):
@@ -397,9 +421,49 @@ def throughput(root):
                   "slices per minute", "PSNR (dB)", "date", "command"], rows)
 
 
+def process_command(rs):
+    """The command of one of several processes, each with its own slice (--first=i --last=i)."""
+    text = command(rs[0])
+    if len(rs) > 1:
+        text = text.replace("--first=0 --last=0", "--first=i --last=i")
+    return text
+
+
+def cores(root):
+    """A 16-core CPU filled by processes against one process of 2 cores, the same slices and
+    steps in the same call; and the CLI's own processes against the CLI on 2 cores."""
+    runs = {}
+    for r in records(root, SOURCES["cores"]):
+        runs.setdefault(r["run"], []).append(r)
+    rows, base = [], None
+    for name, rs in runs.items():
+        if rs[0]["case"] == "throughput":
+            slices = sum(r["slices"] for r in rs)
+            wall = max(r["wall_seconds"] for r in rs)
+            per_slice = [x["seconds"] for r in rs for x in r["per_slice"]]
+            per_minute = 60.0 * slices / wall
+            base = base or per_minute
+            rows.append([name, slices, f"{min(per_slice):.1f}-{max(per_slice):.1f} s",
+                         f"{per_minute:.1f}", f"{per_minute / base:.1f}×",
+                         f2(mean(x["psnr"] for r in rs for x in r["per_slice"])),
+                         day(rs[0]["meta"]), process_command(rs)])
+    cli = [rs[0] for rs in runs.values() if rs[0]["case"] == "slab_stack"]
+    cli_base = min(cli, key=lambda r: r["slices_per_minute"])["slices_per_minute"]
+    for r in cli:
+        rows.append([r["run"], f"{r['volume'][0]} ({r['slices_with_object']} with object)"
+                     if "slices_with_object" in r else r["volume"][0], "",
+                     f"{r['slices_per_minute']:.1f}", f"{r['slices_per_minute'] / cli_base:.1f}×",
+                     f2(r["psnr_mean"]) if r["psnr_mean"] else "", day(r["meta"]),
+                     command(r)])
+    device = machine(runs[next(iter(runs))][0]["meta"]).split(" cores ", 1)[-1]
+    return device, table(["how", "slices", "each slice's training", "slices per minute",
+                          "against the first row of its kind", "PSNR (dB)", "date", "command"],
+                         rows)
+
+
 def training_steps(root):
     rows = []
-    for r in records(root, SOURCES["steps_gpu"]):
+    for r in records(root, SOURCES["steps_gpu"]) + records(root, SOURCES["gpu_slow_step"]):
         if r["case"] != "training_step":
             continue
         rows.append([machine(r["meta"]), r["plan"].split(":")[0], r["rays_per_step"],
@@ -463,6 +527,13 @@ its defaults. The shared data sets (`../shared/data`) sit beside a development c
 a SOURCE.md each (licence, geometry); they are not part of the product.
 
 {deeplesion}
+
+The rows marked "a slow step" ran on 2026-11-27 at 90bfcd3, whose GPU step took 0.62 ms (the
+last row of "One training step", below): since 373649d the loss kernel took beta's relative
+threshold from the batch's median, selected by one work-item (0.29 ms), and since e568258 Adam
+summed each MLP weight's 264 partial gradients in a loop of one work-item for eight weights
+(0.12 ms). Both are spread over the work-group since (the same images on a CPU, bit for bit),
+not yet measured on a GPU; the 6.5 s row (8ebcf43) predates both.
 
 ![PSNR against time per slice: FBP, the classical filters, Riner cold and warm on 2 cores, Riner on a GPU](../bench/figures/deeplesion_psnr_time.png)
 
@@ -541,10 +612,21 @@ between 2.5 and 4.1 ms a step over the session, so read the time column to ±25%
 
 Slices trained one after another or several at once on one device (`throughput`). The 16-core
 CPU rows ran 3000 steps per slice, an eighth of the default, to compare ways of running, not
-accuracy; the processes that fill a CPU's cores (`--processes`, 8 processes of 2 cores: 5.5×
-one process of 2) are in [history/RESULTS.md](history/RESULTS.md), "Issue 30: throughput".
+accuracy. A CPU's cores are filled by processes (`--processes`, MPI ranks), not by trainings
+at once in one process: the table after this one.
 
 {throughput}
+
+Filling the cores of a 16-core CPU ({cores_device}; no hyper-threads) with processes, each
+pinned to its cores, against one process of 2 of them, in the same call: DeepLesion slices at
+3000 steps (`throughput`, started by the shell, `taskset -c` per process, one slice each; the
+slices per minute are the slices over the slowest process's training). Then `riner
+reconstruct` itself (`slab_stack`: a simulated 512-column parallel-beam stack at 3000 steps a
+slice, in 2D; its default on 16 cores is 8 processes of 2 cores, under `taskset -c 0,1` one
+process), whole command. The 16-core stack's ends are air in 6 of its 32 slices, which train in
+about a second: counting only the 26 with object, the CLI's 16 cores give 5.9× its 2 cores.
+
+{cores}
 
 ## One training step
 
@@ -566,7 +648,8 @@ def headline(deeplesion_summary, real_summary):
         f"| FBP with a perfect detector | {d['oracle_psnr']:.1f} dB | |",
         f"| **riner** on {d['cpu_machine']} ({d['cpu_day']}) | **{d['cpu_psnr']:.1f} dB** | "
         f"{d['cpu_seconds']:.0f} s |",
-        f"| **riner** on an {d['gpu_machine']} ({d['gpu_day']}; slices 0-3 only: not "
+        f"| **riner** on an {d['gpu_machine']} ({d['gpu_day']}, git {d['gpu_git']}; slices 0-3 "
+        "only: not "
         "comparable with the row above) | "
         f"**{d['gpu_psnr']:.1f} dB** | "
         f"{d['gpu_seconds']:.1f} s |",
@@ -583,11 +666,13 @@ def render(root):
     deeplesion_text, deeplesion_summary = deeplesion(root)
     real_text, real_summary = real_scans(root)
     volume_text, volume_curve = volumes(root)
+    cores_device, cores_table = cores(root)
     page = PAGE.format(deeplesion=deeplesion_text, classical=classical_methods(root),
                        classical_real=classical_real(root),
                        sizes=sizes(root), real=real_text, partial_rings=partial_rings(root), tube_wall=tube_wall(root),
                        volumes=volume_text,
                        volume_curve=volume_curve, throughput=throughput(root),
+                       cores=cores_table, cores_device=cores_device,
                        steps=training_steps(root))
     with open(os.path.join(root, "README.md")) as f:
         readme = f.read()
