@@ -140,7 +140,9 @@ std::string Args::help() const {
     for (const Spec& o : options_) {
       text +=
           "  --" + o.name + (o.value_name.empty() ? "" : " " + o.value_name) + "\n      " + o.help;
-      if (o.default_value && !o.default_value->empty())
+      // A help that says its default in words (compare's --data-range) keeps its own.
+      if (o.default_value && !o.default_value->empty() &&
+          o.help.find("(default:") == std::string::npos)
         text += " (default: " + *o.default_value + ")";
       text += "\n";
     }
