@@ -332,29 +332,43 @@ Array destripe(const Array& measurement, const Geometry& g, const DestripeOption
   local.large_size = settings.large_size;
   local.sigma = settings.sigma;
   local.levels = settings.levels;
-  for (std::size_t r = 0; r < rows; ++r) {
-    Sinogram s{views, columns, std::vector<double>(views * columns)};
+  // Each row's sinogram as floats, the readings' own type: the device takes them as they are,
+  // the CPU twins in double. What was removed is each column's mean before less its mean after.
+  std::vector<float> row(views * columns);
+  std::vector<double> column_before(columns), column_after(columns);
+  const auto column_sums = [&](std::vector<double>& sums) {
+    std::fill(sums.begin(), sums.end(), 0.0);
     for (std::size_t v = 0; v < views; ++v) {
-      for (std::size_t c = 0; c < columns; ++c) s.at(v, c) = out.data[(v * rows + r) * columns + c];
+      const float* line = row.data() + v * columns;
+      for (std::size_t c = 0; c < columns; ++c) sums[c] += line[c];
     }
-    const Sinogram before = s;
+  };
+  for (std::size_t r = 0; r < rows; ++r) {
+    for (std::size_t v = 0; v < views; ++v) {
+      const float* from = out.data.data() + (v * rows + r) * columns;
+      std::copy(from, from + columns, row.begin() + static_cast<std::ptrdiff_t>(v * columns));
+    }
+    column_sums(column_before);
     std::vector<bool> dead, large;
     if (device) {
-      device->run(s, dead, large);
+      device->run(row, dead, large);
     } else {
+      Sinogram s{views, columns, std::vector<double>(row.begin(), row.end())};
       destripe_on_cpu(options.method, settings, s, dead, large);
+      std::transform(s.values.begin(), s.values.end(), row.begin(),
+                     [](double x) { return static_cast<float>(x); });
     }
+    column_sums(column_after);
     for (std::size_t c = 0; c < columns; ++c) {
       if (c < dead.size() && dead[c]) local.dead.push_back(r * columns + c);
       if (c < large.size() && large[c]) local.large.push_back(r * columns + c);
-      double removed = 0.0;
-      for (std::size_t v = 0; v < views; ++v) removed += before.at(v, c) - s.at(v, c);
-      local.removed.data[r * columns + c] = static_cast<float>(removed / static_cast<double>(views));
+      local.removed.data[r * columns + c] =
+          static_cast<float>((column_before[c] - column_after[c]) / static_cast<double>(views));
     }
     for (std::size_t v = 0; v < views; ++v) {
-      for (std::size_t c = 0; c < columns; ++c) {
-        out.data[(v * rows + r) * columns + c] = static_cast<float>(s.at(v, c));
-      }
+      const float* from = row.data() + v * columns;
+      std::copy(from, from + columns,
+                out.data.begin() + static_cast<std::ptrdiff_t>((v * rows + r) * columns));
     }
   }
   if (report != nullptr) *report = std::move(local);

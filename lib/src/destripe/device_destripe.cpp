@@ -82,9 +82,10 @@ DeviceDestripe::DeviceDestripe(cl::Context& context, DestripeMethod method,
   }
 }
 
-void DeviceDestripe::run(Sinogram& s, std::vector<bool>& dead, std::vector<bool>& large) {
-  if (s.views != views_ || s.columns != columns_) throw Error("device destripe: size mismatch");
-  values_.write(std::span<const float>(to_float(s.values)));
+void DeviceDestripe::run(std::vector<float>& values, std::vector<bool>& dead,
+                         std::vector<bool>& large) {
+  if (values.size() != views_ * columns_) throw Error("device destripe: size mismatch");
+  values_.write(std::span<const float>(values));
   switch (method_) {
     case DestripeMethod::kNormalise: normalise(); break;
     case DestripeMethod::kSorting: sorting_->apply(values_, values_, settings_.size); break;
@@ -99,8 +100,7 @@ void DeviceDestripe::run(Sinogram& s, std::vector<bool>& dead, std::vector<bool>
       sorting_->apply(values_, values_, settings_.size);
       break;
   }
-  const std::vector<float> out = values_.read();
-  s.values.assign(out.begin(), out.end());
+  values_.read(std::span<float>(values));
 }
 
 std::vector<double> DeviceDestripe::read_columns(const cl::Buffer<float>& buffer) {

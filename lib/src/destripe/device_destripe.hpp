@@ -29,8 +29,9 @@ class DeviceDestripe {
   DeviceDestripe(cl::Context& context, DestripeMethod method, const StripeSettings& settings,
                  std::size_t views, std::size_t columns);
 
-  // s destriped in place; the masks of dead and large stripes where the method finds them.
-  void run(Sinogram& s, std::vector<bool>& dead, std::vector<bool>& large);
+  // A views x columns sinogram destriped in place; the masks of dead and large stripes where
+  // the method finds them.
+  void run(std::vector<float>& values, std::vector<bool>& dead, std::vector<bool>& large);
 
  private:
   void normalise();
