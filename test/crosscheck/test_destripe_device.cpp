@@ -154,9 +154,11 @@ TEST_SUITE("destripe_device") {
       }
       riner::ops::LineFilterOp op(ctx, l.n, taps);
       CHECK(op.by_fft());  // PoCL's local memory holds these lines
-      for (int pass = 0; pass < 2; ++pass) {
-        CAPTURE(pass);
-        if (pass == 1) op.use_direct();
+      using Path = riner::ops::LineFilterOp::Path;
+      // The global FFT on 2 work-groups: each filters every second pair of lines.
+      for (Path path : {Path::kLocalFft, Path::kGlobalFft, Path::kDirect}) {
+        CAPTURE(static_cast<int>(path));
+        op.use(path, 2);
         const riner::cl::Buffer<float> d_in(ctx, std::span<const float>(in));
         riner::cl::Buffer<float> d_out(ctx, std::span<const float>(in));  // outside the lines: kept
         op.run(d_in, d_out, riner::ops::LineLayout{l.lines, l.first, l.line_step, l.stride});

@@ -31,7 +31,9 @@ riner::Scan phantom_scan(const riner::Geometry& g, riner::Array* truth) {
 }  // namespace
 
 TEST_SUITE("fbp") {
-  TEST_CASE("the FFT filter, the direct convolution and the reference agree at awkward sizes") {
+  TEST_CASE(
+      "the FFT filter (local and global memory), the direct convolution and the reference agree at "
+      "awkward sizes") {
     riner::cl::Context& ctx = riner::cl::context_of(riner::test::device());
     // Columns around powers of two and odd; an odd line count leaves the last pair half empty.
     for (std::size_t n_u : {1, 2, 3, 37, 64, 65, 300}) {
@@ -48,9 +50,11 @@ TEST_SUITE("fbp") {
         CHECK(op.filters_by_fft());  // PoCL's local memory holds any of these lines
         riner::cl::Buffer<float> d_in(ctx, std::span<const float>(in));
         riner::cl::Buffer<float> d_out(ctx, in.size());
-        for (int pass = 0; pass < 2; ++pass) {
-          CAPTURE(pass);
-          if (pass == 1) op.use_direct_filter();
+        using Path = riner::ops::LineFilterOp::Path;
+        // The global FFT on 2 work-groups: each filters every second pair of lines.
+        for (Path path : {Path::kLocalFft, Path::kGlobalFft, Path::kDirect}) {
+          CAPTURE(static_cast<int>(path));
+          op.use_filter_path(path, 2);
           op.filter(d_in, d_out);
           std::vector<float> out(in.size());
           d_out.read(std::span<float>(out));

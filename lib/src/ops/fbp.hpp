@@ -21,7 +21,9 @@ class FbpOp {
   void filter(const cl::Buffer<float>& in, cl::Buffer<float>& out);
   // Whether filter() goes by FFT; false: by direct convolution (also when `direct` is asked).
   bool filters_by_fft() const { return line_filter_.by_fft(); }
-  void use_direct_filter() { line_filter_.use_direct(); }
+  void use_filter_path(LineFilterOp::Path path, std::size_t groups = 0) {
+    line_filter_.use(path, groups);
+  }
   // volume = weighted backprojection of the filtered measurement onto the axial slices
   // first_slice, first_slice + slice_step, ... (as many as volume holds; 2D: 0, 1).
   void backproject(const cl::Buffer<float>& filtered, cl::Buffer<float>& volume,

@@ -56,6 +56,8 @@ std::vector<cl_float2> fft_twiddles(std::size_t n) {
 
 // The work-group of the FFT filter: up to 256 work-items, half the padded line at most.
 constexpr std::size_t kFftGroup = 256;
+// The global-memory FFT's work-groups: a few per compute unit of a large GPU (132 on an H100).
+constexpr std::size_t kGlobalFftGroups = 512;
 
 }  // namespace
 
@@ -79,17 +81,19 @@ LineFilterOp::LineFilterOp(cl::Context& context, std::size_t n, const std::vecto
       n_(static_cast<cl_uint>(n)),
       program_(context.program({"line_filter"})),
       direct_(*program_, "line_filter_direct"),
-      fft_(*program_, "line_filter_fft") {
+      fft_(*program_, "line_filter_fft"),
+      fft_global_(*program_, "line_filter_fft_global") {
   if (n == 0 || taps.size() != 2 * n - 1) throw Error("line_filter: taps do not match the line");
   const std::vector<float> taps_f(taps.begin(), taps.end());
   taps_ = cl::Buffer<float>(context, std::span<const float>(taps_f));
-  // By FFT where the padded line fits the local memory (a GPU's 48 KB: lines up to 2048).
   const std::size_t n_fft = fft_length(n);
-  if (n_fft * sizeof(cl_float2) + 1024 <= context.info().local_mem_bytes) {
-    fft_size_ = static_cast<cl_uint>(n_fft);
-    spectrum_ = cl::Buffer<cl_float2>(context, std::span<const cl_float2>(taps_spectrum(taps, n, n_fft)));
-    twiddles_ = cl::Buffer<cl_float2>(context, std::span<const cl_float2>(fft_twiddles(n_fft)));
-  }
+  fft_size_ = static_cast<cl_uint>(n_fft);
+  spectrum_ =
+      cl::Buffer<cl_float2>(context, std::span<const cl_float2>(taps_spectrum(taps, n, n_fft)));
+  twiddles_ = cl::Buffer<cl_float2>(context, std::span<const cl_float2>(fft_twiddles(n_fft)));
+  // In local memory where the padded line fits (a GPU's 48 KiB: lines up to 2048).
+  path_ = n_fft * sizeof(cl_float2) + 1024 <= context.info().local_mem_bytes ? Path::kLocalFft
+                                                                             : Path::kGlobalFft;
 }
 
 void LineFilterOp::run(const cl::Buffer<float>& in, cl::Buffer<float>& out,
@@ -103,17 +107,32 @@ void LineFilterOp::run(const cl::Buffer<float>& in, cl::Buffer<float>& out,
   const auto lines = static_cast<cl_uint>(layout.lines), first = static_cast<cl_uint>(layout.first),
              line_step = static_cast<cl_uint>(layout.line_step),
              stride = static_cast<cl_uint>(layout.stride);
-  if (fft_size_ == 0) {
+  if (path_ == Path::kDirect) {
     const cl_uint n_out = lines * n_;
     direct_.set_args(n_out, static_cast<cl_int>(n_), first, line_step, stride, taps_, in, out);
     context_.launch(direct_, n_out);
     return;
   }
+  cl::Kernel& kernel = path_ == Path::kLocalFft ? fft_ : fft_global_;
   const std::size_t group = std::min({kFftGroup, static_cast<std::size_t>(fft_size_) / 2,
-                                      fft_.max_work_group_size(context_.device())});
-  fft_.set_args(lines, n_, first, line_step, stride, fft_size_, spectrum_, twiddles_, in, out,
-                cl::LocalMemory{fft_size_ * sizeof(cl_float2)});
-  context_.launch(fft_, cl::Range((layout.lines + 1) / 2 * group), cl::Range(group));
+                                      kernel.max_work_group_size(context_.device())});
+  const std::size_t pairs = (layout.lines + 1) / 2;
+  if (path_ == Path::kLocalFft) {
+    fft_.set_args(lines, n_, first, line_step, stride, fft_size_, spectrum_, twiddles_, in, out,
+                  cl::LocalMemory{fft_size_ * sizeof(cl_float2)});
+    context_.launch(fft_, cl::Range(pairs * group), cl::Range(group));
+    return;
+  }
+  // Enough work-groups to fill a device, each with its own line of scratch (64 MiB at most).
+  const std::size_t line_bytes = fft_size_ * sizeof(cl_float2);
+  const std::size_t groups = std::max<std::size_t>(
+      1, std::min({pairs, global_groups_ > 0 ? global_groups_ : kGlobalFftGroups,
+                   (64u << 20) / line_bytes}));
+  if (scratch_.size() < groups * fft_size_)
+    scratch_ = cl::Buffer<cl_float2>(context_, groups * fft_size_);
+  fft_global_.set_args(lines, n_, first, line_step, stride, fft_size_, spectrum_, twiddles_, in,
+                       out, scratch_);
+  context_.launch(fft_global_, cl::Range(groups * group), cl::Range(group));
 }
 
 }  // namespace riner::ops

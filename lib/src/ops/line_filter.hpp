@@ -1,6 +1,6 @@
 // Host side of kernels/line_filter.cl: a convolution along the lines of a device array (the rows
-// or the columns of a block of it), by FFT where a padded line fits the device's local memory,
-// by direct convolution otherwise.
+// or the columns of a block of it), by FFT: in local memory where a padded line fits it, else in
+// a global scratch buffer (the direct convolution, n^2 a line, stays for the tests).
 #pragma once
 
 #include <vector>
@@ -30,9 +30,16 @@ class LineFilterOp {
   // out's lines = in's lines convolved with the taps; the rest of out is left as it was. in and
   // out are distinct buffers.
   void run(const cl::Buffer<float>& in, cl::Buffer<float>& out, const LineLayout& layout);
-  // Whether run() goes by FFT; false: by direct convolution (also when `use_direct` was asked).
-  bool by_fft() const { return fft_size_ > 0; }
-  void use_direct() { fft_size_ = 0; }
+  enum class Path { kLocalFft, kGlobalFft, kDirect };
+  Path path() const { return path_; }
+  // Whether run() goes by FFT in local memory (what fits does unless `use` chose otherwise).
+  bool by_fft() const { return path_ == Path::kLocalFft; }
+  // The tests' way to run every path on one device; `groups` > 0 holds the global FFT to that
+  // many work-groups (each then filters several pairs of lines).
+  void use(Path path, std::size_t groups = 0) {
+    path_ = path;
+    global_groups_ = groups;
+  }
 
  private:
   cl::Context& context_;
@@ -40,10 +47,14 @@ class LineFilterOp {
   std::shared_ptr<const cl::Program> program_;
   cl::Kernel direct_;
   cl::Kernel fft_;
+  cl::Kernel fft_global_;
   cl::Buffer<float> taps_;
-  cl_uint fft_size_ = 0;  // the padded line's length; 0: direct convolution
+  Path path_ = Path::kLocalFft;
+  std::size_t global_groups_ = 0;   // 0: as many as fill a device
+  cl_uint fft_size_ = 0;            // the padded line's length
   cl::Buffer<cl_float2> spectrum_;  // the taps', bit-reversed, over fft_size_
   cl::Buffer<cl_float2> twiddles_;
+  cl::Buffer<cl_float2> scratch_;  // kGlobalFft: fft_size_ per work-group, made on first use
 };
 
 }  // namespace riner::ops
