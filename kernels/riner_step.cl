@@ -85,13 +85,17 @@ RINER_INLINE uint response_slot(__global const uint* slots, uint ray, uint eleme
   return slots[o + 1 + slots[o] + ray / elements_per_view];
 }
 
-// values[b]'s place in the sorted order, ties by index: exactly one b has each rank.
+// values[b]'s place in the sorted order, NaNs after every number, ties by index: exactly one b
+// has each rank.
 RINER_INLINE uint stable_rank(__global const float* values, uint n, uint b) {
   const float v = values[b];
+  const int v_nan = isnan(v);
   uint rank = 0;
   for (uint j = 0; j < n; ++j) {
     const float w = values[j];
-    rank += (w < v || (w == v && j < b)) ? 1u : 0u;
+    const int w_nan = isnan(w);
+    const int before = (!w_nan && (v_nan || w < v)) || ((w == v || (w_nan && v_nan)) && j < b);
+    rank += before ? 1u : 0u;
   }
   return rank;
 }

@@ -143,8 +143,11 @@ namespace {
 std::optional<Device> rank_device(const Args& args, Engine engine, const SlabRanks& ranks) {
   if (engine != Engine::kOpenCL) return std::nullopt;
   if (ranks.local_size() <= 1 || !args.get("device").empty()) return device_from(args, engine);
-  const unsigned cores = usable_cores();
-  const std::string share = std::to_string(std::max(1u, cores / ranks.local_size()));
+  // The machine's cores shared out among its ranks, but no more than this rank may use: a
+  // launcher that binds each rank (srun --cpus-per-task, mpirun --bind-to core) has already
+  // given it its share.
+  const unsigned per_rank = machine_cores() / static_cast<unsigned>(ranks.local_size());
+  const std::string share = std::to_string(std::max(1u, std::min(usable_cores(), per_rank)));
   setenv("POCL_MAX_PTHREAD_COUNT", share.c_str(), 0);
   std::vector<int> gpus;
   for (const DeviceInfo& d : list_devices()) {

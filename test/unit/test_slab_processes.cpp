@@ -31,13 +31,13 @@ TEST_SUITE("slab processes") {
     REQUIRE(sched_setaffinity(0, sizeof(one), &one) == 0);
     const unsigned usable = riner::usable_cores();
     const char* before = std::getenv("POCL_MAX_PTHREAD_COUNT");
-    const bool user_chose = before != nullptr || std::getenv("POCL_CPU_MAX_CU_NUM") != nullptr;
+    const bool user_chose = before != nullptr || std::getenv("POCL_CPU_MAX_CU_COUNT") != nullptr ||
+                            std::getenv("POCL_MAX_COMPUTE_UNITS") != nullptr;
     riner::fit_opencl_threads_to_usable_cores();
     const char* after = std::getenv("POCL_MAX_PTHREAD_COUNT");
     const std::string told = after ? after : "";
     if (!user_chose && riner::machine_cores() > 1) {
       unsetenv("POCL_MAX_PTHREAD_COUNT");
-      unsetenv("POCL_CPU_MAX_CU_NUM");
     }
     REQUIRE(sched_setaffinity(0, sizeof(saved), &saved) == 0);
     CHECK(usable == 1);

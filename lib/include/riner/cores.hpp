@@ -14,8 +14,9 @@ unsigned usable_cores();
 // on how the machine is shared out (ranks, processes, affinity) is sized by.
 unsigned machine_cores();
 
-// Holds PoCL's CPU device to usable_cores() threads where the user has not chosen a count
-// (POCL_MAX_PTHREAD_COUNT, PoCL 5's POCL_CPU_MAX_CU_NUM) and the process may not use every core.
+// Holds PoCL's CPU device to usable_cores() threads (POCL_MAX_PTHREAD_COUNT) where the user has
+// not chosen a count (that, or POCL_CPU_MAX_CU_COUNT, POCL_MAX_COMPUTE_UNITS) and the process
+// may not use every core.
 // Takes effect only before OpenCL's platforms are first listed (riner's device listing calls it).
 void fit_opencl_threads_to_usable_cores();
 

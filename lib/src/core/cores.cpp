@@ -24,12 +24,14 @@ void fit_opencl_threads_to_usable_cores() {
     const char* value = std::getenv(name);
     return value != nullptr && *value != '\0';
   };
-  if (chosen("POCL_MAX_PTHREAD_COUNT") || chosen("POCL_CPU_MAX_CU_NUM")) return;
+  // PoCL reads POCL_MAX_PTHREAD_COUNT first (3.1 only that), newer ones then these two.
+  if (chosen("POCL_MAX_PTHREAD_COUNT") || chosen("POCL_CPU_MAX_CU_COUNT") ||
+      chosen("POCL_MAX_COMPUTE_UNITS")) {
+    return;
+  }
   const unsigned usable = usable_cores();
   if (usable >= machine_cores()) return;
-  const std::string count = std::to_string(usable);
-  setenv("POCL_MAX_PTHREAD_COUNT", count.c_str(), 0);
-  setenv("POCL_CPU_MAX_CU_NUM", count.c_str(), 0);
+  setenv("POCL_MAX_PTHREAD_COUNT", std::to_string(usable).c_str(), 0);
 }
 
 }  // namespace riner
