@@ -2,7 +2,7 @@
 // at a detector's widths: the FFT in local memory (where a padded line fits: up to 2048 on a
 // GPU's 48 KiB), the FFT in global memory (longer lines) and the direct convolution (n^2 a line,
 // what longer lines took before the global FFT). --lines rows of --columns values each (a
-// sinogram's views), each path on the same input, the result checked against the direct one.
+// sinogram's views), each path on the same input, its result against the first path's.
 //
 //   riner_bench --case=line_filter [--columns=1024,2560,4096] [--lines=1500] [--direct=1]
 #include <cmath>
@@ -10,7 +10,6 @@
 #include "cl/device_access.hpp"
 #include "harness.hpp"
 #include "op_timer.hpp"
-#include "ops/fbp.hpp"
 #include "ops/line_filter.hpp"
 #include "riner/device.hpp"
 

@@ -19,7 +19,8 @@ class FbpOp {
 
   // out = in convolved with the taps along every detector row.
   void filter(const cl::Buffer<float>& in, cl::Buffer<float>& out);
-  // Whether filter() goes by FFT; false: by direct convolution (also when `direct` is asked).
+  // Whether filter() goes by FFT in local memory; false: by FFT in global memory (a line that
+  // does not fit) or, when the tests ask for it, by direct convolution.
   bool filters_by_fft() const { return line_filter_.by_fft(); }
   void use_filter_path(LineFilterOp::Path path, std::size_t groups = 0) {
     line_filter_.use(path, groups);
