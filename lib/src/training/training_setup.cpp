@@ -156,7 +156,10 @@ std::vector<float> TrainingSetup::initial_parameters() const {
 
 double TrainingSetup::learning_rate(int step) const {
   const TrainingConfig& t = config.training;
-  return t.learning_rate * std::pow(t.lr_decay, step / t.decay_interval());
+  const int interval = t.decay_interval();
+  const double phases = t.lr_decay_smooth ? static_cast<double>(step) / interval
+                                          : static_cast<double>(step / interval);
+  return t.learning_rate * std::pow(t.lr_decay, phases);
 }
 
 std::vector<float> TrainingSetup::level_weights(int step) const {

@@ -67,6 +67,7 @@ TrainingSetup image_fit_setup(const TrainingSetup& setup, const Array& image,
   t.level_warmup_steps = 0;
   t.tail_average_steps = 0;
   t.lr_decay_steps = t.steps;  // one phase: no decay within the fit
+  t.lr_decay_smooth = false;
   t.lambda = 0.0;
   t.relative_beta_threshold = 0.0;
   t.ring_lambda = 0.0;
