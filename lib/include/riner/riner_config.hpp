@@ -199,7 +199,11 @@ struct TrainingConfig {
   // by warm_start_lr_scale: the field starts near an answer, and the full rate's first Adam
   // steps (each parameter moved by about the rate) would throw the fit away. Measured on
   // DeepLesion slice 0 at 8000 steps: 1e-4 38.20 dB, 2e-4 38.59, 3e-4 38.05, 1e-3 37.98 (cold:
-  // 36.99; docs/history/RESULTS.md, issue 31).
+  // 36.99; docs/history/RESULTS.md, issue 31). Under the smooth decay, from `wavelet` on the
+  // ten DeepLesion slices at 8000 steps: a fit of 500 steps 38.96 dB (2.9 s of set-up), of
+  // 1000 steps 39.18 (5.1 s), but on the noisy neutron360 the longer fit copies the FBP's
+  // specks into the image (12.6 per 10^4 pixels against 2.1); rate scale 0.15 / 0.3 on slices
+  // 0-3: -0.1 / -0.4 dB.
   std::string warm_start = "off";
   int warm_start_steps = 500;
   double warm_start_lr_scale = 0.2;
