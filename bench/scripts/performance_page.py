@@ -34,7 +34,7 @@ SOURCES = {
     "steps_gpu": "issue12_gpu_ops.jsonl",
     "volumes": "issue34_volume_defaults.jsonl",
     "partial_rings": "issue32_partial_rings.jsonl",
-    "tube_wall": "issue32_tube_wall.jsonl",
+    "tube_wall": "issue32_tube_wall_smooth.jsonl",
 }
 # The ring chain of today's defaults (mirror, air, gradient, response, gradient again).
 CURRENT_CHAIN = "magrg"
