@@ -5,33 +5,14 @@
 
 #include <cmath>
 
+#include "support/tiny_problem.hpp"
 #include "training/trainer.hpp"
-
-namespace {
-
-riner::Scan small_scan() {
-  riner::Scan scan;
-  scan.geometry.type = riner::GeometryType::kParallel2d;
-  scan.geometry.n_u = 40;
-  for (int v = 0; v < 30; ++v) scan.geometry.angles.push_back(M_PI * v / 30.0);
-  scan.geometry.volume_shape = {32, 32};
-  scan.measurement = riner::Array({30, 40});
-  for (std::size_t v = 0; v < 30; ++v) {
-    for (std::size_t u = 0; u < 40; ++u) {
-      const double x = (static_cast<double>(u) - 20.0) / 10.0;
-      scan.measurement(v, u) = static_cast<float>(0.3 * std::exp(-x * x));
-    }
-  }
-  return scan;
-}
-
-}  // namespace
 
 TEST_SUITE("learning rate") {
   TEST_CASE("smooth: lr_decay per interval, reached continuously") {
     riner::RinerConfig config;
     config.training.steps = 4000;  // interval 1000
-    const riner::detail::TrainingSetup setup(small_scan(), config);
+    const riner::detail::TrainingSetup setup(riner::test::tiny_problem().scan, config);
     CHECK(setup.learning_rate(0) == doctest::Approx(1e-3));
     CHECK(setup.learning_rate(500) == doctest::Approx(1e-3 * std::sqrt(0.5)));
     CHECK(setup.learning_rate(1000) == doctest::Approx(5e-4));
@@ -43,7 +24,7 @@ TEST_SUITE("learning rate") {
     riner::RinerConfig config;
     config.training.steps = 4000;
     config.training.lr_decay_smooth = false;
-    const riner::detail::TrainingSetup setup(small_scan(), config);
+    const riner::detail::TrainingSetup setup(riner::test::tiny_problem().scan, config);
     CHECK(setup.learning_rate(999) == doctest::Approx(1e-3));
     CHECK(setup.learning_rate(1000) == doctest::Approx(5e-4));
     CHECK(setup.learning_rate(3999) == doctest::Approx(1.25e-4));
@@ -52,7 +33,7 @@ TEST_SUITE("learning rate") {
   TEST_CASE("the paper's configuration halves in steps every 1000") {
     const riner::RinerConfig paper = riner::RinerConfig::paper();
     CHECK_FALSE(paper.training.lr_decay_smooth);
-    const riner::detail::TrainingSetup setup(small_scan(), paper);
+    const riner::detail::TrainingSetup setup(riner::test::tiny_problem().scan, paper);
     CHECK(setup.learning_rate(1500) == doctest::Approx(5e-4));
   }
 }
