@@ -22,12 +22,12 @@ SOURCES = {
     "deeplesion_gpu": "issue30_throughput.jsonl",
     "deeplesion_gpu_h100": "issue12_gpu.jsonl",
     "classical": "issue31_destripe_device.jsonl",
-    "classical_real": "issue31_destripe_real.jsonl",
+    "classical_real": "issue31_destripe_real_specks.jsonl",
     "warm_start": "issue31_warm_smooth.jsonl",
     "sizes_cpu": "issue29_draws10.jsonl",
     "sizes_gpu": "issue29_sizes_gpu.jsonl",
     "real_trained": "issue29_beta_real.jsonl",
-    "real_chain": "issue29_smooth_decay_real.jsonl",
+    "real_chain": "issue29_specks_extrema_real.jsonl",
     "throughput": "issue30_throughput.jsonl",
     "cores": "issue30_cores16.jsonl",
     "gpu_slow_step": "issue30_gpu_loss_median.jsonl",
@@ -389,6 +389,9 @@ def real_scans(root):
     text = table(["scan", "ring index FBP → riner", "specks per 10⁴ px FBP / riner",
                   "edges (of FBP's)", "lost object", "time", "machine; date; revision",
                   "command"], rows)
+    text += ("\n\n(This table's specks predate the extremum rule of 2026-11-27: they count "
+             "every pixel over 6 σ from its 3 × 3 median, an edge's wavering pixels included, "
+             "about twice the number by today's rule on these scans.)")
 
     chain = [r for r in records(root, SOURCES["real_chain"])
              if r.get("order") == CURRENT_CHAIN and "fbp_ring_index" in r]
@@ -573,7 +576,8 @@ Shepp-Logan phantom and DeepLesion slice 3; the oracle is FBP with a perfect det
 
 ## The shared real scans (2D, seed 0)
 
-Quality report against the scan's own FBP (no ground truth): ring index and specks (lower is
+Quality report against the scan's own FBP (no ground truth): ring index and specks (pixels
+above or below all their neighbours by over 6 FBP noise σ from their 3 × 3 median; lower is
 better), edge strength as a share of FBP's (1: as sharp), the share of the disc where FBP sees
 object and riner air.
 

@@ -3,9 +3,11 @@
 // grid centre, inside the inscribed disc; of a volume, over its axial slices (the centre
 // deviation only in 2D).
 //   ring index   riner::ring_index (metrics.hpp)
-//   specks       pixels whose difference from their 3 x 3 median exceeds 6 noise sigmas, per
-//                10^4 pixels of the disc; sigma is the FBP's pixel noise (1.4826 x the median
-//                absolute difference of the FBP from its own 3 x 3 median)
+//   specks       pixels above or below all 8 neighbours whose difference from their 3 x 3
+//                median exceeds 6 noise sigmas, per 10^4 pixels of the disc; sigma is the FBP's
+//                pixel noise (1.4826 x the median absolute difference of the FBP from its own
+//                3 x 3 median). A pixel on an edge's slope lies between its neighbours and is
+//                not a speck, however far its median jumps
 //   centre       the largest difference, within `radius_px` of the axis, between the broad
 //                radial profiles (angular means smoothed over radius) of the image and of the
 //                FBP, against the FBP profile's own noise there (the rms of its angular means
