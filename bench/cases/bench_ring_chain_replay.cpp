@@ -48,16 +48,18 @@ riner::Array replay(const std::string& order, const Saved& s,
                     const riner::RingCorrectionConfig& c) {
   riner::Array image = s.field;
   riner::Array alpha = s.alpha;
+  std::vector<double> objects;  // the mirror pairs' objects, as riner::correct_rings_in_order
   for (char step : order) {
     riner::RingCorrection r;
     if (step == 'a') {
       r = riner::correct_rings_from_air(image, alpha, s.geometry, c.air);
     } else if (step == 'g') {
-      r = riner::correct_rings_from_gradient(image, alpha, s.geometry, c.gradient);
+      r = riner::correct_rings_from_gradient(image, alpha, s.geometry, c.gradient, objects);
     } else if (step == 'r') {
       r = riner::correct_rings_from_response(image, alpha, s.geometry, s.dead, c.response);
     } else if (step == 'm') {
       r = riner::correct_rings_from_mirrors(image, alpha, s.geometry, s.dead, c.mirror);
+      objects = r.object_radii_mm;
     } else {
       throw riner::InputError(std::string("--order: unknown step '") + step +
                               "' (a, g, r or m)");

@@ -7,10 +7,14 @@
 //
 //   riner_bench --case=size_scaling [--columns=512,1024,2048] [--scene=deeplesion|shepp-logan]
 //               [--first=3 --last=3] [--seed-offset=N] [--config=JSON] [--json=FILE]
+//               [--images=DIR]
+// --images: the truth, riner's image, the oracle FBP, the learned and the true alpha as .npy
+// per scene and size, for looking at where the error lies.
 // deeplesion: the shared slices (1 mm pixels) resampled bilinearly: no detail finer than 1 mm at
 // any size. shepp-logan: rasterised on each grid (4x supersampled): sharp at every size.
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <sstream>
 
 #include "harness.hpp"
@@ -104,8 +108,8 @@ std::vector<Result> size_scaling(const Options& o) {
       const riner::SimulatedScan twin = riner::simulate(truth, projector, perfect);
       const riner::ImageMetrics fbp =
           riner::compare_images(riner::fbp(sim.scan, fbp_options), truth);
-      const riner::ImageMetrics oracle =
-          riner::compare_images(riner::fbp(twin.scan, fbp_options), truth);
+      const riner::Array oracle_image = riner::fbp(twin.scan, fbp_options);
+      const riner::ImageMetrics oracle = riner::compare_images(oracle_image, truth);
 
       riner::Reconstructor r(sim.scan, config, device);
       r.run();
@@ -124,6 +128,17 @@ std::vector<Result> size_scaling(const Options& o) {
         if (beta.data[e] < riner::Reconstructor::kDeadBelowBeta) (is_dead ? dead_found : live_off) += 1;
       }
       const std::string name = scene + "/" + std::to_string(index);
+      if (const std::string dir = o.get("images", ""); !dir.empty()) {
+        const std::filesystem::path stem =
+            std::filesystem::path(dir) /
+            (scene + "_" + std::to_string(index) + "_" + std::to_string(c) + "_");
+        std::filesystem::create_directories(dir);
+        riner::write_array(stem.string() + "truth.npy", truth);
+        riner::write_array(stem.string() + "riner.npy", r.result().image);
+        riner::write_array(stem.string() + "oracle.npy", oracle_image);
+        riner::write_array(stem.string() + "alpha.npy", r.alpha());
+        riner::write_array(stem.string() + "alpha_true.npy", sim.alpha);
+      }
       rows.push_back(
           {"size_scaling",
            {{"scene", name},

@@ -24,17 +24,18 @@ SOURCES = {
     "classical": "issue31_destripe_device.jsonl",
     "classical_real": "issue31_destripe_real_specks.jsonl",
     "warm_start": "issue31_warm_smooth.jsonl",
-    "sizes_cpu": "issue29_draws10.jsonl",
+    # newest first: a scene and size measured in a later file hides the earlier rows
+    "sizes_cpu": ("issue29_sizes_gradient.jsonl", "issue29_draws10.jsonl"),
     "sizes_gpu": "issue29_sizes_gpu.jsonl",
     "real_trained": "issue29_beta_real.jsonl",
-    "real_chain": "issue29_specks_extrema_real.jsonl",
+    "real_chain": "issue29_gradient_scale_real.jsonl",
     "throughput": "issue30_throughput.jsonl",
     "cores": "issue30_cores16.jsonl",
     "gpu_slow_step": "issue30_gpu_loss_median.jsonl",
     "steps_gpu": "issue12_gpu_ops.jsonl",
     "volumes": "issue34_volume_defaults.jsonl",
     "partial_rings": "issue32_partial_rings.jsonl",
-    "tube_wall": "issue32_tube_wall_smooth.jsonl",
+    "tube_wall": "issue32_tube_wall_gradient.jsonl",
 }
 # The ring chain of today's defaults (mirror, air, gradient, response, gradient again).
 CURRENT_CHAIN = "magrg"
@@ -350,9 +351,11 @@ def classical_real(root):
 
 
 def sizes(root):
-    rows = []
-    for r in records(root, SOURCES["sizes_cpu"]):
-        rows.append(size_row(r))
+    rows, seen = [], set()
+    for name in SOURCES["sizes_cpu"]:
+        fresh = [r for r in records(root, name) if (r["scene"], r["columns"]) not in seen]
+        seen.update((r["scene"], r["columns"]) for r in fresh)
+        rows.extend(size_row(r) for r in fresh)
     for r in records(root, SOURCES["sizes_gpu"]):
         config = r["meta"]["settings"]["options"].get("config", "")
         if config == '{"training":{"min_draws_per_ray":10}}':  # today's default

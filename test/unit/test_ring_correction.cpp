@@ -109,6 +109,23 @@ double rms_difference(const riner::Array& a, const riner::Array& b) {
   return std::sqrt(sum / static_cast<double>(a.size()));
 }
 
+// The phantom with the narrow ring at 12 mm that training left in the image, and responses with
+// a mild structure of their own.
+struct NarrowRingCase {
+  riner::Geometry geometry;
+  riner::Array truth, trained, alpha;
+};
+
+NarrowRingCase narrow_ring_case() {
+  NarrowRingCase k{ring_geometry(), {}, {}, {}};
+  k.truth = phantom(k.geometry, false);
+  k.trained = sum_of(k.truth, narrow_inner_ring(k.geometry));
+  k.alpha = riner::Array({k.geometry.n_u});
+  for (std::size_t e = 0; e < k.geometry.n_u; ++e)
+    k.alpha.data[e] = 0.8f + 0.003f * static_cast<float>(e % 50);
+  return k;
+}
+
 // How far the predicted readings moved between two (image, alpha) pairs: the largest change,
 // over elements, of the view-averaged prediction, and the largest change of a single reading.
 struct PredictionMismatch {
@@ -284,12 +301,9 @@ TEST_SUITE("ring_correction") {
   }
 
   TEST_CASE("gradient: a narrow ring inside the object leaves the image for alpha") {
-    const riner::Geometry g = ring_geometry();
-    const riner::Array truth = phantom(g, false);
-    const riner::Array trained = sum_of(truth, narrow_inner_ring(g));
-    riner::Array alpha({g.n_u});
-    for (std::size_t e = 0; e < g.n_u; ++e)
-      alpha.data[e] = 0.8f + 0.003f * static_cast<float>(e % 50);
+    const NarrowRingCase k = narrow_ring_case();
+    const riner::Geometry& g = k.geometry;
+    const riner::Array &truth = k.truth, &trained = k.trained, &alpha = k.alpha;
 
     const riner::RingCorrection c = riner::correct_rings_from_gradient(trained, alpha, g);
     CHECK(c.applied);
@@ -305,6 +319,29 @@ TEST_SUITE("ring_correction") {
     // projection (measured 3.6%: the projector sees the profile as pixels, the correction
     // integrates it continuously).
     CHECK(check_data_fit_kept(g, trained, alpha, c, 0.05) > 0.002);
+  }
+
+  TEST_CASE("gradient: the radii where the mirror pairs found an object keep their values") {
+    // The narrow ring at 12 mm above, now where an object centred on the axis stands (a
+    // cylinder's bright rim, which the mirror step gave back to the image): left alone there,
+    // taken as before when the object is elsewhere.
+    const NarrowRingCase k = narrow_ring_case();
+    const riner::Geometry& g = k.geometry;
+    const riner::Array &truth = k.truth, &trained = k.trained, &alpha = k.alpha;
+    const riner::RingCorrection kept =
+        riner::correct_rings_from_gradient(trained, alpha, g, {}, {12.0});
+    const riner::RingCorrection taken =
+        riner::correct_rings_from_gradient(trained, alpha, g, {}, {35.0});
+    const double ring = rms_difference(trained, truth);
+    MESSAGE("ring rms " << ring << "; object at 12 mm: " << rms_difference(kept.image, truth)
+                        << ", at 35 mm: " << rms_difference(taken.image, truth));
+    for (std::size_t k = 0; k < kept.profile.size(); ++k) {
+      const double radius_mm = static_cast<double>(k) * kept.radius_step_mm;
+      const double reach_mm = riner::GradientRingSettings::kScaleAt256Px * g.voxel_mm;
+      if (std::fabs(radius_mm - 12.0) <= reach_mm) CHECK(kept.profile[k] == 0.0);
+    }
+    CHECK(rms_difference(kept.image, truth) > 0.9 * ring);
+    CHECK(rms_difference(taken.image, truth) < 0.2 * ring);
   }
 
   TEST_CASE("gradient: an image without rings keeps its values") {
@@ -373,6 +410,20 @@ TEST_SUITE("ring_correction") {
     const double after = rms_difference(c.image, truth);
     MESSAGE("rms error " << before << " -> " << after);
     CHECK(after < 0.25 * before);
+  }
+
+  TEST_CASE("gradient: the median's half width grows with the slice beyond 256 pixels") {
+    // Measured on a 512² DeepLesion slice (1024 columns): 12 px 42.8 dB, 24 px 46.0, 36 px 45.3;
+    // on 256² slices 12 px stays (docs/history/RESULTS.md, issue 29).
+    const riner::GradientRingSettings automatic;
+    CHECK(automatic.scale_px_for(64) == 12.0);
+    CHECK(automatic.scale_px_for(256) == 12.0);
+    CHECK(automatic.scale_px_for(512) == 24.0);
+    CHECK(automatic.scale_px_for(640) == doctest::Approx(30.0));
+    CHECK(automatic.scale_px_for(2048) == 96.0);
+    riner::GradientRingSettings fixed;
+    fixed.scale_px = 12.0;
+    CHECK(fixed.scale_px_for(1024) == 12.0);
   }
 
   TEST_CASE("response: a broad dip the responses carry goes back into the image") {

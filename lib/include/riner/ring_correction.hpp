@@ -40,6 +40,7 @@
 // max_mean_response_change is not applied.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -87,6 +88,9 @@ struct RingCorrection {
   // largest such excess in units of that noise.
   std::size_t elements_moved = 0;
   double largest_even_sigmas = 0.0;
+  // Mirror pairs: the distances from the axis (mm) of those elements' rays, where an object
+  // centred on the axis stands; the radial gradient leaves these radii alone.
+  std::vector<double> object_radii_mm;
 };
 
 // `image` on the 2D geometry's grid ([n_y, n_x]) and `alpha` with one value per detector
@@ -99,8 +103,18 @@ RingCorrection correct_rings_from_air(const Array& image, const Array& alpha,
 
 struct GradientRingSettings {
   // Rings narrower than this (the running median's half width, in pixels) are measured;
-  // broader ones stay, as the image's own radial trends and steps do.
-  double scale_px = 12.0;
+  // broader ones stay, as the image's own radial trends and steps do. 0: kScaleAt256Px on a
+  // slice of up to 256 pixels a side, grown with the side beyond: the rings training leaves
+  // span a share of the field, not a number of pixels (a 512² DeepLesion slice at 12 px
+  // 42.8 dB, at 24 px 45.9; docs/history/RESULTS.md, issue 29). Nearer the axis than this, the
+  // half width is the radius (kScaleAt256Px at least).
+  static constexpr double kScaleAt256Px = 12.0;
+  double scale_px = 0.0;
+  // The half width used on a slice whose larger side is side_px.
+  double scale_px_for(std::size_t side_px) const {
+    if (scale_px > 0.0) return scale_px;
+    return kScaleAt256Px * std::max(1.0, static_cast<double>(side_px) / 256.0);
+  }
   // The fraction of each circle's points whose slopes enter the median: those with the least
   // change along the circle, where anatomy's edges are not.
   double flat_fraction = 0.5;
@@ -110,10 +124,13 @@ struct GradientRingSettings {
 
 // Same inputs and guarantees as correct_rings_from_air; the profile has one node per pixel of
 // radius. Run it after the air reference (the air fixes broad rings where it can see them), and
-// again after the response correction.
+// again after the response correction. The profile is 0 within the median's half width of
+// object_radii_mm (the mirror pairs' objects centred on the axis: a cylinder's bright rim is
+// no ring).
 RingCorrection correct_rings_from_gradient(const Array& image, const Array& alpha,
                                            const Geometry& geometry,
-                                           const GradientRingSettings& settings = {});
+                                           const GradientRingSettings& settings = {},
+                                           const std::vector<double>& object_radii_mm = {});
 
 struct ResponseRingSettings {
   // Structure of -ln(alpha) across the detector broader than this (sigma of a Gaussian over the

@@ -105,12 +105,18 @@ bool ring_slope(const PolarSamples& s, std::size_t r, double flat_fraction, doub
 // values minus their running median over 2 half_width + 1 nodes, mirrored at both ends. A
 // feature narrower than half_width goes; a step (the edge of a disc about the axis) stays, where
 // a Gaussian high-pass would leave rings on both sides of it (docs/history/RESULTS.md, issue 13).
-std::vector<double> high_pass(const std::vector<double>& values, std::size_t half_width) {
+// Within half_width of the axis the window shrinks to the node's radius (least_half_width at
+// least): mirrored there, a wide window takes the object's own radial trend near the axis for
+// a ring (the tooth's centre 0.70 -> 1.28 sigma at 30 px; issue 29).
+std::vector<double> high_pass(const std::vector<double>& values, std::size_t half_width,
+                              std::size_t least_half_width) {
   const auto n = static_cast<std::ptrdiff_t>(values.size());
   std::vector<double> out(values.size());
-  std::vector<double> window(2 * half_width + 1);
-  const auto h = static_cast<std::ptrdiff_t>(half_width);
+  std::vector<double> window;
   for (std::ptrdiff_t i = 0; i < n; ++i) {
+    const auto h = static_cast<std::ptrdiff_t>(std::clamp(
+        static_cast<std::size_t>(i), std::min(least_half_width, half_width), half_width));
+    window.resize(static_cast<std::size_t>(2 * h + 1));
     for (std::ptrdiff_t k = -h; k <= h; ++k) {
       window[static_cast<std::size_t>(k + h)] =
           values[static_cast<std::size_t>(rings::mirrored(i + k, n))];
@@ -127,7 +133,8 @@ std::vector<double> high_pass(const std::vector<double>& values, std::size_t hal
 
 RingCorrection correct_rings_from_gradient(const Array& image, const Array& alpha,
                                            const Geometry& geometry,
-                                           const GradientRingSettings& settings) {
+                                           const GradientRingSettings& settings,
+                                           const std::vector<double>& object_radii_mm) {
   rings::check_inputs("gradient ring correction", image, alpha, geometry);
   rings::validate("gradient ring correction", settings);
   RingCorrection out = rings::unchanged(image, alpha, geometry.voxel_mm);
@@ -147,7 +154,16 @@ RingCorrection correct_rings_from_gradient(const Array& image, const Array& alph
     ring[r + 1] = ring[r] + slope;
   }
   if (out.measured_radii == 0) return out;
-  out.profile = high_pass(ring, static_cast<std::size_t>(std::lround(settings.scale_px)));
+  const double scale_px = settings.scale_px_for(std::max(ny, nx));
+  out.profile = high_pass(ring, static_cast<std::size_t>(std::lround(scale_px)),
+                          static_cast<std::size_t>(GradientRingSettings::kScaleAt256Px));
+  const double reach_mm = scale_px * geometry.voxel_mm;
+  for (std::size_t k = 0; k < out.profile.size(); ++k) {
+    const double radius_mm = static_cast<double>(k) * out.radius_step_mm;
+    for (double r : object_radii_mm) {
+      if (std::fabs(radius_mm - r) <= reach_mm) out.profile[k] = 0.0;
+    }
+  }
   out.profile.push_back(out.profile.back());  // a spare node for the interpolation
   if (rings::fold_into_alpha(out,
                              rings::ring_projections(out.profile, out.radius_step_mm, geometry),

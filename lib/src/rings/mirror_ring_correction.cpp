@@ -313,6 +313,7 @@ RingCorrection correct_rings_from_mirrors(const Array& image, const Array& alpha
   out.elements_moved = evidence.count;
   out.largest_even_sigmas = evidence.largest_sigmas;
   if (evidence.count == 0) return out;
+  out.object_radii_mm = object_radii(evidence, distance);
 
   out.radius_step_mm = kNodeStepPx * geometry.voxel_mm;
   const rings::ProfileNodes at = rings::profile_nodes(image, kNodeStepPx);

@@ -34,15 +34,18 @@ RingChain correct_rings_in_order(const Array& image, const Array& alpha, const G
   if (config.air_reference) {
     take(out.air, correct_rings_from_air(out.image, out.alpha, g, config.air));
   }
+  const std::vector<double> objects =
+      out.mirror ? out.mirror->object_radii_mm : std::vector<double>{};
   if (config.gradient_reference) {
-    take(out.gradient, correct_rings_from_gradient(out.image, out.alpha, g, config.gradient));
+    take(out.gradient,
+         correct_rings_from_gradient(out.image, out.alpha, g, config.gradient, objects));
   }
   if (config.response_reference) {
     take(out.response,
          correct_rings_from_response(out.image, out.alpha, g, dead_elements, config.response));
     if (config.gradient_reference && config.gradient_after_response) {
       take(out.gradient_after_response,
-           correct_rings_from_gradient(out.image, out.alpha, g, config.gradient));
+           correct_rings_from_gradient(out.image, out.alpha, g, config.gradient, objects));
     }
   }
   return out;

@@ -39,9 +39,10 @@ const std::vector<settings::Setting<GradientRingSettings>>& gradient_settings() 
   using S = GradientRingSettings;
   static const std::vector<settings::Setting<S>> table = {
       field<S>(
-          "rings", "gradient_scale_px", open_closed(0, 1000),
+          "rings", "gradient_scale_px", closed(0, 1000),
           "gradient correction: rings narrower than this (pixels; half the running median) are "
-          "measured",
+          "measured; 0: 12 on slices up to 256 px a side, grown with the side beyond (24 at "
+          "512)",
           &S::scale_px),
       field<S>("rings", "gradient_flat_fraction", open_closed(0, 1),
                "gradient correction: fraction of each circle's flattest points in the median",
