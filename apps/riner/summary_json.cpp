@@ -38,6 +38,11 @@ nlohmann::json ring_summary(const std::optional<RingCorrection>& rings) {
     out["even_to_odd"] = std::isfinite(rings->even_to_odd) ? nlohmann::json(rings->even_to_odd)
                                                            : nlohmann::json(nullptr);
   }
+  // The radial-gradient correction's window, and the radii it left to the mirror's objects.
+  if (rings->scale_px > 0.0) {
+    out["scale_px"] = rings->scale_px;
+    out["radii_kept_for_objects"] = rings->radii_kept_for_objects;
+  }
   // The mirror correction's evidence.
   if (rings->elements_moved != 0 || rings->largest_even_sigmas != 0.0) {
     out["elements_moved"] = rings->elements_moved;

@@ -714,6 +714,7 @@ TEST_SUITE("cli") {
     CHECK(rings["measured_radii"].get<int>() > 100);
     const auto gradient = nlohmann::json::parse(with.out)["gradient_ring_correction"];
     CHECK(gradient["measured_radii"].get<int>() > 100);
+    CHECK(gradient["scale_px"] == 12.0);  // a 256² slice: the window of rings.gradient_scale_px 0
     CHECK(nlohmann::json::parse(without.out)["air_ring_correction"]["applied"] == false);
     CHECK(nlohmann::json::parse(without.out)["gradient_ring_correction"]["applied"] == false);
     const auto response = nlohmann::json::parse(with.out)["response_ring_correction"];

@@ -91,6 +91,10 @@ struct RingCorrection {
   // Mirror pairs: the distances from the axis (mm) of those elements' rays, where an object
   // centred on the axis stands; the radial gradient leaves these radii alone.
   std::vector<double> object_radii_mm;
+  // Radial gradient: the running median's half width used (pixels), and the profile's radii
+  // left alone for the mirror pairs' objects.
+  double scale_px = 0.0;
+  std::size_t radii_kept_for_objects = 0;
 };
 
 // `image` on the 2D geometry's grid ([n_y, n_x]) and `alpha` with one value per detector

@@ -157,12 +157,15 @@ RingCorrection correct_rings_from_gradient(const Array& image, const Array& alph
   const double scale_px = settings.scale_px_for(std::max(ny, nx));
   out.profile = high_pass(ring, static_cast<std::size_t>(std::lround(scale_px)),
                           static_cast<std::size_t>(GradientRingSettings::kScaleAt256Px));
+  out.scale_px = scale_px;
   const double reach_mm = scale_px * geometry.voxel_mm;
   for (std::size_t k = 0; k < out.profile.size(); ++k) {
     const double radius_mm = static_cast<double>(k) * out.radius_step_mm;
-    for (double r : object_radii_mm) {
-      if (std::fabs(radius_mm - r) <= reach_mm) out.profile[k] = 0.0;
-    }
+    const bool object = std::any_of(object_radii_mm.begin(), object_radii_mm.end(),
+                                    [&](double r) { return std::fabs(radius_mm - r) <= reach_mm; });
+    if (!object) continue;
+    out.profile[k] = 0.0;
+    ++out.radii_kept_for_objects;
   }
   out.profile.push_back(out.profile.back());  // a spare node for the interpolation
   if (rings::fold_into_alpha(out,
