@@ -161,9 +161,7 @@ RingCorrection correct_rings_from_gradient(const Array& image, const Array& alph
   const double reach_mm = scale_px * geometry.voxel_mm;
   for (std::size_t k = 0; k < out.profile.size(); ++k) {
     const double radius_mm = static_cast<double>(k) * out.radius_step_mm;
-    const bool object = std::any_of(object_radii_mm.begin(), object_radii_mm.end(),
-                                    [&](double r) { return std::fabs(radius_mm - r) <= reach_mm; });
-    if (!object) continue;
+    if (!rings::within_reach(object_radii_mm, radius_mm, reach_mm)) continue;
     out.profile[k] = 0.0;
     ++out.radii_kept_for_objects;
   }

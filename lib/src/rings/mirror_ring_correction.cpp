@@ -211,12 +211,6 @@ std::vector<double> object_radii(const EvenEvidence& ev, const std::vector<doubl
   return radii;
 }
 
-// Whether `radius` lies within `reach` of one of `radii`.
-bool within_reach(const std::vector<double>& radii, double radius, double reach) {
-  return std::any_of(radii.begin(), radii.end(),
-                     [&](double r) { return std::fabs(r - radius) <= reach; });
-}
-
 // Least squares of `a` (the used nodes' projections, rows weighted) against `target`, plus
 // `weight` times the profile's total variation (reweighted least squares).
 Eigen::VectorXd fit_with_variation(const Eigen::MatrixXd& a, const Eigen::VectorXd& target,
@@ -257,7 +251,7 @@ Eigen::VectorXd fit_gain(const EvenEvidence& ev, const Geometry& g,
   std::vector<Eigen::Index> at;
   for (Eigen::Index k = 0; k < solved; ++k) {
     const double radius = static_cast<double>(k) * step_mm;
-    if (within_reach(objects, radius, kObjectMarginPx * g.voxel_mm)) at.push_back(k);
+    if (rings::within_reach(objects, radius, kObjectMarginPx * g.voxel_mm)) at.push_back(k);
   }
   used = at.size();
   Eigen::VectorXd gain = Eigen::VectorXd::Zero(solved);
@@ -276,7 +270,8 @@ Eigen::VectorXd fit_gain(const EvenEvidence& ev, const Geometry& g,
   Eigen::VectorXd target(m);
   for (Eigen::Index r = 0; r < m; ++r) {
     const auto e = static_cast<std::size_t>(rows[static_cast<std::size_t>(r)]);
-    const bool full = within_reach(objects, std::fabs(distance[e]), kEvidenceReachPx * g.voxel_mm);
+    const bool full =
+        rings::within_reach(objects, std::fabs(distance[e]), kEvidenceReachPx * g.voxel_mm);
     const double w = full ? 1.0 : kHoldWeight;
     for (std::size_t k = 0; k < at.size(); ++k) {
       a(r, static_cast<Eigen::Index>(k)) = w * weights(rows[static_cast<std::size_t>(r)], at[k]);

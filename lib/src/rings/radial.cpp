@@ -41,6 +41,11 @@ std::ptrdiff_t mirrored(std::ptrdiff_t j, std::ptrdiff_t n) {
   return j < n ? j : period - j;
 }
 
+bool within_reach(const std::vector<double>& radii, double radius, double reach) {
+  return std::any_of(radii.begin(), radii.end(),
+                     [&](double r) { return std::fabs(r - radius) <= reach; });
+}
+
 std::vector<double> gaussian_smooth(const std::vector<double>& values, double sigma, Ends ends,
                                     const std::vector<char>* use) {
   const auto n = static_cast<std::ptrdiff_t>(values.size());

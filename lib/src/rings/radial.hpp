@@ -44,6 +44,9 @@ enum class Ends {
 // Index j mirrored into 0..n-1 about the first and last nodes (Ends::kMirror).
 std::ptrdiff_t mirrored(std::ptrdiff_t j, std::ptrdiff_t n);
 
+// Whether `radius` lies within `reach` of one of `radii` (same unit).
+bool within_reach(const std::vector<double>& radii, double radius, double reach);
+
 // Gaussian smoothing (sigma in nodes) of regularly spaced values. With `use`, only the values
 // it marks enter, renormalised, and the others come out 0.
 std::vector<double> gaussian_smooth(const std::vector<double>& values, double sigma, Ends ends,
