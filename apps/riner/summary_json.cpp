@@ -38,7 +38,8 @@ nlohmann::json ring_summary(const std::optional<RingCorrection>& rings) {
     out["even_to_odd"] = std::isfinite(rings->even_to_odd) ? nlohmann::json(rings->even_to_odd)
                                                            : nlohmann::json(nullptr);
   }
-  // The radial-gradient correction's window, and the radii it left to the mirror's objects.
+  // The radial-gradient and response corrections' scale, and the radii they left to the mirror
+  // step's objects.
   if (rings->scale_px > 0.0) {
     out["scale_px"] = rings->scale_px;
     out["radii_kept_for_objects"] = rings->radii_kept_for_objects;

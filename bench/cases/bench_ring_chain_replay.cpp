@@ -56,7 +56,7 @@ riner::Array replay(const std::string& order, const Saved& s,
     } else if (step == 'g') {
       r = riner::correct_rings_from_gradient(image, alpha, s.geometry, c.gradient, objects);
     } else if (step == 'r') {
-      r = riner::correct_rings_from_response(image, alpha, s.geometry, s.dead, c.response);
+      r = riner::correct_rings_from_response(image, alpha, s.geometry, s.dead, c.response, objects);
     } else if (step == 'm') {
       r = riner::correct_rings_from_mirrors(image, alpha, s.geometry, s.dead, c.mirror);
       objects = r.object_radii_mm;

@@ -28,7 +28,7 @@ SOURCES = {
     "sizes_cpu": ("issue29_sizes_gradient.jsonl", "issue29_draws10.jsonl"),
     "sizes_gpu": "issue29_sizes_gpu.jsonl",
     "real_trained": "issue29_beta_real.jsonl",
-    "real_chain": "issue29_gradient_scale_real.jsonl",
+    "real_chain": "issue32_response_objects_real.jsonl",
     "throughput": "issue30_throughput.jsonl",
     "cores": "issue30_cores16.jsonl",
     "gpu_slow_step": "issue30_gpu_loss_median.jsonl",

@@ -173,6 +173,33 @@ riner::Array broad_dip(const riner::Geometry& g) {
   });
 }
 
+// Training's split: image = truth + a broad dip about the axis, alpha = the truth's white
+// responses * exp(view-averaged projection of the dip), so the data fit is the truth's.
+struct BroadDipCase {
+  riner::Geometry geometry;
+  riner::Array truth, trained, alpha, true_alpha;
+  riner::ResponseRingSettings settings;
+};
+
+BroadDipCase broad_dip_case() {
+  BroadDipCase k{ring_geometry(), {}, {}, {}, {}, {}};
+  const riner::Geometry& g = k.geometry;
+  k.truth = phantom(g, false);
+  const riner::Array dip = broad_dip(g);
+  k.trained = sum_of(k.truth, dip);
+  k.true_alpha = white_responses(g.n_u);
+  const std::vector<double> dip_projection =
+      riner::ref::project(g, std::vector<double>(dip.data.begin(), dip.data.end()));
+  k.alpha = k.true_alpha;
+  for (std::size_t e = 0; e < g.n_u; ++e) {
+    double sum = 0.0;
+    for (std::size_t v = 0; v < g.n_views(); ++v) sum += dip_projection[v * g.n_u + e];
+    k.alpha.data[e] *= static_cast<float>(std::exp(sum / static_cast<double>(g.n_views())));
+  }
+  k.settings.scale_px = 8.0;  // the phantom is small: a third of the default's scale
+  return k;
+}
+
 // The largest |ln(after / before)| over the elements: the biggest ring projection folded in.
 double largest_response_change(const riner::Array& after, const riner::Array& before) {
   double largest = 0.0;
@@ -335,10 +362,10 @@ TEST_SUITE("ring_correction") {
     const double ring = rms_difference(trained, truth);
     MESSAGE("ring rms " << ring << "; object at 12 mm: " << rms_difference(kept.image, truth)
                         << ", at 35 mm: " << rms_difference(taken.image, truth));
-    for (std::size_t k = 0; k < kept.profile.size(); ++k) {
-      const double radius_mm = static_cast<double>(k) * kept.radius_step_mm;
+    for (std::size_t b = 0; b < kept.profile.size(); ++b) {
+      const double radius_mm = static_cast<double>(b) * kept.radius_step_mm;
       const double reach_mm = riner::GradientRingSettings::kScaleAt256Px * g.voxel_mm;
-      if (std::fabs(radius_mm - 12.0) <= reach_mm) CHECK(kept.profile[k] == 0.0);
+      if (std::fabs(radius_mm - 12.0) <= reach_mm) CHECK(kept.profile[b] == 0.0);
     }
     CHECK(rms_difference(kept.image, truth) > 0.9 * ring);
     CHECK(rms_difference(taken.image, truth) < 0.2 * ring);
@@ -427,23 +454,11 @@ TEST_SUITE("ring_correction") {
   }
 
   TEST_CASE("response: a broad dip the responses carry goes back into the image") {
-    // Training's split: image = truth + dip, alpha = truth's responses * exp(view-averaged
-    // projection of the dip), so the data fit is the truth's.
-    const riner::Geometry g = ring_geometry();
-    const riner::Array truth = phantom(g, false);
-    const riner::Array dip = broad_dip(g);
-    const riner::Array trained = sum_of(truth, dip);
-    const riner::Array true_alpha = white_responses(g.n_u);
-    const std::vector<double> dip_projection =
-        riner::ref::project(g, std::vector<double>(dip.data.begin(), dip.data.end()));
-    riner::Array alpha = true_alpha;
-    for (std::size_t e = 0; e < g.n_u; ++e) {
-      double sum = 0.0;
-      for (std::size_t v = 0; v < g.n_views(); ++v) sum += dip_projection[v * g.n_u + e];
-      alpha.data[e] *= static_cast<float>(std::exp(sum / static_cast<double>(g.n_views())));
-    }
-    riner::ResponseRingSettings settings;
-    settings.scale_px = 8.0;  // the phantom is small: a third of the default's scale
+    const BroadDipCase k = broad_dip_case();
+    const riner::Geometry& g = k.geometry;
+    const riner::Array &truth = k.truth, &trained = k.trained, &alpha = k.alpha;
+    const riner::Array& true_alpha = k.true_alpha;
+    const riner::ResponseRingSettings& settings = k.settings;
 
     const riner::RingCorrection c =
         riner::correct_rings_from_response(trained, alpha, g, {}, settings);
@@ -468,6 +483,38 @@ TEST_SUITE("ring_correction") {
     CHECK(alpha_after < 0.6 * alpha_before);
     // Measured 1.1%: as for the gradient correction, pixels against a continuous profile.
     check_data_fit_kept(g, trained, alpha, c, 0.05);
+  }
+
+  TEST_CASE("response: the radii where the mirror pairs found an object keep their values") {
+    // The broad dip above with an object's rim at 10 mm (the mirror step gave it back to the
+    // image): the profile is held at 0 within the response scale of it, and still moves the
+    // image elsewhere.
+    const BroadDipCase k = broad_dip_case();
+    const riner::Geometry& g = k.geometry;
+    const riner::RingCorrection free =
+        riner::correct_rings_from_response(k.trained, k.alpha, g, {}, k.settings);
+    const riner::RingCorrection held =
+        riner::correct_rings_from_response(k.trained, k.alpha, g, {}, k.settings, {10.0});
+    REQUIRE(free.applied);
+    REQUIRE(held.applied);
+    const double reach_mm = k.settings.scale_px * g.voxel_mm;
+    double largest_free = 0.0;
+    double largest_held = 0.0;
+    std::size_t near = 0;
+    for (std::size_t b = 0; b < held.profile.size(); ++b) {
+      const double radius_mm = static_cast<double>(b) * held.radius_step_mm;
+      if (std::fabs(radius_mm - 10.0) > reach_mm) continue;
+      ++near;
+      largest_free = std::max(largest_free, std::fabs(free.profile[b]));
+      largest_held = std::max(largest_held, std::fabs(held.profile[b]));
+    }
+    MESSAGE("largest |profile| within reach of the object: " << largest_free << " -> "
+                                                             << largest_held);
+    CHECK(held.radii_kept_for_objects == near);
+    CHECK(near > 0);
+    // Measured 7.2e-4 -> 2.8e-5: held by the fit's weight (that of a circle of air), not forced.
+    CHECK(largest_held < 0.1 * largest_free);
+    CHECK(rms_difference(held.image, k.trained) > 0.1 * rms_difference(free.image, k.trained));
   }
 
   TEST_CASE("response: responses without broad structure leave the image as it is") {

@@ -89,10 +89,11 @@ struct RingCorrection {
   std::size_t elements_moved = 0;
   double largest_even_sigmas = 0.0;
   // Mirror pairs: the distances from the axis (mm) of those elements' rays, where an object
-  // centred on the axis stands; the radial gradient leaves these radii alone.
+  // centred on the axis stands; the radial gradient and the response step leave these radii
+  // alone.
   std::vector<double> object_radii_mm;
-  // Radial gradient: the running median's half width used (pixels), and the profile's radii
-  // left alone for the mirror pairs' objects.
+  // Radial gradient: the running median's half width used (pixels); detector response: its
+  // Gaussian's sigma. Both: the profile's radii left alone for the mirror pairs' objects.
   double scale_px = 0.0;
   std::size_t radii_kept_for_objects = 0;
 };
@@ -155,11 +156,13 @@ struct ResponseRingSettings {
 // Same inputs and guarantees as correct_rings_from_air; `dead_elements` (flat indices) do not
 // count: their alpha is not a response. The profile has one node per pixel of radius and is
 // negative where the image gains. Run it after the other two (it is the broad band they leave),
-// then the gradient correction again.
+// then the gradient correction again. Within scale_px of object_radii_mm (the mirror pairs'
+// objects) the profile is held at 0 as over air: the HTC disc's real rim was dimmed 0.6% there.
 RingCorrection correct_rings_from_response(const Array& image, const Array& alpha,
                                            const Geometry& geometry,
                                            const std::vector<std::size_t>& dead_elements,
-                                           const ResponseRingSettings& settings = {});
+                                           const ResponseRingSettings& settings = {},
+                                           const std::vector<double>& object_radii_mm = {});
 
 struct MirrorRingSettings {
   // Gaussian smoothing across elements (sigma, in elements) of -ln(alpha)'s even and odd parts

@@ -112,8 +112,9 @@ double even_to_odd(const ResponseStructure& r) {
 // one's alpha).
 Eigen::VectorXd fit_gain(const ResponseStructure& r, const Array& image, const Geometry& g,
                          const ResponseRingSettings& settings, double threshold, double step_mm,
-                         std::size_t nodes, Eigen::Index solved, Eigen::MatrixXd& weights,
-                         std::size_t& measured) {
+                         std::size_t nodes, Eigen::Index solved,
+                         const std::vector<double>& object_radii_mm, Eigen::MatrixXd& weights,
+                         std::size_t& measured, std::size_t& kept_for_objects) {
   const auto n = static_cast<Eigen::Index>(g.n_u);
   weights.resize(n, solved);
   Eigen::VectorXd mask = Eigen::VectorXd::Zero(n);
@@ -142,8 +143,15 @@ Eigen::VectorXd fit_gain(const ResponseStructure& r, const Array& image, const G
     }
   }
   const std::vector<double> air = air_fraction_per_node(image, threshold, nodes);
+  const double reach_mm = settings.scale_px * g.voxel_mm;
+  kept_for_objects = 0;
   for (Eigen::Index k = 0; k < solved; ++k) {
-    normal(k, k) += scale * (settings.air_weight * air[static_cast<std::size_t>(k)] + kRidgeWeight);
+    // The mirror pairs' objects are the image's, like air: held at no change.
+    const bool object =
+        rings::within_reach(object_radii_mm, static_cast<double>(k) * step_mm, reach_mm);
+    kept_for_objects += object;
+    const double hold = object ? 1.0 : air[static_cast<std::size_t>(k)];
+    normal(k, k) += scale * (settings.air_weight * hold + kRidgeWeight);
   }
   return normal.ldlt().solve(projection.transpose() * broad);
 }
@@ -153,7 +161,8 @@ Eigen::VectorXd fit_gain(const ResponseStructure& r, const Array& image, const G
 RingCorrection correct_rings_from_response(const Array& image, const Array& alpha,
                                            const Geometry& geometry,
                                            const std::vector<std::size_t>& dead_elements,
-                                           const ResponseRingSettings& settings) {
+                                           const ResponseRingSettings& settings,
+                                           const std::vector<double>& object_radii_mm) {
   rings::check_inputs("response ring correction", image, alpha, geometry);
   rings::validate("response ring correction", settings);
   rings::check_dead_elements("response ring correction", dead_elements, geometry.n_u);
@@ -173,8 +182,9 @@ RingCorrection correct_rings_from_response(const Array& image, const Array& alph
   Eigen::MatrixXd weights;
   const Eigen::VectorXd gain =
       fit_gain(structure, image, geometry, settings, threshold, out.radius_step_mm, at.nodes,
-               at.solved, weights, out.measured_radii);
+               at.solved, object_radii_mm, weights, out.measured_radii, out.radii_kept_for_objects);
   if (out.measured_radii == 0) return out;
+  out.scale_px = settings.scale_px;
   rings::move_gain_into_image(out, image, geometry, gain, weights, at.nodes,
                               settings.max_mean_response_change);
   return out;

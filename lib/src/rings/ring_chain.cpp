@@ -41,8 +41,8 @@ RingChain correct_rings_in_order(const Array& image, const Array& alpha, const G
          correct_rings_from_gradient(out.image, out.alpha, g, config.gradient, objects));
   }
   if (config.response_reference) {
-    take(out.response,
-         correct_rings_from_response(out.image, out.alpha, g, dead_elements, config.response));
+    take(out.response, correct_rings_from_response(out.image, out.alpha, g, dead_elements,
+                                                   config.response, objects));
     if (config.gradient_reference && config.gradient_after_response) {
       take(out.gradient_after_response,
            correct_rings_from_gradient(out.image, out.alpha, g, config.gradient, objects));
