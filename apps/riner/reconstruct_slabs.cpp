@@ -107,6 +107,10 @@ void add_slab_options(Args& args) {
               "more than two, else 1); the volume is the same for any N",
               "")
       .option("join-run", "TOKEN", "(used by riner's own slab processes)", "")
+      .flag("pin",
+            "pin each of riner's own slab processes (--processes) to cores of its own (the "
+            "affinity mask's first share of cores, the next, ...) where the mask holds a share "
+            "for each; by default they move as the system schedules them")
       .flag("slices-2d",
             "train each axial slice of a parallel-beam stack as its own 2D scan (the mean of "
             "its detector rows, the 2D defaults) instead of a slab of slices as one 3D field "
@@ -214,6 +218,9 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   }
   // The processes of this machine share its memory, and each gets a slab.
   options.processes = processes > 1 ? processes : ranks.local_size();
+  const int threads_per_process = static_cast<int>(std::max(1u, cores / std::max(1, processes)));
+  const bool pinned = processes > 1 && args.is_set("pin") &&
+                      !core_groups(usable_core_ids(), processes, threads_per_process).empty();
 
   // The leader plans the run (or finds it to resume) before the others join it.
   std::optional<SlabRun> planned;
@@ -241,19 +248,19 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   if (speak) {
     const int at_once = run.workers() * std::max(1, options.processes);
     char line[300];
-    std::snprintf(
-        line, sizeof(line),
-        "%zu slabs of up to %zu slices (%zu x %zu voxels; about %s each, limit %s), "
-        "%d at once%s%s",
-        run.slabs().size(), run.slices_per_slab(), g.volume_shape[1], g.volume_shape[2],
-        bytes_string(static_cast<double>(slab_bytes(g, run.slices_per_slab()))).c_str(),
-        bytes_string(static_cast<double>(run.memory_limit())).c_str(), at_once,
-        done_before ? (", " + std::to_string(done_before) + " done before").c_str() : "",
-        ranks.size() > 1   ? (", over " + std::to_string(ranks.size()) + " ranks").c_str()
-        : processes > 1 ? (" in processes of " + std::to_string(std::max(1u, cores / processes)) +
-                           " threads")
-                              .c_str()
-                        : "");
+    std::snprintf(line, sizeof(line),
+                  "%zu slabs of up to %zu slices (%zu x %zu voxels; about %s each, limit %s), "
+                  "%d at once%s%s",
+                  run.slabs().size(), run.slices_per_slab(), g.volume_shape[1], g.volume_shape[2],
+                  bytes_string(static_cast<double>(slab_bytes(g, run.slices_per_slab()))).c_str(),
+                  bytes_string(static_cast<double>(run.memory_limit())).c_str(), at_once,
+                  done_before ? (", " + std::to_string(done_before) + " done before").c_str() : "",
+                  ranks.size() > 1 ? (", over " + std::to_string(ranks.size()) + " ranks").c_str()
+                  : processes > 1  ? (" in processes of " + std::to_string(threads_per_process) +
+                                     (threads_per_process == 1 ? " thread" : " threads") +
+                                     (pinned ? ", each pinned to its own cores" : ""))
+                                        .c_str()
+                                  : "");
     console.line(line);
     if (run.device_bound()) {
       std::snprintf(line, sizeof(line),
@@ -282,6 +289,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   const auto training_started = std::chrono::steady_clock::now();
   const double training_started_unix = unix_seconds();
   double slices_at_start = static_cast<double>(total);  // until a report says otherwise
+  bool copies_pinned = false;  // as they were started (none on a resume with nothing left)
   try {
     Progress progress("slabs", total * 100, !speak);
     if (processes > 1) {
@@ -289,8 +297,9 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       std::size_t slabs = 0;
       slices_at_start = run.slices_recorded(&slabs);
       if (slabs < run.slabs().size()) {
-        SlabProcesses copies(processes, static_cast<int>(std::max(1u, cores / processes)),
-                             {"--join-run", token, "--quiet"});
+        SlabProcesses copies(processes, threads_per_process, {"--join-run", token, "--quiet"},
+                             pinned);
+        copies_pinned = copies.pinned();
         while (copies.running()) {
           std::this_thread::sleep_for(std::chrono::milliseconds(500));
           const double done = run.slices_recorded(&slabs);
@@ -391,6 +400,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       {"ranks", ranks.size()},
       {"workers", run.workers()},
       {"processes", processes},
+      {"processes_pinned", copies_pinned},
       {"slices_2d", run.slices_2d()},
       {"memory_limit_bytes", run.memory_limit()},
       {"slab_bytes_estimated", slab_bytes(g, run.slices_per_slab())},

@@ -1,5 +1,6 @@
 #include "slab_processes.hpp"
 
+#include <sched.h>
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
@@ -9,6 +10,7 @@
 #include <fstream>
 #include <iterator>
 
+#include "riner/cores.hpp"
 #include "riner/error.hpp"
 
 extern char** environ;
@@ -43,9 +45,22 @@ int default_slab_processes(const std::string& device_type, unsigned cores,
   return static_cast<int>(std::clamp<std::size_t>(slabs_fitting, 1, cores / 2));
 }
 
-SlabProcesses::SlabProcesses(int count, int threads, const std::vector<std::string>& extra) {
-  std::vector<std::string> words = own_command_line();
+SlabProcesses::SlabProcesses(int count, int threads, const std::vector<std::string>& extra,
+                             bool pin, std::vector<std::string> command) {
+  const bool own = command.empty();
+  std::vector<std::string> words = own ? own_command_line() : std::move(command);
   words.insert(words.end(), extra.begin(), extra.end());
+  const std::string program = own ? "/proc/self/exe" : words.front();
+  std::vector<cpu_set_t> masks;
+  if (pin) {
+    for (const std::vector<int>& group : core_groups(usable_core_ids(), count, threads)) {
+      cpu_set_t set;
+      CPU_ZERO(&set);
+      for (int c : group) CPU_SET(c, &set);
+      masks.push_back(set);
+    }
+  }
+  pinned_ = !masks.empty();
   // Everything the child needs is built before fork: between fork and exec only
   // async-signal-safe calls (another thread may hold the allocator's lock).
   std::vector<std::string> environment;
@@ -64,6 +79,7 @@ SlabProcesses::SlabProcesses(int count, int threads, const std::vector<std::stri
   for (std::string& e : environment) envp.push_back(e.data());
   envp.push_back(nullptr);
   static const char kExecFailed[] = "riner: error: cannot start a slab process (exec failed)\n";
+  static const char kNotPinned[] = "riner: warning: a slab process runs unpinned\n";
   const pid_t parent = getpid();
   for (int i = 0; i < count; ++i) {
     const pid_t pid = fork();
@@ -75,7 +91,12 @@ SlabProcesses::SlabProcesses(int count, int threads, const std::vector<std::stri
       // The child dies with its parent and runs this riner again with its share of the cores.
       prctl(PR_SET_PDEATHSIG, SIGKILL);
       if (getppid() != parent) _exit(1);
-      execve("/proc/self/exe", argv.data(), envp.data());
+      // sched_setaffinity and write allocate nothing: safe here.
+      if (pinned_ &&
+          sched_setaffinity(0, sizeof(cpu_set_t), &masks[static_cast<std::size_t>(i)]) != 0) {
+        (void)!write(2, kNotPinned, sizeof(kNotPinned) - 1);
+      }
+      execve(program.c_str(), argv.data(), envp.data());
       (void)!write(2, kExecFailed, sizeof(kExecFailed) - 1);
       _exit(127);
     }

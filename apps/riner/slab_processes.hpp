@@ -4,8 +4,8 @@
 // as MPI ranks do (riner/slab_ranks.hpp's claims). PoCL shares one pool of threads among a
 // process's queues and can abort with several at once, so processes, not queues, fill a CPU:
 // 8 processes of 2 cores gave 5.5x the slices per minute of one on 16 cores
-// (docs/history/RESULTS.md, "Issue 30: throughput"). The copies die with the process that
-// started them.
+// (docs/history/RESULTS.md, "Issue 30: throughput"; each process pinned by taskset there). The
+// copies die with the process that started them.
 #pragma once
 
 #include <string>
@@ -17,8 +17,12 @@ namespace riner::app {
 class SlabProcesses {
  public:
   // Starts `count` copies of this process's command line plus `extra` words, each with
-  // `threads` threads. Error when one cannot be started (those started are stopped).
-  SlabProcesses(int count, int threads, const std::vector<std::string>& extra);
+  // `threads` threads and, when `pin` and this process's cores hold `count` groups of
+  // `threads` (riner::core_groups), pinned to a group of its own. `command` (a program's
+  // absolute path and its words) replaces this process's command line: for tests. Error when one
+  // cannot be started (those started are stopped).
+  SlabProcesses(int count, int threads, const std::vector<std::string>& extra, bool pin = true,
+                std::vector<std::string> command = {});
   ~SlabProcesses();  // stops those still running
   SlabProcesses(const SlabProcesses&) = delete;
   SlabProcesses& operator=(const SlabProcesses&) = delete;
@@ -26,11 +30,13 @@ class SlabProcesses {
   // True while any is running; a failed one stops the others and is named by failure().
   bool running();
   const std::string& failure() const { return failure_; }
+  bool pinned() const { return pinned_; }
 
  private:
   void stop_all();
   std::vector<pid_t> children_;
   std::string failure_;
+  bool pinned_ = false;
 };
 
 // How many processes a slabbed run on this device takes when the user leaves it to riner:

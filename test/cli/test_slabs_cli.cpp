@@ -7,6 +7,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -16,6 +17,7 @@
 #include <utility>
 
 #include "cli/cli_run.hpp"
+#include "riner/cores.hpp"
 #include "riner/io.hpp"
 #include "support/fixture.hpp"
 
@@ -206,8 +208,12 @@ TEST_SUITE("cli") {
   TEST_CASE("riner's own slab processes share a run and give the volume of one") {
     riner::test::TempDir dir;
     Run run;
-    const nlohmann::json summary = one_against_three(dir, "--processes", &run);
+    // Pinned (--pin) where the affinity mask holds a share of cores for each (not on 2 cores).
+    const nlohmann::json summary = one_against_three(dir, "--pin --processes", &run);
     CHECK(summary["processes"] == 3);
+    const int share = static_cast<int>(std::max(1u, riner::usable_cores() / 3));
+    CHECK(summary["processes_pinned"] ==
+          !riner::core_groups(riner::usable_core_ids(), 3, share).empty());
     CHECK(claims_left(dir / "three") == 0);  // cleared at the end
     // The machine's memory is every process's peak together.
     const nlohmann::json manifest =

@@ -181,8 +181,8 @@ struct BroadDipCase {
   riner::ResponseRingSettings settings;
 };
 
-BroadDipCase broad_dip_case() {
-  BroadDipCase k{ring_geometry(), {}, {}, {}, {}, {}};
+BroadDipCase broad_dip_case(const riner::Geometry& geometry = ring_geometry()) {
+  BroadDipCase k{geometry, {}, {}, {}, {}, {}};
   const riner::Geometry& g = k.geometry;
   k.truth = phantom(g, false);
   const riner::Array dip = broad_dip(g);
@@ -196,7 +196,8 @@ BroadDipCase broad_dip_case() {
     for (std::size_t v = 0; v < g.n_views(); ++v) sum += dip_projection[v * g.n_u + e];
     k.alpha.data[e] *= static_cast<float>(std::exp(sum / static_cast<double>(g.n_views())));
   }
-  k.settings.scale_px = 8.0;  // the phantom is small: a third of the default's scale
+  // The phantom is small: a third of the default's scale, 8 mm.
+  k.settings.scale_px = 8.0 / geometry.voxel_mm;
   return k;
 }
 
@@ -487,9 +488,10 @@ TEST_SUITE("ring_correction") {
 
   TEST_CASE("response: the radii where the mirror pairs found an object keep their values") {
     // The broad dip above with an object's rim at 10 mm (the mirror step gave it back to the
-    // image): the profile is held at 0 within the response scale of it, and still moves the
-    // image elsewhere.
-    const BroadDipCase k = broad_dip_case();
+    // image): the profile is pulled to 0 within the response scale of it, and still moves the
+    // image elsewhere. On half-millimetre pixels, so that a radius in pixels would show.
+    const BroadDipCase k = broad_dip_case(
+        riner::test::make_geometry(riner::GeometryType::kFan2d, 32, 361, 1, {256, 256}, 0.75, 0.5));
     const riner::Geometry& g = k.geometry;
     const riner::RingCorrection free =
         riner::correct_rings_from_response(k.trained, k.alpha, g, {}, k.settings);
@@ -512,7 +514,7 @@ TEST_SUITE("ring_correction") {
                                                              << largest_held);
     CHECK(held.radii_kept_for_objects == near);
     CHECK(near > 0);
-    // Measured 7.2e-4 -> 2.8e-5: held by the fit's weight (that of a circle of air), not forced.
+    // Measured 1.3e-3 -> 7.6e-5: pulled by the fit's weight (that of a circle of air), not forced.
     CHECK(largest_held < 0.1 * largest_free);
     CHECK(rms_difference(held.image, k.trained) > 0.1 * rms_difference(free.image, k.trained));
   }

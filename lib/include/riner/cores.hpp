@@ -4,11 +4,22 @@
 // given 2 of 16 cores would start 16 threads on them.
 #pragma once
 
+#include <vector>
+
 namespace riner {
 
 // The cores in this process's affinity mask (at least 1; the machine's count where the mask
 // cannot be read).
 unsigned usable_cores();
+
+// The ids of the cores in this process's affinity mask, in increasing order (empty where the
+// mask cannot be read).
+std::vector<int> usable_core_ids();
+
+// `count` disjoint groups of `per_group` cores each, taken in the mask's order from `cores`:
+// what each of `count` processes is pinned to. Empty, pin nothing, when fewer than two groups
+// or too few cores.
+std::vector<std::vector<int>> core_groups(const std::vector<int>& cores, int count, int per_group);
 
 // Every core of the machine, whatever this process may use: what a plan that must not depend
 // on how the machine is shared out (ranks, processes, affinity) is sized by.

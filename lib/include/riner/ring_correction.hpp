@@ -157,7 +157,8 @@ struct ResponseRingSettings {
 // count: their alpha is not a response. The profile has one node per pixel of radius and is
 // negative where the image gains. Run it after the other two (it is the broad band they leave),
 // then the gradient correction again. Within scale_px of object_radii_mm (the mirror pairs'
-// objects) the profile is held at 0 as over air: the HTC disc's real rim was dimmed 0.6% there.
+// objects) the fit pulls the profile to 0 with the weight it gives a circle of air: the HTC
+// disc's real rim was dimmed 0.6% there without it.
 RingCorrection correct_rings_from_response(const Array& image, const Array& alpha,
                                            const Geometry& geometry,
                                            const std::vector<std::size_t>& dead_elements,

@@ -19,6 +19,30 @@ unsigned usable_cores() {
   return count > 0 ? static_cast<unsigned>(count) : machine_cores();
 }
 
+std::vector<int> usable_core_ids() {
+  cpu_set_t mask;
+  CPU_ZERO(&mask);
+  std::vector<int> ids;
+  if (sched_getaffinity(0, sizeof(mask), &mask) != 0) return ids;
+  for (int c = 0; c < CPU_SETSIZE; ++c) {
+    if (CPU_ISSET(c, &mask)) ids.push_back(c);
+  }
+  return ids;
+}
+
+std::vector<std::vector<int>> core_groups(const std::vector<int>& cores, int count, int per_group) {
+  std::vector<std::vector<int>> groups;
+  if (count < 2 || per_group < 1 ||
+      static_cast<std::size_t>(count) * static_cast<std::size_t>(per_group) > cores.size()) {
+    return groups;
+  }
+  for (int g = 0; g < count; ++g) {
+    const auto first = cores.begin() + static_cast<std::ptrdiff_t>(g) * per_group;
+    groups.emplace_back(first, first + per_group);
+  }
+  return groups;
+}
+
 void fit_opencl_threads_to_usable_cores() {
   const auto chosen = [](const char* name) {
     const char* value = std::getenv(name);
