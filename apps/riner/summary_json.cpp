@@ -45,9 +45,11 @@ nlohmann::json ring_summary(const std::optional<RingCorrection>& rings) {
     out["radii_kept_for_objects"] = rings->radii_kept_for_objects;
   }
   // The mirror correction's evidence.
-  if (rings->elements_moved != 0 || rings->largest_even_sigmas != 0.0) {
+  if (rings->elements_moved != 0 || rings->largest_even_sigmas != 0.0 ||
+      rings->even_sigmas_needed != 0.0) {
     out["elements_moved"] = rings->elements_moved;
     out["largest_even_sigmas"] = rings->largest_even_sigmas;
+    out["even_sigmas_needed"] = rings->even_sigmas_needed;
   }
   return out;
 }

@@ -7,7 +7,7 @@
 //       dead elements, the geometry, the reference (DeepLesion: the ground truth; a real scan:
 //       its FBP) and which pixels the reconstruction zeroed as skipped air
 //   riner_bench --case=ring_chain_replay --replay=DIR [--order=agrg] [--config=JSON] [--json=F]
-//       [--images=OUT] (each result as OUT/SCAN_ORDER.npy)
+//       [--images=OUT] (each result as OUT/SCAN_ORDER.npy) [--verbose=1] (what each step did)
 //       run the corrections in `order` (a = air, g = radial gradient, r = detector response,
 //       m = mirror pairs; the default is the reconstruction's chain) on every saved scan;
 //       DeepLesion: PSNR / SSIM against the truth, real scans: the quality report against FBP
@@ -44,8 +44,23 @@ struct Saved {
   bool simulated = false;  // reference: ground truth (else the scan's FBP)
 };
 
-riner::Array replay(const std::string& order, const Saved& s,
-                    const riner::RingCorrectionConfig& c) {
+// What a step did, on one line (--verbose): whether it applied, what it moved.
+void describe(char step, const riner::RingCorrection& r) {
+  double lowest = 0.0, highest = 0.0;
+  if (!r.object_radii_mm.empty()) {
+    const auto [lo, hi] = std::minmax_element(r.object_radii_mm.begin(), r.object_radii_mm.end());
+    lowest = *lo;
+    highest = *hi;
+  }
+  std::printf(
+      "  %c: applied %d, mean |change of ln alpha| %.4g, radii measured %zu, kept %zu, "
+      "elements moved %zu (largest %.1f sigmas), objects %zu at %.1f-%.1f mm\n",
+      step, r.applied ? 1 : 0, r.mean_response_change, r.measured_radii, r.radii_kept_for_objects,
+      r.elements_moved, r.largest_even_sigmas, r.object_radii_mm.size(), lowest, highest);
+}
+
+riner::Array replay(const std::string& order, const Saved& s, const riner::RingCorrectionConfig& c,
+                    bool verbose) {
   riner::Array image = s.field;
   riner::Array alpha = s.alpha;
   std::vector<double> objects;  // the mirror pairs' objects, as riner::correct_rings_in_order
@@ -64,6 +79,7 @@ riner::Array replay(const std::string& order, const Saved& s,
       throw riner::InputError(std::string("--order: unknown step '") + step +
                               "' (a, g, r or m)");
     }
+    if (verbose) describe(step, r);
     image = std::move(r.image);
     alpha = std::move(r.alpha);
     // As riner::correct_rings_in_order: the skipped air back to 0 before the next step.
@@ -162,7 +178,7 @@ std::vector<Result> ring_chain_replay(const Options& o) {
   int simulated = 0;
   for (const fs::path& dir : dirs) {
     const Saved s = load(dir);
-    const riner::Array image = replay(order, s, config.rings);
+    const riner::Array image = replay(order, s, config.rings, o.get_int("verbose", 0) != 0);
     const std::string name = dir.filename().string();
     if (!images_dir.empty()) {
       riner::write_array(fs::path(images_dir) / (name + "_" + order + ".npy"), image);

@@ -654,6 +654,29 @@ TEST_SUITE("ring_correction") {
     check_left_alone(riner::correct_rings_from_mirrors(truth, flat, g, {}), truth, flat);
   }
 
+  TEST_CASE("mirror: the evidence an object needs grows with the detector's elements") {
+    // The chance that a detector's noise alone passes for an object somewhere grows with its
+    // elements: at 2048 columns a Shepp-Logan's crossed 4 sigmas at one place (-3.1 dB).
+    const riner::Geometry small = ring_geometry();
+    const riner::Geometry large = riner::test::make_geometry(riner::GeometryType::kFan2d, 32, 2049,
+                                                             1, {128, 128}, 0.1325, 1.0);
+    const riner::RingCorrection a = riner::correct_rings_from_mirrors(
+        phantom(small, false), white_responses(small.n_u), small, {});
+    const riner::RingCorrection b = riner::correct_rings_from_mirrors(
+        phantom(large, false), white_responses(large.n_u), large, {});
+    MESSAGE("sigmas needed: " << small.n_u << " elements " << a.even_sigmas_needed << ", "
+                              << large.n_u << " elements " << b.even_sigmas_needed);
+    CHECK(a.even_sigmas_needed == riner::MirrorRingSettings{}.min_sigmas);
+    // Measured 4.2: 2 (1 - Phi(z)) = 0.05 over about 1800 judged elements.
+    CHECK(b.even_sigmas_needed > 4.1);
+    CHECK(b.even_sigmas_needed < 4.4);
+    riner::MirrorRingSettings lenient;
+    lenient.max_false_alarm = 1.0;  // the union bound's z, under min_sigmas here
+    CHECK(riner::correct_rings_from_mirrors(phantom(large, false), white_responses(large.n_u),
+                                            large, {}, lenient)
+              .even_sigmas_needed == lenient.min_sigmas);
+  }
+
   TEST_CASE("mirror: a detector whose structure is even puts no fine rings into the image") {
     // Modules laid out symmetrically about the axis: every element reads as its mirror (here
     // +-3% alternating, an element and its mirror alike), so the even part is all detector and

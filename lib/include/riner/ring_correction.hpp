@@ -88,6 +88,8 @@ struct RingCorrection {
   // largest such excess in units of that noise.
   std::size_t elements_moved = 0;
   double largest_even_sigmas = 0.0;
+  // Mirror pairs: the excess that counted (min_sigmas, or more on a large detector).
+  double even_sigmas_needed = 0.0;
   // Mirror pairs: the distances from the axis (mm) of those elements' rays, where an object
   // centred on the axis stands; the radial gradient and the response step leave these radii
   // alone.
@@ -174,6 +176,10 @@ struct MirrorRingSettings {
   // Even structure at least this many times that noise, where the odd part stays below it, is
   // an object on the axis; so many elements on either side go with it.
   double min_sigmas = 4.0;
+  // ... or more where the detector is large: the threshold that the detector's noise alone
+  // (normal) crosses at some judged element with at most this probability. A 2048-element
+  // detector's noise crossed 4 sigmas by chance (a Shepp-Logan at 2048 columns: -3.1 dB).
+  double max_false_alarm = 0.05;
   int grow_elements = 2;
   // Largest mean |change of ln(alpha)| over the elements still taken (a sanity bound: this
   // correction moves objects, which may be large).

@@ -118,6 +118,20 @@ std::vector<double> running_median_abs(const std::vector<double>& values,
   return out;
 }
 
+// The z for which normal noise at any of `tests` independent elements exceeds |z| with
+// probability `false_alarm` (the union bound): the tail 2 (1 - Phi(z)) = false_alarm / tests.
+double family_threshold(std::size_t tests, double false_alarm) {
+  if (tests == 0) return 0.0;
+  const double tail = false_alarm / static_cast<double>(tests);
+  double lo = 0.0;
+  double hi = 40.0;
+  for (int i = 0; i < 100; ++i) {
+    const double z = 0.5 * (lo + hi);
+    (std::erfc(z / std::sqrt(2.0)) > tail ? lo : hi) = z;
+  }
+  return hi;
+}
+
 // Which elements' even structure is an object, and how much of it: the excess over the even
 // part's level where it stands out and the odd part does not, grown to the neighbours.
 struct EvenEvidence {
@@ -126,6 +140,7 @@ struct EvenEvidence {
   std::vector<double> target;  // every judged element's even part above the level
   std::size_t count = 0;
   double largest_sigmas = 0.0;
+  double sigmas = 0.0;  // the threshold: min_sigmas, or the family's over the judged elements
   // The detector's noise in the even part: the odd part's robust spread over the judged
   // elements, or the even part's own element-to-element roughness where that is larger.
   double noise = 0.0;
@@ -160,12 +175,16 @@ EvenEvidence even_evidence(const MirrorParts& parts, const MirrorRingSettings& s
     });
     return count > 0.0 ? std::sqrt(sum / count) : 0.0;
   };
+  for (std::size_t e = 0; e < n; ++e) {
+    ev.judged[e] = parts.paired[e] && parts.mirror_gap[e] > kMirrorGapWindows * s.window_elements;
+  }
+  const auto judged = static_cast<std::size_t>(std::count(ev.judged.begin(), ev.judged.end(), 1));
+  ev.sigmas = std::max(s.min_sigmas, family_threshold(judged, s.max_false_alarm));
   std::vector<char> seed(n, 0);
   for (std::size_t e = 0; e < n; ++e) {
-    if (!parts.paired[e] || parts.mirror_gap[e] <= kMirrorGapWindows * s.window_elements) continue;
-    ev.judged[e] = 1;
+    if (!ev.judged[e]) continue;
     const double excess = std::fabs(even[e] - level);
-    if (excess <= kSmallestStructure || excess <= s.min_sigmas * noise[e]) continue;
+    if (excess <= kSmallestStructure || excess <= ev.sigmas * noise[e]) continue;
     if (near_rms(even, level, e) <= kEvenOverOdd * near_rms(odd, 0.0, e)) continue;
     seed[e] = 1;
     if (noise[e] > 0.0) ev.largest_sigmas = std::max(ev.largest_sigmas, excess / noise[e]);
@@ -307,6 +326,7 @@ RingCorrection correct_rings_from_mirrors(const Array& image, const Array& alpha
   const EvenEvidence evidence = even_evidence(parts, settings);
   out.elements_moved = evidence.count;
   out.largest_even_sigmas = evidence.largest_sigmas;
+  out.even_sigmas_needed = evidence.sigmas;
   if (evidence.count == 0) return out;
   out.object_radii_mm = object_radii(evidence, distance);
 

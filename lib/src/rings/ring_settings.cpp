@@ -89,6 +89,10 @@ const std::vector<settings::Setting<MirrorRingSettings>>& mirror_settings() {
                "mirror correction: even structure this many times the odd noise is an object on "
                "the axis",
                &S::min_sigmas),
+      field<S>("rings", "mirror_max_false_alarm", open_closed(0, 1),
+               "mirror correction: largest chance that the detector's noise alone passes for an "
+               "object somewhere on it (raises mirror_min_sigmas on large detectors)",
+               &S::max_false_alarm),
       field<S>("rings", "mirror_grow_elements", closed(0, 1000),
                "mirror correction: elements on either side taken with such structure",
                &S::grow_elements),
