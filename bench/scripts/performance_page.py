@@ -25,7 +25,8 @@ SOURCES = {
     "classical_real": "issue31_destripe_real_specks.jsonl",
     "warm_start": "issue31_warm_smooth.jsonl",
     # newest first: a scene and size measured in a later file hides the earlier rows
-    "sizes_cpu": ("issue29_sizes_gradient.jsonl", "issue29_draws10.jsonl"),
+    "sizes_cpu": ("issue29_sl2048_family.jsonl", "issue29_sizes_gradient.jsonl",
+                  "issue29_draws10.jsonl"),
     "sizes_gpu": "issue29_sizes_gpu.jsonl",
     "real_trained": "issue29_beta_real.jsonl",
     "real_chain": "issue32_response_objects_real.jsonl",
