@@ -21,7 +21,7 @@ class SlabProcesses {
   // `threads` (riner::core_groups), pinned to a group of its own. `command` (a program's
   // absolute path and its words) replaces this process's command line: for tests. Error when one
   // cannot be started (those started are stopped).
-  SlabProcesses(int count, int threads, const std::vector<std::string>& extra, bool pin = true,
+  SlabProcesses(int count, int threads, const std::vector<std::string>& extra, bool pin,
                 std::vector<std::string> command = {});
   ~SlabProcesses();  // stops those still running
   SlabProcesses(const SlabProcesses&) = delete;
