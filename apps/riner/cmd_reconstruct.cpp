@@ -60,6 +60,7 @@ RinerConfig config_from(const Args& args) {
     config.rings.gradient_reference = false;
     config.rings.response_reference = false;
     config.rings.mirror_reference = false;
+    config.residual_detail.enabled = false;
   }
   config.engine = engine_from(args);
   config.validate();
@@ -101,8 +102,7 @@ int run_reconstruct(int argc, char** argv, int first) {
               "training steps (default " + std::to_string(TrainingConfig::kSteps2d) +
                   " for a slice, more for a large one so that each ray is drawn " +
                   std::to_string(static_cast<int>(TrainingConfig{}.min_draws_per_ray)) +
-                  " times, " +
-                  std::to_string(TrainingConfig::kSteps3d) +
+                  " times, " + std::to_string(TrainingConfig::kSteps3d) +
                   " or more for a volume so that each voxel is sampled " +
                   std::to_string(static_cast<int>(TrainingConfig{}.min_samples_per_voxel)) +
                   " times; the learning rate halves every quarter of them)",
@@ -116,7 +116,8 @@ int run_reconstruct(int argc, char** argv, int first) {
       .option("report-every", "N", "steps between progress reports", "200")
       .flag("paper", "use the paper's settings (L=10, T=2^10, F=8, width 128, 4000 steps, ...)")
       .flag("no-ring-correction",
-            "write the trained field and alpha as they are (no ring corrections)");
+            "write the trained field and alpha as they are (no ring corrections, no residual "
+            "detail)");
   add_slab_options(args);
   add_engine_flags(args);
   args.output_flags();

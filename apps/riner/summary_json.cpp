@@ -196,6 +196,14 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
           {"gradient_after_response_ring_correction", gradient_again},
           {"mirror_ring_correction", ring_summary(result.mirror_rings)},
           {"slice_ring_corrections", volume_ring_summary(result.volume_rings)},
+          {"residual_detail",
+           {{"applied", result.residual_detail.applied},
+            {"consistent_share", result.residual_detail.consistent_share},
+            {"mean_gain", result.residual_detail.mean_gain},
+            {"rms_added", result.residual_detail.rms_added},
+            {"misfit_before", result.residual_detail.misfit_before},
+            {"misfit_after", result.residual_detail.misfit_after},
+            {"note", result.residual_detail.note}}},
           {"final_loss", history.empty() ? 0.0 : history.back().data_loss}};
 }
 

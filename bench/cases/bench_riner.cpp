@@ -241,6 +241,8 @@ nlohmann::json real_scan_run(const riner::Scan& scan, const riner::Array& fbp_im
           {"response_correction_even_to_odd",
            response && std::isfinite(response->even_to_odd) ? response->even_to_odd : 1e9},
           {"elements_switched_off", off},
+          {"residual_detail_applied", result.residual_detail.applied},
+          {"residual_detail_consistent_share", result.residual_detail.consistent_share},
           {"seconds", r.stats().seconds},
           {"steps", r.stats().steps}};
 }

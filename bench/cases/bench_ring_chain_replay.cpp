@@ -54,9 +54,10 @@ void describe(char step, const riner::RingCorrection& r) {
   }
   std::printf(
       "  %c: applied %d, mean |change of ln alpha| %.4g, radii measured %zu, kept %zu, "
-      "elements moved %zu (largest %.1f sigmas), objects %zu at %.1f-%.1f mm\n",
+      "elements moved %zu (largest %.1f sigmas), objects %zu at %.1f-%.1f mm, even/odd %.2f\n",
       step, r.applied ? 1 : 0, r.mean_response_change, r.measured_radii, r.radii_kept_for_objects,
-      r.elements_moved, r.largest_even_sigmas, r.object_radii_mm.size(), lowest, highest);
+      r.elements_moved, r.largest_even_sigmas, r.object_radii_mm.size(), lowest, highest,
+      r.even_to_odd);
 }
 
 riner::Array replay(const std::string& order, const Saved& s, const riner::RingCorrectionConfig& c,

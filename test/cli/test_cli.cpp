@@ -700,7 +700,10 @@ TEST_SUITE("cli") {
     const std::string sim = (dir / "sim").string();
     REQUIRE(riner_cli("simulate --quiet --seed 3 --out " + sim, dir).code == 0);
     // A short run at the full learning rate: the image is rough, but has rings to correct.
-    riner::test::write_bytes(dir / "short.json", R"({"training": {"lr_decay_steps": 3000}})");
+    // The readings' detail (detail.residual) held off: it is checked on its own below.
+    riner::test::write_bytes(
+        dir / "short.json",
+        R"({"training": {"lr_decay_steps": 3000}, "detail": {"residual": false}})");
     const std::string common = "reconstruct " + sim +
                                "/sino.npy --steps 300 --seed 1 --json --config " +
                                (dir / "short.json").string() + " ";
@@ -769,5 +772,24 @@ TEST_SUITE("cli") {
     }
     CHECK(riner::read_array(dir / "a" / "alpha.npy").array.data !=
           riner::read_array(dir / "b" / "alpha.npy").array.data);
+
+    // With the readings' detail: the rough 300-step field gets it back, held out, and the
+    // skipped air stays 0; --no-ring-correction leaves it off.
+    const Run detail = riner_cli(
+        common + "--set detail.residual=true --format npy --out " + (dir / "c").string(), dir);
+    REQUIRE(detail.code == 0);
+    const auto d = nlohmann::json::parse(detail.out)["residual_detail"];
+    CHECK(d["applied"] == true);
+    CHECK(d["consistent_share"].get<double>() >= 0.2);
+    CHECK(d["misfit_after"].get<double>() < d["misfit_before"].get<double>());
+    CHECK(d["rms_added"].get<double>() > 0.0);
+    CHECK(nlohmann::json::parse(without.out)["residual_detail"]["applied"] == false);
+    const riner::Array c = riner::read_array(dir / "c" / "image.npy").array;
+    std::size_t changed = 0;
+    for (std::size_t p = 0; p < c.size(); ++p) {
+      if (a.data[p] == 0.0f) CHECK(c.data[p] == 0.0f);
+      changed += c.data[p] != a.data[p];
+    }
+    CHECK(changed > c.size() / 4);
   }
 }

@@ -18,6 +18,7 @@
 #include "riner/array.hpp"
 #include "riner/device.hpp"
 #include "riner/execution_plan.hpp"
+#include "riner/residual_detail.hpp"
 #include "riner/riner_config.hpp"
 #include "riner/ring_correction.hpp"
 #include "riner/scan.hpp"
@@ -60,6 +61,8 @@ struct ReconstructionResult {
   std::optional<RingCorrection> mirror_rings;
   // 3D: the same corrections slice by slice (parallel beam; a cone beam gets a note).
   std::optional<VolumeRingCorrection> volume_rings;
+  // The readings' detail given back after the corrections (riner/residual_detail.hpp).
+  ResidualDetail residual_detail;
 };
 
 // An element taken for dead, and why: its readings are all non-finite, they stay steady while
@@ -222,6 +225,8 @@ class Reconstructor {
  private:
   ReconstructionResult evaluate_result() const;
   void evaluate_rings(ReconstructionResult& r) const;
+  void evaluate_residual_detail(ReconstructionResult& r, const std::vector<float>& parameters,
+                                const Array& trained_alpha) const;
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -12,6 +12,7 @@
 
 #include "riner/engine.hpp"
 #include "riner/execution_plan.hpp"
+#include "riner/residual_detail.hpp"
 #include "riner/ring_correction.hpp"
 
 namespace riner {
@@ -280,6 +281,9 @@ struct RinerConfig {
   NetworkConfig network;
   TrainingConfig training;
   RingCorrectionConfig rings;
+  // After the ring corrections, the readings' detail the field has not learnt, through FBP
+  // (riner/residual_detail.hpp).
+  ResidualDetailSettings residual_detail;
   PlanConfig plan;  // how the OpenCL engine shapes its work (riner/execution_plan.hpp)
   Engine engine = Engine::kOpenCL;
 

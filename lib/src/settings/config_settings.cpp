@@ -258,6 +258,21 @@ void add_rings(Table& t) {
                        &C::rings, &R::slice_by_slice));
 }
 
+void add_residual_detail(Table& t) {
+  using D = ResidualDetailSettings;
+  t.push_back(field<C>("detail", "residual", {},
+                       "2D: after the ring corrections, add the FBP of what the readings hold "
+                       "beyond the field, where the even and odd views agree it is not noise",
+                       &C::residual_detail, &D::enabled));
+  t.push_back(field<C>("detail", "min_consistent_share", closed(0, 1),
+                       "detail.residual: only when the even and odd views' FBPs of the residual "
+                       "agree on this share of its energy",
+                       &C::residual_detail, &D::min_consistent_share));
+  t.push_back(field<C>("detail", "window_px", closed(1, 63),
+                       "detail.residual: side of the square the noise gain is judged over (odd)",
+                       &C::residual_detail, &D::window_px));
+}
+
 void add_plan(Table& t) {
   t.push_back(string_choice<C>("plan", "kind", {"auto", "cpu", "gpu"},
                                "the OpenCL engine's execution plan; auto: from the device",
@@ -287,6 +302,7 @@ const std::vector<settings::Setting<C>>& config_settings() {
     add_training_sampling(t);
     add_training_schedule(t);
     add_rings(t);
+    add_residual_detail(t);
     add_plan(t);
     t.push_back(enum_choice<C>("", "engine", {Engine::kOpenCL, Engine::kReference}, engine_name,
                                "opencl: the kernels; reference: their CPU twins (slow)",

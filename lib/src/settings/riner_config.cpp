@@ -212,6 +212,7 @@ RinerConfig RinerConfig::paper() {
   c.rings.gradient_reference = false;
   c.rings.response_reference = false;
   c.rings.mirror_reference = false;
+  c.residual_detail.enabled = false;
   return c;
 }
 

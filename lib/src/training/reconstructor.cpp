@@ -30,12 +30,14 @@ struct Reconstructor::Impl {
   std::optional<ReconstructionResult> result;
   int result_steps = -1;
   std::optional<WarmStartStats> warm_start;
+  std::optional<Device> device;  // the OpenCL engine's (the residual detail's FBP runs there)
 
-  Impl(Scan scan, RinerConfig config, std::optional<Device> device = std::nullopt)
-      : setup(std::move(scan), std::move(config), std::move(device)),
+  Impl(Scan scan, RinerConfig config, std::optional<Device> device_ = std::nullopt)
+      : setup(std::move(scan), std::move(config), device_),
         sampler(setup.scan.geometry, setup.config.training,
                 setup.stuck_count > 0 ? setup.stuck : std::vector<std::uint8_t>{}),
-        element_rays(setup.elements_per_view, 0) {}
+        element_rays(setup.elements_per_view, 0),
+        device(std::move(device_)) {}
 
   void drain() {
     for (LossRecord& r : trainer->drain_losses()) {
@@ -251,7 +253,26 @@ ReconstructionResult Reconstructor::evaluate_result() const {
   const Array trained = r.alpha;
   evaluate_rings(r);
   r.alpha_by_view = responses_by_view(impl_->setup, p, trained, r.alpha);
+  evaluate_residual_detail(r, p, trained);
   return r;
+}
+
+void Reconstructor::evaluate_residual_detail(ReconstructionResult& r, const std::vector<float>& p,
+                                             const Array& trained) const {
+  const detail::TrainingSetup& setup = impl_->setup;
+  // The residual is against what training fitted: its field and its responses, per view where
+  // they change.
+  Array log_alpha = responses_by_view(setup, p, trained, trained);
+  if (log_alpha.size() == 0) log_alpha = trained;
+  for (float& a : log_alpha.data) a = std::log(a);
+  const model::Occupancy& occupancy = setup.occupancy;
+  const std::vector<std::uint8_t> everything;
+  ResidualDetailResult d =
+      return_residual_detail(r.image, r.field_image, setup.scan, log_alpha, dead_elements(),
+                             occupancy.carved ? occupancy.inside : everything,
+                             setup.config.residual_detail, setup.config.engine, impl_->device);
+  r.image = std::move(d.image);
+  r.residual_detail = std::move(d.report);
 }
 
 void Reconstructor::evaluate_rings(ReconstructionResult& r) const {

@@ -1,0 +1,69 @@
+// The detail the trained field leaves in the readings, given back through FBP.
+//
+// The field is a smooth fit: at scanner size, and on low-noise scans, the readings hold detail
+// it has not learnt (edges, fine texture), which FBP of the readings would show but the field
+// does not. What the readings say beyond the field and the learnt responses, the residual
+// rho + ln(alpha) - A f, carries that detail and the noise. Its FBP is split between the even
+// and the odd views: the detail is the same in both halves, the noise is not, so their
+// difference measures the noise where it lies. The residual's FBP is added where it stands
+// above that noise (a local Wiener gain), and only on scans where the two halves agree on a
+// stated share of the residual's energy, and only when the detail of either half fits the
+// other half's readings better than the field alone; on a scan whose residual is noise (every
+// shared real scan) nothing changes. Each element's mean residual is taken out first: a constant
+// offset along a detector column is alpha's, and its FBP would be a ring. (docs/history/RESULTS.md,
+// "Issue 29: the detail the field leaves in the readings".)
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "riner/array.hpp"
+#include "riner/device.hpp"
+#include "riner/engine.hpp"
+#include "riner/scan.hpp"
+
+namespace riner {
+
+struct ResidualDetailSettings {
+  bool enabled = true;
+  // Given back only when the even and odd views' FBPs agree on this share of the residual's
+  // energy (1 - |difference|^2 / |residual FBP|^2 over the sampled pixels): the simulated
+  // DeepLesion slices 0.38-0.49, the shared real scans -0.05-0.05.
+  double min_consistent_share = 0.2;
+  int window_px = 3;  // side of the square over which the Wiener gain compares the two
+};
+
+struct ResidualDetail {
+  bool applied = false;
+  double consistent_share = 0.0;  // as min_consistent_share measures it
+  double mean_gain = 0.0;         // the Wiener gain's mean over the sampled pixels
+  double rms_added = 0.0;         // of what was added, over the sampled pixels (1/mm)
+  // Held out: mean |rho + ln(alpha) - A image| over the odd views' readings with the even
+  // views' detail and the other way round (averaged), and the same without; the detail is
+  // added only when it fits readings it was not taken from better.
+  double misfit_before = 0.0;
+  double misfit_after = 0.0;
+  std::string note;  // why not applied, when it was not
+};
+
+struct ResidualDetailResult {
+  Array image;
+  ResidualDetail report;
+};
+
+// `image` plus the residual's detail. `field`: the trained field on the grid (its projection
+// is what the readings are compared with); `log_alpha`: ln(alpha) per element ([n_u]) or per
+// view and element ([views, n_u]); `dead`: elements whose readings are left out; `sampled`:
+// per pixel, 1 where training sampled (empty: all), the only pixels that get detail. 2D
+// geometries (fan and parallel beam) only; a 3D scan comes back unchanged with a note.
+ResidualDetailResult return_residual_detail(const Array& image, const Array& field,
+                                            const Scan& scan, const Array& log_alpha,
+                                            const std::vector<std::size_t>& dead,
+                                            const std::vector<std::uint8_t>& sampled,
+                                            const ResidualDetailSettings& settings,
+                                            Engine engine = Engine::kOpenCL,
+                                            std::optional<Device> device = std::nullopt);
+
+}  // namespace riner
