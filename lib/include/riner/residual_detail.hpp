@@ -53,13 +53,14 @@ struct ResidualDetailResult {
   ResidualDetail report;
 };
 
-// `image` plus the residual's detail. `field`: the trained field on the grid (its projection
-// is what the readings are compared with); `log_alpha`: ln(alpha) per element ([n_u]) or per
-// view and element ([views, n_u]); `dead`: elements whose readings are left out; `sampled`:
-// per pixel, 1 where training sampled (empty: all), the only pixels that get detail. 2D
-// geometries (fan and parallel beam) only; a 3D scan comes back unchanged with a note.
-ResidualDetailResult return_residual_detail(const Array& image, const Array& field,
-                                            const Scan& scan, const Array& log_alpha,
+// `image` (taken, and given back unchanged when no detail is added) plus the residual's detail.
+// `field`: the trained field on the grid (its projection is what the readings are compared with);
+// `log_alpha`: ln(alpha) per element ([n_u]) or per view and element ([views, n_u]); `dead`:
+// elements whose readings are left out; `sampled`: per pixel, 1 where training sampled (empty:
+// all), the only pixels that get detail. 2D geometries (fan and parallel beam) only; a 3D scan
+// comes back unchanged with a note.
+ResidualDetailResult return_residual_detail(Array image, const Array& field, const Scan& scan,
+                                            const Array& log_alpha,
                                             const std::vector<std::size_t>& dead,
                                             const std::vector<std::uint8_t>& sampled,
                                             const ResidualDetailSettings& settings,

@@ -6,6 +6,7 @@
 #include "riner/error.hpp"
 #include "riner/fbp.hpp"
 #include "riner/projector.hpp"
+#include "util/along_each_axis.hpp"
 
 namespace riner {
 
@@ -50,9 +51,10 @@ Array without_element_means(const Array& residual, const std::vector<char>& used
   return out;
 }
 
-// Mean |residual - change| over the readings used in the views of `parity` (0: even, 1: odd;
-// the last view of an odd count left out, as every_other_view leaves it).
-double mean_misfit(const Array& residual, const Array& change, const std::vector<char>& used,
+// Mean |residual - change| (change nullptr: |residual|) over the readings used in the views of
+// `parity` (0: even, 1: odd; the last view of an odd count left out, as every_other_view leaves
+// it).
+double mean_misfit(const Array& residual, const Array* change, const std::vector<char>& used,
                    std::size_t n, std::size_t parity) {
   const std::size_t views = residual.size() / n;
   const std::size_t paired = views - views % 2;
@@ -60,7 +62,7 @@ double mean_misfit(const Array& residual, const Array& change, const std::vector
   for (std::size_t v = parity; v < paired; v += 2) {
     for (std::size_t i = v * n; i < (v + 1) * n; ++i) {
       if (!used[i]) continue;
-      total += std::fabs(static_cast<double>(residual.data[i]) - change.data[i]);
+      total += std::fabs(static_cast<double>(residual.data[i]) - (change ? change->data[i] : 0.0f));
       count += 1.0;
     }
   }
@@ -86,52 +88,33 @@ Scan every_other_view(const Scan& residual, std::size_t parity) {
   return out;
 }
 
-// Mean over a square of side w about each pixel (clamped at the borders).
-std::vector<double> box_mean(const std::vector<double>& a, std::size_t rows, std::size_t cols,
-                             int w) {
+// Mean over a square of side w about each pixel (clamped at the borders), axis by axis.
+std::vector<float> box_mean(std::vector<float> a, const std::vector<std::size_t>& shape, int w) {
   const long h = w / 2;
-  std::vector<double> across(a.size()), out(a.size());
-  for (std::size_t i = 0; i < rows; ++i) {
-    for (std::size_t k = 0; k < cols; ++k) {
-      double s = 0.0;
-      for (long d = -h; d <= h; ++d) {
-        const long c = std::clamp<long>(static_cast<long>(k) + d, 0, static_cast<long>(cols) - 1);
-        s += a[i * cols + static_cast<std::size_t>(c)];
-      }
-      across[i * cols + k] = s / static_cast<double>(2 * h + 1);
-    }
-  }
-  for (std::size_t i = 0; i < rows; ++i) {
-    for (std::size_t k = 0; k < cols; ++k) {
-      double s = 0.0;
-      for (long d = -h; d <= h; ++d) {
-        const long r = std::clamp<long>(static_cast<long>(i) + d, 0, static_cast<long>(rows) - 1);
-        s += across[static_cast<std::size_t>(r) * cols + k];
-      }
-      out[i * cols + k] = s / static_cast<double>(2 * h + 1);
-    }
-  }
-  return out;
+  return util::along_each_axis(
+      std::move(a), shape, [h](const float* in, float* out, std::size_t n, std::size_t stride) {
+        const long last = static_cast<long>(n) - 1;
+        for (long i = 0; i <= last; ++i) {
+          double sum = 0.0;
+          for (long d = -h; d <= h; ++d) {
+            sum += in[static_cast<std::size_t>(std::clamp(i + d, 0L, last)) * stride];
+          }
+          out[static_cast<std::size_t>(i) * stride] = static_cast<float>(sum / (2.0 * h + 1.0));
+        }
+      });
 }
 
 }  // namespace
 
-ResidualDetailResult return_residual_detail(const Array& image, const Array& field,
-                                            const Scan& scan, const Array& log_alpha,
+ResidualDetailResult return_residual_detail(Array image, const Array& field, const Scan& scan,
+                                            const Array& log_alpha,
                                             const std::vector<std::size_t>& dead,
                                             const std::vector<std::uint8_t>& sampled,
                                             const ResidualDetailSettings& settings, Engine engine,
                                             std::optional<Device> device) {
-  ResidualDetailResult out{image, {}};
   const Geometry& g = scan.geometry;
-  if (!settings.enabled) {
-    out.report.note = "off";
-    return out;
-  }
-  if (g.is_3d()) {
-    out.report.note = "3D scans keep the field's image";
-    return out;
-  }
+  if (!settings.enabled) return {std::move(image), {.note = "off"}};
+  if (g.is_3d()) return {std::move(image), {.note = "3D scans keep the field's image"}};
   if (image.shape != g.volume_shape || field.shape != g.volume_shape)
     throw InputError("residual detail: the image's shape is not the geometry's grid");
   if (log_alpha.size() != g.n_u && log_alpha.size() != g.n_views() * g.n_u)
@@ -139,16 +122,11 @@ ResidualDetailResult return_residual_detail(const Array& image, const Array& fie
                      " values, not one per element or per view and element");
   if (!sampled.empty() && sampled.size() != image.size())
     throw InputError("residual detail: the sampled mask is not one value per pixel");
-  if (g.n_views() < 4) {
-    out.report.note = "fewer than 4 views";
-    return out;
-  }
+  if (g.n_views() < 4) return {std::move(image), {.note = "fewer than 4 views"}};
   for (float v : field.data) {
-    if (!std::isfinite(v)) {
-      out.report.note = "the field is not finite";
-      return out;
-    }
+    if (!std::isfinite(v)) return {std::move(image), {.note = "the field is not finite"}};
   }
+  ResidualDetailResult out{std::move(image), {}};
 
   const Projector projector(g, engine, device);
   const Array projected = projector.project(field);
@@ -162,15 +140,16 @@ ResidualDetailResult return_residual_detail(const Array& image, const Array& fie
   const Array even = fbp(every_other_view(residual, 0), options);
   const Array odd = fbp(every_other_view(residual, 1), options);
 
-  const std::size_t pixels = image.size();
-  std::vector<double> detail(pixels), detail_sq(pixels), noise_sq(pixels);
+  const std::size_t pixels = out.image.size();
+  std::vector<double> detail(pixels);
+  std::vector<float> detail_sq(pixels), noise_sq(pixels);
   double detail_sum = 0.0, noise_sum = 0.0, counted = 0.0;
   for (std::size_t p = 0; p < pixels; ++p) {
     const double d = whole.data[p];
     const double n = 0.5 * (static_cast<double>(even.data[p]) - odd.data[p]);
     detail[p] = std::isfinite(d) ? d : 0.0;
-    detail_sq[p] = detail[p] * detail[p];
-    noise_sq[p] = std::isfinite(n) ? n * n : 0.0;
+    detail_sq[p] = static_cast<float>(detail[p] * detail[p]);
+    noise_sq[p] = std::isfinite(n) ? static_cast<float>(n * n) : 0.0f;
     if (!sampled.empty() && !sampled[p]) continue;
     detail_sum += detail_sq[p];
     noise_sum += noise_sq[p];
@@ -181,15 +160,19 @@ ResidualDetailResult return_residual_detail(const Array& image, const Array& fie
     out.report.note = "the residual is noise: the even and odd views agree on too little of it";
     return out;
   }
-  const std::size_t rows = image.shape[0], cols = image.shape[1];
-  const std::vector<double> local_detail = box_mean(detail_sq, rows, cols, settings.window_px);
-  const std::vector<double> local_noise = box_mean(noise_sq, rows, cols, settings.window_px);
+  const std::vector<float> local_detail =
+      box_mean(std::move(detail_sq), out.image.shape, settings.window_px);
+  const std::vector<float> local_noise =
+      box_mean(std::move(noise_sq), out.image.shape, settings.window_px);
   double gain_sum = 0.0, added_sq = 0.0;
-  Array added(image.shape, 0.0f), from_even(image.shape, 0.0f), from_odd(image.shape, 0.0f);
+  Array added(out.image.shape, 0.0f), from_even(out.image.shape, 0.0f),
+      from_odd(out.image.shape, 0.0f);
   for (std::size_t p = 0; p < pixels; ++p) {
     if (!sampled.empty() && !sampled[p]) continue;
     const double gain =
-        local_detail[p] > 0.0 ? std::max(0.0, 1.0 - local_noise[p] / local_detail[p]) : 0.0;
+        local_detail[p] > 0.0f
+            ? std::max(0.0, 1.0 - static_cast<double>(local_noise[p]) / local_detail[p])
+            : 0.0;
     added.data[p] = static_cast<float>(gain * detail[p]);
     from_even.data[p] = static_cast<float>(gain * even.data[p]);
     from_odd.data[p] = static_cast<float>(gain * odd.data[p]);
@@ -200,12 +183,13 @@ ResidualDetailResult return_residual_detail(const Array& image, const Array& fie
   // field alone, and the odd views' the even ones'. Detail does; noise, and what FBP draws of
   // its own where the field is already sharper than FBP (a piecewise-constant phantom's
   // edges: view aliasing, streaks), does not.
-  const Array none(misfit.shape, 0.0f);
   const std::size_t n = g.n_u;
+  const Array even_change = projector.project(from_even);
+  const Array odd_change = projector.project(from_odd);
   out.report.misfit_before =
-      0.5 * (mean_misfit(misfit, none, used, n, 1) + mean_misfit(misfit, none, used, n, 0));
-  out.report.misfit_after = 0.5 * (mean_misfit(misfit, projector.project(from_even), used, n, 1) +
-                                   mean_misfit(misfit, projector.project(from_odd), used, n, 0));
+      0.5 * (mean_misfit(misfit, nullptr, used, n, 1) + mean_misfit(misfit, nullptr, used, n, 0));
+  out.report.misfit_after = 0.5 * (mean_misfit(misfit, &even_change, used, n, 1) +
+                                   mean_misfit(misfit, &odd_change, used, n, 0));
   if (!(out.report.misfit_after < out.report.misfit_before)) {
     out.report.note = "the detail of half the views does not fit the other half's readings better";
     return out;

@@ -269,7 +269,8 @@ void add_residual_detail(Table& t) {
                        "agree on this share of its energy",
                        &C::residual_detail, &D::min_consistent_share));
   t.push_back(field<C>("detail", "window_px", closed(1, 63),
-                       "detail.residual: side of the square the noise gain is judged over (odd)",
+                       "detail.residual: side of the square the noise gain is judged over (an even "
+                       "side counts as the next odd one)",
                        &C::residual_detail, &D::window_px));
 }
 

@@ -268,8 +268,8 @@ void Reconstructor::evaluate_residual_detail(ReconstructionResult& r, const std:
   const model::Occupancy& occupancy = setup.occupancy;
   const std::vector<std::uint8_t> everything;
   ResidualDetailResult d =
-      return_residual_detail(r.image, r.field_image, setup.scan, log_alpha, dead_elements(),
-                             occupancy.carved ? occupancy.inside : everything,
+      return_residual_detail(std::move(r.image), r.field_image, setup.scan, log_alpha,
+                             dead_elements(), occupancy.carved ? occupancy.inside : everything,
                              setup.config.residual_detail, setup.config.engine, impl_->device);
   r.image = std::move(d.image);
   r.residual_detail = std::move(d.report);
