@@ -97,6 +97,7 @@ std::vector<Result> volume_case(const Options& o) {
   }
   const riner::ReconstructionResult result = r.result();
   const riner::ImageMetrics m = riner::compare_images(result.image, sim.ground_truth);
+  const riner::ImageMetrics field_m = riner::compare_images(result.field_image, sim.ground_truth);
   const riner::TrainingStats st = r.stats();
   const std::string png = o.get("png", "");
   if (!png.empty()) write_panel(png, {&sim.ground_truth, &fdk, &result.image});
@@ -106,6 +107,12 @@ std::vector<Result> volume_case(const Options& o) {
                  {"psnr", m.psnr},
                  {"ssim", m.ssim},
                  {"edges", m.edge_ratio},
+                 {"field_psnr", field_m.psnr},
+                 {"residual_detail_applied", result.residual_detail.applied},
+                 {"residual_detail_consistent_share", result.residual_detail.consistent_share},
+                 {"residual_detail_seconds", result.residual_detail.seconds},
+                 {"residual_detail_misfit",
+                  {result.residual_detail.misfit_before, result.residual_detail.misfit_after}},
                  {"fdk_psnr", fdk_m.psnr},
                  {"fdk_ssim", fdk_m.ssim},
                  {"oracle_fdk_psnr", oracle_m.psnr},
@@ -117,9 +124,11 @@ std::vector<Result> volume_case(const Options& o) {
                  {"peak_rss_mb", peak_rss_mb()},
                  {"curve", curve}});
   const std::string line = riner::bench::format(
-      "%s: riner %.2f dB / %.3f (edges %.2f) in %.0f s training, %d steps; FDK %.2f / %.3f, "
-      "oracle FDK %.2f / %.3f; peak %.0f MB",
-      path.c_str(), m.psnr, m.ssim, m.edge_ratio, st.seconds, st.steps, fdk_m.psnr, fdk_m.ssim,
+      "%s: riner %.2f dB / %.3f (edges %.2f; the field %.2f dB, residual detail %s at share "
+      "%.3f) in %.0f s training, %d steps; FDK %.2f / %.3f, oracle FDK %.2f / %.3f; peak %.0f MB",
+      path.c_str(), m.psnr, m.ssim, m.edge_ratio, field_m.psnr,
+      result.residual_detail.applied ? "added" : "not added",
+      result.residual_detail.consistent_share, st.seconds, st.steps, fdk_m.psnr, fdk_m.ssim,
       oracle_m.psnr, oracle_m.ssim, peak_rss_mb());
   return {{"volume", fields, line}};
 }

@@ -34,7 +34,8 @@ SOURCES = {
     "cores": "issue30_cores16.jsonl",
     "gpu_slow_step": "issue30_gpu_loss_median.jsonl",
     "steps_gpu": "issue12_gpu_ops.jsonl",
-    "volumes": "issue34_volume_defaults.jsonl",
+    # newest first: a volume at the defaults in a later file hides the earlier row
+    "volumes": ("issue29_residual_detail_volume.jsonl", "issue34_volume_defaults.jsonl"),
     "partial_rings": "issue32_partial_rings.jsonl",
     "tube_wall": "issue32_tube_wall_gradient.jsonl",
 }
@@ -91,10 +92,10 @@ def command(record, extra=()):
         value = options[key]
         if key in ("out", "png", "riner"):
             continue  # where that run wrote its files: not part of the measurement
-        if value.startswith("/tmp"):
-            value = "DIR"  # a folder of that session's
         if key == "volume" and value.startswith("/"):
             value = "DIR/" + os.path.basename(value)  # the folder the volume's recipe wrote
+        elif value.startswith("/tmp"):
+            value = "DIR"  # a folder of that session's
         if key == "data" and value.startswith(".gpu/"):
             value = "../shared/data/deeplesion"
         quote = any(c in value for c in " {}\"'")
@@ -507,16 +508,23 @@ def volume_steps(r):
 
 
 def volumes(root):
-    runs = records(root, SOURCES["volumes"])
-    defaults = [r for r in runs if volume_steps(r) == ""]
+    runs = [r for name in SOURCES["volumes"] for r in records(root, name)]
+    defaults, seen = [], set()
+    for r in runs:
+        if volume_steps(r) == "" and volume_name(r) not in seen:
+            seen.add(volume_name(r))
+            defaults.append(r)
     rows = [[volume_name(r), f"{r['steps']} × {r['rays_per_step']}", f2(r["psnr"]) + " / " +
-             f3(r["ssim"]), f2(r["edges"]), f2(r["fdk_psnr"]), f2(r["oracle_fdk_psnr"]),
-             seconds(r["seconds"]), f"{r['peak_rss_mb'] / 1024:.1f} GB", stamp(r), command(r)]
+             f3(r["ssim"]), f2(r["field_psnr"]) if "field_psnr" in r else "–", f2(r["edges"]),
+             f2(r["fdk_psnr"]), f2(r["oracle_fdk_psnr"]), seconds(r["seconds"]),
+             seconds(r["residual_detail_seconds"]) if "residual_detail_seconds" in r else "–",
+             f"{r['peak_rss_mb'] / 1024:.1f} GB", stamp(r), command(r)]
             for r in defaults]
-    at_defaults = table(["volume", "steps × rays", "PSNR (dB) / SSIM", "edges (of truth's)",
-                         "FDK", "oracle FDK", "training", "peak host memory",
-                         "machine; date; revision", "command"], rows)
-    chest = sorted([r for r in runs if volume_name(r).startswith("chest")],
+    at_defaults = table(["volume", "steps × rays", "PSNR (dB) / SSIM", "the field alone (dB)",
+                         "edges (of truth's)", "FDK", "oracle FDK", "training",
+                         "the detail", "peak host memory", "machine; date; revision", "command"], rows)
+    before_detail = records(root, SOURCES["volumes"][-1])
+    chest = sorted([r for r in before_detail if volume_name(r).startswith("chest")],
                    key=lambda r: r["steps"])
     curve = table(["steps", "training", "PSNR (dB) / SSIM", "edges (of truth's)", "command"],
                   [[r["steps"], seconds(r["seconds"]), f2(r["psnr"]) + " / " + f3(r["ssim"]),
@@ -616,17 +624,19 @@ paper's per-pixel responses and two dead pixels, Poisson noise, projected by the
 (`riner_bench --case=volume`): the shared head (smooth: a 64 × 64 × 93 scan interpolated) and a
 real chest CT with lung vessels, airways and bone (TCIA CPTAC-PDA, CC BY 3.0; the recipe in
 `bench/data/chest_ct/`, which writes `DIR/mu.npy` for `--volume`). riner at its defaults; the
-oracle is FDK with a perfect detector.
+oracle is FDK with a perfect detector. "The field alone" is the trained field before the
+readings' detail is given back ([method](method.md#the-readings-detail-the-field-has-not-learnt)).
 
 {volumes}
 
-The chest against the training budget (`--config='{{"training":{{"steps":N}}}}'`; each row a
+The chest against the training budget, measured before the readings' detail was given back in 3D
+(`--config='{{"training":{{"steps":N}}}}'`; each row a
 whole run with its own schedule, the same machine, one after another; its speed drifted
 between 2.5 and 4.1 ms a step over the session, so read the time column to ±25%):
 
 {volume_curve}
 
-![The chest CT: truth | FDK of the ring scan | riner at the defaults; axial, coronal and sagittal slices](../bench/figures/chest_ct_volume_default.png)
+![The chest CT: truth | FDK of the ring scan | riner at the defaults; axial, coronal and sagittal slices](../bench/figures/chest_ct_volume_detail.png)
 
 ## Whole scans: slices per minute
 

@@ -45,6 +45,7 @@ struct ResidualDetail {
   // added only when it fits readings it was not taken from better.
   double misfit_before = 0.0;
   double misfit_after = 0.0;
+  double seconds = 0.0;  // what the step took
   std::string note;  // why not applied, when it was not
 };
 
@@ -55,10 +56,11 @@ struct ResidualDetailResult {
 
 // `image` (taken, and given back unchanged when no detail is added) plus the residual's detail.
 // `field`: the trained field on the grid (its projection is what the readings are compared with);
-// `log_alpha`: ln(alpha) per element ([n_u]) or per view and element ([views, n_u]); `dead`:
+// `log_alpha`: ln(alpha) per element or per view and element; `dead`:
 // elements whose readings are left out; `sampled`: per pixel, 1 where training sampled (empty:
-// all), the only pixels that get detail. 2D geometries (fan and parallel beam) only; a 3D scan
-// comes back unchanged with a note.
+// all), the only pixels that get detail. Every geometry: in 3D the elements are the detector's
+// pixels ([n_v, n_u] values of ln(alpha), or [views, n_v, n_u]), the FBP is FDK (cone beam) or
+// slice by slice (parallel beam), and the Wiener gain compares the halves over a cube.
 ResidualDetailResult return_residual_detail(Array image, const Array& field, const Scan& scan,
                                             const Array& log_alpha,
                                             const std::vector<std::size_t>& dead,

@@ -261,8 +261,9 @@ void add_rings(Table& t) {
 void add_residual_detail(Table& t) {
   using D = ResidualDetailSettings;
   t.push_back(field<C>("detail", "residual", {},
-                       "2D: after the ring corrections, add the FBP of what the readings hold "
-                       "beyond the field, where the even and odd views agree it is not noise",
+                       "after the ring corrections, add the FBP (FDK in cone beam) of what the "
+                       "readings hold beyond the field, where the even and odd views agree it is "
+                       "not noise",
                        &C::residual_detail, &D::enabled));
   t.push_back(field<C>("detail", "min_consistent_share", closed(0, 1),
                        "detail.residual: only when the even and odd views' FBPs of the residual "
