@@ -148,15 +148,19 @@ ResidualDetailResult detail_of(Array image, const Array& field, const Scan& scan
   const Array even = fbp(even_views, options);
   const Array odd = fbp(odd_views, options);
 
+  // The detail and its gain are recomputed where they are used rather than held: in 3D each
+  // copy is a volume.
+  auto detail_at = [&](std::size_t p) {
+    const double d = 0.5 * (static_cast<double>(even.data[p]) + odd.data[p]);
+    return std::isfinite(d) ? d : 0.0;
+  };
   const std::size_t pixels = out.image.size();
-  std::vector<double> detail(pixels);
   std::vector<float> detail_sq(pixels), noise_sq(pixels);
   double detail_sum = 0.0, noise_sum = 0.0, counted = 0.0;
   for (std::size_t p = 0; p < pixels; ++p) {
-    const double d = 0.5 * (static_cast<double>(even.data[p]) + odd.data[p]);
+    const double d = detail_at(p);
     const double half_difference = 0.5 * (static_cast<double>(even.data[p]) - odd.data[p]);
-    detail[p] = std::isfinite(d) ? d : 0.0;
-    detail_sq[p] = static_cast<float>(detail[p] * detail[p]);
+    detail_sq[p] = static_cast<float>(d * d);
     noise_sq[p] = std::isfinite(half_difference)
                       ? static_cast<float>(half_difference * half_difference)
                       : 0.0f;
@@ -174,20 +178,21 @@ ResidualDetailResult detail_of(Array image, const Array& field, const Scan& scan
       box_mean(std::move(detail_sq), out.image.shape, settings.window_px);
   const std::vector<float> local_noise =
       box_mean(std::move(noise_sq), out.image.shape, settings.window_px);
+  auto gain_at = [&](std::size_t p) {
+    return local_detail[p] > 0.0f
+               ? std::max(0.0, 1.0 - static_cast<double>(local_noise[p]) / local_detail[p])
+               : 0.0;
+  };
   double gain_sum = 0.0, added_sq = 0.0;
-  Array added(out.image.shape, 0.0f), from_even(out.image.shape, 0.0f),
-      from_odd(out.image.shape, 0.0f);
+  Array from_even(out.image.shape, 0.0f), from_odd(out.image.shape, 0.0f);
   for (std::size_t p = 0; p < pixels; ++p) {
     if (!sampled.empty() && !sampled[p]) continue;
-    const double gain =
-        local_detail[p] > 0.0f
-            ? std::max(0.0, 1.0 - static_cast<double>(local_noise[p]) / local_detail[p])
-            : 0.0;
-    added.data[p] = static_cast<float>(gain * detail[p]);
+    const double gain = gain_at(p);
+    const float added = static_cast<float>(gain * detail_at(p));
     from_even.data[p] = static_cast<float>(gain * even.data[p]);
     from_odd.data[p] = static_cast<float>(gain * odd.data[p]);
     gain_sum += gain;
-    added_sq += static_cast<double>(added.data[p]) * added.data[p];
+    added_sq += static_cast<double>(added) * added;
   }
   // Held out: the detail of the even views must fit the odd views' readings better than the
   // field alone, and the odd views' the even ones'. Detail does; noise, and what FBP draws of
@@ -204,7 +209,10 @@ ResidualDetailResult detail_of(Array image, const Array& field, const Scan& scan
     out.report.note = "the detail of half the views does not fit the other half's readings better";
     return out;
   }
-  for (std::size_t p = 0; p < pixels; ++p) out.image.data[p] += added.data[p];
+  for (std::size_t p = 0; p < pixels; ++p) {
+    if (sampled.empty() || sampled[p])
+      out.image.data[p] += static_cast<float>(gain_at(p) * detail_at(p));
+  }
   out.report.applied = true;
   out.report.mean_gain = counted > 0.0 ? gain_sum / counted : 0.0;
   out.report.rms_added = counted > 0.0 ? std::sqrt(added_sq / counted) : 0.0;
