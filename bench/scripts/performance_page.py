@@ -508,7 +508,8 @@ def volume_steps(r):
 
 
 def volumes(root):
-    runs = [r for name in SOURCES["volumes"] for r in records(root, name)]
+    by_file = [records(root, name) for name in SOURCES["volumes"]]
+    runs = [r for file_runs in by_file for r in file_runs]
     defaults, seen = [], set()
     for r in runs:
         if volume_steps(r) == "" and volume_name(r) not in seen:
@@ -522,9 +523,9 @@ def volumes(root):
             for r in defaults]
     at_defaults = table(["volume", "steps × rays", "PSNR (dB) / SSIM", "the field alone (dB)",
                          "edges (of truth's)", "FDK", "oracle FDK", "training",
-                         "the detail", "peak host memory", "machine; date; revision", "command"], rows)
-    before_detail = records(root, SOURCES["volumes"][-1])
-    chest = sorted([r for r in before_detail if volume_name(r).startswith("chest")],
+                         "the detail", "peak host memory", "machine; date; revision",
+                         "command"], rows)
+    chest = sorted([r for r in by_file[-1] if volume_name(r).startswith("chest")],
                    key=lambda r: r["steps"])
     curve = table(["steps", "training", "PSNR (dB) / SSIM", "edges (of truth's)", "command"],
                   [[r["steps"], seconds(r["seconds"]), f2(r["psnr"]) + " / " + f3(r["ssim"]),
