@@ -45,7 +45,7 @@ inline void backproject_parallel_block(const uint gid, const uint n_items, const
   for (int s = 0; s < slices; ++s) {
     const uint selected = block * slices + s;
     const int l = first_slice + min(selected, n_selected - 1) * slice_step;
-    const float z = g.is_3d ? ((float)l - 0.5f * (float)(g.nz - 1)) * g.voxel : 0.0f;
+    const float z = g.is_3d ? ((float)l - 0.5f * (float)(g.nz - 1)) * g.voxel + g.grid_z : 0.0f;
     const float v = g.is_3d ? z / g.pitch_v + 0.5f * (float)(g.n_v - 1) - g.offset_v : 0.0f;
     const float fv = floor(v);
     const int r = (int)fv;
@@ -122,7 +122,8 @@ inline void backproject_divergent_block(const uint gid, const uint n_items,
   for (int s = 0; s < slices; ++s) {
     const uint selected = block * slices + s;
     const int l = first_slice + min(selected, n_selected - 1) * slice_step;
-    z_over_pitch[s] = g.is_3d ? ((float)l - 0.5f * (float)(g.nz - 1)) * g.voxel / g.pitch_v : 0.0f;
+    z_over_pitch[s] =
+        g.is_3d ? (((float)l - 0.5f * (float)(g.nz - 1)) * g.voxel + g.grid_z) / g.pitch_v : 0.0f;
     sum[s] = 0.0f;
   }
   const float u_centre = 0.5f * (float)(g.n_u - 1) - g.offset_u;

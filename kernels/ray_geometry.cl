@@ -26,7 +26,7 @@ typedef struct {
   int ny;
   int nz;
   int is_3d;
-  int reserved;
+  float grid_z;  // the grid's centre above the source's plane (a cone-beam slab's)
 } ScanGeometry;
 
 inline int geometry_is_divergent(const ScanGeometry* g) {
@@ -39,10 +39,11 @@ inline int geometry_is_divergent(const ScanGeometry* g) {
 inline void detector_ray(const ScanGeometry* g, float2 cs, float u, float v, float3* origin,
                          float3* direction) {
   const float a = (u - 0.5f * (float)(g->n_u - 1) + g->offset_u) * g->pitch_u;
-  const float z = g->is_3d ? (v - 0.5f * (float)(g->n_v - 1) + g->offset_v) * g->pitch_v : 0.0f;
+  const float z =
+      g->is_3d ? (v - 0.5f * (float)(g->n_v - 1) + g->offset_v) * g->pitch_v - g->grid_z : 0.0f;
   if (geometry_is_divergent(g)) {
     const float3 target = (float3)(a * cs.x - g->odd * cs.y, a * cs.y + g->odd * cs.x, z);
-    const float3 source = (float3)(g->sod * cs.y, -g->sod * cs.x, 0.0f);
+    const float3 source = (float3)(g->sod * cs.y, -g->sod * cs.x, -g->grid_z);
     *origin = source;
     *direction = normalize(target - source);
   } else {

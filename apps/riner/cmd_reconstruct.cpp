@@ -129,8 +129,9 @@ int run_reconstruct(int argc, char** argv, int first) {
   if (wants_slabs(args)) return reconstruct_by_slabs(args, console, config_from(args), started);
   // Only a slabbed run shares out its work; anything else would run N times into one folder.
   if (SlabRanks::launched_size() > 1) {
-    throw UsageError("several processes share only a slabbed run (a parallel-beam stack with "
-                     "--slab-slices or --memory-limit): run this one as one process");
+    throw UsageError(
+        "several processes share only a slabbed run (a projection stack with "
+        "--slab-slices or --memory-limit): run this one as one process");
   }
   LoadedScan loaded = scan_from(args, console);
   const std::optional<CentreEstimate> centre_check = check_centre(loaded, console);

@@ -1,5 +1,6 @@
 #include "reconstruct_slabs.hpp"
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <thread>
@@ -87,9 +88,10 @@ std::string bytes_string(double bytes) {
 
 void add_slab_options(Args& args) {
   args.option("slab-slices", "N",
-              "a projection stack (parallel beam) in slabs of N axial slices, each trained "
-              "alone and written as it finishes (volume/slice_NNNNN.tif, manifest.json); "
-              "default: as many as --memory-limit allows",
+              "a projection stack in slabs of N axial slices, each trained alone (a cone "
+              "beam's with the slices around it that its rays cross) and written as it "
+              "finishes (volume/slice_NNNNN.tif, manifest.json); default: as many as "
+              "--memory-limit allows",
               "")
       .option("memory-limit", "SIZE",
               "memory the slabs may take, on the host and on a GPU (8G, 512M); a volume larger "
@@ -133,10 +135,10 @@ bool wants_slabs(const Args& args) {
   for (const char* name : {"slab-slices", "memory-limit", "workers", "processes", "join-run"}) {
     if (auto v = args.maybe(name); v && !v->empty()) return true;
   }
-  // Left to the scan: by slabs when a parallel-beam volume does not fit whole, or when its
+  // Left to the scan: by slabs when a volume does not fit whole, or when a parallel beam's
   // slices are large enough to train each alone.
   const std::optional<Geometry> g = stack_geometry(args);
-  return g && g->type == GeometryType::kParallel3d &&
+  return g && g->is_3d() &&
          (slices_2d_by_default(*g) || slab_bytes(*g, g->volume_shape[0]) > default_memory_limit());
 }
 
@@ -262,6 +264,15 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
                                         .c_str()
                                   : "");
     console.line(line);
+    std::size_t trained = 0;
+    for (const Slab& slab : run.slabs()) trained = std::max(trained, slab.trained_slices);
+    if (trained > run.slices_per_slab()) {
+      std::snprintf(line, sizeof(line),
+                    "cone beam: each slab also trains the slices beside it that its rows' rays "
+                    "cross, up to %zu slices in all (the rest are not written)",
+                    trained);
+      console.line(line);
+    }
     if (run.device_bound()) {
       std::snprintf(line, sizeof(line),
                     "device memory: slabs of %zu slice(s), %d at once, each about %s of the "

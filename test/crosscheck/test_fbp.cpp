@@ -67,9 +67,11 @@ TEST_SUITE("fbp") {
   }
 
   TEST_CASE("OpenCL and reference agree for every geometry type and filter") {
+    riner::Geometry raised = riner::test::small_cone3d();  // a cone-beam slab's grid
+    raised.grid_centre_z_mm = 3.5 * raised.voxel_mm;
     for (const riner::Geometry& g :
          {riner::test::small_fan2d(), riner::test::small_parallel2d(), riner::test::small_cone3d(),
-          riner::test::small_parallel3d()}) {
+          raised, riner::test::small_parallel3d()}) {
       for (riner::FbpFilter filter : {riner::FbpFilter::kRamLak, riner::FbpFilter::kHann}) {
         CAPTURE(std::string(riner::geometry_type_name(g.type)));
         CAPTURE(std::string(riner::fbp_filter_name(filter)));

@@ -36,9 +36,16 @@ riner::Geometry axis_aligned(riner::Geometry g) {
   return g;
 }
 
+// A cone beam's grid above the source's plane, as a slab's: the rays move, not the grid.
+riner::Geometry raised(riner::Geometry g) {
+  g.grid_centre_z_mm = 3.5 * g.voxel_mm;
+  return g;
+}
+
 const riner::Geometry kGeometries[] = {riner::test::small_fan2d(),
                                        riner::test::small_parallel2d(),
                                        riner::test::small_cone3d(),
+                                       raised(riner::test::small_cone3d()),
                                        riner::test::small_parallel3d(),
                                        axis_aligned(riner::test::small_parallel2d()),
                                        axis_aligned(riner::test::small_parallel3d())};

@@ -81,6 +81,22 @@ TEST_SUITE("geometry_json") {
     }
   }
 
+  TEST_CASE("a grid's height on the axis: parsed, round-tripped, checked") {
+    std::string raised = kCone;
+    const std::string voxel = "\"voxel_mm\": 1.0";
+    raised.replace(raised.find(voxel), voxel.size(), voxel + ", \"centre_z_mm\": -12.5");
+    const riner::Geometry g = riner::Geometry::from_json(raised);
+    CHECK(g.grid_centre_z_mm == -12.5);
+    CHECK(riner::Geometry::from_json(g.to_json()).grid_centre_z_mm == -12.5);
+    // Absent when 0, so every other geometry's JSON reads as before.
+    CHECK(riner::Geometry::from_json(kCone).to_json().find("centre_z_mm") == std::string::npos);
+    check_error(fan_with("\"voxel_mm\": 1.0", "\"voxel_mm\": 1.0, \"centre_z_mm\": 3"),
+                "g.json: volume.centre_z_mm belongs to a 3D geometry");
+    riner::Geometry bad = g;
+    bad.grid_centre_z_mm = NAN;
+    CHECK_THROWS_WITH_AS(bad.validate(), "volume.centre_z_mm must be finite", riner::InputError);
+  }
+
   TEST_CASE("every bad field is named") {
     try {
       riner::Geometry::from_json("{", "g.json");

@@ -1,5 +1,6 @@
 // Cutting a volume into slabs: the slabs cover every slice once, each slab's rows are the rows
-// its slices project to, and a slab's geometry projects its slices onto exactly those rows.
+// its slices project to (in a cone beam: every row that sees them, on the slices those rows'
+// rays cross), and a slab's geometry projects its slices onto exactly those rows.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -8,6 +9,7 @@
 #include "riner/error.hpp"
 #include "riner/geometry.hpp"
 #include "riner/projector.hpp"
+#include "riner/rays.hpp"
 #include "riner/slab_plan.hpp"
 
 namespace {
@@ -99,14 +101,141 @@ TEST_CASE("a slab's geometry projects its slices onto the same rows as the whole
   }
 }
 
-TEST_CASE("a cone beam is not cut; sizes and memory parse") {
-  riner::Geometry cone = parallel3d(10, 10, 1.0, 0.0);
-  cone.type = riner::GeometryType::kCone3d;
-  cone.source_origin_mm = 200;
-  cone.origin_detector_mm = 200;
-  CHECK(riner::plan_slabs(cone, 10).size() == 1);
-  CHECK_THROWS_WITH_AS(riner::plan_slabs(cone, 4), doctest::Contains("is not cut into slabs"),
-                       riner::InputError);
+namespace {
+
+// 30 views of a 40 x 48 detector at magnification 2 round a 24 x 16 x 16 volume: the rows at
+// the top and bottom climb through up to 5 slices inside the box.
+riner::Geometry cone3d() {
+  riner::Geometry g = parallel3d(24, 48, 1.0, 0.0);
+  g.type = riner::GeometryType::kCone3d;
+  g.n_u = 40;
+  g.source_origin_mm = 60;
+  g.origin_detector_mm = 60;
+  g.angles.clear();
+  for (int i = 0; i < 30; ++i) g.angles.push_back(2.0 * M_PI * i / 30.0);
+  return g;
+}
+
+// The volume's values in slices [first, end), zero elsewhere.
+riner::Array only_slices(const riner::Array& volume, std::size_t first, std::size_t end) {
+  riner::Array part = volume;
+  const std::size_t each = volume.shape[1] * volume.shape[2];
+  for (std::size_t i = 0; i < part.size(); ++i) {
+    const std::size_t z = i / each;
+    if (z < first || z >= end) part.data[i] = 0.0f;
+  }
+  return part;
+}
+
+double largest_difference(const riner::Array& a, const riner::Array& b) {
+  double worst = 0.0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    worst = std::max(worst, std::fabs(double(a.data[i]) - b.data[i]));
+  }
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE(
+    "a cone-beam slab trains every row that sees its slices, on the slices those rows cross") {
+  // Joseph's projector interpolates between slice centres, so a voxel model's slice reaches a
+  // voxel beyond its edges: the checks keep a slice's distance where they mean "no ray".
+  const riner::Geometry g = cone3d();
+  riner::Array volume({24, 16, 16});
+  for (std::size_t i = 0; i < volume.size(); ++i) {
+    volume.data[i] = 0.01f * static_cast<float>(1 + (i * 7 + i / 16 * 3) % 13);
+  }
+  const riner::Projector whole(g, riner::Engine::kReference);
+  std::vector<int> mapped(g.n_v, 0);
+  const std::vector<riner::Slab> slabs = riner::plan_slabs(g, 6);
+  REQUIRE(slabs.size() == 4);
+  for (const riner::Slab& s : slabs) {
+    CAPTURE(s.index);
+    const std::size_t end = s.first_slice + s.slices,
+                      trained_end = s.trained_first + s.trained_slices;
+    CHECK(s.trained_first <= s.first_slice);
+    CHECK(trained_end >= end);
+    // Every row that sees the slab's own slices (inside them by a slice) is one of its rows.
+    const riner::Array own = whole.project(only_slices(volume, s.first_slice + 1, end - 1));
+    for (std::size_t r = 0; r < g.n_v; ++r) {
+      if (r >= s.rows.first && r < s.rows.end()) continue;
+      CAPTURE(r);
+      CHECK(largest_difference(riner::detector_rows(own, {r, 1}),
+                               riner::Array({g.n_views(), 1, g.n_u})) == 0.0);
+    }
+    // Its rows see nothing beyond its trained slices (a slice's distance away).
+    riner::Array outside = volume;
+    for (std::size_t z = std::max<std::size_t>(s.trained_first, 1) - 1;
+         z < std::min<std::size_t>(trained_end + 1, 24); ++z) {
+      std::fill_n(outside.data.begin() + static_cast<std::ptrdiff_t>(z * 256), 256, 0.0f);
+    }
+    const riner::Array beyond = riner::detector_rows(whole.project(outside), s.rows);
+    CHECK(largest_difference(beyond, riner::Array(beyond.shape)) == 0.0);
+    // Its geometry projects its trained slices as the whole volume's geometry does.
+    const riner::Geometry sg = riner::slab_geometry(g, s);
+    CHECK(sg.volume_shape[0] == s.trained_slices);
+    riner::Array part({s.trained_slices, 16, 16});
+    std::copy_n(volume.data.begin() + static_cast<std::ptrdiff_t>(s.trained_first * 256),
+                part.size(), part.data.begin());
+    const riner::Array expected = riner::detector_rows(
+        whole.project(only_slices(volume, s.trained_first, trained_end)), s.rows);
+    const riner::Array projected = riner::Projector(sg, riner::Engine::kReference).project(part);
+    REQUIRE(projected.shape == expected.shape);
+    CHECK(largest_difference(projected, expected) < 1e-5);
+    for (std::size_t r = s.map_rows.first; r < s.map_rows.end(); ++r) ++mapped[r];
+    CHECK(s.map_rows.first >= s.rows.first);
+    CHECK(s.map_rows.end() <= s.rows.end());
+  }
+  // The outer slabs cross slices beside their own; every row's response comes from one slab.
+  CHECK(slabs.front().trained_slices > 6);
+  CHECK(slabs.back().trained_slices > 6);
+  for (std::size_t r = 0; r < g.n_v; ++r) {
+    CAPTURE(r);
+    CHECK(mapped[r] == 1);
+  }
+  // Whole, a cone beam keeps its detector and grid.
+  const std::vector<riner::Slab> one = riner::plan_slabs(g, 24);
+  REQUIRE(one.size() == 1);
+  CHECK(one[0].rows == riner::RowRange{0, g.n_v});
+  CHECK(riner::slab_geometry(g, one[0]).grid_centre_z_mm == 0.0);
+  // A cone's slabs cost more than their share of the detector: the rows of the slices beside.
+  riner::Geometry flat = g;
+  flat.type = riner::GeometryType::kParallel3d;
+  CHECK(riner::slab_bytes(g, 6) > riner::slab_bytes(flat, 6));
+  CHECK(riner::slab_bytes(g, 6) < riner::slab_bytes(g, 24));
+  CHECK(riner::slab_bytes(g, 24) == riner::slab_bytes(flat, 24));
+}
+
+TEST_CASE("a cone-beam slab's field of view: the heights of its grid that every view sees") {
+  const riner::Geometry g = cone3d();
+  // The whole detector, centred: as before, symmetric about the source's plane.
+  const riner::FieldOfView whole = riner::field_of_view(g);
+  CHECK(whole.centre_z_mm == 0.0);
+  CHECK(whole.half_height_mm ==
+        doctest::Approx(24.0 * (60.0 - whole.radius_mm) / 120.0).epsilon(1e-12));
+  for (const riner::Slab& s : riner::plan_slabs(g, 6)) {
+    CAPTURE(s.index);
+    const riner::Geometry sg = riner::slab_geometry(g, s);
+    const riner::FieldOfView f = riner::field_of_view(sg);
+    CHECK(f.radius_mm == whole.radius_mm);
+    // Points on the field's edge, top and bottom, land on the slab's rows at every view.
+    for (double z :
+         {f.centre_z_mm - 0.999 * f.half_height_mm, f.centre_z_mm + 0.999 * f.half_height_mm}) {
+      for (double phi = 0.0; phi < 6.28; phi += 0.5) {
+        const riner::Vec3 p{0.999 * f.radius_mm * std::cos(phi),
+                            0.999 * f.radius_mm * std::sin(phi), z};
+        for (std::size_t view = 0; view < sg.n_views(); ++view) {
+          const double v = riner::project_to_detector(sg, view, p).v;
+          CHECK(v >= -0.5);
+          CHECK(v <= static_cast<double>(sg.n_v) - 0.5);
+        }
+      }
+    }
+  }
+}
+
+TEST_CASE("sizes and memory parse") {
   CHECK(riner::parse_memory_size("8G") == (std::size_t{8} << 30));
   CHECK(riner::parse_memory_size("512M") == (std::size_t{512} << 20));
   CHECK(riner::parse_memory_size("1000") == 1000);

@@ -38,6 +38,10 @@ std::size_t shape_size(const std::vector<std::size_t>& shape);
 // Slice z of a volume [z, y, x] as a 2D image [y, x] (a copy).
 Array axial_slice(const Array& volume, std::size_t z);
 
+// Entries [first, first + count) along the first axis (slices of a volume, rows of a map): a
+// copy. InputError past the end.
+Array first_axis_range(const Array& a, std::size_t first, std::size_t count);
+
 // Detector row `row` of a stack [frames, rows, columns]: [frames, columns] (a copy).
 // InputError when there is no such row.
 Array detector_row(const Array& stack, std::size_t row);

@@ -45,6 +45,10 @@ struct Geometry {
   // Reconstruction grid: [n_y, n_x] in 2D, [n_z, n_y, n_x] in 3D; isotropic voxels.
   std::vector<std::size_t> volume_shape;
   double voxel_mm = 1.0;
+  // 3D only: the height of the grid's centre on the axis above the source's plane (the plane
+  // of the detector's centre ray; 0: the grid is centred there). A cone-beam slab's grid sits
+  // at its own height, and the rays, not the grid, move by as much.
+  double grid_centre_z_mm = 0.0;
 
   bool is_3d() const { return type == GeometryType::kCone3d || type == GeometryType::kParallel3d; }
   bool is_divergent() const {
@@ -80,11 +84,14 @@ constexpr double kHalfAcquisitionShare = 0.8;
 bool is_half_acquisition(const Geometry& g);
 
 // The cylinder (disc in 2D) around the axis that the scan sees whole: its radius from the
-// detector's nearer end (a half acquisition's: from its farther end), its half height (3D)
-// from the rows at the largest magnification. Zero when the axis is off the detector.
+// detector's nearer end (a half acquisition's: from its farther end; zero when the axis is off
+// the detector), and in 3D its heights in the grid's frame, from the detector's first and last
+// rows at the magnification that sees least of them (zero half height when no height is seen
+// whole).
 struct FieldOfView {
   double radius_mm = 0.0;
   double half_height_mm = 0.0;
+  double centre_z_mm = 0.0;
 };
 FieldOfView field_of_view(const Geometry& g);
 

@@ -1,8 +1,9 @@
 // Cutting a volume into slabs of axial slices, each trained alone on the detector rows its
 // voxels project to: how a scan larger than memory (or than one device) goes through riner.
-// Parallel beam only: there a row's rays stay in one slice, so slabs are independent and a
-// slab's result does not depend on its neighbours. A cone beam's rays cross slices (a slab
-// would need the rows of its neighbours' voxels too): it goes through whole.
+// In a parallel beam a row's rays stay in one slice, so slabs are independent. In a cone beam
+// a row's rays climb through several slices: a slab trains its own slices and those around
+// them that its rows' rays cross, on every row whose rays stay within them (so each reading is
+// the sum of what the slab's field holds), and writes its own slices only.
 #pragma once
 
 #include <cstddef>
@@ -17,19 +18,32 @@ namespace riner {
 
 struct Slab {
   std::size_t index = 0;
-  std::size_t first_slice = 0;  // voxel slices [first_slice, first_slice + slices) of the volume
+  std::size_t first_slice = 0;  // voxel slices [first_slice, first_slice + slices) it writes
   std::size_t slices = 0;
-  RowRange rows;  // the detector rows whose centres fall inside those slices
+  // The detector rows it trains on: in a parallel beam those whose centres fall inside its
+  // slices; in a cone beam every row whose rays, inside the reconstruction box, stay within
+  // its trained slices (which holds every row that sees its own slices).
+  RowRange rows;
+  // The slices it trains: its own, and in a cone beam those around them its rows' rays cross.
+  std::size_t trained_first = 0;
+  std::size_t trained_slices = 0;
+  // The rows whose response (alpha, beta) it gives the whole detector's maps: its rows in a
+  // parallel beam; in a cone beam those whose centre ray crosses the axis within its own
+  // slices (below the volume: the first slab's; above it: the last's).
+  RowRange map_rows;
 };
 
 // Slabs of at most `slices_per_slab` slices covering the volume, as even as they come (64
-// slices in slabs of 30: 22, 21, 21). InputError for a cone beam cut into more than one slab,
-// or a slab no detector row falls in.
+// slices in slabs of 30: 22, 21, 21). InputError for a slab no detector row sees.
 std::vector<Slab> plan_slabs(const Geometry& g, std::size_t slices_per_slab);
 
-// The slab's own geometry: its rows of the detector and its slices of the volume, re-centred
-// on the grid (the detector rows moved by as much along the axis).
+// The slab's own geometry: its rows of the detector and its trained slices of the volume. A
+// parallel beam's grid is re-centred and the rows moved by as much along the axis; a cone
+// beam's grid sits at the slices' height (Geometry::grid_centre_z_mm).
 Geometry slab_geometry(const Geometry& g, const Slab& slab);
+
+// The slab of `count` slices from `first` as plan_slabs would cut it (rows, trained slices).
+Slab slab_extent(const Geometry& g, std::size_t first, std::size_t count);
 
 // Host memory a slab of `slices` slices takes to train and check (measured, docs/history/RESULTS.md
 // "Slabs"): a base for the model and the kernels, and per slice its share of the measurement

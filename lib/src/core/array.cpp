@@ -67,6 +67,18 @@ ArrayStats compute_stats(const Array& array) {
   return stats;
 }
 
+Array first_axis_range(const Array& a, std::size_t first, std::size_t count) {
+  if (a.rank() < 1 || first + count > a.shape[0]) {
+    throw InputError("no entries " + std::to_string(first) + ".." + std::to_string(first + count) +
+                     " in an array of shape " + shape_string(a.shape));
+  }
+  const std::size_t each = a.shape[0] ? a.size() / a.shape[0] : 0;
+  std::vector<std::size_t> shape = a.shape;
+  shape[0] = count;
+  const auto begin = a.data.begin() + static_cast<std::ptrdiff_t>(first * each);
+  return Array(shape, std::vector<float>(begin, begin + static_cast<std::ptrdiff_t>(count * each)));
+}
+
 Array axial_slice(const Array& volume, std::size_t z) {
   if (volume.rank() != 3 || z >= volume.shape[0]) {
     throw InputError("no slice " + std::to_string(z) + " in an array of shape " +

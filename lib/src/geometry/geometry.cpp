@@ -37,6 +37,8 @@ void Geometry::validate() const {
     if (n < 1) fail("volume.shape entries must be >= 1");
   }
   if (!(voxel_mm > 0.0) || !std::isfinite(voxel_mm)) fail("volume.voxel_mm must be finite and > 0");
+  if (!std::isfinite(grid_centre_z_mm)) fail("volume.centre_z_mm must be finite");
+  if (!is_3d() && grid_centre_z_mm != 0.0) fail("volume.centre_z_mm belongs to a 3D geometry");
   if (is_divergent()) {
     if (!(source_origin_mm > 0.0) || !std::isfinite(source_origin_mm)) {
       fail("source_origin_mm must be finite and > 0");
@@ -106,12 +108,23 @@ bool is_half_acquisition(const Geometry& g) {
 FieldOfView field_of_view(const Geometry& g) {
   const auto [nearer, farther] = detector_ends(g.n_u, g.offset_u, g.pitch_u);
   const double u = is_half_acquisition(g) ? farther : nearer;
-  const double v = g.is_3d() ? detector_ends(g.n_v, g.offset_v, g.pitch_v).first : 0.0;
-  if (!g.is_divergent()) return {u, v};
   const double sdd = g.source_origin_mm + g.origin_detector_mm;
   FieldOfView f;
-  f.radius_mm = g.source_origin_mm * u / std::hypot(u, sdd);
-  f.half_height_mm = v * std::max(0.0, g.source_origin_mm - f.radius_mm) / sdd;
+  f.radius_mm = g.is_divergent() ? g.source_origin_mm * u / std::hypot(u, sdd) : u;
+  if (!g.is_3d()) return f;
+  // The rows' outer edges above the source's plane (mm on the detector).
+  const double half_rows = 0.5 * static_cast<double>(g.n_v);
+  const double a = (-half_rows + g.offset_v) * g.pitch_v, b = (half_rows + g.offset_v) * g.pitch_v;
+  double low = std::min(a, b), high = std::max(a, b);
+  if (g.is_divergent()) {
+    // A height is seen whole where its nearest and farthest points both land on the rows.
+    const double near = (g.source_origin_mm - f.radius_mm) / sdd;
+    const double far = (g.source_origin_mm + f.radius_mm) / sdd;
+    low *= low < 0.0 ? near : far;
+    high *= high > 0.0 ? near : far;
+  }
+  f.half_height_mm = std::max(0.0, 0.5 * (high - low));
+  f.centre_z_mm = 0.5 * (high + low) - g.grid_centre_z_mm;
   return f;
 }
 

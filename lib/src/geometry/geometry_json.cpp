@@ -175,6 +175,9 @@ Geometry Geometry::from_json(std::string_view json_text, std::string_view source
     g.volume_shape.push_back(p.count(shape[i], "volume.shape[" + std::to_string(i) + "]"));
   }
   g.voxel_mm = p.positive(p.member(volume, "voxel_mm", "volume.voxel_mm"), "volume.voxel_mm");
+  if (volume.contains("centre_z_mm")) {
+    g.grid_centre_z_mm = p.number(volume["centre_z_mm"], "volume.centre_z_mm");
+  }
   try {
     g.validate();
   } catch (const InputError& e) {
@@ -209,6 +212,7 @@ std::string Geometry::to_json() const {
     root["angles_rad"] = angles;
   }
   root["volume"] = {{"shape", volume_shape}, {"voxel_mm", voxel_mm}};
+  if (grid_centre_z_mm != 0.0) root["volume"]["centre_z_mm"] = grid_centre_z_mm;
   return root.dump(1) + "\n";
 }
 

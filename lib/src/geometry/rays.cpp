@@ -37,7 +37,8 @@ Vec3 detector_position(const Geometry& g, std::size_t view, double u, double v) 
   const double c = std::cos(g.angles[view]);
   const double s = std::sin(g.angles[view]);
   const double a = element_offset(u, g.n_u, g.offset_u, g.pitch_u);
-  const double z = g.is_3d() ? element_offset(v, g.n_v, g.offset_v, g.pitch_v) : 0.0;
+  const double z =
+      g.is_3d() ? element_offset(v, g.n_v, g.offset_v, g.pitch_v) - g.grid_centre_z_mm : 0.0;
   // R(theta) (a, b) = (a c - b s, a s + b c); the detector plane is at b = ODD (0 for parallel).
   const double b = g.is_divergent() ? g.origin_detector_mm : 0.0;
   return {a * c - b * s, a * s + b * c, z};
@@ -59,7 +60,7 @@ Ray detector_ray(const Geometry& g, std::size_t view, double u, double v) {
   const double s = std::sin(g.angles[view]);
   const Vec3 target = detector_position(g, view, u, v);
   if (g.is_divergent()) {
-    const Vec3 source{g.source_origin_mm * s, -g.source_origin_mm * c, 0.0};
+    const Vec3 source{g.source_origin_mm * s, -g.source_origin_mm * c, -g.grid_centre_z_mm};
     return {source, normalised({target.x - source.x, target.y - source.y, target.z - source.z})};
   }
   return {target, {-s, c, 0.0}};
@@ -84,7 +85,8 @@ DetectorPoint project_to_detector(const Geometry& g, const ViewRotation& rotatio
     d.magnification = (g.source_origin_mm + g.origin_detector_mm) / (g.source_origin_mm + b);
   d.u = a * d.magnification / g.pitch_u + 0.5 * (static_cast<double>(g.n_u) - 1.0) - g.offset_u;
   if (g.is_3d()) {
-    d.v = p.z * d.magnification / g.pitch_v + 0.5 * (static_cast<double>(g.n_v) - 1.0) - g.offset_v;
+    d.v = (p.z + g.grid_centre_z_mm) * d.magnification / g.pitch_v +
+          0.5 * (static_cast<double>(g.n_v) - 1.0) - g.offset_v;
   }
   return d;
 }

@@ -115,7 +115,7 @@ Scan binned_scan(const Scan& scan, std::size_t f) {
 // Whether a point is inside the field every view sees whole, `margin` inside its edge.
 bool in_field(const Vec3& p, const FieldOfView& field, const Geometry& g, double margin) {
   if (std::hypot(p.x, p.y) > field.radius_mm - margin) return false;
-  return !g.is_3d() || std::fabs(p.z) <= field.half_height_mm - margin;
+  return !g.is_3d() || std::fabs(p.z - field.centre_z_mm) <= field.half_height_mm - margin;
 }
 
 // The rings the stripes left (the running median's own error makes broad ones): per axial slice,

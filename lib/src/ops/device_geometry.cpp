@@ -25,6 +25,7 @@ DeviceGeometry to_device(const Geometry& g) {
   d.ny = static_cast<cl_int>(g.volume_shape[rank - 2]);
   d.nz = static_cast<cl_int>(g.is_3d() ? g.volume_shape[0] : 1);
   d.is_3d = g.is_3d() ? 1 : 0;
+  d.grid_z = static_cast<cl_float>(g.is_3d() ? g.grid_centre_z_mm : 0.0);
   return d;
 }
 

@@ -26,7 +26,7 @@ struct DeviceGeometry {
   cl_int ny;
   cl_int nz;
   cl_int is_3d;
-  cl_int reserved;
+  cl_float grid_z;  // Geometry::grid_centre_z_mm
 };
 static_assert(sizeof(DeviceGeometry) == 64, "must match ScanGeometry in ray_geometry.cl");
 

@@ -93,8 +93,9 @@ std::vector<double> fbp_backproject(const Geometry& g, const std::vector<double>
           weight *= std::pow(g.source_origin_mm / distance, 2);
         }
         const double u = a * scale / g.pitch_u + 0.5 * (g.n_u - 1.0) - g.offset_u;
-        const double row =
-            g.is_3d() ? p.z * scale / g.pitch_v + 0.5 * (g.n_v - 1.0) - g.offset_v : 0.0;
+        const double row = g.is_3d() ? (p.z + g.grid_centre_z_mm) * scale / g.pitch_v +
+                                           0.5 * (g.n_v - 1.0) - g.offset_v
+                                     : 0.0;
         sum += weight * sample(v, u, row);
       }
       volume[index] = sum;

@@ -21,7 +21,8 @@ std::vector<long> rows_of_slices(const Geometry& g) {
   const std::size_t nz = g.volume_shape[0];
   std::vector<long> rows(nz, -1);
   for (std::size_t s = 0; s < nz; ++s) {
-    const double z = (static_cast<double>(s) - 0.5 * (static_cast<double>(nz) - 1.0)) * g.voxel_mm;
+    const double z = (static_cast<double>(s) - 0.5 * (static_cast<double>(nz) - 1.0)) * g.voxel_mm +
+                     g.grid_centre_z_mm;
     const double r = z / g.pitch_v + 0.5 * (static_cast<double>(g.n_v) - 1.0) - g.offset_v;
     const double nearest = std::round(r);
     if (std::fabs(r - nearest) <= kRowTolerance && nearest >= 0.0 &&

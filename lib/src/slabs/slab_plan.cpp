@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <utility>
 
 #include "riner/error.hpp"
 
@@ -28,11 +29,6 @@ constexpr std::size_t kDeviceBaseBytes = std::size_t{256} << 20;
 constexpr double kDeviceReadingCopies = 2.0;
 constexpr double kDeviceVoxelCopies = 2.0;
 
-double readings_per_slice(const Geometry& g) {
-  return static_cast<double>(g.n_views()) * static_cast<double>(g.n_u) *
-         static_cast<double>(g.n_v) / static_cast<double>(g.volume_shape[0]);
-}
-
 double voxels_per_slice(const Geometry& g) {
   return static_cast<double>(g.volume_shape[1]) * static_cast<double>(g.volume_shape[2]);
 }
@@ -42,46 +38,160 @@ double row_at(const Geometry& g, double z_mm) {
   return z_mm / g.pitch_v + (static_cast<double>(g.n_v) - 1.0) / 2.0 - g.offset_v;
 }
 
+// The height of slice k's centre (fractional k: its edges at k -+ 0.5) in the grid's frame.
 double slice_z(const Geometry& g, double k) {
   return (k - (static_cast<double>(g.volume_shape[0]) - 1.0) / 2.0) * g.voxel_mm;
 }
 
+// Where a detector row sits above the source's plane (mm on the detector; fractional rows).
+double row_mm(const Geometry& g, double row) {
+  return (row - (static_cast<double>(g.n_v) - 1.0) / 2.0 + g.offset_v) * g.pitch_v;
+}
+
+Slab parallel_slab(const Geometry& g, std::size_t first, std::size_t count) {
+  Slab s;
+  s.first_slice = s.trained_first = first;
+  s.slices = s.trained_slices = count;
+  // Rows whose centres lie in [bottom, top) of the slab's slices, in row order (the detector's
+  // v runs along +z when pitch_v > 0).
+  const double a = row_at(g, slice_z(g, static_cast<double>(first) - 0.5) + g.grid_centre_z_mm);
+  const double b =
+      row_at(g, slice_z(g, static_cast<double>(first + count) - 0.5) + g.grid_centre_z_mm);
+  const double lo = std::min(a, b), hi = std::max(a, b);
+  const long begin = std::max<long>(0, static_cast<long>(std::ceil(lo - 1e-9)));
+  const long end =
+      std::min<long>(static_cast<long>(g.n_v), static_cast<long>(std::ceil(hi - 1e-9)));
+  if (end > begin) {
+    s.rows = {static_cast<std::size_t>(begin), static_cast<std::size_t>(end - begin)};
+  }
+  s.map_rows = s.rows;
+  return s;
+}
+
+// A cone beam's slab. Heights are in the scan's frame (0 at the source's plane). A ray of a row
+// at v mm on the detector is at height v (SOD + b) / SDD at depth b towards the detector, and
+// the reconstruction box holds depths within its half-diagonal R of the axis: so a row's rays
+// inside the box stay between v (SOD - R) / SDD and v (SOD + R) / SDD, whatever the view and
+// the column.
+Slab cone_slab(const Geometry& g, std::size_t first, std::size_t count) {
+  const std::size_t nz = g.volume_shape[0];
+  const double sdd = g.source_origin_mm + g.origin_detector_mm;
+  const double reach =
+      0.5 * g.voxel_mm *
+      std::hypot(static_cast<double>(g.volume_shape[1]), static_cast<double>(g.volume_shape[2]));
+  const double near = (g.source_origin_mm - reach) / sdd;  // > 0: validate() keeps the source out
+  const double far = (g.source_origin_mm + reach) / sdd;
+  const double box_low = slice_z(g, -0.5) + g.grid_centre_z_mm;
+  const double box_high = slice_z(g, static_cast<double>(nz) - 0.5) + g.grid_centre_z_mm;
+  // The heights a row's rays cross inside the box (a whole element: its lower and upper edges);
+  // a row whose rays miss the box keeps the box's nearer face.
+  auto heights = [&](std::size_t row) {
+    const double a = row_mm(g, static_cast<double>(row) - 0.5);
+    const double b = row_mm(g, static_cast<double>(row) + 0.5);
+    const double low = std::min(a * near, a * far), high = std::max(b * near, b * far);
+    return std::pair{std::clamp(low, box_low, box_high), std::clamp(high, box_low, box_high)};
+  };
+  const double own_low = slice_z(g, static_cast<double>(first) - 0.5) + g.grid_centre_z_mm;
+  const double own_high = slice_z(g, static_cast<double>(first + count) - 0.5) + g.grid_centre_z_mm;
+  // Every row that sees the slab's own slices, and the heights their rays cross.
+  double low = own_low, high = own_high;
+  bool seen = false;
+  for (std::size_t r = 0; r < g.n_v; ++r) {
+    const auto [lo, hi] = heights(r);
+    if (hi < own_low || lo > own_high || !(hi > lo)) continue;
+    seen = true;
+    low = std::min(low, lo);
+    high = std::max(high, hi);
+  }
+  Slab s;
+  s.first_slice = first;
+  s.slices = count;
+  if (!seen) return s;
+  // Whole slices around them, and every row whose rays stay within those.
+  const double voxel = g.voxel_mm;
+  s.trained_first =
+      static_cast<std::size_t>(std::max(0.0, std::floor((low - box_low) / voxel + 1e-9)));
+  const auto trained_end = static_cast<std::size_t>(
+      std::min(static_cast<double>(nz), std::ceil((high - box_low) / voxel - 1e-9)));
+  s.trained_slices = trained_end - s.trained_first;
+  const double trained_low = box_low + static_cast<double>(s.trained_first) * voxel;
+  const double trained_high = box_low + static_cast<double>(trained_end) * voxel;
+  const double slack = 1e-9 * voxel;
+  std::size_t begin = g.n_v, end = 0;
+  for (std::size_t r = 0; r < g.n_v; ++r) {
+    const auto [lo, hi] = heights(r);
+    if (lo < trained_low - slack || hi > trained_high + slack) continue;
+    begin = std::min(begin, r);
+    end = r + 1;
+  }
+  s.rows = {begin, end - begin};
+  // The rows whose centre ray crosses the axis in the slab's own slices.
+  const bool bottom = first == 0, top = first + count == nz;
+  std::size_t map_begin = end, map_end = begin;
+  for (std::size_t r = begin; r < end; ++r) {
+    const double axis = row_mm(g, static_cast<double>(r)) * g.source_origin_mm / sdd;
+    if ((axis < own_low && !bottom) || (axis >= own_high && !top)) continue;
+    map_begin = std::min(map_begin, r);
+    map_end = r + 1;
+  }
+  if (map_end > map_begin) s.map_rows = {map_begin, map_end - map_begin};
+  return s;
+}
+
+// The readings and voxels a slab of `slices` slices holds at most: the outermost slab's in a
+// cone beam (it crosses the most slices beside its own), a share of the detector otherwise.
+struct SlabSize {
+  double readings = 0.0;
+  double voxels = 0.0;
+};
+
+SlabSize slab_size(const Geometry& g, std::size_t slices) {
+  const std::size_t nz = g.volume_shape[0];
+  slices = std::max<std::size_t>(1, std::min(slices, nz));
+  const double per_row = static_cast<double>(g.n_views()) * static_cast<double>(g.n_u);
+  if (g.type != GeometryType::kCone3d || slices == nz) {
+    return {per_row * static_cast<double>(g.n_v) * static_cast<double>(slices) /
+                static_cast<double>(nz),
+            voxels_per_slice(g) * static_cast<double>(slices)};
+  }
+  SlabSize most;
+  for (std::size_t first : {std::size_t{0}, (nz - slices) / 2, nz - slices}) {
+    const Slab s = cone_slab(g, first, slices);
+    most.readings = std::max(most.readings, per_row * static_cast<double>(s.rows.count));
+    most.voxels =
+        std::max(most.voxels, voxels_per_slice(g) * static_cast<double>(s.trained_slices));
+  }
+  return most;
+}
+
 }  // namespace
+
+Slab slab_extent(const Geometry& g, std::size_t first, std::size_t count) {
+  if (g.type != GeometryType::kCone3d) return parallel_slab(g, first, count);
+  if (first == 0 && count == g.volume_shape[0]) {  // the whole volume, on the whole detector
+    Slab s;
+    s.slices = s.trained_slices = count;
+    s.rows = s.map_rows = {0, g.n_v};
+    return s;
+  }
+  return cone_slab(g, first, count);
+}
 
 std::vector<Slab> plan_slabs(const Geometry& g, std::size_t slices_per_slab) {
   if (!g.is_3d()) throw InputError("slabs cut a volume: the geometry is 2D");
   const std::size_t nz = g.volume_shape[0];
   const std::size_t per = std::max<std::size_t>(1, std::min(slices_per_slab, nz));
   const std::size_t count = (nz + per - 1) / per;
-  if (count > 1 && g.type != GeometryType::kParallel3d) {
-    throw InputError(std::string("a ") + geometry_type_name(g.type) +
-                     " scan is not cut into slabs (its rays cross slices): it needs memory for " +
-                     "the whole volume; raise --memory-limit");
-  }
   std::vector<Slab> slabs;
   for (std::size_t i = 0; i < count; ++i) {
-    Slab s;
+    const std::size_t first = i * nz / count;
+    Slab s = slab_extent(g, first, (i + 1) * nz / count - first);
     s.index = i;
-    s.first_slice = i * nz / count;
-    s.slices = (i + 1) * nz / count - s.first_slice;
-    if (g.type == GeometryType::kParallel3d) {
-      // Rows whose centres lie in [bottom, top) of the slab's slices, in row order (the
-      // detector's v runs along +z when pitch_v > 0).
-      const double a = row_at(g, slice_z(g, static_cast<double>(s.first_slice) - 0.5));
-      const double b = row_at(g, slice_z(g, static_cast<double>(s.first_slice + s.slices) - 0.5));
-      const double lo = std::min(a, b), hi = std::max(a, b);
-      const long first = std::max<long>(0, static_cast<long>(std::ceil(lo - 1e-9)));
-      const long end = std::min<long>(static_cast<long>(g.n_v),
-                                      static_cast<long>(std::ceil(hi - 1e-9)));
-      if (end <= first) {
-        throw InputError("slices " + std::to_string(s.first_slice) + ".." +
-                         std::to_string(s.first_slice + s.slices) +
-                         " project onto no detector row: use thicker slabs (the detector's " +
-                         "rows are coarser than the voxels) or check the geometry");
-      }
-      s.rows = {static_cast<std::size_t>(first), static_cast<std::size_t>(end - first)};
-    } else {
-      s.rows = {0, g.n_v};
+    if (s.rows.count == 0) {
+      throw InputError("slices " + std::to_string(s.first_slice) + ".." +
+                       std::to_string(s.first_slice + s.slices) +
+                       " project onto no detector row: use thicker slabs (the detector's " +
+                       "rows are coarser than the voxels) or check the geometry");
     }
     slabs.push_back(s);
   }
@@ -90,29 +200,34 @@ std::vector<Slab> plan_slabs(const Geometry& g, std::size_t slices_per_slab) {
 
 Geometry slab_geometry(const Geometry& g, const Slab& slab) {
   Geometry s = detector_rows_geometry(g, slab.rows.first, slab.rows.count);
-  if (slab.slices == g.volume_shape[0]) return s;
-  s.volume_shape[0] = slab.slices;
-  // The slab's grid is centred on the axis' origin; its detector rows move down by as much.
-  const double shift_mm = slice_z(g, static_cast<double>(slab.first_slice) +
-                                         (static_cast<double>(slab.slices) - 1.0) / 2.0);
-  s.offset_v -= shift_mm / g.pitch_v;
+  if (slab.trained_slices == g.volume_shape[0]) return s;
+  s.volume_shape[0] = slab.trained_slices;
+  const double centre = slice_z(g, static_cast<double>(slab.trained_first) +
+                                       (static_cast<double>(slab.trained_slices) - 1.0) / 2.0);
+  if (g.type == GeometryType::kCone3d) {
+    // A cone's rays do not move with the detector: the grid goes to the slices' height.
+    s.grid_centre_z_mm = g.grid_centre_z_mm + centre;
+  } else {
+    // The slab's grid is centred on the axis' origin; its detector rows move down by as much.
+    s.offset_v -= centre / g.pitch_v;
+  }
   return s;
 }
 
 std::size_t slab_bytes(const Geometry& g, std::size_t slices) {
-  const double per_slice =
-      4.0 * (kReadingCopies * readings_per_slice(g) + kVoxelCopies * voxels_per_slice(g));
-  return kBaseBytes + static_cast<std::size_t>(per_slice * static_cast<double>(slices));
+  const SlabSize size = slab_size(g, slices);
+  return kBaseBytes + static_cast<std::size_t>(
+                          4.0 * (kReadingCopies * size.readings + kVoxelCopies * size.voxels));
 }
 
 std::size_t slab_device_bytes(const Geometry& g, std::size_t slices) {
-  const double per_slice = 4.0 * (kDeviceReadingCopies * readings_per_slice(g) +
-                                  kDeviceVoxelCopies * voxels_per_slice(g));
-  return kDeviceBaseBytes + static_cast<std::size_t>(per_slice * static_cast<double>(slices));
+  const SlabSize size = slab_size(g, slices);
+  return kDeviceBaseBytes + static_cast<std::size_t>(4.0 * (kDeviceReadingCopies * size.readings +
+                                                            kDeviceVoxelCopies * size.voxels));
 }
 
 std::size_t slab_largest_buffer_bytes(const Geometry& g, std::size_t slices) {
-  return static_cast<std::size_t>(4.0 * readings_per_slice(g) * static_cast<double>(slices));
+  return static_cast<std::size_t>(4.0 * slab_size(g, slices).readings);
 }
 
 SlabSizing size_slabs(const Geometry& g, const SlabMemory& memory, int wanted_workers,

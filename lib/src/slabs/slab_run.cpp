@@ -167,6 +167,10 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
                                   {"slices", s.slices},
                                   {"rows", {s.rows.first, s.rows.count}},
                                   {"done", false}});
+    if (s.trained_slices != s.slices) {  // a cone beam's: the slices around it its rays cross
+      manifest_["slabs"].back()["trained_slices"] = {s.trained_first, s.trained_slices};
+      manifest_["slabs"].back()["map_rows"] = {s.map_rows.first, s.map_rows.count};
+    }
   }
   std::filesystem::create_directories(volume_dir());
   std::filesystem::create_directories(out_ / "slabs");
@@ -295,11 +299,17 @@ void SlabRun::write_slab(const Slab& slab, const Reconstructor& r, const Summari
     alpha = on_rows(alpha, slab.rows.count);
     beta = on_rows(beta, slab.rows.count);
   }
+  alpha.shape = {slab.rows.count, g.n_u};
+  beta.shape = {slab.rows.count, g.n_u};
+  if (slab.trained_slices != slab.slices) {
+    // A cone beam's slab: its own slices of those it trained, its own rows of those it read.
+    image = first_axis_range(image, slab.first_slice - slab.trained_first, slab.slices);
+    alpha = first_axis_range(alpha, slab.map_rows.first - slab.rows.first, slab.map_rows.count);
+    beta = first_axis_range(beta, slab.map_rows.first - slab.rows.first, slab.map_rows.count);
+  }
   for (std::size_t k = 0; k < slab.slices; ++k) {
     write_array(slice_path(slab.first_slice + k), axial_slice(image, k));
   }
-  alpha.shape = {slab.rows.count, g.n_u};
-  beta.shape = {slab.rows.count, g.n_u};
   write_array(slab_file(slab, "alpha"), alpha);
   write_array(slab_file(slab, "beta"), beta);
   write_array(slab_file(slab, "coronal"), coronal_plane(image, image.shape[1] / 2));
@@ -353,13 +363,13 @@ Array SlabRun::detector_map(const std::string& what) const {
   Array map({g.n_v, g.n_u}, NAN);
   for (const Slab& slab : slabs_) {
     const Array part = read_array(slab_file(slab, what)).array;
-    if (part.shape != std::vector<std::size_t>{slab.rows.count, g.n_u}) {
+    if (part.shape != std::vector<std::size_t>{slab.map_rows.count, g.n_u}) {
       throw InputError(slab_file(slab, what).string() + ": is " + shape_string(part.shape) +
-                       "; the slab's rows are " + std::to_string(slab.rows.count) + " x " +
+                       "; the slab's rows are " + std::to_string(slab.map_rows.count) + " x " +
                        std::to_string(g.n_u));
     }
     std::copy(part.data.begin(), part.data.end(),
-              map.data.begin() + static_cast<std::ptrdiff_t>(slab.rows.first * g.n_u));
+              map.data.begin() + static_cast<std::ptrdiff_t>(slab.map_rows.first * g.n_u));
   }
   return map;
 }
