@@ -203,6 +203,7 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
             {"rms_added", result.residual_detail.rms_added},
             {"misfit_before", result.residual_detail.misfit_before},
             {"misfit_after", result.residual_detail.misfit_after},
+            {"held_out_views", result.residual_detail.held_out_views},
             {"seconds", result.residual_detail.seconds},
             {"note", result.residual_detail.note}}},
           {"final_loss", history.empty() ? 0.0 : history.back().data_loss}};

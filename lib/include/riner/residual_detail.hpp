@@ -33,6 +33,9 @@ struct ResidualDetailSettings {
   // DeepLesion slices 0.38-0.49, the shared real scans -0.05-0.05.
   double min_consistent_share = 0.2;
   int window_px = 3;  // side of the square over which the Wiener gain compares the two
+  // The held-out check projects each half's detail at every k-th view of the other half, k as
+  // large as leaves this many readings (a 2D slice's half holds fewer: every view).
+  int held_out_readings = 1 << 21;
 };
 
 struct ResidualDetail {
@@ -42,9 +45,11 @@ struct ResidualDetail {
   double rms_added = 0.0;         // of what was added, over the sampled pixels (1/mm)
   // Held out: mean |rho + ln(alpha) - A image| over the odd views' readings with the even
   // views' detail and the other way round (averaged), and the same without; the detail is
-  // added only when it fits readings it was not taken from better.
+  // added only when it fits readings it was not taken from better. Over every view, or every
+  // k-th of each half where that leaves two million readings or more (a volume's scan).
   double misfit_before = 0.0;
   double misfit_after = 0.0;
+  std::size_t held_out_views = 0;  // the views the check projected (both halves')
   double seconds = 0.0;  // what the step took
   std::string note;  // why not applied, when it was not
 };

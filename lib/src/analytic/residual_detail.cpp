@@ -52,18 +52,41 @@ Array without_element_means(const Array& residual, const std::vector<char>& used
   return out;
 }
 
-// Mean |residual - change| over the readings used in the views of `parity` (0: even, 1: odd;
-// the last view of an odd count left out, as every_other_view leaves it); `change` (nullptr: no
-// change) holds those views only, in order.
+// The held-out check compares two means over many readings: it needs enough of them, not every
+// view. Each half's detail is projected at every stride-th view of the other half, the stride
+// leaving at least `readings` readings (a 3D scan's half holds tens of millions; a 2D slice's,
+// under a million, keeps every view).
+std::size_t held_out_stride(std::size_t views, std::size_t n, int readings) {
+  const double half = static_cast<double>(views / 2) * static_cast<double>(n);
+  return std::max<std::size_t>(1, static_cast<std::size_t>(half / std::max(1, readings)));
+}
+
+// Views parity, parity + 2 step, ... of a geometry (the last view of an odd count left out, so
+// that both parities hold as many).
+std::vector<std::size_t> views_of(const Geometry& g, std::size_t parity, std::size_t step) {
+  std::vector<std::size_t> views;
+  const std::size_t paired = g.n_views() - g.n_views() % 2;
+  for (std::size_t v = parity; v < paired; v += 2 * step) views.push_back(v);
+  return views;
+}
+
+Geometry with_views(const Geometry& g, const std::vector<std::size_t>& views) {
+  Geometry out = g;
+  out.uniform_angles.reset();
+  out.angles.clear();
+  for (std::size_t v : views) out.angles.push_back(g.angles[v]);
+  return out;
+}
+
+// Mean |residual - change| over the readings used in `views`; `change` (nullptr: no change)
+// holds those views only, in order.
 double held_out_misfit(const Array& residual, const Array* change, const std::vector<char>& used,
-                       std::size_t n, std::size_t parity) {
-  const std::size_t views = residual.size() / n;
-  const std::size_t paired = views - views % 2;
+                       std::size_t n, const std::vector<std::size_t>& views) {
   double total = 0.0, count = 0.0;
-  for (std::size_t v = parity; v < paired; v += 2) {
-    const float* changed = change ? change->data.data() + (v / 2) * n : nullptr;
+  for (std::size_t k = 0; k < views.size(); ++k) {
+    const float* changed = change ? change->data.data() + k * n : nullptr;
     for (std::size_t e = 0; e < n; ++e) {
-      const std::size_t i = v * n + e;
+      const std::size_t i = views[k] * n + e;
       if (!used[i]) continue;
       total += std::fabs(static_cast<double>(residual.data[i]) - (changed ? changed[e] : 0.0f));
       count += 1.0;
@@ -76,19 +99,17 @@ double held_out_misfit(const Array& residual, const Array* change, const std::ve
 Scan every_other_view(const Scan& residual, std::size_t parity) {
   const Geometry& g = residual.geometry;
   const std::size_t n = residual.measurement.size() / g.n_views();
+  const std::vector<std::size_t> views = views_of(g, parity, 1);
   Scan out;
-  out.geometry = g;
-  out.geometry.uniform_angles.reset();
-  out.geometry.angles.clear();
+  out.geometry = with_views(g, views);
   std::vector<float> data;
-  const std::size_t paired = g.n_views() - g.n_views() % 2;  // both halves the same size
-  for (std::size_t v = parity; v < paired; v += 2) {
-    out.geometry.angles.push_back(g.angles[v]);
+  data.reserve(views.size() * n);
+  for (std::size_t v : views) {
     data.insert(data.end(), residual.measurement.data.begin() + static_cast<long>(v * n),
                 residual.measurement.data.begin() + static_cast<long>((v + 1) * n));
   }
   std::vector<std::size_t> shape = residual.measurement.shape;
-  shape[0] = out.geometry.angles.size();
+  shape[0] = views.size();
   out.measurement = Array(std::move(shape), std::move(data));
   return out;
 }
@@ -198,13 +219,17 @@ ResidualDetailResult detail_of(Array image, const Array& field, const Scan& scan
   // field alone, and the odd views' the even ones'. Detail does; noise, and what FBP draws of
   // its own where the field is already sharper than FBP (a piecewise-constant phantom's
   // edges: view aliasing, streaks), does not.
-  // Each half's detail projected at the other half's views only.
-  const Array even_change = Projector(odd_views.geometry, engine, device).project(from_even);
-  const Array odd_change = Projector(even_views.geometry, engine, device).project(from_odd);
-  out.report.misfit_before = 0.5 * (held_out_misfit(misfit, nullptr, used, n, 1) +
-                                    held_out_misfit(misfit, nullptr, used, n, 0));
-  out.report.misfit_after = 0.5 * (held_out_misfit(misfit, &even_change, used, n, 1) +
-                                   held_out_misfit(misfit, &odd_change, used, n, 0));
+  // Each half's detail projected at (a share of) the other half's views only.
+  const std::size_t stride = held_out_stride(g.n_views(), n, settings.held_out_readings);
+  const std::vector<std::size_t> odd_held = views_of(g, 1, stride),
+                                 even_held = views_of(g, 0, stride);
+  const Array even_change = Projector(with_views(g, odd_held), engine, device).project(from_even);
+  const Array odd_change = Projector(with_views(g, even_held), engine, device).project(from_odd);
+  out.report.held_out_views = odd_held.size() + even_held.size();
+  out.report.misfit_before = 0.5 * (held_out_misfit(misfit, nullptr, used, n, odd_held) +
+                                    held_out_misfit(misfit, nullptr, used, n, even_held));
+  out.report.misfit_after = 0.5 * (held_out_misfit(misfit, &even_change, used, n, odd_held) +
+                                   held_out_misfit(misfit, &odd_change, used, n, even_held));
   if (!(out.report.misfit_after < out.report.misfit_before)) {
     out.report.note = "the detail of half the views does not fit the other half's readings better";
     return out;

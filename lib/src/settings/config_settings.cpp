@@ -273,6 +273,11 @@ void add_residual_detail(Table& t) {
                        "detail.residual: side of the square the noise gain is judged over (an even "
                        "side counts as the next odd one)",
                        &C::residual_detail, &D::window_px));
+  t.push_back(field<C>("detail", "held_out_readings", closed(1, 1 << 30),
+                       "detail.residual: the held-out check projects each half's detail at every "
+                       "k-th view of the other half, k as large as leaves this many readings (a "
+                       "volume's scan; a slice keeps every view)",
+                       &C::residual_detail, &D::held_out_readings));
 }
 
 void add_plan(Table& t) {
