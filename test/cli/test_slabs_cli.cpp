@@ -391,7 +391,8 @@ TEST_SUITE("cli") {
 
   TEST_CASE("a cone beam by slabs: each slab trains the slices its rays cross, no seam") {
     // 60 views of a 40 x 40 detector at magnification 2 round a 24 x 20 x 20 volume: in slabs
-    // of 8 slices, the outer slabs' rows climb through 4-5 slices beside their own.
+    // of up to 8 slices, cut at the source's plane first (4 of 6), the outer slabs' rows climb
+    // through slices beside their own.
     riner::test::TempDir dir;
     riner::test::simulate_geometry(dir, "g.json", R"({"type": "cone3d",
         "detector": {"count": [40, 40], "pitch_mm": [1.0, 1.0]},
@@ -408,12 +409,12 @@ TEST_SUITE("cli") {
         "reconstruct " + scan + " --slab-slices 8" + settings + (dir / "slabs").string(), dir);
     CAPTURE(run.err);
     REQUIRE(run.code == 0);
-    CHECK(slabs_done(dir / "slabs") == 3);
+    CHECK(slabs_done(dir / "slabs") == 4);
     const nlohmann::json manifest =
         nlohmann::json::parse(riner::test::read_bytes(dir / "slabs" / "manifest.json"));
     // The outer slabs train slices beside their own; the detector's maps take each row once.
-    CHECK(manifest["slabs"][0]["trained_slices"][1].get<int>() > 8);
-    CHECK(manifest["slabs"][2]["trained_slices"][1].get<int>() > 8);
+    CHECK(manifest["slabs"][0]["trained_slices"][1].get<int>() > 6);
+    CHECK(manifest["slabs"][3]["trained_slices"][1].get<int>() > 6);
     std::size_t mapped = 0;
     for (const auto& slab : manifest["slabs"]) mapped += slab["map_rows"][1].get<std::size_t>();
     CHECK(mapped == 40);
@@ -426,7 +427,7 @@ TEST_SUITE("cli") {
     const riner::Array slabs = riner::read_array(dir / "slabs" / "volume.npy").array;
     REQUIRE(slabs.shape == truth.shape);
     const double whole_psnr = riner::psnr(whole, truth), slabs_psnr = riner::psnr(slabs, truth);
-    MESSAGE("cone beam, 600 steps: whole " << whole_psnr << " dB, 3 slabs " << slabs_psnr);
+    MESSAGE("cone beam, 600 steps: whole " << whole_psnr << " dB, 4 slabs " << slabs_psnr);
     CHECK(slabs_psnr > whole_psnr - 1.0);
     // No seam: the slices at the slabs' borders are as close to the truth as the others.
     auto slice_error = [&](std::size_t k) {
@@ -438,8 +439,8 @@ TEST_SUITE("cli") {
       return std::sqrt(sum / 400.0);
     };
     double inner = 0.0;
-    for (std::size_t k : {3, 4, 11, 12, 19, 20}) inner = std::max(inner, slice_error(k));
-    for (std::size_t k : {7, 8, 15, 16}) {
+    for (std::size_t k : {2, 3, 8, 9, 14, 15, 20, 21}) inner = std::max(inner, slice_error(k));
+    for (std::size_t k : {5, 6, 11, 12, 17, 18}) {
       CAPTURE(k);
       CHECK(slice_error(k) < 1.5 * inner);
     }

@@ -194,6 +194,24 @@ TEST_CASE(
     CAPTURE(r);
     CHECK(mapped[r] == 1);
   }
+  // Cut at the source's plane first: slabs of up to 8 of 24 slices are 4 of 6, not 3 of 8, of
+  // which the middle one would cross the plane, its rows climbing away both ways.
+  const std::vector<riner::Slab> eights = riner::plan_slabs(g, 8);
+  REQUIRE(eights.size() == 4);
+  std::size_t most_rows = 0;
+  for (const riner::Slab& s : eights) {
+    CHECK(s.slices == 6);
+    CHECK((s.first_slice + s.slices <= 12 || s.first_slice >= 12));
+    most_rows = std::max(most_rows, s.rows.count);
+  }
+  const riner::Slab across = riner::slab_extent(g, 8, 8);
+  CHECK(across.trained_first < 8);
+  CHECK(across.trained_first + across.trained_slices > 16);
+  CHECK(across.rows.count > most_rows);
+  MESSAGE("cone slabs of up to 8 of 24 slices: at most " << most_rows
+                                                         << " rows each; the middle "
+                                                            "one of 3 even slabs would read "
+                                                         << across.rows.count);
   // Whole, a cone beam keeps its detector and grid.
   const std::vector<riner::Slab> one = riner::plan_slabs(g, 24);
   REQUIRE(one.size() == 1);

@@ -138,6 +138,36 @@ Slab cone_slab(const Geometry& g, std::size_t first, std::size_t count) {
   return s;
 }
 
+// Where slabs of at most `per` slices cut the volume: [first, count) each, as even as they
+// come. A cone beam is cut at the source's plane first (when it crosses the volume): a row
+// above the plane climbs upwards across the object and a row below it downwards, so a slab
+// across the plane would train the slices both ways (at a wide cone, the whole volume).
+std::vector<std::pair<std::size_t, std::size_t>> slab_cuts(const Geometry& g, std::size_t per) {
+  const std::size_t nz = g.volume_shape[0];
+  per = std::max<std::size_t>(1, std::min(per, nz));
+  std::vector<std::pair<std::size_t, std::size_t>> cuts;
+  auto even = [&](std::size_t from, std::size_t slices) {
+    const std::size_t count = (slices + per - 1) / per;
+    for (std::size_t i = 0; i < count; ++i) {
+      const std::size_t first = i * slices / count;
+      cuts.emplace_back(from + first, (i + 1) * slices / count - first);
+    }
+  };
+  std::size_t plane = 0;
+  if (g.type == GeometryType::kCone3d && per < nz) {
+    // The slice edge nearest the source's plane (height 0).
+    const double edge = std::round(-(slice_z(g, -0.5) + g.grid_centre_z_mm) / g.voxel_mm);
+    if (edge > 0.0 && edge < static_cast<double>(nz)) plane = static_cast<std::size_t>(edge);
+  }
+  if (plane == 0) {
+    even(0, nz);
+  } else {
+    even(0, plane);
+    even(plane, nz - plane);
+  }
+  return cuts;
+}
+
 // The readings and voxels a slab of `slices` slices holds at most: the outermost slab's in a
 // cone beam (it crosses the most slices beside its own), a share of the detector otherwise.
 struct SlabSize {
@@ -155,8 +185,8 @@ SlabSize slab_size(const Geometry& g, std::size_t slices) {
             voxels_per_slice(g) * static_cast<double>(slices)};
   }
   SlabSize most;
-  for (std::size_t first : {std::size_t{0}, (nz - slices) / 2, nz - slices}) {
-    const Slab s = cone_slab(g, first, slices);
+  for (const auto& [first, count] : slab_cuts(g, slices)) {
+    const Slab s = cone_slab(g, first, count);
     most.readings = std::max(most.readings, per_row * static_cast<double>(s.rows.count));
     most.voxels =
         std::max(most.voxels, voxels_per_slice(g) * static_cast<double>(s.trained_slices));
@@ -179,14 +209,10 @@ Slab slab_extent(const Geometry& g, std::size_t first, std::size_t count) {
 
 std::vector<Slab> plan_slabs(const Geometry& g, std::size_t slices_per_slab) {
   if (!g.is_3d()) throw InputError("slabs cut a volume: the geometry is 2D");
-  const std::size_t nz = g.volume_shape[0];
-  const std::size_t per = std::max<std::size_t>(1, std::min(slices_per_slab, nz));
-  const std::size_t count = (nz + per - 1) / per;
   std::vector<Slab> slabs;
-  for (std::size_t i = 0; i < count; ++i) {
-    const std::size_t first = i * nz / count;
-    Slab s = slab_extent(g, first, (i + 1) * nz / count - first);
-    s.index = i;
+  for (const auto& [first, count] : slab_cuts(g, slices_per_slab)) {
+    Slab s = slab_extent(g, first, count);
+    s.index = slabs.size();
     if (s.rows.count == 0) {
       throw InputError("slices " + std::to_string(s.first_slice) + ".." +
                        std::to_string(s.first_slice + s.slices) +
