@@ -249,11 +249,18 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   const std::size_t done_before = run.slabs_done();
   if (speak) {
     const int at_once = run.workers() * std::max(1, options.processes);
+    // The thickest slab as cut (a cone beam's are cut at the source's plane first, so they can
+    // be thinner than the size the memory allows).
+    std::size_t thickest = 0, trained = 0;
+    for (const Slab& slab : run.slabs()) {
+      thickest = std::max(thickest, slab.slices);
+      trained = std::max(trained, slab.trained_slices);
+    }
     char line[300];
     std::snprintf(line, sizeof(line),
                   "%zu slabs of up to %zu slices (%zu x %zu voxels; about %s each, limit %s), "
                   "%d at once%s%s",
-                  run.slabs().size(), run.slices_per_slab(), g.volume_shape[1], g.volume_shape[2],
+                  run.slabs().size(), thickest, g.volume_shape[1], g.volume_shape[2],
                   bytes_string(static_cast<double>(slab_bytes(g, run.slices_per_slab()))).c_str(),
                   bytes_string(static_cast<double>(run.memory_limit())).c_str(), at_once,
                   done_before ? (", " + std::to_string(done_before) + " done before").c_str() : "",
@@ -264,9 +271,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
                                         .c_str()
                                   : "");
     console.line(line);
-    std::size_t trained = 0;
-    for (const Slab& slab : run.slabs()) trained = std::max(trained, slab.trained_slices);
-    if (trained > run.slices_per_slab()) {
+    if (trained > thickest) {
       std::snprintf(line, sizeof(line),
                     "cone beam: each slab also trains the slices beside it that its rows' rays "
                     "cross, up to %zu slices in all (the rest are not written)",
