@@ -33,6 +33,10 @@ Ray detector_ray(const Geometry& g, std::size_t view, double u, double v = 0.0);
 // d and -d, and a ray at d has its conjugate at -d.
 std::vector<double> column_ray_distances(const Geometry& g);
 
+// Where detector row v (fractional: an element's edges at v -+ 0.5) sits above the source's
+// plane, in mm on the detector (3D; before any grid_centre_z_mm).
+double detector_row_mm(const Geometry& g, double v);
+
 // Where detector element (u, v) sits in the world at `view` (its centre for integer indices).
 Vec3 detector_position(const Geometry& g, std::size_t view, double u, double v = 0.0);
 

@@ -7,6 +7,7 @@
 
 #include "riner/array.hpp"
 #include "riner/error.hpp"
+#include "riner/rays.hpp"
 
 namespace riner {
 
@@ -112,10 +113,9 @@ FieldOfView field_of_view(const Geometry& g) {
   FieldOfView f;
   f.radius_mm = g.is_divergent() ? g.source_origin_mm * u / std::hypot(u, sdd) : u;
   if (!g.is_3d()) return f;
-  // The rows' outer edges above the source's plane (mm on the detector).
-  const double half_rows = 0.5 * static_cast<double>(g.n_v);
-  const double a = (-half_rows + g.offset_v) * g.pitch_v, b = (half_rows + g.offset_v) * g.pitch_v;
-  double low = std::min(a, b), high = std::max(a, b);
+  // The rows' outer edges above the source's plane (mm on the detector; pitch_v > 0).
+  double low = detector_row_mm(g, -0.5);
+  double high = detector_row_mm(g, static_cast<double>(g.n_v) - 0.5);
   if (g.is_divergent()) {
     // A height is seen whole where its nearest and farthest points both land on the rows.
     const double near = (g.source_origin_mm - f.radius_mm) / sdd;

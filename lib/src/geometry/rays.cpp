@@ -33,12 +33,15 @@ void clip_axis(double o, double d, double half, Segment& s) {
 
 }  // namespace
 
+double detector_row_mm(const Geometry& g, double v) {
+  return element_offset(v, g.n_v, g.offset_v, g.pitch_v);
+}
+
 Vec3 detector_position(const Geometry& g, std::size_t view, double u, double v) {
   const double c = std::cos(g.angles[view]);
   const double s = std::sin(g.angles[view]);
   const double a = element_offset(u, g.n_u, g.offset_u, g.pitch_u);
-  const double z =
-      g.is_3d() ? element_offset(v, g.n_v, g.offset_v, g.pitch_v) - g.grid_centre_z_mm : 0.0;
+  const double z = g.is_3d() ? detector_row_mm(g, v) - g.grid_centre_z_mm : 0.0;
   // R(theta) (a, b) = (a c - b s, a s + b c); the detector plane is at b = ODD (0 for parallel).
   const double b = g.is_divergent() ? g.origin_detector_mm : 0.0;
   return {a * c - b * s, a * s + b * c, z};

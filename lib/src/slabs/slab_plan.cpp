@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "riner/error.hpp"
+#include "riner/rays.hpp"
 
 namespace riner {
 
@@ -41,11 +42,6 @@ double row_at(const Geometry& g, double z_mm) {
 // The height of slice k's centre (fractional k: its edges at k -+ 0.5) in the grid's frame.
 double slice_z(const Geometry& g, double k) {
   return (k - (static_cast<double>(g.volume_shape[0]) - 1.0) / 2.0) * g.voxel_mm;
-}
-
-// Where a detector row sits above the source's plane (mm on the detector; fractional rows).
-double row_mm(const Geometry& g, double row) {
-  return (row - (static_cast<double>(g.n_v) - 1.0) / 2.0 + g.offset_v) * g.pitch_v;
 }
 
 Slab parallel_slab(const Geometry& g, std::size_t first, std::size_t count) {
@@ -86,8 +82,8 @@ Slab cone_slab(const Geometry& g, std::size_t first, std::size_t count) {
   // The heights a row's rays cross inside the box (a whole element: its lower and upper edges);
   // a row whose rays miss the box keeps the box's nearer face.
   auto heights = [&](std::size_t row) {
-    const double a = row_mm(g, static_cast<double>(row) - 0.5);
-    const double b = row_mm(g, static_cast<double>(row) + 0.5);
+    const double a = detector_row_mm(g, static_cast<double>(row) - 0.5);
+    const double b = detector_row_mm(g, static_cast<double>(row) + 0.5);
     const double low = std::min(a * near, a * far), high = std::max(b * near, b * far);
     return std::pair{std::clamp(low, box_low, box_high), std::clamp(high, box_low, box_high)};
   };
@@ -129,7 +125,7 @@ Slab cone_slab(const Geometry& g, std::size_t first, std::size_t count) {
   const bool bottom = first == 0, top = first + count == nz;
   std::size_t map_begin = end, map_end = begin;
   for (std::size_t r = begin; r < end; ++r) {
-    const double axis = row_mm(g, static_cast<double>(r)) * g.source_origin_mm / sdd;
+    const double axis = detector_row_mm(g, static_cast<double>(r)) * g.source_origin_mm / sdd;
     if ((axis < own_low && !bottom) || (axis >= own_high && !top)) continue;
     map_begin = std::min(map_begin, r);
     map_end = r + 1;

@@ -167,8 +167,11 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
                                   {"slices", s.slices},
                                   {"rows", {s.rows.first, s.rows.count}},
                                   {"done", false}});
-    if (s.trained_slices != s.slices) {  // a cone beam's: the slices around it its rays cross
+    // A cone beam's: the slices around it its rays cross, and the rows it maps.
+    if (s.trained_slices != s.slices) {
       manifest_["slabs"].back()["trained_slices"] = {s.trained_first, s.trained_slices};
+    }
+    if (!(s.map_rows == s.rows)) {
       manifest_["slabs"].back()["map_rows"] = {s.map_rows.first, s.map_rows.count};
     }
   }
@@ -301,9 +304,11 @@ void SlabRun::write_slab(const Slab& slab, const Reconstructor& r, const Summari
   }
   alpha.shape = {slab.rows.count, g.n_u};
   beta.shape = {slab.rows.count, g.n_u};
+  // A cone beam's slab: its own slices of those it trained, its own rows of those it read.
   if (slab.trained_slices != slab.slices) {
-    // A cone beam's slab: its own slices of those it trained, its own rows of those it read.
     image = first_axis_range(image, slab.first_slice - slab.trained_first, slab.slices);
+  }
+  if (!(slab.map_rows == slab.rows)) {
     alpha = first_axis_range(alpha, slab.map_rows.first - slab.rows.first, slab.map_rows.count);
     beta = first_axis_range(beta, slab.map_rows.first - slab.rows.first, slab.map_rows.count);
   }
