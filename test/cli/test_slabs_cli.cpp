@@ -447,6 +447,26 @@ TEST_SUITE("cli") {
       CAPTURE(k);
       CHECK(slice_error(k) < 1.5 * inner);
     }
+
+#ifdef RINER_TEST_MPI
+    // Two ranks share the cone slabs (each with its padding slices and rows) and write the
+    // volume and maps of one process, byte for byte.
+    const std::string ranks = "mpirun --allow-run-as-root --oversubscribe -n 2 " +
+                              std::string(RINER_CLI_PATH) + " reconstruct " + scan +
+                              " --slab-slices 8" + settings + (dir / "ranks").string() +
+                              " >/dev/null 2>" + (dir / "stderr.txt").string();
+    CAPTURE(ranks);
+    const int status = std::system(ranks.c_str());
+    CAPTURE(riner::test::read_bytes(dir / "stderr.txt"));
+    REQUIRE(WIFEXITED(status));
+    REQUIRE(WEXITSTATUS(status) == 0);
+    CHECK(slabs_done(dir / "ranks") == 4);
+    for (const char* name : {"volume.npy", "alpha.npy", "beta.npy"}) {
+      CAPTURE(name);
+      CHECK(riner::test::read_bytes(dir / "slabs" / name) ==
+            riner::test::read_bytes(dir / "ranks" / name));
+    }
+#endif
   }
 
   TEST_CASE("riner fbp by slabs writes the whole volume's slices, into a folder or an HDF5 file") {
