@@ -131,8 +131,7 @@ TEST_SUITE("riner_step") {
       const riner::model::ResponseMap map(per_view, views, changes);
       const riner::model::ParameterLayout l =
           riner::model::make_layout(g.is_3d() ? 3 : 2, c.encoding, c.network, map.slots());
-      const std::vector<riner::model::RaySegment> segments =
-          riner::model::ray_segments(g, 1.3 * g.voxel_mm, false);
+      const riner::model::RaySegments segments(g, 1.3 * g.voxel_mm, false);
       // Parameters away from the initial ones, so every layer matters.
       std::vector<float> params = riner::model::initial_parameters(l, riner::test::seed());
       std::uniform_real_distribution<float> grid(-0.2f, 0.2f), response(0.8f, 1.2f),
@@ -262,8 +261,7 @@ TEST_SUITE("riner_step") {
     riner::RinerConfig c;
     const riner::model::ParameterLayout l =
         riner::model::make_layout(2, {6, 2, 14, 4, 64}, {16, 1}, g.n_u);
-    const std::vector<riner::model::RaySegment> segments =
-        riner::model::ray_segments(g, 1.5, false);
+    const riner::model::RaySegments segments(g, 1.5, false);
     std::vector<float> params = riner::model::initial_parameters(l, 3);
     std::mt19937_64 rng(riner::test::seed() + 5);
     std::uniform_real_distribution<float> u(-0.2f, 0.2f);

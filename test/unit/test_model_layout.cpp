@@ -201,8 +201,7 @@ TEST_SUITE("model_layout") {
     t.elements_per_step = 3;
     const riner::model::BatchSampler sampler(g, t);
     const riner::model::Batch b = sampler.batch(7);
-    const std::vector<riner::model::RaySegment> segments =
-        riner::model::ray_segments(g, 1.0, false);
+    const riner::model::RaySegments segments(g, 1.0, false);
     std::vector<float> rho(g.n_views() * g.n_u);
     for (std::size_t i = 0; i < rho.size(); ++i) rho[i] = 0.001f * static_cast<float>(i);
     riner::model::PackedBatch p;
@@ -219,7 +218,8 @@ TEST_SUITE("model_layout") {
       std::memcpy(&weight, &w[p.weights_at + i], 4);
       CHECK(weight == b.weights[i]);
       // The ray's own segment and reading travel with it.
-      CHECK(std::memcmp(&w[p.segments_at + 8 * i], &segments[b.rays[i]], 32) == 0);
+      const riner::model::RaySegment segment = segments[b.rays[i]];
+      CHECK(std::memcmp(&w[p.segments_at + 8 * i], &segment, 32) == 0);
       float reading;
       std::memcpy(&reading, &w[p.rho_at + i], 4);
       CHECK(reading == rho[b.rays[i]]);

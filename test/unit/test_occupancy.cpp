@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstring>
 
 #include "model/air_readings.hpp"
 #include "model/occupancy.hpp"
@@ -116,15 +117,14 @@ TEST_SUITE("occupancy") {
     const riner::Phantom p = discs(g);
     const riner::Scan scan = ring_scan(g, p, 1e6);
     const double spacing = 1.5;
-    const std::vector<riner::model::RaySegment> full =
-        riner::model::ray_segments(g, spacing, false);
-    std::vector<riner::model::RaySegment> clipped = full;
+    const riner::model::RaySegments full(g, spacing, false);
+    riner::model::RaySegments clipped = full;
     const riner::model::Occupancy o =
         riner::model::carve_occupancy(scan, clipped, spacing / g.voxel_mm, on_cpu());
     REQUIRE(o.carved);
     const double kept = o.samples_kept;
     // clip_segments clips as the carving did.
-    std::vector<riner::model::RaySegment> again = full;
+    riner::model::RaySegments again = full;
     CHECK(riner::model::clip_segments(again, scan, o, spacing / g.voxel_mm) == kept);
     double total = 0.0, inside_samples = 0.0;
     const long n = static_cast<long>(g.volume_shape[1]);
@@ -157,6 +157,64 @@ TEST_SUITE("occupancy") {
     }
     CHECK(kept < total);
     CHECK(kept >= inside_samples);
+  }
+
+  TEST_CASE("rays computed again when drawn are the table's, before and after the clip") {
+    // A volume's rays past RaySegments::kTableBytes keep only their clip: each segment is
+    // computed from the geometry when drawn, and must be the table's to the bit.
+    for (const riner::Geometry& g : {riner::test::small_fan2d(), riner::test::small_cone3d()}) {
+      CAPTURE(g.is_3d());
+      const double spacing = 1.3 * g.voxel_mm;
+      riner::model::RaySegments table(g, spacing, false);
+      riner::model::RaySegments computed(g, spacing, false, 0);
+      REQUIRE(table.tabled());
+      REQUIRE_FALSE(computed.tabled());
+      REQUIRE(computed.size() == table.size());
+      auto same = [&] {
+        std::size_t differing = 0;
+        for (std::size_t r = 0; r < table.size(); ++r) {
+          const riner::model::RaySegment a = table[r], b = computed[r];
+          differing += std::memcmp(&a, &b, sizeof a) != 0 || table.count(r) != computed.count(r);
+        }
+        return differing;
+      };
+      CHECK(same() == 0);
+      // A ball of half the grid's width: most rays are cut at both ends, some miss it.
+      riner::model::Occupancy ball;
+      ball.carved = true;
+      const std::vector<std::size_t>& shape = g.volume_shape;
+      const std::size_t nx = shape.back(), ny = shape[shape.size() - 2];
+      const std::size_t nz = shape.size() == 3 ? shape[0] : 1;
+      ball.inside.assign(nx * ny * nz, 0);
+      for (std::size_t z = 0; z < nz; ++z) {
+        for (std::size_t y = 0; y < ny; ++y) {
+          for (std::size_t x = 0; x < nx; ++x) {
+            const double dx = (x - 0.5 * (nx - 1.0)) / nx, dy = (y - 0.5 * (ny - 1.0)) / ny,
+                         dz = nz > 1 ? (z - 0.5 * (nz - 1.0)) / nz : 0.0;
+            ball.inside[(z * ny + y) * nx + x] = dx * dx + dy * dy + dz * dz < 0.0625;
+          }
+        }
+      }
+      const riner::Scan scan{
+          riner::Array(g.is_3d() ? std::vector<std::size_t>{g.n_views(), g.n_v, g.n_u}
+                                 : std::vector<std::size_t>{g.n_views(), g.n_u},
+                       0.0f),
+          g, 0};
+      const double kept = riner::model::clip_segments(table, scan, ball, 1.3);
+      CHECK(riner::model::clip_segments(computed, scan, ball, 1.3) == kept);
+      double before = 0.0;
+      std::size_t cut = 0, missed = 0;
+      const riner::model::RaySegments whole(g, spacing, false);
+      for (std::size_t r = 0; r < whole.size(); ++r) {
+        before += whole.count(r);
+        cut += table.count(r) > 0 && table.count(r) < whole.count(r);
+        missed += whole.count(r) > 0 && table.count(r) == 0;
+      }
+      CHECK(kept < 0.8 * before);
+      CHECK(cut > 0);
+      CHECK(missed > 0);
+      CHECK(same() == 0);
+    }
   }
 }
 

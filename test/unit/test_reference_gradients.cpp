@@ -23,7 +23,7 @@ TEST_SUITE("reference_gradients") {
       }
       const riner::model::ResponseMap map(t.geometry.n_u, t.geometry.n_views(), changes);
       const auto layout = riner::model::make_layout(2, {3, 2, 6, 4, 16}, {16, 2}, map.slots());
-      const auto segments = riner::model::ray_segments(t.geometry, 1.0, false);
+      const riner::model::RaySegments segments(t.geometry, 1.0, false);
       std::vector<double> params;
       for (float v : riner::model::initial_parameters(layout, 5)) params.push_back(v);
       // (A draw away from the L1 and ReLU kinks for both maps.)
@@ -98,7 +98,7 @@ TEST_SUITE("reference_gradients") {
     const riner::test::TinyProblem t = riner::test::tiny_problem(4);
     const auto layout = riner::model::make_layout(2, {3, 2, 6, 4, 16}, {16, 1}, t.geometry.n_u, 5);
     REQUIRE(layout.factor_columns == 10);
-    const auto segments = riner::model::ray_segments(t.geometry, 1.0, false);
+    const riner::model::RaySegments segments(t.geometry, 1.0, false);
     std::vector<double> params;
     for (float v : riner::model::initial_parameters(layout, 6)) params.push_back(v);
     std::mt19937 rng(static_cast<unsigned>(riner::test::seed()) + 3);

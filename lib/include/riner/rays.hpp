@@ -27,6 +27,9 @@ struct Ray {
 // The ray to detector element (u, v) at `view`. u and v are element indices and may be
 // fractional (positions inside an element); v is ignored in 2D.
 Ray detector_ray(const Geometry& g, std::size_t view, double u, double v = 0.0);
+struct ViewRotation;
+// The same with the view's angle as its cosine and sine (ViewRotation::of): the same numbers.
+Ray detector_ray(const Geometry& g, const ViewRotation& rotation, double u, double v = 0.0);
 
 // Signed distance from the rotation axis, in the axial plane, of each detector column's ray at
 // view 0 (through the detector's middle row in 3D): a ring about the axis projects the same at
@@ -39,6 +42,7 @@ double detector_row_mm(const Geometry& g, double v);
 
 // Where detector element (u, v) sits in the world at `view` (its centre for integer indices).
 Vec3 detector_position(const Geometry& g, std::size_t view, double u, double v = 0.0);
+Vec3 detector_position(const Geometry& g, const ViewRotation& rotation, double u, double v = 0.0);
 
 // Where the ray through world point p lands at `view`: fractional element indices (u, v) (the
 // inverse of detector_position along the ray; v = 0 in 2D), and the magnification there

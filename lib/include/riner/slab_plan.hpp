@@ -61,7 +61,8 @@ std::size_t slab_largest_buffer_bytes(const Geometry& g, std::size_t slices);
 // The most slices per slab within `limit` bytes (at least 1).
 std::size_t slices_within(const Geometry& g, std::size_t limit);
 // The same for any memory model: the most of `slices` whose bytes(n), rising with n, stay
-// within `limit` (at least 1).
+// within `limit` (at least 1). Where bytes(n) also falls somewhere (a cone beam's cuts, the ray
+// table given up past its size) the size returned still fits, though a larger one may too.
 std::size_t most_slices_within(std::size_t slices, std::size_t limit,
                                const std::function<std::size_t(std::size_t)>& bytes);
 

@@ -13,43 +13,45 @@ namespace riner {
 
 namespace {
 
-// The residual rho + ln(alpha) - A f, 0 where a reading is not finite or its element is dead;
-// `used` marks the readings it holds.
-Array residual_readings(const Scan& scan, const Array& projected, const Array& log_alpha,
+// The residual rho + ln(alpha) - A f, written over the projection A f (a scan's worth of
+// readings, not held twice), 0 where a reading is not finite or its element is dead; `used`
+// marks the readings it holds.
+Array residual_readings(const Scan& scan, Array projected, const Array& log_alpha,
                         const std::vector<std::size_t>& dead, std::vector<char>& used) {
   const std::size_t views = scan.geometry.n_views();
   const std::size_t n = scan.measurement.size() / views;
   const bool per_view = log_alpha.size() == views * n;
   std::vector<char> excluded(n, 0);
   for (std::size_t e : dead) excluded[e] = 1;
-  Array r(scan.measurement.shape, 0.0f);
+  if (projected.size() != scan.measurement.size())
+    throw InputError("residual detail: the projection is not one value per reading");
+  projected.shape = scan.measurement.shape;
+  std::vector<float>& r = projected.data;
   used.assign(r.size(), 0);
   for (std::size_t v = 0; v < views; ++v) {
     for (std::size_t e = 0; e < n; ++e) {
       const std::size_t i = v * n + e;
-      const double x = static_cast<double>(scan.measurement.data[i]) +
-                       log_alpha.data[per_view ? i : e] - projected.data[i];
-      if (excluded[e] || !std::isfinite(x)) continue;
-      r.data[i] = static_cast<float>(x);
-      used[i] = 1;
+      const double x =
+          static_cast<double>(scan.measurement.data[i]) + log_alpha.data[per_view ? i : e] - r[i];
+      const bool kept = !excluded[e] && std::isfinite(x);
+      r[i] = kept ? static_cast<float>(x) : 0.0f;
+      used[i] = kept;
     }
   }
-  return r;
+  return projected;
 }
 
-// The residual less each element's mean over the readings it holds.
-Array without_element_means(const Array& residual, const std::vector<char>& used, std::size_t n) {
-  Array out = residual;
+// Each element's mean residual over the readings it holds.
+std::vector<double> element_means(const Array& residual, const std::vector<char>& used,
+                                  std::size_t n) {
   std::vector<double> sum(n, 0.0), count(n, 0.0);
-  for (std::size_t i = 0; i < out.size(); ++i) {
+  for (std::size_t i = 0; i < residual.size(); ++i) {
     if (!used[i]) continue;
-    sum[i % n] += out.data[i];
+    sum[i % n] += residual.data[i];
     count[i % n] += 1.0;
   }
-  for (std::size_t i = 0; i < out.size(); ++i) {
-    if (used[i]) out.data[i] = static_cast<float>(out.data[i] - sum[i % n] / count[i % n]);
-  }
-  return out;
+  for (std::size_t e = 0; e < n; ++e) sum[e] = count[e] > 0.0 ? sum[e] / count[e] : 0.0;
+  return sum;
 }
 
 // The held-out check compares two means over many readings: it needs enough of them, not every
@@ -95,20 +97,22 @@ double held_out_misfit(const Array& residual, const Array* change, const std::ve
   return count > 0.0 ? total / count : 0.0;
 }
 
-// The views of `parity` (0: even, 1: odd) of a residual scan, as a scan of their own.
-Scan every_other_view(const Scan& residual, std::size_t parity) {
-  const Geometry& g = residual.geometry;
-  const std::size_t n = residual.measurement.size() / g.n_views();
+// The views of `parity` (0: even, 1: odd) of the residual, less each element's mean (a
+// constant offset along a detector column is alpha's), as a scan of their own.
+Scan every_other_view(const Array& residual, const Geometry& g, const std::vector<char>& used,
+                      const std::vector<double>& means, std::size_t parity) {
+  const std::size_t n = residual.size() / g.n_views();
   const std::vector<std::size_t> views = views_of(g, parity, 1);
   Scan out;
   out.geometry = with_views(g, views);
-  std::vector<float> data;
-  data.reserve(views.size() * n);
-  for (std::size_t v : views) {
-    data.insert(data.end(), residual.measurement.data.begin() + static_cast<long>(v * n),
-                residual.measurement.data.begin() + static_cast<long>((v + 1) * n));
+  std::vector<float> data(views.size() * n, 0.0f);
+  for (std::size_t k = 0; k < views.size(); ++k) {
+    for (std::size_t e = 0; e < n; ++e) {
+      const std::size_t i = views[k] * n + e;
+      if (used[i]) data[k * n + e] = static_cast<float>(residual.data[i] - means[e]);
+    }
   }
-  std::vector<std::size_t> shape = residual.measurement.shape;
+  std::vector<std::size_t> shape = residual.shape;
   shape[0] = views.size();
   out.measurement = Array(std::move(shape), std::move(data));
   return out;
@@ -154,20 +158,19 @@ ResidualDetailResult detail_of(Array image, const Array& field, const Scan& scan
   }
   ResidualDetailResult out{std::move(image), {}};
 
-  const Projector projector(g, engine, device);
-  const Array projected = projector.project(field);
+  // In 3D a scan's readings are most of the memory: the residual is written over the
+  // projection, and each half is taken from it only for its own FBP.
   std::vector<char> used;
-  const Array misfit = residual_readings(scan, projected, log_alpha, dead, used);
-  Scan residual{without_element_means(misfit, used, n), g, 0};
+  const Array misfit =
+      residual_readings(scan, Projector(g, engine, device).project(field), log_alpha, dead, used);
+  const std::vector<double> means = element_means(misfit, used, n);
   FbpOptions options;
   options.engine = engine;
   options.device = device;
   // The whole scan's FBP is the halves' mean (each half's views weigh twice the angle): two
   // half backprojections instead of three, which in 3D cost more than the training's own rays.
-  const Scan even_views = every_other_view(residual, 0);
-  const Scan odd_views = every_other_view(residual, 1);
-  const Array even = fbp(even_views, options);
-  const Array odd = fbp(odd_views, options);
+  const Array even = fbp(every_other_view(misfit, g, used, means, 0), options);
+  const Array odd = fbp(every_other_view(misfit, g, used, means, 1), options);
 
   // The detail and its gain are recomputed where they are used rather than held: in 3D each
   // copy is a volume.

@@ -38,8 +38,12 @@ double detector_row_mm(const Geometry& g, double v) {
 }
 
 Vec3 detector_position(const Geometry& g, std::size_t view, double u, double v) {
-  const double c = std::cos(g.angles[view]);
-  const double s = std::sin(g.angles[view]);
+  return detector_position(g, ViewRotation::of(g, view), u, v);
+}
+
+Vec3 detector_position(const Geometry& g, const ViewRotation& rotation, double u, double v) {
+  const double c = rotation.c;
+  const double s = rotation.s;
   const double a = element_offset(u, g.n_u, g.offset_u, g.pitch_u);
   const double z = g.is_3d() ? detector_row_mm(g, v) - g.grid_centre_z_mm : 0.0;
   // R(theta) (a, b) = (a c - b s, a s + b c); the detector plane is at b = ODD (0 for parallel).
@@ -59,9 +63,13 @@ std::vector<double> column_ray_distances(const Geometry& g) {
 }
 
 Ray detector_ray(const Geometry& g, std::size_t view, double u, double v) {
-  const double c = std::cos(g.angles[view]);
-  const double s = std::sin(g.angles[view]);
-  const Vec3 target = detector_position(g, view, u, v);
+  return detector_ray(g, ViewRotation::of(g, view), u, v);
+}
+
+Ray detector_ray(const Geometry& g, const ViewRotation& rotation, double u, double v) {
+  const double c = rotation.c;
+  const double s = rotation.s;
+  const Vec3 target = detector_position(g, rotation, u, v);
   if (g.is_divergent()) {
     const Vec3 source{g.source_origin_mm * s, -g.source_origin_mm * c, -g.grid_centre_z_mm};
     return {source, normalised({target.x - source.x, target.y - source.y, target.z - source.z})};

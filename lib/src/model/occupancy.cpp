@@ -162,7 +162,7 @@ struct RayCheck {
 // it misses) and, with `air`, runs step 4 on the rays that miss it: each must read air. One that
 // reads more near the region says the carving took object; one far from it is a detector's
 // spike or a separate faint object. One walk along each ray serves both.
-RayCheck clip_and_check(std::vector<RaySegment>& segments, const Scan& scan,
+RayCheck clip_and_check(RaySegments& segments, const Scan& scan,
                         const std::vector<std::uint8_t>& region, double spacing_voxels,
                         const AirReadings* air, double sigmas, int reach) {
   const RegionWalk walk(scan.geometry, region);
@@ -174,14 +174,14 @@ RayCheck clip_and_check(std::vector<RaySegment>& segments, const Scan& scan,
       util::parallel_map_chunks(segments.size(), [&](std::size_t begin, std::size_t end) {
         RayCheck part;
         for (std::size_t r = begin; r < end; ++r) {
-          RaySegment& s = segments[r];
-          if (s.count == 0) continue;
+          if (segments.count(r) == 0) continue;
+          const RaySegment s = segments[r];
           const auto range = walk.kept_range(s, spacing_voxels);
           if (range) {
             const auto [first, last] = *range;
-            for (int a = 0; a < 3; ++a) s.start[a] += static_cast<float>(first) * s.step[a];
-            s.count = static_cast<std::uint32_t>(last - first + 1);
-            part.samples += s.count;
+            const auto kept = static_cast<std::uint32_t>(last - first + 1);
+            segments.clip(r, static_cast<std::uint32_t>(first), kept);
+            part.samples += kept;
             continue;
           }
           const double z =
@@ -202,7 +202,7 @@ RayCheck clip_and_check(std::vector<RaySegment>& segments, const Scan& scan,
               }
             }
           }
-          s.count = 0;
+          segments.clip(r, 0, 0);
         }
         return part;
       });
@@ -235,8 +235,8 @@ OccupancySettings occupancy_settings(const TrainingConfig& training, const Geome
   return s;
 }
 
-Occupancy carve_occupancy(const Scan& scan, std::vector<RaySegment>& segments,
-                          double spacing_voxels, const OccupancySettings& settings) {
+Occupancy carve_occupancy(const Scan& scan, RaySegments& segments, double spacing_voxels,
+                          const OccupancySettings& settings) {
   const Geometry& g = scan.geometry;
   const std::size_t voxels = shape_size(g.volume_shape);
   Occupancy o;
@@ -290,7 +290,7 @@ Occupancy carve_occupancy(const Scan& scan, std::vector<RaySegment>& segments,
 Occupancy carve_occupancy(const Scan& scan, const OccupancySettings& settings) {
   constexpr double kSpacingVoxels = 1.5;
   const Geometry& g = scan.geometry;
-  std::vector<RaySegment> segments = ray_segments(g, kSpacingVoxels * g.voxel_mm, false);
+  RaySegments segments(g, kSpacingVoxels * g.voxel_mm, false);
   return carve_occupancy(scan, segments, kSpacingVoxels, settings);
 }
 
@@ -314,11 +314,11 @@ void fade_into_skipped_air(const Occupancy& occupancy, const std::vector<std::si
   }
 }
 
-double clip_segments(std::vector<RaySegment>& segments, const Scan& scan,
-                     const Occupancy& occupancy, double spacing_voxels) {
+double clip_segments(RaySegments& segments, const Scan& scan, const Occupancy& occupancy,
+                     double spacing_voxels) {
   if (!occupancy.carved) {
     double samples = 0.0;
-    for (const RaySegment& s : segments) samples += s.count;
+    for (std::size_t r = 0; r < segments.size(); ++r) samples += segments.count(r);
     return samples;
   }
   return clip_and_check(segments, scan, occupancy.inside, spacing_voxels, nullptr, 0.0, 0).samples;

@@ -83,8 +83,8 @@ struct Occupancy {
 // `segments`: the scan's rays as training samples them (ray_segments), spacing in voxels; when
 // the scan is carved they come back clipped to the region (clip_segments) and the rays that miss
 // it (whose samples all do) are checked (4.).
-Occupancy carve_occupancy(const Scan& scan, std::vector<RaySegment>& segments,
-                          double spacing_voxels, const OccupancySettings& settings);
+Occupancy carve_occupancy(const Scan& scan, RaySegments& segments, double spacing_voxels,
+                          const OccupancySettings& settings);
 
 // The same with the rays sampled every 1.5 voxels across the whole grid.
 Occupancy carve_occupancy(const Scan& scan, const OccupancySettings& settings);
@@ -101,7 +101,7 @@ inline int air_taper_px(int margin_px) { return margin_px >= 4 ? 2 : margin_px /
 
 // Keeps each segment's samples from its first to its last inside the region (none when it
 // misses it: count 0). Returns the samples left, summed over all rays.
-double clip_segments(std::vector<RaySegment>& segments, const Scan& scan,
-                     const Occupancy& occupancy, double spacing_voxels);
+double clip_segments(RaySegments& segments, const Scan& scan, const Occupancy& occupancy,
+                     double spacing_voxels);
 
 }  // namespace riner::model

@@ -17,9 +17,9 @@ std::uint32_t bits(float v) {
 
 }  // namespace
 
-void pack_batch(const Batch& batch, const std::vector<RaySegment>& segments,
-                const std::vector<float>& rho, std::size_t elements_per_view,
-                const std::vector<float>& level_weights, PackedBatch& out) {
+void pack_batch(const Batch& batch, const RaySegments& segments, const std::vector<float>& rho,
+                std::size_t elements_per_view, const std::vector<float>& level_weights,
+                PackedBatch& out) {
   static_assert(sizeof(RaySegment) == 8 * sizeof(std::uint32_t));
   const auto n = static_cast<std::uint32_t>(batch.rays.size());
   const auto e = static_cast<std::uint32_t>(batch.elements.size());
@@ -40,9 +40,10 @@ void pack_batch(const Batch& batch, const std::vector<RaySegment>& segments,
     const std::uint32_t ray = batch.rays[b];
     w[out.rays_at + b] = ray;
     w[out.offsets_at + b] = samples;
-    samples += segments[ray].count;
+    const RaySegment segment = segments[ray];
+    samples += segment.count;
     w[out.weights_at + b] = bits(batch.weights[b]);
-    std::memcpy(w.data() + out.segments_at + 8 * b, &segments[ray], sizeof(RaySegment));
+    std::memcpy(w.data() + out.segments_at + 8 * b, &segment, sizeof(RaySegment));
     w[out.rho_at + b] = bits(rho[ray]);
   }
   w[out.offsets_at + n] = samples;

@@ -31,8 +31,8 @@ struct PackedBatch {
 
 // Fills `out` (reusing its storage). batch.elements must be the sorted distinct elements of
 // batch.rays (BatchSampler's contract); segments and rho hold every ray of the scan.
-void pack_batch(const Batch& batch, const std::vector<RaySegment>& segments,
-                const std::vector<float>& rho, std::size_t elements_per_view,
-                const std::vector<float>& level_weights, PackedBatch& out);
+void pack_batch(const Batch& batch, const RaySegments& segments, const std::vector<float>& rho,
+                std::size_t elements_per_view, const std::vector<float>& level_weights,
+                PackedBatch& out);
 
 }  // namespace riner::model

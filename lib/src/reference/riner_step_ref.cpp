@@ -27,10 +27,11 @@ void scale_levels(const model::ParameterLayout& l, const std::vector<float>& lev
 namespace {
 
 // The position of a ray's sample k (jittered like the kernel when the step asks for it).
-void sample_at(const StepInputs& in, std::uint32_t ray, std::uint32_t k, double pos[3]) {
+void sample_at(const StepInputs& in, const model::RaySegment& s, std::uint32_t ray, std::uint32_t k,
+               double pos[3]) {
   const float u = in.jitter ? sample_jitter(in.seed, in.step, ray, k) : 0.5f;
   float p[3];
-  model::sample_position((*in.segments)[ray], k, u, p);
+  model::sample_position(s, k, u, p);
   for (int d = 0; d < 3; ++d) pos[d] = p[d];
 }
 
@@ -43,11 +44,11 @@ std::vector<double> ray_sums(const StepInputs& in, const model::Batch& batch,
     std::vector<double> features(static_cast<std::size_t>(l.inputs));
     for (std::size_t b = begin; b < end; ++b) {
       const std::uint32_t ray = batch.rays[b];
-      const model::RaySegment& s = (*in.segments)[ray];
+      const model::RaySegment s = (*in.segments)[ray];
       double sum = 0.0;
       for (std::uint32_t k = 0; k < s.count; ++k) {
         double pos[3];
-        sample_at(in, ray, k, pos);
+        sample_at(in, s, ray, k, pos);
         hash_grid_encode(l, params.data(), pos, features.data());
         scale_levels(l, in.level_weights, features.data());
         sum += mlp_forward(l, params.data(), features.data());
@@ -137,12 +138,12 @@ void backward(const StepInputs& in, const model::Batch& batch, const std::vector
         std::vector<double> d_features(static_cast<std::size_t>(l.inputs));
         for (std::size_t b = begin; b < end; ++b) {
           const std::uint32_t ray = batch.rays[b];
-          const model::RaySegment& s = (*in.segments)[ray];
+          const model::RaySegment s = (*in.segments)[ray];
           const double d_mu = result.d_sums[b] * s.dx;
           if (d_mu == 0.0) continue;
           for (std::uint32_t k = 0; k < s.count; ++k) {
             double pos[3];
-            sample_at(in, ray, k, pos);
+            sample_at(in, s, ray, k, pos);
             hash_grid_encode(l, params.data(), pos, features.data());
             scale_levels(l, in.level_weights, features.data());
             MlpTrace trace;

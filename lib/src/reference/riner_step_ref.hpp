@@ -15,7 +15,7 @@ namespace riner::ref {
 
 struct StepInputs {
   const model::ParameterLayout* layout = nullptr;
-  const std::vector<model::RaySegment>* segments = nullptr;
+  const model::RaySegments* segments = nullptr;
   const std::vector<float>* measurement = nullptr;  // rho per ray id
   std::size_t elements_per_view = 0;                // n_u * n_v
   bool jitter = true;

@@ -7,6 +7,7 @@
 #include <cstdlib>
 #include <utility>
 
+#include "model/ray_segments.hpp"
 #include "riner/error.hpp"
 #include "riner/rays.hpp"
 
@@ -14,18 +15,30 @@ namespace riner {
 
 namespace {
 
-// Measured with `riner_bench --case=slab_stack` (docs/history/RESULTS.md, "Issue 30"): at 1024
-// columns x 720 views, a slab's peak resident memory is about 260 MB plus 24 MB per detector
-// row (32 bytes per reading: the readings, their ray segments, the carving's and the quality
-// check's filtered copies); the voxels count for little beside them.
-constexpr double kReadingCopies = 8.0;
-constexpr double kVoxelCopies = 12.0;
+// Measured (docs/history/RESULTS.md, "Issue 30: a volume's rays computed when drawn"): a slab's
+// peak resident memory is about 260 MB (PoCL, the kernels, the model) plus, per reading, its ray
+// segment (RaySegments: 32 bytes in a table, 8 past the table's size) and 4-5 float copies (the
+// readings in the scan and in training, the detail's residual and halves), plus 6 per voxel.
+// Fitted on a parallel slab of 720 x 8 x 1024 readings (582 MB measured, the segments tabled)
+// and cone-beam slabs and volumes of the chest CT (548-863 MB, the segments computed).
+constexpr double kReadingCopies = 5.0;
+constexpr double kVoxelCopies = 6.0;
 constexpr std::size_t kBaseBytes = std::size_t{260} << 20;  // model, kernels, libraries
+
+// The ray segments' bytes: a table while it fits RaySegments::kTableBytes, then each ray's clip
+// alone. The bytes fall past the table's size; most_slices_within still gives a size that fits
+// (it keeps only sizes it found within the limit), at worst not the largest.
+double segment_bytes(double readings) {
+  const double table = static_cast<double>(sizeof(model::RaySegment)) * readings;
+  return table <= static_cast<double>(model::RaySegments::kTableBytes)
+             ? table
+             : 2.0 * sizeof(std::uint32_t) * readings;
+}
 
 // On a device (PoCL's buffers, counted as on a GPU; docs/history/RESULTS.md "device memory"): the
 // model, the per-sample caches and the batch (95-256 MB measured), then per slice the quality
 // check's FBP with its readings in two copies and the voxels (2048 columns x 1440 views: 26.4
-// MB per slice against 32 MB here).
+// MB per slice against 32 MB here). The ray segments stay on the host.
 constexpr std::size_t kDeviceBaseBytes = std::size_t{256} << 20;
 constexpr double kDeviceReadingCopies = 2.0;
 constexpr double kDeviceVoxelCopies = 2.0;
@@ -239,7 +252,8 @@ Geometry slab_geometry(const Geometry& g, const Slab& slab) {
 std::size_t slab_bytes(const Geometry& g, std::size_t slices) {
   const SlabSize size = slab_size(g, slices);
   return kBaseBytes + static_cast<std::size_t>(
-                          4.0 * (kReadingCopies * size.readings + kVoxelCopies * size.voxels));
+                          4.0 * (kReadingCopies * size.readings + kVoxelCopies * size.voxels) +
+                          segment_bytes(size.readings));
 }
 
 std::size_t slab_device_bytes(const Geometry& g, std::size_t slices) {

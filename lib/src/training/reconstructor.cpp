@@ -102,7 +102,7 @@ void Reconstructor::step(int n) {
     const model::Batch batch = impl_->sampler.batch(static_cast<std::uint32_t>(index));
     const std::size_t per_view = impl_->setup.elements_per_view;
     for (std::uint32_t r : batch.rays) {
-      impl_->samples += impl_->setup.segments[r].count;
+      impl_->samples += impl_->setup.segments.count(r);
       ++impl_->element_rays[r % per_view];
     }
     impl_->trainer->step(index, batch);

@@ -26,7 +26,7 @@ struct TrainingSetup {
   Scan scan;
   RinerConfig config;
   model::ParameterLayout layout;
-  std::vector<model::RaySegment> segments;
+  model::RaySegments segments;
   std::size_t elements_per_view = 0;
   std::uint32_t seed = 0;
   std::vector<std::uint32_t> invalid_readings;  // per response slot: its non-finite measurements

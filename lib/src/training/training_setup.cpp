@@ -62,13 +62,15 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
   check_scan(scan);
   const Geometry& g = scan.geometry;
   elements_per_view = g.n_u * (g.is_3d() ? g.n_v : 1);
-  segments = model::ray_segments(g, config.training.sample_spacing * g.voxel_mm,
-                                 config.training.circle_region);
+  segments = model::RaySegments(g, config.training.sample_spacing * g.voxel_mm,
+                                config.training.circle_region);
   std::size_t hit = 0;
-  for (const model::RaySegment& segment : segments) hit += segment.count > 0;
+  for (std::size_t r = 0; r < segments.size(); ++r) {
+    hit += segments.count(r) > 0;
+    samples_in_grid += segments.count(r);
+  }
   if (hit == 0)
     throw InputError("no detector ray crosses the reconstruction grid: check the geometry");
-  for (const model::RaySegment& segment : segments) samples_in_grid += segment.count;
   samples_kept = samples_in_grid;
   voxel_samples_per_ray = samples_in_grid / static_cast<double>(segments.size()) /
                           static_cast<double>(shape_size(g.volume_shape));

@@ -78,11 +78,11 @@ TrainingSetup image_fit_setup(const TrainingSetup& setup, const Array& image,
   fit.scan.geometry.volume_shape = g.volume_shape;
   fit.scan.geometry.voxel_mm = g.voxel_mm;
   fit.scan.measurement = Array({1, pixels.size()});
-  fit.segments.resize(pixels.size());
+  std::vector<model::RaySegment> segments(pixels.size());
   for (std::size_t k = 0; k < pixels.size(); ++k) {
     const std::size_t i = pixels[k];
     fit.scan.measurement.data[k] = std::isfinite(image.data[i]) ? image.data[i] : 0.0f;
-    model::RaySegment& s = fit.segments[k];
+    model::RaySegment& s = segments[k];
     for (std::size_t d = 0; d < 3; ++d) {
       s.start[d] = d < dims ? positions[i * dims + d] : 0.5f;
       s.step[d] = 0.0f;
@@ -90,6 +90,7 @@ TrainingSetup image_fit_setup(const TrainingSetup& setup, const Array& image,
     s.dx = 1.0f;
     s.count = 1;
   }
+  fit.segments = model::RaySegments(std::move(segments));
   fit.elements_per_view = pixels.size();
   fit.layout = model::make_layout(static_cast<int>(dims), fit.config.encoding, fit.config.network,
                                   pixels.size());
