@@ -19,6 +19,10 @@ typedef struct {
   float step_length;  // mm of ray per plane
   int n[3];
   int stride[3];
+  // The same by role, as scalars: indexing n and stride by a run-time axis inside the walk
+  // keeps them in memory on a CPU device (PoCL) instead of in registers.
+  int n0, n1;                  // cells along other0, other1
+  int s_main, s_other0, s_other1;  // strides along main_axis, other0, other1
 } JosephWalk;
 
 inline float joseph_axis(float3 v, int axis) { return axis == 0 ? v.x : (axis == 1 ? v.y : v.z); }
@@ -80,6 +84,11 @@ inline int joseph_setup(const ScanGeometry* g, float3 origin, float3 direction, 
   if (!(m_lo <= m_hi)) return 0;
   w->m_lo = (int)m_lo;
   w->m_hi = (int)m_hi;
+  w->n0 = w->n[w->other0];
+  w->n1 = w->n[w->other1];
+  w->s_main = w->stride[main_axis];
+  w->s_other0 = w->stride[w->other0];
+  w->s_other1 = w->stride[w->other1];
   return 1;
 }
 
@@ -97,9 +106,32 @@ inline void joseph_cell(const JosephWalk* w, int m, int cell, int* index, float*
   const int i1 = (int)f1 + (cell >> 1);
   const float w0 = (cell & 1) ? c0 - f0 : 1.0f - (c0 - f0);
   const float w1 = (cell >> 1) ? c1 - f1 : 1.0f - (c1 - f1);
-  const int inside = i0 >= 0 && i0 < w->n[w->other0] && i1 >= 0 && i1 < w->n[w->other1];
-  *index = inside
-               ? m * w->stride[w->main_axis] + i0 * w->stride[w->other0] + i1 * w->stride[w->other1]
-               : 0;
+  const int inside = i0 >= 0 && i0 < w->n0 && i1 >= 0 && i1 < w->n1;
+  *index = inside ? m * w->s_main + i0 * w->s_other0 + i1 * w->s_other1 : 0;
   *weight = inside ? w0 * w1 * w->step_length : 0.0f;
 }
+
+// The sum along the walk of weight * volume over every cell, in joseph_cell's order and with its
+// numbers (the same floats), each plane's crossing computed once for its cells.
+inline float joseph_sum(const JosephWalk* w, int cells, __global const float* volume) {
+  float sum = 0.0f;
+  for (int m = w->m_lo; m <= w->m_hi; ++m) {
+    const float c0 = w->base0 + (float)m * w->slope0;
+    const float c1 = w->base1 + (float)m * w->slope1;
+    const float f0 = floor(c0);
+    const float f1 = floor(c1);
+    const int plane = m * w->s_main;
+    for (int cell = 0; cell < cells; ++cell) {
+      const int i0 = (int)f0 + (cell & 1);
+      const int i1 = (int)f1 + (cell >> 1);
+      const float w0 = (cell & 1) ? c0 - f0 : 1.0f - (c0 - f0);
+      const float w1 = (cell >> 1) ? c1 - f1 : 1.0f - (c1 - f1);
+      const int inside = i0 >= 0 && i0 < w->n0 && i1 >= 0 && i1 < w->n1;
+      // Selects, not a branch: the work-items of a group stay in step (a CPU device's vectors).
+      const int index = inside ? plane + i0 * w->s_other0 + i1 * w->s_other1 : 0;
+      sum += (inside ? w0 * w1 * w->step_length : 0.0f) * volume[index];
+    }
+  }
+  return sum;
+}
+

@@ -14,17 +14,8 @@ __kernel void project_forward(const uint n_rays, const ScanGeometry g, __global 
   float3 direction;
   measurement_ray(&g, views, r, &origin, &direction);
   JosephWalk w;
-  float sum = 0.0f;
-  if (joseph_setup(&g, origin, direction, &w)) {
-    const int cells = joseph_cells(&g);
-    for (int m = w.m_lo; m <= w.m_hi; ++m) {
-      for (int c = 0; c < cells; ++c) {
-        int index;
-        float weight;
-        joseph_cell(&w, m, c, &index, &weight);
-        sum += weight * volume[index];
-      }
-    }
-  }
+  const float sum = joseph_setup(&g, origin, direction, &w)
+                        ? joseph_sum(&w, joseph_cells(&g), volume)
+                        : 0.0f;
   out[r] = sum;
 }
