@@ -95,24 +95,30 @@ inline int joseph_setup(const ScanGeometry* g, float3 origin, float3 direction, 
 // Number of interpolation cells per plane: 2 in 2D, 4 in 3D.
 inline int joseph_cells(const ScanGeometry* g) { return g->is_3d ? 4 : 2; }
 
-inline void joseph_cell(const JosephWalk* w, int m, int cell, int* index, float* weight) {
-  // In 2D the second axis is z with one slice, base and slope 0: cells 0 and 1 get weight 1
-  // from it and cells 2 and 3 are never asked for.
-  const float c0 = w->base0 + (float)m * w->slope0;
-  const float c1 = w->base1 + (float)m * w->slope1;
-  const float f0 = floor(c0);
-  const float f1 = floor(c1);
+// Cell `cell` of the plane at `plane` (m times the main axis's stride), whose crossing sits at
+// (c0, c1) with floors (f0, f1); weight 0 and index 0 for a cell off the grid.
+inline void joseph_plane_cell(const JosephWalk* w, int plane, float c0, float c1, float f0,
+                              float f1, int cell, int* index, float* weight) {
   const int i0 = (int)f0 + (cell & 1);
   const int i1 = (int)f1 + (cell >> 1);
   const float w0 = (cell & 1) ? c0 - f0 : 1.0f - (c0 - f0);
   const float w1 = (cell >> 1) ? c1 - f1 : 1.0f - (c1 - f1);
   const int inside = i0 >= 0 && i0 < w->n0 && i1 >= 0 && i1 < w->n1;
-  *index = inside ? m * w->s_main + i0 * w->s_other0 + i1 * w->s_other1 : 0;
+  // Selects, not a branch: the work-items of a group stay in step (a CPU device's vectors).
+  *index = inside ? plane + i0 * w->s_other0 + i1 * w->s_other1 : 0;
   *weight = inside ? w0 * w1 * w->step_length : 0.0f;
 }
 
-// The sum along the walk of weight * volume over every cell, in joseph_cell's order and with its
-// numbers (the same floats), each plane's crossing computed once for its cells.
+inline void joseph_cell(const JosephWalk* w, int m, int cell, int* index, float* weight) {
+  // In 2D the second axis is z with one slice, base and slope 0: cells 0 and 1 get weight 1
+  // from it and cells 2 and 3 are never asked for.
+  const float c0 = w->base0 + (float)m * w->slope0;
+  const float c1 = w->base1 + (float)m * w->slope1;
+  joseph_plane_cell(w, m * w->s_main, c0, c1, floor(c0), floor(c1), cell, index, weight);
+}
+
+// The sum along the walk of weight * volume over every cell, in joseph_cell's order (the same
+// floats), each plane's crossing computed once for its cells.
 inline float joseph_sum(const JosephWalk* w, int cells, __global const float* volume) {
   float sum = 0.0f;
   for (int m = w->m_lo; m <= w->m_hi; ++m) {
@@ -120,18 +126,12 @@ inline float joseph_sum(const JosephWalk* w, int cells, __global const float* vo
     const float c1 = w->base1 + (float)m * w->slope1;
     const float f0 = floor(c0);
     const float f1 = floor(c1);
-    const int plane = m * w->s_main;
     for (int cell = 0; cell < cells; ++cell) {
-      const int i0 = (int)f0 + (cell & 1);
-      const int i1 = (int)f1 + (cell >> 1);
-      const float w0 = (cell & 1) ? c0 - f0 : 1.0f - (c0 - f0);
-      const float w1 = (cell >> 1) ? c1 - f1 : 1.0f - (c1 - f1);
-      const int inside = i0 >= 0 && i0 < w->n0 && i1 >= 0 && i1 < w->n1;
-      // Selects, not a branch: the work-items of a group stay in step (a CPU device's vectors).
-      const int index = inside ? plane + i0 * w->s_other0 + i1 * w->s_other1 : 0;
-      sum += (inside ? w0 * w1 * w->step_length : 0.0f) * volume[index];
+      int index;
+      float weight;
+      joseph_plane_cell(w, m * w->s_main, c0, c1, f0, f1, cell, &index, &weight);
+      sum += weight * volume[index];
     }
   }
   return sum;
 }
-

@@ -24,11 +24,18 @@ struct Ray {
   Vec3 direction;
 };
 
+// A view's angle as its cosine and sine, for loops over many rays or points per view: the
+// overloads that take it give the same numbers as those that take the view, without a sin and
+// cos per call.
+struct ViewRotation {
+  double c = 1.0;
+  double s = 0.0;
+  static ViewRotation of(const Geometry& g, std::size_t view);
+};
+
 // The ray to detector element (u, v) at `view`. u and v are element indices and may be
 // fractional (positions inside an element); v is ignored in 2D.
 Ray detector_ray(const Geometry& g, std::size_t view, double u, double v = 0.0);
-struct ViewRotation;
-// The same with the view's angle as its cosine and sine (ViewRotation::of): the same numbers.
 Ray detector_ray(const Geometry& g, const ViewRotation& rotation, double u, double v = 0.0);
 
 // Signed distance from the rotation axis, in the axial plane, of each detector column's ray at
@@ -54,14 +61,6 @@ struct DetectorPoint {
   double magnification = 1.0;
 };
 DetectorPoint project_to_detector(const Geometry& g, std::size_t view, const Vec3& p);
-
-// The same with the view's angle given as its cosine and sine (ViewRotation::of), for loops
-// that project many points per view: the same numbers without a sin and cos per point.
-struct ViewRotation {
-  double c = 1.0;
-  double s = 0.0;
-  static ViewRotation of(const Geometry& g, std::size_t view);
-};
 DetectorPoint project_to_detector(const Geometry& g, const ViewRotation& rotation, const Vec3& p);
 
 // Parameter interval [enter, exit] of a ray inside a region; empty when it misses.

@@ -78,7 +78,7 @@ std::vector<RaySegment> ray_segments(const Geometry& g, double spacing_mm, bool 
 RaySegments::RaySegments(const Geometry& g, double spacing_mm, bool circle,
                          std::size_t table_bytes) {
   const std::size_t rays = rays_of(g);
-  if (rays * sizeof(RaySegment) <= table_bytes) {
+  if (tabled_for(rays, table_bytes)) {
     table_ = ray_segments(g, spacing_mm, circle);
     return;
   }

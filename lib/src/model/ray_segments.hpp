@@ -43,6 +43,14 @@ class RaySegments {
  public:
   static constexpr std::size_t kTableBytes = std::size_t{256} << 20;
 
+  // Whether `rays` rays are held as a table (else as their clips), and the bytes they take.
+  static bool tabled_for(std::size_t rays, std::size_t table_bytes = kTableBytes) {
+    return rays * sizeof(RaySegment) <= table_bytes;
+  }
+  static std::size_t held_bytes(std::size_t rays) {
+    return rays * (tabled_for(rays) ? sizeof(RaySegment) : 2 * sizeof(std::uint32_t));
+  }
+
   RaySegments() = default;
   RaySegments(const Geometry& g, double spacing_mm, bool circle,
               std::size_t table_bytes = kTableBytes);

@@ -25,16 +25,6 @@ constexpr double kReadingCopies = 5.0;
 constexpr double kVoxelCopies = 6.0;
 constexpr std::size_t kBaseBytes = std::size_t{260} << 20;  // model, kernels, libraries
 
-// The ray segments' bytes: a table while it fits RaySegments::kTableBytes, then each ray's clip
-// alone. The bytes fall past the table's size; most_slices_within still gives a size that fits
-// (it keeps only sizes it found within the limit), at worst not the largest.
-double segment_bytes(double readings) {
-  const double table = static_cast<double>(sizeof(model::RaySegment)) * readings;
-  return table <= static_cast<double>(model::RaySegments::kTableBytes)
-             ? table
-             : 2.0 * sizeof(std::uint32_t) * readings;
-}
-
 // On a device (PoCL's buffers, counted as on a GPU; docs/history/RESULTS.md "device memory"): the
 // model, the per-sample caches and the batch (95-256 MB measured), then per slice the quality
 // check's FBP with its readings in two copies and the voxels (2048 columns x 1440 views: 26.4
@@ -251,9 +241,12 @@ Geometry slab_geometry(const Geometry& g, const Slab& slab) {
 
 std::size_t slab_bytes(const Geometry& g, std::size_t slices) {
   const SlabSize size = slab_size(g, slices);
-  return kBaseBytes + static_cast<std::size_t>(
-                          4.0 * (kReadingCopies * size.readings + kVoxelCopies * size.voxels) +
-                          segment_bytes(size.readings));
+  return kBaseBytes +
+         static_cast<std::size_t>(4.0 *
+                                  (kReadingCopies * size.readings + kVoxelCopies * size.voxels)) +
+         // Falls past the table's size; most_slices_within still gives a size that fits (it
+         // keeps only sizes found within the limit), at worst not the largest.
+         model::RaySegments::held_bytes(static_cast<std::size_t>(size.readings));
 }
 
 std::size_t slab_device_bytes(const Geometry& g, std::size_t slices) {
