@@ -17,11 +17,31 @@
 //     for fan and cone beams: a voxel's u, magnification and distance weight in a view do not
 //     depend on its height, so they are found once per view for the block of slices, and only
 //     each slice's row per view.
+//   The GPU's shape: one voxel (column) per work-item; a GPU runs neighbouring work-items
+//   together and its caches serve their neighbouring reads.
+//
+//   fbp_pair_lines(n_items, n_u, first_line, filtered, pairs): detector lines from first_line
+//     as pairs, pairs[line][j + 2] = (f(j), f(j + 1)) for j in [-2, n_u], f = 0 off the
+//     detector.
+//   fbp_backproject_parallel_lanes(n_items, first_slice, slice_step, g, views, view_weights,
+//     first_view, chunk_views, accumulate, pairs, volume), fbp_backproject_divergent_lanes(...):
+//     the same sums over the views first_view .. + chunk_views (the pairs hold theirs), written
+//     into the volume or added to it; the CPU's shape. PoCL
+//     vectorises a work-group's work-items only when their loads are contiguous, so a
+//     backprojection's lookups left it one voxel at a time: here each work-item holds
+//     kLanes voxels of a row in a vector, for kLaneRows rows (their lookups in a view fall on
+//     the same detector lines, in cache), and takes both neighbours of a lookup in one read
+//     of the pairs; off the detector it reads (0, 0).
 // Needs common.cl and ray_geometry.cl. No -D constants.
 // Buffers: filtered float[views][rows][n_u]; views float2 (cos,
 // sin); view_weights float[views]; volume float[selected slices][ny][nx].
 
 #define kParallelSlices 4
+
+// The height (mm) of slice l's centre in the scan's frame.
+inline float slice_height(const ScanGeometry g, const int l) {
+  return ((float)l - 0.5f * (float)(g.nz - 1)) * g.voxel + g.grid_z;
+}
 
 // One work-item's block of `slices` (1 or kParallelSlices, a constant where it is inlined, so
 // the per-slice arrays stay in registers).
@@ -45,7 +65,7 @@ inline void backproject_parallel_block(const uint gid, const uint n_items, const
   for (int s = 0; s < slices; ++s) {
     const uint selected = block * slices + s;
     const int l = first_slice + min(selected, n_selected - 1) * slice_step;
-    const float z = g.is_3d ? ((float)l - 0.5f * (float)(g.nz - 1)) * g.voxel + g.grid_z : 0.0f;
+    const float z = g.is_3d ? slice_height(g, l) : 0.0f;
     const float v = g.is_3d ? z / g.pitch_v + 0.5f * (float)(g.n_v - 1) - g.offset_v : 0.0f;
     const float fv = floor(v);
     const int r = (int)fv;
@@ -123,7 +143,7 @@ inline void backproject_divergent_block(const uint gid, const uint n_items,
     const uint selected = block * slices + s;
     const int l = first_slice + min(selected, n_selected - 1) * slice_step;
     z_over_pitch[s] =
-        g.is_3d ? (((float)l - 0.5f * (float)(g.nz - 1)) * g.voxel + g.grid_z) / g.pitch_v : 0.0f;
+        g.is_3d ? slice_height(g, l) / g.pitch_v : 0.0f;
     sum[s] = 0.0f;
   }
   const float u_centre = 0.5f * (float)(g.n_u - 1) - g.offset_u;
@@ -180,4 +200,175 @@ __kernel void fbp_backproject_divergent_one(const uint n_items, const uint first
                                             __global float* volume) {
   backproject_divergent_block(get_global_id(0), n_items, first_slice, slice_step, n_selected, g,
                               views, view_weights, filtered, volume, 1);
+}
+
+// ---- The CPU's shape ------------------------------------------------------------------------
+
+#define kLanes 16
+#define kLaneRows 4
+
+__kernel void fbp_pair_lines(const uint n_items, const int n_u, const uint first_line,
+                             __global const float* filtered, __global float2* pairs) {
+  const uint gid = get_global_id(0);
+  if (gid >= n_items) return;
+  const uint per_line = (uint)n_u + 3u;
+  __global const float* f = filtered + (first_line + gid / per_line) * (uint)n_u;
+  const int j = (int)(gid % per_line) - 2;
+  const float here = f[clamp(j, 0, n_u - 1)], next = f[clamp(j + 1, 0, n_u - 1)];
+  pairs[gid] = (float2)(j >= 0 && j < n_u ? here : 0.0f, j + 1 >= 0 && j + 1 < n_u ? next : 0.0f);
+}
+
+// clamp() of an int16 by scalar bounds, written out: oclgrind 21.10's returns garbage lanes.
+inline int16 clamp_lanes(const int16 x, const int lo, const int hi) {
+  return min(max(x, (int16)(lo)), (int16)(hi));
+}
+
+// The linear interpolation at u of the pairs' line starting at `line` (an index per lane).
+inline float16 lanes_interpolate(__global const float2* pairs, const int16 line, const float16 u,
+                                 const int n_u) {
+  const float16 fu = floor(u);
+  const int16 at = line + clamp_lanes(convert_int16(fu), -2, n_u) + 2;
+  const float2 q0 = pairs[at.s0], q1 = pairs[at.s1], q2 = pairs[at.s2], q3 = pairs[at.s3],
+               q4 = pairs[at.s4], q5 = pairs[at.s5], q6 = pairs[at.s6], q7 = pairs[at.s7],
+               q8 = pairs[at.s8], q9 = pairs[at.s9], qa = pairs[at.sa], qb = pairs[at.sb],
+               qc = pairs[at.sc], qd = pairs[at.sd], qe = pairs[at.se], qf = pairs[at.sf];
+  const float16 a = (float16)(q0.x, q1.x, q2.x, q3.x, q4.x, q5.x, q6.x, q7.x, q8.x, q9.x, qa.x,
+                              qb.x, qc.x, qd.x, qe.x, qf.x);
+  const float16 b = (float16)(q0.y, q1.y, q2.y, q3.y, q4.y, q5.y, q6.y, q7.y, q8.y, q9.y, qa.y,
+                              qb.y, qc.y, qd.y, qe.y, qf.y);
+  return a + (u - fu) * (b - a);
+}
+
+// A work-item's tile: kLanes columns from k0, kLaneRows rows from i0, of selected slice `s`.
+typedef struct {
+  int k0, i0;
+  uint selected;
+  float16 x;  // the columns' x (mm)
+} LaneTile;
+
+inline LaneTile lane_tile(const uint gid, const ScanGeometry g) {
+  const uint tiles_x = ((uint)g.nx + kLanes - 1) / kLanes;
+  const uint tiles = tiles_x * (((uint)g.ny + kLaneRows - 1) / kLaneRows);
+  LaneTile t;
+  t.selected = gid / tiles;
+  t.k0 = (int)((gid % tiles) % tiles_x) * kLanes;
+  t.i0 = (int)((gid % tiles) / tiles_x) * kLaneRows;
+  const int16 k = (int16)(t.k0) + (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+  t.x = (convert_float16(k) - 0.5f * (float)(g.nx - 1)) * g.voxel;
+  return t;
+}
+
+inline float lane_row_y(const ScanGeometry g, const int i) {
+  return (0.5f * (float)(g.ny - 1) - (float)i) * g.voxel;
+}
+
+inline void store_lane_tile(const LaneTile t, const ScanGeometry g, const float16* sum,
+                            const int accumulate, __global float* volume) {
+  __global float* slice = volume + t.selected * (uint)(g.nx * g.ny);
+  for (int r = 0; r < kLaneRows && t.i0 + r < g.ny; ++r) {
+    __global float* row = slice + (t.i0 + r) * g.nx + t.k0;
+    if (t.k0 + kLanes <= g.nx) {
+      vstore16(accumulate ? vload16(0, row) + sum[r] : sum[r], 0, row);
+    } else {
+      float lanes[kLanes];
+      vstore16(sum[r], 0, lanes);
+      for (int l = 0; t.k0 + l < g.nx; ++l) row[l] = accumulate ? row[l] + lanes[l] : lanes[l];
+    }
+  }
+}
+
+__kernel void fbp_backproject_parallel_lanes(const uint n_items, const uint first_slice,
+                                             const uint slice_step, const ScanGeometry g,
+                                             __global const float2* views,
+                                             __global const float* view_weights,
+                                             const int first_view, const int chunk_views,
+                                             const int accumulate,
+                                             __global const float2* pairs,
+                                             __global float* volume) {
+  const uint gid = get_global_id(0);
+  if (gid >= n_items) return;
+  const LaneTile t = lane_tile(gid, g);
+  const int rows = g.is_3d ? g.n_v : 1;
+  const int per_line = g.n_u + 3;
+  // The slice's two rows (clamped) and their weights (0 off the detector), as in the GPU's
+  // shape.
+  const int l = first_slice + t.selected * slice_step;
+  const float z = g.is_3d ? slice_height(g, l) : 0.0f;
+  const float v = g.is_3d ? z / g.pitch_v + 0.5f * (float)(g.n_v - 1) - g.offset_v : 0.0f;
+  const float fv = floor(v);
+  const int r = (int)fv;
+  const float w_row0 = (r >= 0 && r < rows) ? 1.0f - (v - fv) : 0.0f;
+  const float w_row1 = (r + 1 >= 0 && r + 1 < rows) ? v - fv : 0.0f;
+  const int row0 = clamp(r, 0, rows - 1) * per_line;
+  const int row1 = clamp(r + 1, 0, rows - 1) * per_line;
+  const float u_centre = 0.5f * (float)(g.n_u - 1) - g.offset_u;
+  const float16 x = t.x / g.pitch_u;
+  float16 sum[kLaneRows];
+  for (int i = 0; i < kLaneRows; ++i) sum[i] = 0.0f;
+  for (int c = 0; c < chunk_views; ++c) {
+    const float2 cs = views[first_view + c];
+    const float weight = view_weights[first_view + c];
+    const int16 line0 = (int16)(c * rows * per_line + row0);
+    const int16 line1 = (int16)(c * rows * per_line + row1);
+    const float16 ux = x * cs.x + u_centre;
+#pragma unroll
+    for (int i = 0; i < kLaneRows; ++i) {
+      const float16 u = ux + lane_row_y(g, t.i0 + i) / g.pitch_u * cs.y;
+      float16 value = w_row0 * lanes_interpolate(pairs, line0, u, g.n_u);
+      if (w_row1 != 0.0f) value += w_row1 * lanes_interpolate(pairs, line1, u, g.n_u);
+      sum[i] += weight * value;
+    }
+  }
+  store_lane_tile(t, g, sum, accumulate, volume);
+}
+
+__kernel void fbp_backproject_divergent_lanes(const uint n_items, const uint first_slice,
+                                              const uint slice_step, const ScanGeometry g,
+                                              __global const float2* views,
+                                              __global const float* view_weights,
+                                              const int first_view, const int chunk_views,
+                                              const int accumulate,
+                                              __global const float2* pairs,
+                                              __global float* volume) {
+  const uint gid = get_global_id(0);
+  if (gid >= n_items) return;
+  const LaneTile t = lane_tile(gid, g);
+  const int rows = g.is_3d ? g.n_v : 1;
+  const int per_line = g.n_u + 3;
+  const int l = first_slice + t.selected * slice_step;
+  const float z_over_pitch =
+      g.is_3d ? slice_height(g, l) / g.pitch_v : 0.0f;
+  const float u_centre = 0.5f * (float)(g.n_u - 1) - g.offset_u;
+  const float v_centre = g.is_3d ? 0.5f * (float)(g.n_v - 1) - g.offset_v : 0.0f;
+  float16 sum[kLaneRows];
+  for (int i = 0; i < kLaneRows; ++i) sum[i] = 0.0f;
+  for (int c = 0; c < chunk_views; ++c) {
+    const float2 cs = views[first_view + c];
+    const float view_weight = view_weights[first_view + c];
+    const int first_line = c * rows;
+#pragma unroll
+    for (int i = 0; i < kLaneRows; ++i) {
+      const float y = lane_row_y(g, t.i0 + i);
+      const float16 a = t.x * cs.x + y * cs.y;   // along the detector's u axis
+      const float16 b = -t.x * cs.y + y * cs.x;  // towards the detector
+      const float16 distance = g.sod + b;
+      const float16 scale = (g.sod + g.odd) / distance;
+      const float16 weight = view_weight * (g.sod / distance) * (g.sod / distance);
+      const float16 u = a * scale / g.pitch_u + u_centre;
+      if (!g.is_3d) {
+        sum[i] += weight * lanes_interpolate(pairs, (int16)(first_line * per_line), u, g.n_u);
+        continue;
+      }
+      const float16 v = z_over_pitch * scale + v_centre;
+      const float16 fv = floor(v);
+      const int16 r = convert_int16(fv);
+      const float16 w_row0 = select((float16)0.0f, 1.0f - (v - fv), r >= 0 && r < rows);
+      const float16 w_row1 = select((float16)0.0f, v - fv, r + 1 >= 0 && r + 1 < rows);
+      const int16 line0 = (first_line + clamp_lanes(r, 0, rows - 1)) * per_line;
+      const int16 line1 = (first_line + clamp_lanes(r + 1, 0, rows - 1)) * per_line;
+      sum[i] += weight * (w_row0 * lanes_interpolate(pairs, line0, u, g.n_u) +
+                          w_row1 * lanes_interpolate(pairs, line1, u, g.n_u));
+    }
+  }
+  store_lane_tile(t, g, sum, accumulate, volume);
 }

@@ -85,10 +85,15 @@ Array fbp(const Scan& scan, const FbpOptions& options, FbpReport* report) {
   Device device = options.device ? *options.device : Device::open();
   cl::Context& ctx = cl::context_of(device);
   ops::FbpOp op(ctx, g, taps, view_weights);
-  cl::Buffer<float> d_in(ctx, std::span<const float>(weighted.data));
   cl::Buffer<float> d_filtered(ctx, weighted.size());
+  {
+    // The weighted readings go once filtered: a CPU's backprojection holds the filtered ones
+    // again as pairs, and on a CPU device every buffer is host memory.
+    cl::Buffer<float> d_in(ctx, std::span<const float>(weighted.data));
+    weighted = Array();
+    op.filter(d_in, d_filtered);
+  }
   cl::Buffer<float> d_volume(ctx, volume.size());
-  op.filter(d_in, d_filtered);
   op.backproject(d_filtered, d_volume, first, step);
   d_volume.read(std::span<float>(volume.data));
   return volume;

@@ -25,12 +25,27 @@ class FbpOp {
   void use_filter_path(LineFilterOp::Path path, std::size_t groups = 0) {
     line_filter_.use(path, groups);
   }
+  // How backproject() lays its work out (kernels/fbp.cl): one voxel per work-item (a GPU's
+  // shape), or vectors of voxels that read the detector's values as pairs (a CPU's, the
+  // default on a CPU device; it holds the filtered measurement again, twice over, while it
+  // runs).
+  enum class Shape { kPerVoxel, kLanes };
+  Shape shape() const { return shape_; }
+  // The tests' way to run both shapes on one device; `pairs_bytes` > 0 bounds the CPU's shape's
+  // pairs to a chunk of views that size (default 64 MiB: every view of a slice at once).
+  void use_shape(Shape shape, std::size_t pairs_bytes = 0) {
+    shape_ = shape;
+    if (pairs_bytes > 0) pairs_bytes_ = pairs_bytes;
+  }
   // volume = weighted backprojection of the filtered measurement onto the axial slices
   // first_slice, first_slice + slice_step, ... (as many as volume holds; 2D: 0, 1).
   void backproject(const cl::Buffer<float>& filtered, cl::Buffer<float>& volume,
                    std::size_t first_slice = 0, std::size_t slice_step = 1);
 
  private:
+  void backproject_by_lanes(const cl::Buffer<float>& filtered, cl::Buffer<float>& volume,
+                            std::size_t first_slice, std::size_t slice_step, std::size_t slices);
+
   cl::Context& context_;
   DeviceGeometry geometry_;
   bool divergent_;
@@ -45,6 +60,11 @@ class FbpOp {
   cl::Kernel backproject_parallel_one_;
   cl::Kernel backproject_divergent_;
   cl::Kernel backproject_divergent_one_;
+  cl::Kernel pair_lines_;
+  cl::Kernel backproject_parallel_lanes_;
+  cl::Kernel backproject_divergent_lanes_;
+  Shape shape_;
+  std::size_t pairs_bytes_ = std::size_t{64} << 20;
 };
 
 }  // namespace riner::ops
