@@ -9,6 +9,7 @@
 #include "model/air_readings.hpp"
 #include "model/chessboard_distance.hpp"
 #include "model/object_seen_by_fbp.hpp"
+#include "model/shadow_carving.hpp"
 #include "riner/array.hpp"
 #include "riner/rays.hpp"
 #include "util/parallel.hpp"
@@ -29,59 +30,6 @@ double upper_quantile(double p) {
     (0.5 * std::erfc(mid / std::sqrt(2.0)) > p ? lo : hi) = mid;
   }
   return hi;
-}
-
-// Whether view v certifies every element of the shadow of a voxel centred at p (a sphere
-// circumscribing the voxel), widened along the row by `widen` elements; a view whose shadow
-// leaves the detector does not.
-bool shadow_certified(const Geometry& g, std::size_t v, const ViewRotation& rotation, const Vec3& p,
-                      double radius, double widen, std::size_t rows,
-                      const std::vector<std::uint8_t>& certified) {
-  const DetectorPoint d = project_to_detector(g, rotation, p);
-  const double hu = radius * d.magnification / g.pitch_u + widen;
-  const double u0 = std::floor(d.u - hu), u1 = std::ceil(d.u + hu);
-  if (!(u0 >= 0.0 && u1 <= static_cast<double>(g.n_u) - 1.0)) return false;
-  double r0 = 0.0, r1 = 0.0;
-  if (g.is_3d()) {
-    const double hv = radius * d.magnification / g.pitch_v;
-    r0 = std::floor(d.v - hv);
-    r1 = std::ceil(d.v + hv);
-    if (!(r0 >= 0.0 && r1 <= static_cast<double>(rows) - 1.0)) return false;
-  }
-  for (auto r = static_cast<std::size_t>(r0); r <= static_cast<std::size_t>(r1); ++r) {
-    const std::uint8_t* line = certified.data() + (v * rows + r) * g.n_u;
-    for (auto u = static_cast<std::size_t>(u0); u <= static_cast<std::size_t>(u1); ++u) {
-      if (line[u] == 0) return false;
-    }
-  }
-  return true;
-}
-
-// 0 for the voxels at least min_views views certify as air, 1 elsewhere.
-std::vector<std::uint8_t> carve(const Geometry& g, std::size_t rows,
-                                const std::vector<std::uint8_t>& certified, int min_views,
-                                double widen) {
-  const std::size_t voxels = shape_size(g.volume_shape);
-  const std::size_t rank = g.volume_shape.size();
-  const std::size_t nx = g.volume_shape[rank - 1];
-  const std::size_t ny = g.volume_shape[rank - 2];
-  const double radius = 0.5 * g.voxel_mm * std::sqrt(static_cast<double>(rank));
-  std::vector<std::uint8_t> inside(voxels, 1);
-  std::vector<ViewRotation> rotations;
-  for (std::size_t v = 0; v < g.n_views(); ++v) rotations.push_back(ViewRotation::of(g, v));
-  util::parallel_for(voxels, [&](std::size_t begin, std::size_t end) {
-    for (std::size_t i = begin; i < end; ++i) {
-      const Vec3 p =
-          voxel_centre(g, static_cast<double>(i % nx), static_cast<double>((i / nx) % ny),
-                       static_cast<double>(i / (nx * ny)));
-      int views = 0;
-      for (std::size_t v = 0; v < g.n_views() && views < min_views; ++v) {
-        views += shadow_certified(g, v, rotations[v], p, radius, widen, rows, certified);
-      }
-      inside[i] = views < min_views;
-    }
-  });
-  return inside;
 }
 
 // The nearest integer of x >= -0.5, and some integer <= 0 below that (callers clamp to the
@@ -250,9 +198,9 @@ Occupancy carve_occupancy(const Scan& scan, RaySegments& segments, double spacin
     o.note = air.note;
     return o;
   }
-  std::vector<std::uint8_t> kept =
-      carve(g, g.is_3d() ? g.n_v : 1, air.certified(scan, settings.noise_sigmas),
-            std::max(1, settings.min_views), std::max(0.0, settings.centre_tolerance_px));
+  std::vector<std::uint8_t> kept = carve_by_shadows(
+      g, g.is_3d() ? g.n_v : 1, air.certified(scan, settings.noise_sigmas),
+      std::max(1, settings.min_views), std::max(0.0, settings.centre_tolerance_px));
   if (settings.fbp_check) {
     const ObjectSeenByFbp seen =
         object_seen_by_fbp(scan, kept, {settings.fbp_sigmas, settings.engine, settings.device});
