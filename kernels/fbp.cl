@@ -43,6 +43,28 @@ inline float slice_height(const ScanGeometry g, const int l) {
   return ((float)l - 0.5f * (float)(g.nz - 1)) * g.voxel + g.grid_z;
 }
 
+// A parallel beam's slice l on the detector: its two rows' first values (rows clamped, lines of
+// `line` values) and their weights (0 off the detector).
+typedef struct {
+  int row0, row1;
+  float w_row0, w_row1;
+} SliceRows;
+
+inline SliceRows parallel_slice_rows(const ScanGeometry g, const int l, const int line) {
+  const int rows = g.is_3d ? g.n_v : 1;
+  const float z = g.is_3d ? slice_height(g, l) : 0.0f;
+  const float v = g.is_3d ? z / g.pitch_v + 0.5f * (float)(g.n_v - 1) - g.offset_v : 0.0f;
+  const float fv = floor(v);
+  const int r = (int)fv;
+  const float wv = v - fv;
+  SliceRows out;
+  out.w_row0 = (r >= 0 && r < rows) ? 1.0f - wv : 0.0f;
+  out.w_row1 = (r + 1 >= 0 && r + 1 < rows) ? wv : 0.0f;
+  out.row0 = clamp(r, 0, rows - 1) * line;
+  out.row1 = clamp(r + 1, 0, rows - 1) * line;
+  return out;
+}
+
 // One work-item's block of `slices` (1 or kParallelSlices, a constant where it is inlined, so
 // the per-slice arrays stay in registers).
 inline void backproject_parallel_block(const uint gid, const uint n_items, const uint first_slice,
@@ -64,16 +86,12 @@ inline void backproject_parallel_block(const uint gid, const uint n_items, const
   float w_row0[kParallelSlices], w_row1[kParallelSlices], sum[kParallelSlices];
   for (int s = 0; s < slices; ++s) {
     const uint selected = block * slices + s;
-    const int l = first_slice + min(selected, n_selected - 1) * slice_step;
-    const float z = g.is_3d ? slice_height(g, l) : 0.0f;
-    const float v = g.is_3d ? z / g.pitch_v + 0.5f * (float)(g.n_v - 1) - g.offset_v : 0.0f;
-    const float fv = floor(v);
-    const int r = (int)fv;
-    const float wv = v - fv;
-    w_row0[s] = (r >= 0 && r < rows) ? 1.0f - wv : 0.0f;
-    w_row1[s] = (r + 1 >= 0 && r + 1 < rows) ? wv : 0.0f;
-    row0[s] = clamp(r, 0, rows - 1) * g.n_u;
-    row1[s] = clamp(r + 1, 0, rows - 1) * g.n_u;
+    const SliceRows on =
+        parallel_slice_rows(g, first_slice + min(selected, n_selected - 1) * slice_step, g.n_u);
+    row0[s] = on.row0;
+    row1[s] = on.row1;
+    w_row0[s] = on.w_row0;
+    w_row1[s] = on.w_row1;
     sum[s] = 0.0f;
   }
   // Slices on the rows' centres (a 2D scan; voxels as tall as the rows) need one row.
@@ -239,18 +257,22 @@ inline float16 lanes_interpolate(__global const float2* pairs, const int16 line,
   return a + (u - fu) * (b - a);
 }
 
-// A work-item's tile: kLanes columns from k0, kLaneRows rows from i0, of selected slice `s`.
+// A work-item's tile: kLanes columns from k0, kLaneRows rows from i0, of the selected slice
+// `selected` (the grid's slice l).
 typedef struct {
   int k0, i0;
   uint selected;
+  int l;
   float16 x;  // the columns' x (mm)
 } LaneTile;
 
-inline LaneTile lane_tile(const uint gid, const ScanGeometry g) {
+inline LaneTile lane_tile(const uint gid, const ScanGeometry g, const uint first_slice,
+                          const uint slice_step) {
   const uint tiles_x = ((uint)g.nx + kLanes - 1) / kLanes;
   const uint tiles = tiles_x * (((uint)g.ny + kLaneRows - 1) / kLaneRows);
   LaneTile t;
   t.selected = gid / tiles;
+  t.l = first_slice + t.selected * slice_step;
   t.k0 = (int)((gid % tiles) % tiles_x) * kLanes;
   t.i0 = (int)((gid % tiles) / tiles_x) * kLaneRows;
   const int16 k = (int16)(t.k0) + (int16)(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
@@ -287,20 +309,10 @@ __kernel void fbp_backproject_parallel_lanes(const uint n_items, const uint firs
                                              __global float* volume) {
   const uint gid = get_global_id(0);
   if (gid >= n_items) return;
-  const LaneTile t = lane_tile(gid, g);
+  const LaneTile t = lane_tile(gid, g, first_slice, slice_step);
   const int rows = g.is_3d ? g.n_v : 1;
   const int per_line = g.n_u + 3;
-  // The slice's two rows (clamped) and their weights (0 off the detector), as in the GPU's
-  // shape.
-  const int l = first_slice + t.selected * slice_step;
-  const float z = g.is_3d ? slice_height(g, l) : 0.0f;
-  const float v = g.is_3d ? z / g.pitch_v + 0.5f * (float)(g.n_v - 1) - g.offset_v : 0.0f;
-  const float fv = floor(v);
-  const int r = (int)fv;
-  const float w_row0 = (r >= 0 && r < rows) ? 1.0f - (v - fv) : 0.0f;
-  const float w_row1 = (r + 1 >= 0 && r + 1 < rows) ? v - fv : 0.0f;
-  const int row0 = clamp(r, 0, rows - 1) * per_line;
-  const int row1 = clamp(r + 1, 0, rows - 1) * per_line;
+  const SliceRows on = parallel_slice_rows(g, t.l, per_line);
   const float u_centre = 0.5f * (float)(g.n_u - 1) - g.offset_u;
   const float16 x = t.x / g.pitch_u;
   float16 sum[kLaneRows];
@@ -308,14 +320,14 @@ __kernel void fbp_backproject_parallel_lanes(const uint n_items, const uint firs
   for (int c = 0; c < chunk_views; ++c) {
     const float2 cs = views[first_view + c];
     const float weight = view_weights[first_view + c];
-    const int16 line0 = (int16)(c * rows * per_line + row0);
-    const int16 line1 = (int16)(c * rows * per_line + row1);
+    const int16 line0 = (int16)(c * rows * per_line + on.row0);
+    const int16 line1 = (int16)(c * rows * per_line + on.row1);
     const float16 ux = x * cs.x + u_centre;
 #pragma unroll
     for (int i = 0; i < kLaneRows; ++i) {
       const float16 u = ux + lane_row_y(g, t.i0 + i) / g.pitch_u * cs.y;
-      float16 value = w_row0 * lanes_interpolate(pairs, line0, u, g.n_u);
-      if (w_row1 != 0.0f) value += w_row1 * lanes_interpolate(pairs, line1, u, g.n_u);
+      float16 value = on.w_row0 * lanes_interpolate(pairs, line0, u, g.n_u);
+      if (on.w_row1 != 0.0f) value += on.w_row1 * lanes_interpolate(pairs, line1, u, g.n_u);
       sum[i] += weight * value;
     }
   }
@@ -332,12 +344,10 @@ __kernel void fbp_backproject_divergent_lanes(const uint n_items, const uint fir
                                               __global float* volume) {
   const uint gid = get_global_id(0);
   if (gid >= n_items) return;
-  const LaneTile t = lane_tile(gid, g);
+  const LaneTile t = lane_tile(gid, g, first_slice, slice_step);
   const int rows = g.is_3d ? g.n_v : 1;
   const int per_line = g.n_u + 3;
-  const int l = first_slice + t.selected * slice_step;
-  const float z_over_pitch =
-      g.is_3d ? slice_height(g, l) / g.pitch_v : 0.0f;
+  const float z_over_pitch = g.is_3d ? slice_height(g, t.l) / g.pitch_v : 0.0f;
   const float u_centre = 0.5f * (float)(g.n_u - 1) - g.offset_u;
   const float v_centre = g.is_3d ? 0.5f * (float)(g.n_v - 1) - g.offset_v : 0.0f;
   float16 sum[kLaneRows];

@@ -16,19 +16,29 @@ double voxel_radius(const Geometry& g) {
   return 0.5 * g.voxel_mm * std::sqrt(static_cast<double>(g.volume_shape.size()));
 }
 
+// A voxel's shadow around its centre's projection d: half widths in elements along the row
+// (widened) and in rows. block_verdict bounds these over a block: one formula for both.
+struct ShadowHalfWidths {
+  double u = 0.0, v = 0.0;
+};
+
+ShadowHalfWidths shadow_half_widths(const Geometry& g, const DetectorPoint& d, double radius,
+                                    double widen) {
+  return {radius * d.magnification / g.pitch_u + widen, radius * d.magnification / g.pitch_v};
+}
+
 // Whether view v certifies every element of the shadow of a voxel centred at p.
 bool shadow_certified(const Geometry& g, std::size_t v, const ViewRotation& rotation, const Vec3& p,
                       double radius, double widen, std::size_t rows,
                       const std::vector<std::uint8_t>& certified) {
   const DetectorPoint d = project_to_detector(g, rotation, p);
-  const double hu = radius * d.magnification / g.pitch_u + widen;
-  const double u0 = std::floor(d.u - hu), u1 = std::ceil(d.u + hu);
+  const ShadowHalfWidths h = shadow_half_widths(g, d, radius, widen);
+  const double u0 = std::floor(d.u - h.u), u1 = std::ceil(d.u + h.u);
   if (!(u0 >= 0.0 && u1 <= static_cast<double>(g.n_u) - 1.0)) return false;
   double r0 = 0.0, r1 = 0.0;
   if (g.is_3d()) {
-    const double hv = radius * d.magnification / g.pitch_v;
-    r0 = std::floor(d.v - hv);
-    r1 = std::ceil(d.v + hv);
+    r0 = std::floor(d.v - h.v);
+    r1 = std::ceil(d.v + h.v);
     if (!(r0 >= 0.0 && r1 <= static_cast<double>(rows) - 1.0)) return false;
   }
   for (auto r = static_cast<std::size_t>(r0); r <= static_cast<std::size_t>(r1); ++r) {
@@ -112,13 +122,12 @@ std::uint8_t block_verdict(const Geometry& g, const ViewRotation& rotation, cons
   for (int c = 0; c < corners; ++c) {
     const Vec3 p{(c & 1) ? high.x : low.x, (c & 2) ? high.y : low.y, (c & 4) ? high.z : low.z};
     const DetectorPoint d = project_to_detector(g, rotation, p);
-    const double hu = radius * d.magnification / g.pitch_u + widen;
-    lo_u = std::min(lo_u, d.u - hu);
-    hi_u = std::max(hi_u, d.u + hu);
+    const ShadowHalfWidths h = shadow_half_widths(g, d, radius, widen);
+    lo_u = std::min(lo_u, d.u - h.u);
+    hi_u = std::max(hi_u, d.u + h.u);
     if (g.is_3d()) {
-      const double hv = radius * d.magnification / g.pitch_v;
-      lo_v = std::min(lo_v, d.v - hv);
-      hi_v = std::max(hi_v, d.v + hv);
+      lo_v = std::min(lo_v, d.v - h.v);
+      hi_v = std::max(hi_v, d.v + h.v);
     }
   }
   auto floor_of = [](double x) { return std::floor(x - 1e-9 * (1.0 + std::abs(x))); };

@@ -39,7 +39,7 @@ FbpOp::FbpOp(cl::Context& context, const Geometry& geometry, const std::vector<d
       pair_lines_(*program_, "fbp_pair_lines"),
       backproject_parallel_lanes_(*program_, "fbp_backproject_parallel_lanes"),
       backproject_divergent_lanes_(*program_, "fbp_backproject_divergent_lanes"),
-      // Measured on PoCL (docs/history/RESULTS.md, "a CPU's backprojection"): 7-9x faster there.
+      // Measured on PoCL (docs/history/RESULTS.md, "a CPU's backprojection"): 7-8x faster there.
       shape_(context.info().type == "CPU" ? Shape::kLanes : Shape::kPerVoxel) {
   if (taps.size() != 2 * geometry.n_u - 1 || view_weights.size() != geometry.n_views()) {
     throw Error("fbp: taps or view weights do not match the geometry");

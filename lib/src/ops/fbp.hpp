@@ -27,10 +27,8 @@ class FbpOp {
   }
   // How backproject() lays its work out (kernels/fbp.cl): one voxel per work-item (a GPU's
   // shape), or vectors of voxels that read the detector's values as pairs (a CPU's, the
-  // default on a CPU device; it holds the filtered measurement again, twice over, while it
-  // runs).
+  // default on a CPU device; the pairs of a chunk of views, at most 64 MiB, while it runs).
   enum class Shape { kPerVoxel, kLanes };
-  Shape shape() const { return shape_; }
   // The tests' way to run both shapes on one device; `pairs_bytes` > 0 bounds the CPU's shape's
   // pairs to a chunk of views that size (default 64 MiB: every view of a slice at once).
   void use_shape(Shape shape, std::size_t pairs_bytes = 0) {
