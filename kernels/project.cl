@@ -42,6 +42,8 @@ __kernel void project_forward(const uint n_rays, const ScanGeometry g, __global 
 // the 32 values read from just below the lowest (with ROUNDING's slack).
 #define PROJECT_MAX_SPAN 28.0f
 #define PROJECT_ROUNDING 0.01f
+// The widest spread of a 3D group's crossings across its lines (cells): at most 5 lines a plane.
+#define PROJECT_MAX_SPREAD 3.0f
 
 __kernel void project_transpose_xy(const uint n, const ScanGeometry g,
                                    __global const float* volume, __global float* volume_t) {
@@ -179,7 +181,7 @@ inline int lane_walks(const ScanGeometry* g, float2 cs, int first_element, int r
     }
   }
   lanes->by_lines = ordered && spread0 <= PROJECT_MAX_SPAN &&
-                    spread1 <= 1.0f - 2.0f * PROJECT_ROUNDING;
+                    spread1 <= PROJECT_MAX_SPREAD - 2.0f * PROJECT_ROUNDING;
   const int main_axis = lanes->shared.main_axis;
   const int plane = g->nx * g->ny;
   lanes->line_main = main_axis == 0 ? g->ny : (main_axis == 1 ? g->nx : plane);
@@ -265,28 +267,34 @@ inline float16 lanes_sum_3d(const LaneWalks* lanes, __global const float* volume
     const float16 near1 = 1.0f - t1;
     float16 a, b, c, d;  // the cells (0, 0), (1, 0), (0, 1), (1, 1)
     if (lanes->by_lines) {
-      // The lanes' cells lie on lines j, j + 1 (lanes at i1 = j) or j + 1, j + 2 (at j + 1).
+      // The lanes' cells lie on lines j .. top + 1, a lane's two on its i1 and i1 + 1.
       const int k0 = lanes->lowest0;
       const int start = line_start(lanes->base0[k0] + (float)m * lanes->slope0[k0], w->n0);
       __global const float* plane = lines + m * lanes->line_main + start;
       const uint16 o = as_uint16(i0 - start);
       const float c_low = lanes->base1[lanes->lowest1] + (float)m * lanes->slope1[lanes->lowest1];
       const int j = lanes->level1 ? (int)c_low : (int)floor(c_low - PROJECT_ROUNDING);
+      const int h = lanes->highest1;
+      const int top = lanes->level1 ? j
+                                    : (int)floor(lanes->base1[h] + (float)m * lanes->slope1[h] +
+                                                 PROJECT_ROUNDING);
       const int n1 = w->n1;
       line_cells(plane + clamp(j, 0, n1 - 1) * lanes->line_other1, o, &a, &b);
       if (lanes->level1) {
         c = d = 0.0f;  // their weights are 0
-      } else {
+      } else if (top == j) {
         line_cells(plane + clamp(j + 1, 0, n1 - 1) * lanes->line_other1, o, &c, &d);
-        const int h = lanes->highest1;
-        if ((int)floor(lanes->base1[h] + (float)m * lanes->slope1[h] + PROJECT_ROUNDING) != j) {
-          float16 here2, next2;
-          line_cells(plane + clamp(j + 2, 0, n1 - 1) * lanes->line_other1, o, &here2, &next2);
-          const int16 upper = i1 != (int16)(j);
-          a = select(a, c, upper);
-          b = select(b, d, upper);
-          c = select(c, here2, upper);
-          d = select(d, next2, upper);
+      } else {
+        c = d = 0.0f;
+        for (int q = j + 1; q <= top + 1; ++q) {
+          float16 here, next;
+          line_cells(plane + clamp(q, 0, n1 - 1) * lanes->line_other1, o, &here, &next);
+          const int16 on = i1 == (int16)(q);
+          const int16 below = i1 == (int16)(q - 1);
+          a = select(a, here, on);
+          b = select(b, next, on);
+          c = select(c, here, below);
+          d = select(d, next, below);
         }
       }
     } else {
