@@ -30,7 +30,7 @@ __kernel void project_forward(const uint n_rays, const ScanGeometry g, __global 
 //     item = (view * n_v + row) * groups + group, groups = ceil(n_u / 16); the same sums as
 //     project_forward, term by term in the same order.
 // At each plane the rays' cells lie along a line of the plane (the other axis in 2D; in 3D two
-// or three neighbouring lines): where the group's crossings span at most 28 cells, the work-item
+// to five neighbouring lines): where the group's crossings span at most 28 cells, the work-item
 // reads 32 contiguous values of each line and permutes them to its lanes. Elsewhere (a fan
 // beam's widest groups, lines under 32 cells, a 3D group spread over more lines) it gathers
 // each lane's cells, and a group whose rays do not share their main axis (a fan near 45
