@@ -2,7 +2,9 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <iterator>
 #include <random>
+#include <vector>
 
 #include "cl/buffer.hpp"
 #include "cl/device_access.hpp"
@@ -54,7 +56,8 @@ const riner::Geometry kGeometries[] = {riner::test::small_fan2d(),
                                        axis_aligned(riner::test::small_parallel2d()),
                                        axis_aligned(riner::test::small_parallel3d())};
 
-// Geometries for the projector's two shapes (ops::ProjectOp::Shape).
+// Geometries for the projector's two shapes (ops::ProjectOp::Shape): the suite's, and the cases
+// of the CPU's shape.
 std::vector<riner::Geometry> forward_shape_geometries() {
   using riner::GeometryType;
   using riner::test::make_geometry;
@@ -74,18 +77,9 @@ std::vector<riner::Geometry> forward_shape_geometries() {
   steep.origin_detector_mm = 10.0;
   steep.pitch_v = 4.0;
   steep.validate();
-  return {riner::test::small_fan2d(),
-          riner::test::small_parallel2d(),
-          axis_aligned(riner::test::small_parallel2d()),
-          narrow,
-          coarse,
-          riner::test::small_cone3d(),
-          raised(riner::test::small_cone3d()),
-          riner::test::small_parallel3d(),
-          level,
-          between,
-          axis_aligned(riner::test::small_parallel3d()),
-          steep};
+  std::vector<riner::Geometry> geometries(std::begin(kGeometries), std::end(kGeometries));
+  geometries.insert(geometries.end(), {narrow, coarse, level, between, steep});
+  return geometries;
 }
 
 // Both shapes against the reference and each other, on random volumes.
