@@ -1,5 +1,6 @@
 // hash_grid.cl: the multiresolution grid encoding (instant-NGP) and its gradient.
 //   Helpers: hash_grid_encode(levels, table, pos, out), hash_grid_scatter(levels, grad, pos, d_out)
+//            and, for 16 positions in float16 lanes, hash_grid_encode_lanes and its parts
 //   hash_grid_forward(n, levels, table, positions, features)
 //     one work-item per point; features [n][N_LEVELS * N_FEATURES]
 //   hash_grid_backward(n, levels, positions, d_features, grad)
@@ -156,6 +157,121 @@ RINER_INLINE void hash_grid_scatter(__constant const GridLevel* levels, __global
       for (int f = 0; f < N_FEATURES; ++f)
         GRAD_ADD(&grad[index + f], w * d_out[l * N_FEATURES + f]);
     }
+  }
+}
+
+// ---- 16 positions at once (the CPU's shape: riner_step_lanes.cl, hash_grid_gradient.cl) ----
+// The same arithmetic as the helpers above, lane by lane.
+
+#define GRID_LANES 16
+
+// 16 lanes' values table[at[k]].
+RINER_INLINE float16 gather16(__global const float* table, const uint* at) {
+  float v[GRID_LANES];
+  RINER_UNROLL
+  for (int k = 0; k < GRID_LANES; ++k) v[k] = table[at[k]];
+  return vload16(0, v);
+}
+
+RINER_INLINE void hash_grid_cell_lanes(__constant const GridLevel* level, const float16* pos,
+                                       uint16* cell, float16* frac) {
+  RINER_UNROLL
+  for (int d = 0; d < DIMS; ++d) {
+    const float16 x = clamp(pos[d], 0.0f, 1.0f) * level->scale + 0.5f;
+    cell[d] = convert_uint16(x);
+    frac[d] = x - convert_float16(cell[d]);
+  }
+}
+
+RINER_INLINE uint16 hash_grid_corner_entry_lanes(__constant const GridLevel* level,
+                                                 const uint16* cell, const float16* frac,
+                                                 int corner, float16* weight) {
+  uint16 coords[DIMS];
+  float16 w = 1.0f;
+  RINER_UNROLL
+  for (int d = 0; d < DIMS; ++d) {
+    const uint upper = (corner >> d) & 1;
+    coords[d] = cell[d] + upper;
+    w *= upper ? frac[d] : 1.0f - frac[d];
+  }
+  *weight = w;
+  uint16 index;
+  if (level->hashed) {
+    index = coords[0] ^ (coords[1] * 2654435761u);
+#if DIMS == 3
+    index ^= coords[2] * 805459861u;
+#endif
+    index %= TABLE_SIZE;
+  } else {
+    index = coords[0] + coords[1] * level->resolution;
+#if DIMS == 3
+    index += coords[2] * level->resolution * level->resolution;
+#endif
+  }
+  return index;
+}
+
+RINER_INLINE void hash_grid_encode_lanes(__constant const GridLevel* levels,
+                                         __global const float* table, const float16* pos,
+                                         float16* out) {
+  RINER_UNROLL
+  for (int l = 0; l < N_LEVELS; ++l) {
+    __constant const GridLevel* level = &levels[l];
+    uint16 cell[DIMS];
+    float16 frac[DIMS];
+    hash_grid_cell_lanes(level, pos, cell, frac);
+    __global const float* entries = table + level->offset;
+#if N_FEATURES == 2
+    if (!level->hashed) {
+      const uint res = level->resolution;
+      uint16 base = cell[0] + cell[1] * res;
+#if DIMS == 3
+      base += cell[2] * res * res;
+#endif
+      float16 acc0 = 0.0f;
+      float16 acc1 = 0.0f;
+      RINER_UNROLL
+      for (int pair = 0; pair < N_CORNERS / 2; ++pair) {
+        uint16 index = base;
+        float16 w = 1.0f;
+        if (pair & 1) index += res;
+        w *= (pair & 1) ? frac[1] : 1.0f - frac[1];
+#if DIMS == 3
+        if (pair & 2) index += res * res;
+        w *= (pair & 2) ? frac[2] : 1.0f - frac[2];
+#endif
+        uint at[GRID_LANES];
+        vstore16(index * 2, 0, at);
+        float v[4][GRID_LANES];
+        RINER_UNROLL
+        for (int k = 0; k < GRID_LANES; ++k) {
+          const float4 e = vload4(0, entries + at[k]);
+          v[0][k] = e.x;
+          v[1][k] = e.y;
+          v[2][k] = e.z;
+          v[3][k] = e.w;
+        }
+        acc0 += w * ((1.0f - frac[0]) * vload16(0, v[0]) + frac[0] * vload16(0, v[2]));
+        acc1 += w * ((1.0f - frac[0]) * vload16(0, v[1]) + frac[0] * vload16(0, v[3]));
+      }
+      out[l * 2] = acc0;
+      out[l * 2 + 1] = acc1;
+      continue;
+    }
+#endif
+    float16 acc[N_FEATURES];
+    RINER_UNROLL
+    for (int f = 0; f < N_FEATURES; ++f) acc[f] = 0.0f;
+    RINER_UNROLL
+    for (int c = 0; c < N_CORNERS; ++c) {
+      float16 w;
+      uint at[GRID_LANES];
+      vstore16(hash_grid_corner_entry_lanes(level, cell, frac, c, &w) * N_FEATURES, 0, at);
+      RINER_UNROLL
+      for (int f = 0; f < N_FEATURES; ++f) acc[f] += w * gather16(entries + f, at);
+    }
+    RINER_UNROLL
+    for (int f = 0; f < N_FEATURES; ++f) out[l * N_FEATURES + f] = acc[f];
   }
 }
 

@@ -34,6 +34,7 @@ SOURCES = {
     "cores": "issue30_cores16.jsonl",
     "gpu_slow_step": "issue30_gpu_loss_median.jsonl",
     "steps_gpu": "issue12_gpu_ops.jsonl",
+    "steps_cpu": "cpu_step_lanes.jsonl",
     # newest first: a volume at the defaults in a later file hides the earlier row
     "volumes": ("issue29_residual_detail_volume.jsonl", "issue34_volume_defaults.jsonl"),
     "partial_rings": "issue32_partial_rings.jsonl",
@@ -483,7 +484,8 @@ def cores(root):
 
 def training_steps(root):
     rows = []
-    for r in records(root, SOURCES["steps_gpu"]) + records(root, SOURCES["gpu_slow_step"]):
+    for r in (records(root, SOURCES["steps_gpu"]) + records(root, SOURCES["gpu_slow_step"]) +
+              records(root, SOURCES["steps_cpu"])):
         if r["case"] != "training_step":
             continue
         rows.append([machine(r["meta"]), r["plan"].split(":")[0], r["rays_per_step"],

@@ -1,12 +1,15 @@
 // The training step of each execution plan (kernels/riner_step.cl with mlp_gradient.cl and
 // hash_grid_gradient.cl, ops::RinerStepOp) against its CPU twin ref::riner_step, in double, on
 // random parameters, measurements and batches: ray sums, their loss gradients, every
-// parameter's gradient, the losses.
+// parameter's gradient, the losses. The cpu plan runs both shapes of its per-sample kernels
+// (riner_step_lanes.cl and one sample per work-item), which must agree to the bit.
 #include <doctest/doctest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 #include <random>
+#include <string>
 
 #include "cl/buffer.hpp"
 #include "cl/device_access.hpp"
@@ -35,15 +38,21 @@ struct Scenario {
   bool hold_valid_beta = false;
   bool coarse_to_fine = false;
   int hidden_layers = 1;
+  int features = 2;  // 2: the dense levels' paired loads; else corner by corner
+  int width = 16;
   bool changing_responses = false;  // a few elements' responses change or die part-way
   int rays_per_step = 40;
 };
 
 std::vector<Scenario> scenarios() {
   std::vector<Scenario> s;
-  s.push_back({"fan 2D, uniform rays, midpoints", riner::test::small_fan2d()});
-  Scenario mixed{"parallel 2D, mixed batch, ring prior, jitter, coarse to fine, relative beta",
-                 riner::test::small_parallel2d()};
+  Scenario fan{"fan 2D, uniform rays, midpoints, 3 features", riner::test::small_fan2d()};
+  fan.features = 3;
+  s.push_back(fan);
+  Scenario mixed{
+      "parallel 2D, mixed batch, ring prior, jitter, coarse to fine, relative beta, 2 hidden "
+      "layers",
+      riner::test::small_parallel2d()};
   mixed.sampler = riner::Sampler::kMixed;
   mixed.jitter = true;
   mixed.ring_lambda = 3.0;
@@ -59,8 +68,10 @@ std::vector<Scenario> scenarios() {
   changing.hold_valid_beta = true;
   changing.rays_per_step = 400;  // ~4 rays per element: every segment of 40, 45 and 50 is read
   s.push_back(changing);
-  Scenario cone{"cone 3D, uniform rays, jitter, hashed levels", riner::test::small_cone3d()};
+  Scenario cone{"cone 3D, uniform rays, jitter, hashed levels, width 32",
+                riner::test::small_cone3d()};
   cone.jitter = true;
+  cone.width = 32;
   s.push_back(cone);
   return s;
 }
@@ -112,8 +123,8 @@ TEST_SUITE("riner_step") {
       if (sc.changing_responses != changing_responses) continue;
       const riner::Geometry& g = sc.geometry;
       riner::RinerConfig c;
-      c.encoding = {5, 2, g.is_3d() ? 10 : 14, 4, 48};  // 3D: hashed fine levels
-      c.network = {16, sc.hidden_layers};
+      c.encoding = {5, sc.features, g.is_3d() ? 10 : 14, 4, 48};  // 3D: hashed fine levels
+      c.network = {sc.width, sc.hidden_layers};
       riner::TrainingConfig& t = c.training;
       t.sampler = sc.sampler;
       t.rays_per_step = sc.rays_per_step;
@@ -162,14 +173,21 @@ TEST_SUITE("riner_step") {
 
       // The steps read every changing segment's slot (else the case would test nothing).
       std::vector<std::uint8_t> read(map.slots() - per_view, 0);
-      for (const char* kind : {"cpu", "gpu"}) {
+      using Shape = riner::ops::RinerStepOp::Shape;
+      std::map<std::uint32_t, std::vector<double>> lanes_grad;  // by step
+      std::map<std::uint32_t, std::vector<float>> lanes_sums;
+      for (const char* kind : {"cpu", "cpu per-sample", "gpu"}) {
         riner::PlanConfig pc;
-        pc.kind = kind;
+        pc.kind = kind[0] == 'c' ? "cpu" : "gpu";
         const riner::ExecutionPlan plan = riner::choose_execution_plan(ctx().info(), pc);
         riner::ops::RinerStepOp op(ctx(), l, plan, sampler.rays_per_step());
+        const bool per_sample_cpu = std::string(kind) == "cpu per-sample";
+        if (per_sample_cpu) op.use_shape(Shape::kPerSample);
+        const std::string scenario = sc.name;
+        const std::string kind_name = kind;
         for (std::uint32_t step : {3u, 11u}) {
-          CAPTURE(sc.name);
-          CAPTURE(kind);
+          CAPTURE(scenario);
+          CAPTURE(kind_name);
           CAPTURE(step);
           const riner::model::Batch batch = sampler.batch(step);
           riner::model::PackedBatch packed;
@@ -191,6 +209,15 @@ TEST_SUITE("riner_step") {
           p.block_elements = batch.block_elements;
           riner::cl::Buffer<float> grad(ctx(), std::vector<float>(l.total, 0.0f));
           device.step(op, p, words, grad);
+          // The cpu plan's two shapes: the same ray sums and gradients to the bit.
+          if (std::string(kind) == "cpu") {
+            lanes_grad[step] = full_gradient(op, l, grad.read());
+            lanes_sums[step] = op.ray_sums().read();
+          }
+          if (per_sample_cpu) {
+            CHECK(op.ray_sums().read() == lanes_sums[step]);
+            CHECK(full_gradient(op, l, grad.read()) == lanes_grad[step]);
+          }
 
           riner::ref::StepInputs in;
           in.layout = &l;

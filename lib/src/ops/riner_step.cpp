@@ -13,9 +13,12 @@ namespace {
 // save in parallelism.
 constexpr std::size_t kMinSliceSamples = 64;
 
+// Samples per work-item of the lanes kernels (riner_step_lanes.cl).
+constexpr std::size_t kLanes = 16;
+
 std::vector<std::string> step_sources() {
-  return {"common",       "hash_grid",  "mlp",          "ray_sum",
-          "sample_cache", "riner_step", "mlp_gradient", "hash_grid_gradient"};
+  return {"common",     "hash_grid",        "mlp",          "ray_sum",           "sample_cache",
+          "riner_step", "riner_step_lanes", "mlp_gradient", "hash_grid_gradient"};
 }
 
 }  // namespace
@@ -54,17 +57,30 @@ RinerStepOp::RinerStepOp(cl::Context& context, const model::ParameterLayout& lay
           model_build_options(layout, plan.kind == PlanKind::kGpu, plan.float_atomics) +
               " -cl-mad-enable")),
       forward_(*program_, "riner_step_forward"),
+      forward_lanes_(*program_, "riner_step_forward_lanes"),
       loss_(*program_, "riner_step_loss"),
       backward_(*program_, "riner_step_backward"),
+      backward_lanes_(*program_, "riner_step_backward_lanes"),
       mlp_gradient_(*program_,
                     plan.kind == PlanKind::kCpu ? "mlp_gradient_blocked" : "mlp_gradient_partial"),
       grid_gradient_(*program_, "hash_grid_gradient_accumulate"),
-      evaluate_(*program_, "riner_step_field_evaluate") {}
+      grid_gradient_lanes_(*program_, "hash_grid_gradient_accumulate_lanes"),
+      evaluate_(*program_, "riner_step_field_evaluate"),
+      // The lanes kernels leave the grid's gradient to hash_grid_gradient.cl: the CPU plan's.
+      shape_(plan.kind == PlanKind::kCpu ? Shape::kLanes : Shape::kPerSample) {}
+
+void RinerStepOp::use_shape(Shape shape) {
+  if (shape == Shape::kLanes && plan_.kind != PlanKind::kCpu)
+    throw Error("riner_step: the lanes shape needs the CPU plan (the grid reduced by ownership)");
+  shape_ = shape;
+}
 
 void RinerStepOp::reserve_samples(std::size_t n) {
-  if (n <= cache_stride_ && cache_stride_ > 0) return;
-  // Room to grow, and a multiple of 4 so each cache row starts 16-byte aligned.
-  const std::size_t capacity = (std::max<std::size_t>(n + n / 4, 64) + 3) / 4 * 4;
+  // The lanes kernels write whole vectors of 16 (their last one padded).
+  const std::size_t rows = (n + kLanes - 1) / kLanes * kLanes;
+  if (rows <= cache_stride_ && cache_stride_ > 0) return;
+  // Room to grow, and a multiple of 16 so each cache row starts 64-byte aligned.
+  const std::size_t capacity = (std::max<std::size_t>(rows + rows / 4, 64) + 15) / 16 * 16;
   mu_dx_ = cl::Buffer<float>(context_, capacity);
   cache_ = cl::Buffer<float>(context_, capacity * cache_rows_);
   cache_stride_ = capacity;
@@ -83,7 +99,12 @@ void RinerStepOp::step(StepParams p, const cl::Buffer<cl_uint>& batch, const Ste
   p.beta_offset = static_cast<cl_uint>(layout_.beta_offset);
   p.mlp_offset = static_cast<cl_uint>(layout_.mlp_offset);
   const std::size_t samples = p.n_samples;
-  if (samples > 0) {
+  const bool lanes = shape_ == Shape::kLanes;
+  const std::size_t lane_items = (samples + kLanes - 1) / kLanes;
+  if (samples > 0 && lanes) {
+    forward_lanes_.set_args(p, batch, levels_, params, mu_dx_, cache_);
+    context_.launch(forward_lanes_, lane_items);
+  } else if (samples > 0) {
     forward_.set_args(p, batch, levels_, params, mu_dx_, cache_);
     context_.launch(forward_, samples, plan_.sample_group);
   }
@@ -93,12 +114,18 @@ void RinerStepOp::step(StepParams p, const cl::Buffer<cl_uint>& batch, const Ste
   context_.launch(loss_, plan_.loss_group, plan_.loss_group);
   slices_ = 0;
   if (samples == 0) return;
-  backward_.set_args(p, batch, levels_, params, d_sums_, cache_, grad);
-  context_.launch(backward_, samples, plan_.sample_group);
+  if (lanes) {
+    backward_lanes_.set_args(p, batch, levels_, params, d_sums_, cache_);
+    context_.launch(backward_lanes_, lane_items);
+  } else {
+    backward_.set_args(p, batch, levels_, params, d_sums_, cache_, grad);
+    context_.launch(backward_, samples, plan_.sample_group);
+  }
   if (plan_.kind == PlanKind::kCpu) {
     const auto bands = static_cast<cl_uint>(plan_.grid_bands);
-    grid_gradient_.set_args(p.n_samples, bands, p.cache_stride, levels_, cache_, grad);
-    context_.launch(grid_gradient_, static_cast<std::size_t>(layout_.levels) * bands, 1);
+    cl::Kernel& grid_gradient = lanes ? grid_gradient_lanes_ : grid_gradient_;
+    grid_gradient.set_args(p.n_samples, bands, p.cache_stride, levels_, cache_, grad);
+    context_.launch(grid_gradient, static_cast<std::size_t>(layout_.levels) * bands, 1);
   }
   slices_ = std::clamp<std::size_t>(samples / kMinSliceSamples, 1, plan_.gradient_slices);
   const std::size_t chunk = ((samples + slices_ - 1) / slices_ + 3) / 4 * 4;

@@ -75,6 +75,11 @@ class RinerStepOp {
   RinerStepOp(cl::Context& context, const model::ParameterLayout& layout, const ExecutionPlan& plan,
               std::size_t max_batch);
 
+  // The per-sample kernels' shape: one sample per work-item, or 16 in float16 lanes
+  // (riner_step_lanes.cl; the CPU plan's). The same values either way; tests compare them.
+  enum class Shape { kPerSample, kLanes };
+  void use_shape(Shape shape);
+
   // Enqueues the step's kernels: grad (zero on entry; Adam zeroes it after use) receives the
   // grid, alpha0 and beta0 gradients, mlp_partials() the MLP's (mlp_slices() slices of
   // layout.mlp_params), history[2 p.history_slot ..] the data term and the penalties.
@@ -111,11 +116,15 @@ class RinerStepOp {
   std::size_t slices_ = 0;
   std::shared_ptr<const cl::Program> program_;
   cl::Kernel forward_;
+  cl::Kernel forward_lanes_;
   cl::Kernel loss_;
   cl::Kernel backward_;
+  cl::Kernel backward_lanes_;
   cl::Kernel mlp_gradient_;
   cl::Kernel grid_gradient_;
+  cl::Kernel grid_gradient_lanes_;
   cl::Kernel evaluate_;
+  Shape shape_;
 };
 
 }  // namespace riner::ops
