@@ -8,9 +8,9 @@
 //   mlp_gradient_partial(n_samples, chunk, stride, cache, partials)
 //     one work-item per parameter (o = lid, lid + size, ...): many narrow work-items (GPUs).
 //   mlp_gradient_blocked(n_samples, chunk, stride, cache, partials)
-//     one work-item per block of 8 parameters that share a row (an input of 8 units, or the
-//     output unit's 8 inputs), 8 samples at a time in float8: few wide work-items that keep
-//     their rows in registers (CPUs, where PoCL runs a work-group on one thread).
+//     one work-item per block of up to 2 x 8 parameters: two inputs of the same 8 units (or
+//     the output unit's 8 inputs), 8 samples at a time in float8: few wide work-items that
+//     keep their rows in registers (CPUs, where PoCL runs a work-group on one thread).
 // Needs mlp.cl, sample_cache.cl (and their -D constants).
 
 #define ROW_ONE 0xffffffffu
@@ -70,41 +70,63 @@ __kernel void mlp_gradient_partial(const uint n_samples, const uint chunk, const
   }
 }
 
-// Blocks of 8 parameters: per layer (inputs + bias) x (units / 8) blocks whose shared row is
-// one input (or ROW_ONE for the biases) and whose 8 rows are 8 units' deltas; then the output
-// unit's weights as units / 8 blocks sharing the d_mu row; then b_out alone.
-#define BLOCKS_IN ((MLP_INPUTS + 1) * MLP_V * 2)
-#define BLOCKS_HIDDEN ((MLP_WIDTH + 1) * MLP_V * 2)
+// Blocks of 2 x 8 parameters: per layer, (inputs / 2 rounded up + 1) x (units / 8) blocks whose
+// two shared rows are two inputs (a layer's odd last input alone; ROW_ONE alone for the
+// biases) and whose 8 rows are 8 units' deltas, so each delta row read serves two weights;
+// then the output unit's weights as units / 8 blocks sharing the d_mu row; then b_out alone.
+#define NO_ROW 0xfffffffeu
+#define BLOCKS_IN (((MLP_INPUTS + 1) / 2 + 1) * MLP_V * 2)
+#define BLOCKS_HIDDEN (((MLP_WIDTH + 1) / 2 + 1) * MLP_V * 2)
 #define BLOCKS_OUT (MLP_V * 2)
 #define MLP_BLOCKS (BLOCKS_IN + (MLP_HIDDEN - 1) * BLOCKS_HIDDEN + BLOCKS_OUT + 1)
 
-// Block k: its shared row, its first of 8 consecutive rows, and the parameter of row 0.
-RINER_INLINE void mlp_gradient_block(uint k, uint* shared, uint* rows, uint* param) {
+// Block k of a layer with n_in inputs (rows first_input ..), deltas from first_delta, weights
+// from w and biases from b: its shared rows (the second NO_ROW when alone), its first of 8
+// consecutive rows, and the parameters of row 0 under each shared row.
+RINER_INLINE void layer_block(uint k, uint n_in, uint first_input, uint first_delta, uint w, uint b,
+                              uint* shared, uint* rows, uint* param) {
   const uint groups = MLP_WIDTH / 8;
+  const uint pair = k / groups;
+  const uint unit = k % groups * 8;
+  const uint input = 2 * pair;
+  *rows = first_delta + unit;
+  if (input >= n_in) {  // the biases
+    shared[0] = ROW_ONE;
+    shared[1] = NO_ROW;
+    param[0] = b + unit;
+    return;
+  }
+  shared[0] = first_input + input;
+  shared[1] = input + 1 < n_in ? first_input + input + 1 : NO_ROW;
+  param[0] = w + input * MLP_WIDTH + unit;
+  param[1] = param[0] + MLP_WIDTH;
+}
+
+RINER_INLINE void mlp_gradient_block(uint k, uint* shared, uint* rows, uint* param) {
   if (k < BLOCKS_IN) {
-    const uint input = k / groups;
-    const uint unit = k % groups * 8;
-    *shared = input < MLP_INPUTS ? CACHE_FEATURES + input : ROW_ONE;
-    *rows = CACHE_DELTA(0) + unit;
-    *param = input < MLP_INPUTS ? MLP_W_IN + input * MLP_WIDTH + unit : MLP_B_IN + unit;
+    layer_block(k, MLP_INPUTS, CACHE_FEATURES, CACHE_DELTA(0), MLP_W_IN, MLP_B_IN, shared, rows,
+                param);
     return;
   }
   k -= BLOCKS_IN;
   for (int h = 1; h < MLP_HIDDEN; ++h) {
     if (k < BLOCKS_HIDDEN) {
-      const uint input = k / groups;
-      const uint unit = k % groups * 8;
-      *shared = input < MLP_WIDTH ? CACHE_ACT(h - 1) + input : ROW_ONE;
-      *rows = CACHE_DELTA(h) + unit;
-      *param =
-          input < MLP_WIDTH ? MLP_W_HIDDEN(h) + input * MLP_WIDTH + unit : MLP_B_HIDDEN(h) + unit;
+      layer_block(k, MLP_WIDTH, CACHE_ACT(h - 1), CACHE_DELTA(h), MLP_W_HIDDEN(h), MLP_B_HIDDEN(h),
+                  shared, rows, param);
       return;
     }
     k -= BLOCKS_HIDDEN;
   }
-  *shared = CACHE_DMU;
+  shared[0] = CACHE_DMU;
+  shared[1] = NO_ROW;
   *rows = CACHE_ACT(MLP_HIDDEN - 1) + k * 8;
-  *param = MLP_W_OUT + k * 8;
+  param[0] = MLP_W_OUT + k * 8;
+}
+
+// (acc.lo + acc.hi) summed pairwise, then the tail: each parameter's sum in one fixed order.
+RINER_INLINE float block_total(float8 acc, float tail) {
+  const float4 h = acc.lo + acc.hi;
+  return (h.x + h.y) + (h.z + h.w) + tail;
 }
 
 __kernel void mlp_gradient_blocked(const uint n_samples, const uint chunk, const uint stride,
@@ -120,43 +142,55 @@ __kernel void mlp_gradient_blocked(const uint n_samples, const uint chunk, const
       out[MLP_B_OUT] = sum;
       continue;
     }
-    uint shared;
+    uint shared[2];
     uint rows;
-    uint param;
-    mlp_gradient_block(k, &shared, &rows, &param);
+    uint param[2];
+    mlp_gradient_block(k, shared, &rows, param);
     __global const float* r = cache + (size_t)rows * stride;
-    float8 acc[8];
+    float8 acc[2][8];
+    float tail[2][8];
     RINER_UNROLL
-    for (int j = 0; j < 8; ++j) acc[j] = (float8)(0.0f);
-    float tail[8];
-    RINER_UNROLL
-    for (int j = 0; j < 8; ++j) tail[j] = 0.0f;
+    for (int j = 0; j < 8; ++j) {
+      acc[0][j] = acc[1][j] = (float8)(0.0f);
+      tail[0][j] = tail[1][j] = 0.0f;
+    }
     uint s = first;
-    if (shared == ROW_ONE) {
+    if (shared[0] == ROW_ONE) {
       for (; s + 8 <= last; s += 8) {
         RINER_UNROLL
-        for (int j = 0; j < 8; ++j) acc[j] += vload8(0, r + j * stride + s);
+        for (int j = 0; j < 8; ++j) acc[0][j] += vload8(0, r + j * stride + s);
       }
       for (; s < last; ++s) {
         RINER_UNROLL
-        for (int j = 0; j < 8; ++j) tail[j] += r[j * stride + s];
+        for (int j = 0; j < 8; ++j) tail[0][j] += r[j * stride + s];
       }
     } else {
-      __global const float* x = cache + (size_t)shared * stride;
+      // A lone shared row is read as both (its second sums are not stored).
+      __global const float* x0 = cache + (size_t)shared[0] * stride;
+      __global const float* x1 = shared[1] == NO_ROW ? x0 : cache + (size_t)shared[1] * stride;
       for (; s + 8 <= last; s += 8) {
-        const float8 xs = vload8(0, x + s);
+        const float8 xs0 = vload8(0, x0 + s);
+        const float8 xs1 = vload8(0, x1 + s);
         RINER_UNROLL
-        for (int j = 0; j < 8; ++j) acc[j] = mad(xs, vload8(0, r + j * stride + s), acc[j]);
+        for (int j = 0; j < 8; ++j) {
+          const float8 rs = vload8(0, r + j * stride + s);
+          acc[0][j] = mad(xs0, rs, acc[0][j]);
+          acc[1][j] = mad(xs1, rs, acc[1][j]);
+        }
       }
       for (; s < last; ++s) {
         RINER_UNROLL
-        for (int j = 0; j < 8; ++j) tail[j] = mad(x[s], r[j * stride + s], tail[j]);
+        for (int j = 0; j < 8; ++j) {
+          tail[0][j] = mad(x0[s], r[j * stride + s], tail[0][j]);
+          tail[1][j] = mad(x1[s], r[j * stride + s], tail[1][j]);
+        }
       }
     }
     RINER_UNROLL
-    for (int j = 0; j < 8; ++j) {
-      const float4 h = acc[j].lo + acc[j].hi;
-      out[param + j] = (h.x + h.y) + (h.z + h.w) + tail[j];
+    for (int j = 0; j < 8; ++j) out[param[0] + j] = block_total(acc[0][j], tail[0][j]);
+    if (shared[1] != NO_ROW) {
+      RINER_UNROLL
+      for (int j = 0; j < 8; ++j) out[param[1] + j] = block_total(acc[1][j], tail[1][j]);
     }
   }
 }
