@@ -7,10 +7,10 @@
 //     order (positions and feature gradients from the sample cache, sample_cache.cl) and adds
 //     the corners that fall in its band into grad. Each entry has one writer: no atomics, the
 //     same sums in the same order every run. Launch levels x bands work-groups of any size
-//     (work-items other than 0 idle; the plan uses 1).
-//   hash_grid_gradient_accumulate_lanes(...)   the same sums in the same order, each block of
-//     16 samples' cells, weights and products computed in float16 lanes (the CPU's shape, with
-//     riner_step_lanes.cl); only the carrying and writing go sample by sample.
+//     (work-items other than 0 idle; the plan uses 1). Each block of 16 samples' cells,
+//     weights and products is computed in float16 lanes (hash_grid.cl's lanes helpers); only
+//     the carrying and writing go sample by sample. It reads samples below n_samples only, so
+//     it serves both shapes of the step's per-sample kernels.
 // Consecutive samples of a ray often share corners (at coarse levels, whole cells): their
 // sums stay in registers until a corner is left, so memory sees one read-modify-write per run
 // instead of a chain of dependent ones through the same address (measured 2x on a CPU).
@@ -72,48 +72,6 @@ RINER_INLINE void flush_held(__global float* table, uint lo, uint hi, const uint
   }
 }
 
-__kernel void hash_grid_gradient_accumulate(const uint n_samples, const uint bands,
-                                            const uint stride, __constant const GridLevel* levels,
-                                            __global const float* cache, __global float* grad) {
-  if (get_local_id(0) != 0 || get_group_id(0) / bands >= N_LEVELS) return;
-  uint lo;
-  uint hi;
-  const uint l = owned_band(get_group_id(0), bands, levels, &lo, &hi);
-  __constant const GridLevel* level = &levels[l];
-  __global float* table = grad + level->offset;
-  uint held[N_CORNERS];  // the previous sample's corners and their running sums
-  float held_sum[N_CORNERS][N_FEATURES];
-  RINER_UNROLL
-  for (int c = 0; c < N_CORNERS; ++c) held[c] = NO_ENTRY;
-  for (uint i = 0; i < n_samples; ++i) {
-    float d_out[N_FEATURES];
-    float any = 0.0f;
-    RINER_UNROLL
-    for (int f = 0; f < N_FEATURES; ++f) {
-      d_out[f] = cache[(CACHE_DIN + l * N_FEATURES + f) * stride + i];
-      any += fabs(d_out[f]);
-    }
-    if (any == 0.0f) continue;
-    float pos[DIMS];
-    RINER_UNROLL
-    for (int d = 0; d < DIMS; ++d) pos[d] = cache[(CACHE_POS + d) * stride + i];
-    uint cell[DIMS];
-    float frac[DIMS];
-    hash_grid_cell(level, pos, cell, frac);
-    uint entry[N_CORNERS];
-    float sum[N_CORNERS][N_FEATURES];
-    RINER_UNROLL
-    for (int c = 0; c < N_CORNERS; ++c) {
-      float w;
-      entry[c] = hash_grid_corner_entry(level, cell, frac, c, &w);
-      RINER_UNROLL
-      for (int f = 0; f < N_FEATURES; ++f) sum[c][f] = w * d_out[f];
-    }
-    carry_corners(table, lo, hi, entry, sum, held, held_sum);
-  }
-  flush_held(table, lo, hi, held, held_sum);
-}
-
 // Samples first .. first + 15 of a cache row (lanes past n read 0).
 RINER_INLINE float16 cache_row_lanes(__global const float* row, uint first, uint n) {
   if (first + GRID_LANES <= n) return vload16(0, row + first);
@@ -123,11 +81,9 @@ RINER_INLINE float16 cache_row_lanes(__global const float* row, uint first, uint
   return vload16(0, v);
 }
 
-__kernel void hash_grid_gradient_accumulate_lanes(const uint n_samples, const uint bands,
-                                                  const uint stride,
-                                                  __constant const GridLevel* levels,
-                                                  __global const float* cache,
-                                                  __global float* grad) {
+__kernel void hash_grid_gradient_accumulate(const uint n_samples, const uint bands,
+                                            const uint stride, __constant const GridLevel* levels,
+                                            __global const float* cache, __global float* grad) {
   if (get_local_id(0) != 0 || get_group_id(0) / bands >= N_LEVELS) return;
   uint lo;
   uint hi;

@@ -36,7 +36,7 @@ struct PlanConfig {
   std::string kind = "auto";           // auto, cpu, gpu
   std::string float_atomics = "auto";  // auto, nvidia-ptx, cl_ext_float_atomics, amd-builtin,
                                        // compare-exchange
-  int sample_group = 0;                // work-group size of the per-sample kernels
+  int sample_group = 0;                // work-group of the per-sample kernels, in samples
   int gradient_slices = 0;             // most work-groups of the MLP weight gradient
   int grid_bands = 0;                  // cpu plan: owners per encoding level
 };

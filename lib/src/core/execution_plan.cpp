@@ -79,8 +79,10 @@ ExecutionPlan choose_execution_plan(const DeviceInfo& d, const PlanConfig& c) {
   const std::size_t units = std::max<std::uint32_t>(1, d.compute_units);
   const std::size_t max_group = std::max<std::size_t>(1, d.max_work_group_size);
   if (plan.kind == PlanKind::kCpu) {
-    // PoCL runs a work-group on one thread: two or more per core, each with real work.
-    plan.sample_group = 64;
+    // PoCL runs a work-group on one thread: two or more per core, each with real work. 128
+    // samples a group (8 work-items of the lanes kernels): a step's ~10^4 samples make ~90
+    // groups, where 64 work-items of 16 made 11, unevenly shared by 2 threads.
+    plan.sample_group = 128;
     plan.loss_group = 1;
     plan.gradient_slices = 2 * units;
     plan.gradient_group = 64;

@@ -15,9 +15,6 @@ constexpr std::size_t kMinSliceSamples = 64;
 
 // Samples per work-item of the lanes kernels (riner_step_lanes.cl).
 constexpr std::size_t kLanes = 16;
-// Their work-items per group: 128 samples, so a step's ~10^4 samples make ~90 groups to share
-// among a CPU's threads (the default 64 would make 11: 16 cores half idle).
-constexpr std::size_t kLaneGroup = 8;
 
 std::vector<std::string> step_sources() {
   return {"common",     "hash_grid",        "mlp",          "ray_sum",           "sample_cache",
@@ -67,7 +64,6 @@ RinerStepOp::RinerStepOp(cl::Context& context, const model::ParameterLayout& lay
       mlp_gradient_(*program_,
                     plan.kind == PlanKind::kCpu ? "mlp_gradient_blocked" : "mlp_gradient_partial"),
       grid_gradient_(*program_, "hash_grid_gradient_accumulate"),
-      grid_gradient_lanes_(*program_, "hash_grid_gradient_accumulate_lanes"),
       evaluate_(*program_, "riner_step_field_evaluate"),
       // The lanes kernels leave the grid's gradient to hash_grid_gradient.cl: the CPU plan's.
       shape_(plan.kind == PlanKind::kCpu ? Shape::kLanes : Shape::kPerSample) {}
@@ -104,9 +100,11 @@ void RinerStepOp::step(StepParams p, const cl::Buffer<cl_uint>& batch, const Ste
   const std::size_t samples = p.n_samples;
   const bool lanes = shape_ == Shape::kLanes;
   const std::size_t lane_items = (samples + kLanes - 1) / kLanes;
+  // The plan's group counts samples; a lanes work-item holds 16.
+  const std::size_t lane_group = std::max<std::size_t>(1, plan_.sample_group / kLanes);
   if (samples > 0 && lanes) {
     forward_lanes_.set_args(p, batch, levels_, params, mu_dx_, cache_);
-    context_.launch(forward_lanes_, lane_items, kLaneGroup);
+    context_.launch(forward_lanes_, lane_items, lane_group);
   } else if (samples > 0) {
     forward_.set_args(p, batch, levels_, params, mu_dx_, cache_);
     context_.launch(forward_, samples, plan_.sample_group);
@@ -119,16 +117,15 @@ void RinerStepOp::step(StepParams p, const cl::Buffer<cl_uint>& batch, const Ste
   if (samples == 0) return;
   if (lanes) {
     backward_lanes_.set_args(p, batch, levels_, params, d_sums_, cache_);
-    context_.launch(backward_lanes_, lane_items, kLaneGroup);
+    context_.launch(backward_lanes_, lane_items, lane_group);
   } else {
     backward_.set_args(p, batch, levels_, params, d_sums_, cache_, grad);
     context_.launch(backward_, samples, plan_.sample_group);
   }
   if (plan_.kind == PlanKind::kCpu) {
     const auto bands = static_cast<cl_uint>(plan_.grid_bands);
-    cl::Kernel& grid_gradient = lanes ? grid_gradient_lanes_ : grid_gradient_;
-    grid_gradient.set_args(p.n_samples, bands, p.cache_stride, levels_, cache_, grad);
-    context_.launch(grid_gradient, static_cast<std::size_t>(layout_.levels) * bands, 1);
+    grid_gradient_.set_args(p.n_samples, bands, p.cache_stride, levels_, cache_, grad);
+    context_.launch(grid_gradient_, static_cast<std::size_t>(layout_.levels) * bands, 1);
   }
   slices_ = std::clamp<std::size_t>(samples / kMinSliceSamples, 1, plan_.gradient_slices);
   const std::size_t chunk = ((samples + slices_ - 1) / slices_ + 3) / 4 * 4;

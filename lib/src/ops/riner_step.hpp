@@ -122,7 +122,6 @@ class RinerStepOp {
   cl::Kernel backward_lanes_;
   cl::Kernel mlp_gradient_;
   cl::Kernel grid_gradient_;
-  cl::Kernel grid_gradient_lanes_;
   cl::Kernel evaluate_;
   Shape shape_;
 };

@@ -289,8 +289,9 @@ void add_plan(Table& t) {
       {"auto", "nvidia-ptx", "cl_ext_float_atomics", "amd-builtin", "compare-exchange"},
       "gpu plan: how the grid gradient adds floats", &C::plan, &P::float_atomics));
   t.push_back(field<C>("plan", "sample_group", closed(0, 4096),
-                       "work-group of the per-sample kernels; 0: the device's choice", &C::plan,
-                       &P::sample_group));
+                       "work-group of the per-sample kernels, in samples (the cpu plan's "
+                       "work-items hold 16 each); 0: the device's choice",
+                       &C::plan, &P::sample_group));
   t.push_back(field<C>("plan", "gradient_slices", closed(0, 65536),
                        "most work-groups of the MLP weight gradient; 0: the device's choice",
                        &C::plan, &P::gradient_slices));
