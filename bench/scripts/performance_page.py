@@ -29,7 +29,7 @@ SOURCES = {
                   "issue29_sizes_gradient.jsonl", "issue29_draws10.jsonl"),
     "sizes_gpu": "issue29_sizes_gpu.jsonl",
     "real_trained": "issue29_beta_real.jsonl",
-    "real_chain": "issue32_response_objects_real.jsonl",
+    "real_chain": "issue32_mirror_image_variation_real.jsonl",
     "throughput": "issue30_throughput.jsonl",
     "cores": "issue30_cores16.jsonl",
     "gpu_slow_step": "issue30_gpu_loss_median.jsonl",
@@ -38,7 +38,8 @@ SOURCES = {
     # newest first: a volume at the defaults in a later file hides the earlier row
     "volumes": ("issue29_residual_detail_volume.jsonl", "issue34_volume_defaults.jsonl"),
     "partial_rings": "issue32_partial_rings.jsonl",
-    "tube_wall": "issue32_tube_wall_gradient.jsonl",
+    "tube_wall": "issue32_tube_wall_image_variation.jsonl",
+    "tube_wall_seeds": "issue32_tube_wall_image_variation_seeds.jsonl",
 }
 # The ring chain of today's defaults (mirror, air, gradient, response, gradient again).
 CURRENT_CHAIN = "magrg"
@@ -325,12 +326,17 @@ def tube_wall(root):
                          f2(m["edges"])])
     first = recs[0]
     lo, hi = first["wall_px"]
+    others = "; ".join(
+        f"seed {r['seed']}, ±{100 * r['spread']:.0f}%: wall {pct(r['riner']['wall_mean_error'])}, "
+        f"worst radius {pct(r['riner']['wall_worst_error'])}, {f2(r['riner']['psnr'])} dB"
+        for r in records(root, SOURCES["tube_wall_seeds"]))
     return (table(["", "responses", "wall, mean", "wall, worst radius",
                    "farthest from a perfect detector's FBP", "PSNR (dB)",
                    "edges (of the truth's)"], rows) +
             f"\n\nThe wall's radial profile: angular means in one-pixel bins about the axis (the "
             f"off-centre discs left out), the bins {lo}-{hi} px lying wholly inside the wall, "
-            f"against the truth. {stamp(first)}; {command(first)}.")
+            f"against the truth. Seed {first['seed']}; {stamp(first)}; {command(first)}. Riner "
+            f"at the defaults on other seeds (`--seed=N`, the same day): {others}.")
 
 
 def classical_real(root):

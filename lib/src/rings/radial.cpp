@@ -33,6 +33,22 @@ std::size_t PixelRadii::nearest_nodes() const {
   return nodes;
 }
 
+std::vector<double> PixelRadii::angular_means(const std::vector<float>& values,
+                                              std::size_t nodes) const {
+  std::vector<double> sum(nodes, 0.0);
+  std::vector<double> weight(nodes, 0.0);
+  for (std::size_t p = 0; p < radii_.size(); ++p) {
+    const Between at = between(p);
+    if (at.lower + 1 >= nodes) continue;
+    sum[at.lower] += (1.0 - at.upper_weight) * values[p];
+    weight[at.lower] += 1.0 - at.upper_weight;
+    sum[at.lower + 1] += at.upper_weight * values[p];
+    weight[at.lower + 1] += at.upper_weight;
+  }
+  for (std::size_t k = 0; k < nodes; ++k) sum[k] = weight[k] > 0.0 ? sum[k] / weight[k] : 0.0;
+  return sum;
+}
+
 std::ptrdiff_t mirrored(std::ptrdiff_t j, std::ptrdiff_t n) {
   if (n == 1) return 0;
   const std::ptrdiff_t period = 2 * (n - 1);

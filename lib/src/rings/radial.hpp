@@ -30,6 +30,10 @@ class PixelRadii {
   Between between(std::size_t pixel) const;
   // Nodes up to the farthest pixel's nearest one.
   std::size_t nearest_nodes() const;
+  // The angular mean of `values` (one per pixel) at each of `nodes` nodes, each pixel weighing
+  // on its two nodes as linear interpolation from them would (the adjoint of drawing a profile
+  // into the pixels); 0 at a node no pixel reaches.
+  std::vector<double> angular_means(const std::vector<float>& values, std::size_t nodes) const;
 
  private:
   std::vector<double> radii_;
