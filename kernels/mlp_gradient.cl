@@ -7,10 +7,13 @@
 // groups' partials in group order. Deterministic, no atomics. Two shapes of the same sums:
 //   mlp_gradient_partial(n_samples, chunk, stride, cache, partials)
 //     one work-item per parameter (o = lid, lid + size, ...): many narrow work-items (GPUs).
-//   mlp_gradient_blocked(n_samples, chunk, stride, cache, partials)
+//   mlp_gradient_blocked(n_samples, chunk, stride, cache, params, mlp_offset, partials)
 //     one work-item per block of up to 2 x 8 parameters: two inputs of the same 8 units (or
 //     the output unit's 8 inputs), 8 samples at a time in float8: few wide work-items that
-//     keep their rows in registers (CPUs, where PoCL runs a work-group on one thread).
+//     keep their rows in registers (CPUs, where PoCL runs a work-group on one thread). The
+//     last hidden layer's deltas are not read from the cache but formed from its activations,
+//     d_mu and the output weights (the MLP's from params[mlp_offset]), as mlp_deltas forms them:
+//     the CPU's backward (riner_step_lanes.cl) does not store them.
 // Needs mlp.cl, sample_cache.cl (and their -D constants).
 
 #define ROW_ONE 0xffffffffu
@@ -102,6 +105,33 @@ RINER_INLINE void layer_block(uint k, uint n_in, uint first_input, uint first_de
   param[1] = param[0] + MLP_WIDTH;
 }
 
+// The last hidden layer's delta of unit `unit` for 8 samples from s, as mlp_deltas forms it:
+// d_mu times the unit's output weight where the unit is active.
+RINER_INLINE float8 last_deltas8(__global const float* cache, uint stride, uint unit, uint s,
+                                 float w_out) {
+  const float8 act = vload8(0, cache + (size_t)(CACHE_ACT(MLP_HIDDEN - 1) + unit) * stride + s);
+  const float8 d_mu = vload8(0, cache + (size_t)CACHE_DMU * stride + s);
+  return select((float8)(0.0f), d_mu * w_out, act > 0.0f);
+}
+
+RINER_INLINE float last_delta(__global const float* cache, uint stride, uint unit, uint s,
+                              float w_out) {
+  const float act = cache[(size_t)(CACHE_ACT(MLP_HIDDEN - 1) + unit) * stride + s];
+  return act > 0.0f ? cache[(size_t)CACHE_DMU * stride + s] * w_out : 0.0f;
+}
+
+// Row j of a block's 8 delta rows (from r) at 8 samples from s, or at sample s: read, or formed
+// (the last hidden layer's, of unit `unit`).
+RINER_INLINE float8 delta_rows8(__global const float* cache, uint stride, __global const float* r,
+                                int formed, uint unit, int j, uint s, float w_out) {
+  return formed ? last_deltas8(cache, stride, unit, s, w_out) : vload8(0, r + j * stride + s);
+}
+
+RINER_INLINE float delta_row(__global const float* cache, uint stride, __global const float* r,
+                             int formed, uint unit, int j, uint s, float w_out) {
+  return formed ? last_delta(cache, stride, unit, s, w_out) : r[j * stride + s];
+}
+
 RINER_INLINE void mlp_gradient_block(uint k, uint* shared, uint* rows, uint* param) {
   if (k < BLOCKS_IN) {
     layer_block(k, MLP_INPUTS, CACHE_FEATURES, CACHE_DELTA(0), MLP_W_IN, MLP_B_IN, shared, rows,
@@ -130,15 +160,17 @@ RINER_INLINE float block_total(float8 acc, float tail) {
 }
 
 __kernel void mlp_gradient_blocked(const uint n_samples, const uint chunk, const uint stride,
-                                   __global const float* cache, __global float* partials) {
+                                   __global const float* cache, __global const float* params,
+                                   const uint mlp_offset, __global float* partials) {
+  __global const float* mlp = params + mlp_offset;
   const uint g = get_group_id(0);
   const uint first = min(g * chunk, n_samples);
-  const uint last = min(first + chunk, n_samples);
+  const uint end = min(first + chunk, n_samples);
   __global float* out = partials + g * MLP_PARAMS;
   for (uint k = get_local_id(0); k < MLP_BLOCKS; k += get_local_size(0)) {
     if (k == MLP_BLOCKS - 1) {  // b_out: the sum of d_mu
       float sum = 0.0f;
-      for (uint s = first; s < last; ++s) sum += cache[CACHE_DMU * stride + s];
+      for (uint s = first; s < end; ++s) sum += cache[CACHE_DMU * stride + s];
       out[MLP_B_OUT] = sum;
       continue;
     }
@@ -147,6 +179,13 @@ __kernel void mlp_gradient_blocked(const uint n_samples, const uint chunk, const
     uint param[2];
     mlp_gradient_block(k, shared, &rows, param);
     __global const float* r = cache + (size_t)rows * stride;
+    // Deltas of the last hidden layer: formed here (last_deltas8) from unit `unit`.
+    const uint last = CACHE_DELTA(MLP_HIDDEN - 1);
+    const int formed = rows >= last && rows < last + MLP_WIDTH;
+    const uint unit = rows - last;
+    float w_out[8];
+    RINER_UNROLL
+    for (int j = 0; j < 8; ++j) w_out[j] = formed ? mlp[MLP_W_OUT + unit + j] : 0.0f;
     float8 acc[2][8];
     float tail[2][8];
     RINER_UNROLL
@@ -156,33 +195,36 @@ __kernel void mlp_gradient_blocked(const uint n_samples, const uint chunk, const
     }
     uint s = first;
     if (shared[0] == ROW_ONE) {
-      for (; s + 8 <= last; s += 8) {
+      for (; s + 8 <= end; s += 8) {
         RINER_UNROLL
-        for (int j = 0; j < 8; ++j) acc[0][j] += vload8(0, r + j * stride + s);
+        for (int j = 0; j < 8; ++j)
+          acc[0][j] += delta_rows8(cache, stride, r, formed, unit + j, j, s, w_out[j]);
       }
-      for (; s < last; ++s) {
+      for (; s < end; ++s) {
         RINER_UNROLL
-        for (int j = 0; j < 8; ++j) tail[0][j] += r[j * stride + s];
+        for (int j = 0; j < 8; ++j)
+          tail[0][j] += delta_row(cache, stride, r, formed, unit + j, j, s, w_out[j]);
       }
     } else {
       // A lone shared row is read as both (its second sums are not stored).
       __global const float* x0 = cache + (size_t)shared[0] * stride;
       __global const float* x1 = shared[1] == NO_ROW ? x0 : cache + (size_t)shared[1] * stride;
-      for (; s + 8 <= last; s += 8) {
+      for (; s + 8 <= end; s += 8) {
         const float8 xs0 = vload8(0, x0 + s);
         const float8 xs1 = vload8(0, x1 + s);
         RINER_UNROLL
         for (int j = 0; j < 8; ++j) {
-          const float8 rs = vload8(0, r + j * stride + s);
+          const float8 rs = delta_rows8(cache, stride, r, formed, unit + j, j, s, w_out[j]);
           acc[0][j] = mad(xs0, rs, acc[0][j]);
           acc[1][j] = mad(xs1, rs, acc[1][j]);
         }
       }
-      for (; s < last; ++s) {
+      for (; s < end; ++s) {
         RINER_UNROLL
         for (int j = 0; j < 8; ++j) {
-          tail[0][j] = mad(x0[s], r[j * stride + s], tail[0][j]);
-          tail[1][j] = mad(x1[s], r[j * stride + s], tail[1][j]);
+          const float rs = delta_row(cache, stride, r, formed, unit + j, j, s, w_out[j]);
+          tail[0][j] = mad(x0[s], rs, tail[0][j]);
+          tail[1][j] = mad(x1[s], rs, tail[1][j]);
         }
       }
     }

@@ -168,7 +168,9 @@ __kernel void riner_step_backward_lanes(const StepParams p, __global const uint*
   float16 delta[MLP_HIDDEN][MLP_WIDTH];
   float16 d_features[N_ENCODED];
   mlp_deltas_lanes(params + p.mlp_offset, act, d_mu, delta, d_features);
-  for (int h = 0; h < MLP_HIDDEN; ++h) {
+  // The last hidden layer's deltas are formed again where they are summed (mlp_gradient.cl's
+  // last_deltas8, from the activations and d_mu): 64 rows a sample not stored.
+  for (int h = 0; h + 1 < MLP_HIDDEN; ++h) {
     for (int j = 0; j < MLP_WIDTH; ++j)
       vstore16(delta[h][j], 0, rows + (CACHE_DELTA(h) + j) * stride);
   }

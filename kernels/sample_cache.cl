@@ -11,7 +11,9 @@
 //   CACHE_DIN       N_ENCODED rows   dloss/d(feature), after the level scales     backward
 //   CACHE_POS       DIMS rows        the sample's normalised position             backward
 // The last two are read only by hash_grid_gradient.cl (plans that reduce the grid gradient by
-// ownership instead of atomics).
+// ownership instead of atomics). The CPU's backward (riner_step_lanes.cl) leaves the last hidden
+// layer's CACHE_DELTA rows unwritten: mlp_gradient_blocked forms them from CACHE_ACT and
+// CACHE_DMU where it sums them.
 //
 // The packed batch (uint words; floats by bit pattern), section starts in StepParams:
 //   rays [n_batch]             ray ids of the scan

@@ -130,8 +130,13 @@ void RinerStepOp::step(StepParams p, const cl::Buffer<cl_uint>& batch, const Ste
   slices_ = std::clamp<std::size_t>(samples / kMinSliceSamples, 1, plan_.gradient_slices);
   const std::size_t chunk = ((samples + slices_ - 1) / slices_ + 3) / 4 * 4;
   slices_ = (samples + chunk - 1) / chunk;
-  mlp_gradient_.set_args(p.n_samples, static_cast<cl_uint>(chunk), p.cache_stride, cache_,
-                         partials_);
+  if (plan_.kind == PlanKind::kCpu) {  // mlp_gradient_blocked forms the last layer's deltas
+    mlp_gradient_.set_args(p.n_samples, static_cast<cl_uint>(chunk), p.cache_stride, cache_, params,
+                           p.mlp_offset, partials_);
+  } else {
+    mlp_gradient_.set_args(p.n_samples, static_cast<cl_uint>(chunk), p.cache_stride, cache_,
+                           partials_);
+  }
   context_.launch(mlp_gradient_, slices_ * plan_.gradient_group, plan_.gradient_group);
 }
 
