@@ -215,14 +215,7 @@ BroadDipCase broad_dip_case(const riner::Geometry& geometry = ring_geometry()) {
   const riner::Array dip = broad_dip(g);
   k.trained = sum_of(k.truth, dip);
   k.true_alpha = white_responses(g.n_u);
-  const std::vector<double> dip_projection =
-      riner::ref::project(g, std::vector<double>(dip.data.begin(), dip.data.end()));
-  k.alpha = k.true_alpha;
-  for (std::size_t e = 0; e < g.n_u; ++e) {
-    double sum = 0.0;
-    for (std::size_t v = 0; v < g.n_views(); ++v) sum += dip_projection[v * g.n_u + e];
-    k.alpha.data[e] *= static_cast<float>(std::exp(sum / static_cast<double>(g.n_views())));
-  }
+  k.alpha = responses_taking(g, k.truth, k.trained);
   // The phantom is small: a third of the default's scale, 8 mm.
   k.settings.scale_px = 8.0 / geometry.voxel_mm;
   return k;

@@ -23,20 +23,10 @@ constexpr double kRidgeWeight = 1e-9;
 // Per profile node, the fraction of the image's pixels there that are air (pixels shared
 // between the two nodes around their radius, as the profile is interpolated).
 std::vector<double> air_fraction_per_node(const Array& image, double threshold, std::size_t nodes) {
-  const rings::PixelRadii radii(image.shape[0], image.shape[1], 1.0);
-  std::vector<double> air(nodes, 0.0);
-  std::vector<double> all(nodes, 0.0);
-  for (std::size_t p = 0; p < image.size(); ++p) {
-    const rings::PixelRadii::Between at = radii.between(p);
-    if (at.lower + 1 >= nodes) continue;
-    const double is_air = image.data[p] < threshold ? 1.0 : 0.0;
-    air[at.lower] += (1 - at.upper_weight) * is_air;
-    air[at.lower + 1] += at.upper_weight * is_air;
-    all[at.lower] += 1 - at.upper_weight;
-    all[at.lower + 1] += at.upper_weight;
-  }
-  for (std::size_t b = 0; b < nodes; ++b) air[b] = all[b] > 0.0 ? air[b] / all[b] : 0.0;
-  return air;
+  std::vector<float> is_air(image.size());
+  for (std::size_t p = 0; p < image.size(); ++p)
+    is_air[p] = image.data[p] < threshold ? 1.0f : 0.0f;
+  return rings::PixelRadii(image.shape[0], image.shape[1], 1.0).angular_means(is_air, nodes);
 }
 
 // -ln(alpha) across the detector and its broad part: what rings and one common level have to
