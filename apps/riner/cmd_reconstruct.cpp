@@ -136,6 +136,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   LoadedScan loaded = scan_from(args, console);
   const std::optional<CentreEstimate> centre_check = check_centre(loaded, console);
   Scan& scan = loaded.scan;
+  require_quality_grid(scan.geometry);
   const RinerConfig config = config_from(args);
   const std::string format = output_format(args);
   if (format == "h5" && !scan.geometry.is_3d()) {

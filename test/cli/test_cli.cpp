@@ -207,6 +207,26 @@ TEST_SUITE("cli") {
                  "cannot compare images of shapes [360, 500] and [256, 256]");
     expect_error(riner_cli("simulate --phantom " + out + "/sino.npy --out " + out + "/again", dir),
                  2, out + "/sino.npy has shape [360, 500] but the geometry's grid is [256, 256]");
+    // A detector beside the grid, and a grid too small to check: refused before any work (the
+    // grid's check ended a whole training).
+    riner::test::write_bytes(dir / "beside.json", R"({"type": "fan2d",
+      "detector": {"count": 500, "pitch_mm": 2.0, "offset_px": 1000}, "source_origin_mm": 370,
+      "origin_detector_mm": 370, "angles": {"count": 360, "range_rad": 6.283185307179586},
+      "volume": {"shape": [256, 256], "voxel_mm": 1.0}})");
+    expect_error(riner_cli("fbp " + out + "/sino.npy --geometry " + (dir / "beside.json").string() +
+                               " --out " + out + "/x.nii",
+                           dir),
+                 2,
+                 (dir / "beside.json").string() +
+                     ": no detector ray crosses the reconstruction grid: the rays pass");
+    riner::test::write_bytes(dir / "tiny.json", R"({"type": "fan2d",
+      "detector": {"count": 500, "pitch_mm": 2.0}, "source_origin_mm": 370, "origin_detector_mm": 370,
+      "angles": {"count": 360, "range_rad": 6.283185307179586}, "volume": {"shape": [8, 8], "voxel_mm": 32.0}})");
+    expect_error(riner_cli("reconstruct " + out + "/sino.npy --geometry " +
+                               (dir / "tiny.json").string() + " --out " + out + "/tiny",
+                           dir),
+                 2, "the grid's slices are 8 x 8 pixels: the quality report against FBP needs");
+    CHECK_FALSE(std::filesystem::exists(dir / "sim" / "tiny" / "image.nii"));
   }
 
   TEST_CASE("simulate from an image in 1/cm, on the reference engine") {
@@ -452,7 +472,10 @@ TEST_SUITE("cli") {
                  raw + "/typo.json: files.flats is not a scan file");
     expect_error(riner_cli("fbp " + (dir / "g3.json").string() + " --out " + raw + "/x.nii", dir),
                  2, (dir / "g3.json").string() + ": a geometry without \"files\"");
-    // Bad raw input: one line, exit 2.
+    // Bad raw input: one line, exit 2. Raw projections without their flat field are no line
+    // integrals (they were reconstructed into garbage without a word).
+    expect_error(riner_cli("fbp " + raw + "/projections --out " + raw + "/x.nii", dir), 2,
+                 raw + "/projections: 99% of the readings exceed 20 (the 1st percentile: ");
     expect_error(
         riner_cli("fbp " + raw + "/projections --dark " + raw + "/dark.npy --out " + raw + "/x.nii",
                   dir),

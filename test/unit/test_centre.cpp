@@ -76,6 +76,19 @@ TEST_SUITE("centre") {
     }
   }
 
+  TEST_CASE(
+      "readings without structure (all equal) are refused, not matched at the search's edge") {
+    const riner::Geometry g = riner::test::small_parallel2d();
+    for (float value : {0.0f, 0.5f, 1e-40f}) {
+      riner::Scan flat{riner::Array(g.measurement_shape(), value), g, 0};
+      flat.measurement.data[3] = NAN;  // a dead reading changes nothing
+      CHECK_THROWS_WITH_AS(riner::estimate_centre(flat),
+                           doctest::Contains("the readings are all equal: they hold nothing to "
+                                             "find the centre from"),
+                           riner::InputError);
+    }
+  }
+
   TEST_CASE("parallel 3D: every row shares the axis") {
     const riner::Geometry g = with_angles(riner::test::small_parallel3d(), 31, M_PI, true);
     const riner::CentreEstimate e = riner::estimate_centre(scan_with_offset(g, -2.7));

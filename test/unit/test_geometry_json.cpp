@@ -135,6 +135,12 @@ TEST_SUITE("geometry_json") {
     check_error(fan_with("\"voxel_mm\": 1.0", "\"voxel_mm\": 0"),
                 "g.json: volume.voxel_mm must be > 0 (got 0)");
     check_error(fan_with("\"volume\"", "\"volumes\""), "g.json: volume is missing");
+    // The detector shifted off the grid: every ray misses it (FBP gave an image of zeros).
+    check_error(
+        fan_with("\"offset_px\": 0.0", "\"offset_px\": 600"),
+        "g.json: no detector ray crosses the reconstruction grid: the rays pass 254.5 mm or "
+        "more from the axis, the grid reaches 181 mm (check detector.offset_px, pitch_mm "
+        "and volume.voxel_mm)");
   }
 
   TEST_CASE("measurement shape mismatch names both shapes and the view count") {

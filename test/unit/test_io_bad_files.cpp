@@ -202,4 +202,46 @@ TEST_SUITE("io_bad_files") {
     const riner::Scan scan = riner::load_scan(dir / "ok.npy");
     CHECK(scan.geometry.n_u == 4);
   }
+
+  TEST_CASE("raw intensities, or readings nearly all beyond 1e20, are refused as a scan") {
+    riner::test::TempDir dir;
+    riner::test::write_bytes(dir / "geometry.json", R"({"type": "parallel2d",
+      "detector": {"count": 40, "pitch_mm": 1.0}, "angles": {"count": 30, "range_rad": 3.14159},
+      "volume": {"shape": [40, 40], "voxel_mm": 1.0}})");
+    // Counts of a 16-bit detector: 2000 behind the object, 60000 in the beam.
+    riner::Array counts({30, 40});
+    for (std::size_t i = 0; i < counts.size(); ++i) {
+      counts.data[i] = i % 40 < 5 || i % 40 >= 35 ? 60000.0f : 2000.0f + 10.0f * (i % 40);
+    }
+    riner::write_array(dir / "counts.npy", counts);
+    CHECK_THROWS_WITH_AS(
+        riner::load_scan(dir / "counts.npy"),
+        ((dir / "counts.npy").string() +
+         ": 99% of the readings exceed 20 (the 1st percentile: 2050), beyond any line integral "
+         "-ln(I/I0): these look like raw intensities; give their flat field (--flat, and --dark) "
+         "or take -ln(I/I0) first")
+            .c_str(),
+        riner::InputError);
+    // Their logarithm passes, and so do large line integrals beside air (a dense object).
+    riner::Array rho = counts;
+    for (float& v : rho.data) v = std::log(60000.0f / v);
+    riner::write_array(dir / "rho.npy", rho);
+    CHECK_NOTHROW(riner::load_scan(dir / "rho.npy"));
+    riner::Array dense = rho;
+    for (float& v : dense.data) v *= 10.0f;  // up to 34
+    riner::write_array(dir / "dense.npy", dense);
+    CHECK_NOTHROW(riner::load_scan(dir / "dense.npy"));
+    // 95% of the readings corrupt (1e30): FBP would interpolate an image from the rest.
+    riner::Array corrupt = rho;
+    for (std::size_t i = 0; i < corrupt.size(); ++i) {
+      if (i % 20 != 0) corrupt.data[i] = 1e30f;
+    }
+    riner::write_array(dir / "corrupt.npy", corrupt);
+    CHECK_THROWS_WITH_AS(riner::load_scan(dir / "corrupt.npy"),
+                         ((dir / "corrupt.npy").string() +
+                          ": 95.0% of the readings are NaN, infinite or beyond 1e+20: there is "
+                          "too little left to reconstruct")
+                             .c_str(),
+                         riner::InputError);
+  }
 }

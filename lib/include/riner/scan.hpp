@@ -10,6 +10,11 @@
 
 namespace riner {
 
+// Readings beyond this magnitude are no line integral (rho = -ln(I/I0) of a real scan stays
+// below a few tens) nor raw counts: a corrupt value, which FBP repairs like a non-finite one.
+// Below it every sum the filters form stays finite in float (a column of 10^7 views).
+constexpr float kLargestReading = 1e20f;
+
 struct Scan {
   Array measurement;  // [views, elements] in 2D, [views, rows, columns] in 3D
   Geometry geometry;
@@ -48,7 +53,9 @@ struct ScanFiles {
 // measurement and projections, a flat or dark beside a measurement).
 std::optional<ScanFiles> read_scan_files(const std::filesystem::path& scan_json);
 
-// Checks a measurement array against its geometry (shape, at least one finite value).
+// Checks a measurement array against its geometry: its shape; InputError when every value is
+// NaN or infinite, when nearly all are (or beyond kLargestReading), or when nearly all exceed
+// what any line integral reaches (raw intensities: give the flat field).
 void check_scan(const Scan& scan, std::string_view what = "measurement");
 
 }  // namespace riner

@@ -8,17 +8,13 @@
 #include "riner/array.hpp"
 #include "riner/fbp.hpp"
 #include "riner/geometry.hpp"
+#include "riner/scan.hpp"
 
 namespace riner::analytic {
 
-// Readings beyond this magnitude are no line integral (rho = -ln(I/I0) of a real scan stays
-// below a few hundred) nor raw counts: a corrupt value, repaired like a non-finite one. Below
-// it every sum the filters form stays finite in float (a column of 10^7 views).
-constexpr float kLargestReading = 1e20f;
-
-// Replaces NaN/inf, and readings beyond kLargestReading, in every detector row of every view by
-// linear interpolation between the nearest valid neighbours (constant beyond the last one; 0
-// for a row with none). Returns the number replaced.
+// Replaces NaN/inf, and readings beyond kLargestReading (riner/scan.hpp), in every detector row of
+// every view by linear interpolation between the nearest valid neighbours (constant beyond the last
+// one; 0 for a row with none). Returns the number replaced.
 std::size_t repair_non_finite(Array& measurement, std::size_t n_u);
 
 // Multiplies fan/cone measurements by SDD / sqrt(SDD^2 + u^2 + v^2) (the cosine of the ray's

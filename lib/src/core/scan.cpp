@@ -1,9 +1,15 @@
 #include "riner/scan.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <vector>
+
 #include <nlohmann/json.hpp>
 
 #include "io/file_access.hpp"
 #include "io/stack.hpp"
+#include "util/robust_statistics.hpp"
 
 #include "riner/error.hpp"
 #include "riner/io.hpp"
@@ -11,11 +17,65 @@
 
 namespace riner {
 
+namespace {
+
+// Line integrals -ln(I / I0) of a real scan stay within a few tens (a 16-bit detector's range
+// is ln 65536 = 11, a simulation's 10^7 photons 16): where even the least of them exceeds this,
+// the file holds intensities, which riner would reconstruct into garbage without a word.
+constexpr double kLargestLeastReading = 20.0;
+constexpr double kLeastShare = 0.01;  // "the least": the 1st percentile
+// Beyond this share of unusable readings (NaN, infinite or beyond kLargestReading) what is
+// left cannot carry an image: FBP would interpolate it from the few.
+constexpr double kMostUnusableShare = 0.9;
+constexpr std::size_t kReadingsLooked = std::size_t{1} << 20;
+
+struct ReadingsLook {
+  double unusable_share = 0.0;
+  double least = 0.0;  // the 1st percentile of the usable ones (NaN: none)
+};
+
+// From at most kReadingsLooked readings, one at a scrambled place in each of as many equal
+// stretches (a stack in milliseconds; an even stride could land on one dead column throughout).
+ReadingsLook look_at_readings(const Array& measurement) {
+  const std::size_t stride = std::max<std::size_t>(1, measurement.size() / kReadingsLooked);
+  const std::size_t looked = measurement.size() / stride;
+  std::vector<double> usable;
+  usable.reserve(looked);
+  for (std::size_t k = 0; k < looked; ++k) {
+    const std::size_t i = k * stride + (k * 2654435761u) % stride;
+    const float v = measurement.data[i];
+    if (std::fabs(v) <= kLargestReading) usable.push_back(v);  // NaN fails it too
+  }
+  ReadingsLook out;
+  if (looked == 0) return out;
+  out.unusable_share = 1.0 - static_cast<double>(usable.size()) / static_cast<double>(looked);
+  out.least = usable.empty() ? std::nan("") : util::quantile(usable, kLeastShare);
+  return out;
+}
+
+}  // namespace
+
 void check_scan(const Scan& scan, std::string_view what) {
   scan.geometry.check_measurement_shape(scan.measurement.shape, what);
   if (scan.measurement.size() > 0 && scan.non_finite >= scan.measurement.size()) {
     throw InputError(std::string(what) + ": all " + std::to_string(scan.measurement.size()) +
                      " values are NaN or infinite; there is nothing to reconstruct");
+  }
+  const ReadingsLook look = look_at_readings(scan.measurement);
+  char line[200];
+  if (look.unusable_share > kMostUnusableShare) {
+    std::snprintf(line, sizeof(line),
+                  "%.1f%% of the readings are NaN, infinite or beyond %.0e: there is too little "
+                  "left to reconstruct",
+                  100.0 * look.unusable_share, static_cast<double>(kLargestReading));
+    throw InputError(std::string(what) + ": " + line);
+  }
+  if (look.least > kLargestLeastReading) {
+    std::snprintf(line, sizeof(line), "99%% of the readings exceed %.0f (the 1st percentile: %.4g)",
+                  kLargestLeastReading, look.least);
+    throw InputError(std::string(what) + ": " + line +
+                     ", beyond any line integral -ln(I/I0): these look like raw intensities; "
+                     "give their flat field (--flat, and --dark) or take -ln(I/I0) first");
   }
 }
 

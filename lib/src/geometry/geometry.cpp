@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <utility>
 #include <vector>
 
@@ -56,6 +57,22 @@ void Geometry::validate() const {
            ") puts the source inside the reconstruction grid (half-diagonal " +
            std::to_string(half_diagonal) + " mm)");
     }
+  }
+  // A detector beside the grid reads none of it: FBP would give zeros and training nothing.
+  const double nx = static_cast<double>(volume_shape[rank - 1]);
+  const double ny = static_cast<double>(volume_shape[rank - 2]);
+  const double reach = 0.5 * voxel_mm * std::hypot(nx, ny);
+  const std::vector<double> d = column_ray_distances(*this);
+  const auto [low, high] = std::minmax_element(d.begin(), d.end());
+  const double nearest = *low > 0.0 ? *low : (*high < 0.0 ? -*high : 0.0);
+  if (nearest >= reach) {
+    char line[240];
+    std::snprintf(line, sizeof(line),
+                  "no detector ray crosses the reconstruction grid: the rays pass %.4g mm or more "
+                  "from the axis, the grid reaches %.4g mm (check detector.offset_px, pitch_mm "
+                  "and volume.voxel_mm)",
+                  nearest, reach);
+    fail(line);
   }
 }
 

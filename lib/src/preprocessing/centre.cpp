@@ -18,6 +18,19 @@ namespace riner {
 
 namespace {
 
+// Whether the finite readings differ at all (a constant scan would match itself at every
+// offset, and the search would report the edge of its range).
+bool holds_structure(const Array& measurement) {
+  float low = std::numeric_limits<float>::infinity();
+  float high = -low;
+  for (float v : measurement.data) {
+    if (!std::isfinite(v)) continue;
+    low = std::min(low, v);
+    high = std::max(high, v);
+  }
+  return high > low;
+}
+
 // Enough pairs and rows for a stable sum, few enough to stay a fraction of a second.
 constexpr std::size_t kMostPairs = 32;
 constexpr std::size_t kMostRows = 24;
@@ -292,14 +305,8 @@ Scan midplane_fan(const Scan& cone) {
   return fan;
 }
 
-}  // namespace
-
-bool centre_search_covers(const Geometry& g) {
-  if (g.is_divergent() || covers_full_turn(g)) return true;
-  return std::fabs(g.offset_u) <= kCentreSearchShare * static_cast<double>(g.n_u);
-}
-
-CentreEstimate estimate_centre(const Scan& scan) {
+// estimate_centre before the check of the readings (the geometry's reasons come first).
+CentreEstimate estimate_from(const Scan& scan) {
   const Geometry& g = scan.geometry;
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   if (g.is_divergent()) {
@@ -340,6 +347,23 @@ CentreEstimate estimate_centre(const Scan& scan) {
     e.offset_px = 0.5 * (static_cast<double>(g.n_u) - 1.0) - e.axis_column;
     e.sinogram_offset_px = e.offset_px;
     e.rows = sinogram->rows;
+  }
+  return e;
+}
+
+}  // namespace
+
+bool centre_search_covers(const Geometry& g) {
+  if (g.is_divergent() || covers_full_turn(g)) return true;
+  return std::fabs(g.offset_u) <= kCentreSearchShare * static_cast<double>(g.n_u);
+}
+
+CentreEstimate estimate_centre(const Scan& scan) {
+  const CentreEstimate e = estimate_from(scan);
+  if (!holds_structure(scan.measurement)) {
+    throw InputError(
+        "the readings are all equal: they hold nothing to find the centre from; pass the offset "
+        "with --offset-px");
   }
   return e;
 }
