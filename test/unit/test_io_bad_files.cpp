@@ -203,6 +203,35 @@ TEST_SUITE("io_bad_files") {
     CHECK(scan.geometry.n_u == 4);
   }
 
+  TEST_CASE("transmissions I/I0 given as the measurement get a note; their logarithm none") {
+    riner::Geometry g;
+    g.type = riner::GeometryType::kParallel2d;
+    g.n_u = 40;
+    g.angles.assign(30, 0.0);
+    for (std::size_t v = 0; v < 30; ++v) g.angles[v] = M_PI * static_cast<double>(v) / 30.0;
+    g.volume_shape = {40, 40};
+    // A disc's chords over columns 5-34, air beside it.
+    riner::Scan rho{riner::Array({30, 40}), g, 0};
+    for (std::size_t i = 0; i < rho.measurement.size(); ++i) {
+      const double x = (static_cast<double>(i % 40) - 19.5) / 15.0;
+      rho.measurement.data[i] =
+          static_cast<float>(x * x < 1.0 ? 1.5 * std::sqrt(1.0 - x * x) : 0.0);
+    }
+    CHECK_FALSE(riner::transmission_note(rho).has_value());
+    riner::Scan transmission = rho;
+    for (float& v : transmission.measurement.data) v = std::exp(-v);
+    const std::optional<std::string> note = riner::transmission_note(transmission);
+    REQUIRE(note.has_value());
+    CHECK(note->find("note: the readings look like transmissions I/I0, not -ln(I/I0): all within "
+                     "0.") == 0);
+    CHECK(note->find("the detector's outer columns at 1.00") != std::string::npos);
+    // A faint object whose transmissions stay above 0.6 of the air's: no object far below the
+    // air, no note (nor for a scan of readings near 1 everywhere).
+    riner::Scan faint = rho;
+    for (float& v : faint.measurement.data) v = std::exp(-0.2f * v);
+    CHECK_FALSE(riner::transmission_note(faint).has_value());
+  }
+
   TEST_CASE("raw intensities, or readings nearly all beyond 1e20, are refused as a scan") {
     riner::test::TempDir dir;
     riner::test::write_bytes(dir / "geometry.json", R"({"type": "parallel2d",
@@ -218,8 +247,8 @@ TEST_SUITE("io_bad_files") {
         riner::load_scan(dir / "counts.npy"),
         ((dir / "counts.npy").string() +
          ": 99% of the readings exceed 20 (the 1st percentile: 2050), beyond any line integral "
-         "-ln(I/I0): these look like raw intensities; give their flat field (--flat, and --dark) "
-         "or take -ln(I/I0) first")
+         "-ln(I/I0): these look like raw intensities; give their flat field (--flat and --dark; "
+         "in Python flat= and dark=) or take -ln(I/I0) first")
             .c_str(),
         riner::InputError);
     // Their logarithm passes, and so do large line integrals beside air (a dense object).

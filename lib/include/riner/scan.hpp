@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <optional>
+#include <string>
 
 #include "riner/array.hpp"
 #include "riner/geometry.hpp"
@@ -57,5 +58,11 @@ std::optional<ScanFiles> read_scan_files(const std::filesystem::path& scan_json)
 // NaN or infinite, when nearly all are (or beyond kLargestReading), or when nearly all exceed
 // what any line integral reaches (raw intensities: give the flat field).
 void check_scan(const Scan& scan, std::string_view what = "measurement");
+
+// A note when the readings look like transmissions I/I0 rather than -ln(I/I0): all within
+// about 0..1 (a detector's gains let air read up to 1.25), the detector's outer columns near 1
+// (where air reads 0 as a line integral) and some readings far below them. Only a note: a pipe's
+// wall seen edge-on at the detector's ends reads like that too.
+std::optional<std::string> transmission_note(const Scan& scan);
 
 }  // namespace riner

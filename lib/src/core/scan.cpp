@@ -28,24 +28,37 @@ constexpr double kLeastShare = 0.01;  // "the least": the 1st percentile
 // left cannot carry an image: FBP would interpolate it from the few.
 constexpr double kMostUnusableShare = 0.9;
 constexpr std::size_t kReadingsLooked = std::size_t{1} << 20;
+// Transmissions: at least 0 but for noise, at most 1 but for the detector's gains (the paper's
+// responses reach 1.25), the outer columns' median near 1 (air), the least readings below a
+// share of it (an object).
+constexpr double kTransmissionNoise = 0.05;
+constexpr double kLargestTransmission = 1.5;
+constexpr double kAirTransmissionLow = 0.8;
+constexpr double kAirTransmissionHigh = 1.25;
+constexpr double kTransmissionObjectShare = 0.6;
 
 struct ReadingsLook {
   double unusable_share = 0.0;
   double least = 0.0;  // the 1st percentile of the usable ones (NaN: none)
 };
 
-// From at most kReadingsLooked readings, one at a scrambled place in each of as many equal
-// stretches (a stack in milliseconds; an even stride could land on one dead column throughout).
-ReadingsLook look_at_readings(const Array& measurement) {
+// Calls look(i) for at most kReadingsLooked indices of `measurement`, one at a scrambled place
+// in each of as many equal stretches (a stack in milliseconds; an even stride could land on one
+// dead column throughout). Returns how many.
+template <class Look>
+std::size_t look_at_some(const Array& measurement, Look look) {
   const std::size_t stride = std::max<std::size_t>(1, measurement.size() / kReadingsLooked);
   const std::size_t looked = measurement.size() / stride;
+  for (std::size_t k = 0; k < looked; ++k) look(k * stride + (k * 2654435761u) % stride);
+  return looked;
+}
+
+ReadingsLook look_at_readings(const Array& measurement) {
   std::vector<double> usable;
-  usable.reserve(looked);
-  for (std::size_t k = 0; k < looked; ++k) {
-    const std::size_t i = k * stride + (k * 2654435761u) % stride;
+  const std::size_t looked = look_at_some(measurement, [&](std::size_t i) {
     const float v = measurement.data[i];
     if (std::fabs(v) <= kLargestReading) usable.push_back(v);  // NaN fails it too
-  }
+  });
   ReadingsLook out;
   if (looked == 0) return out;
   out.unusable_share = 1.0 - static_cast<double>(usable.size()) / static_cast<double>(looked);
@@ -75,8 +88,41 @@ void check_scan(const Scan& scan, std::string_view what) {
                   kLargestLeastReading, look.least);
     throw InputError(std::string(what) + ": " + line +
                      ", beyond any line integral -ln(I/I0): these look like raw intensities; "
-                     "give their flat field (--flat, and --dark) or take -ln(I/I0) first");
+                     "give their flat field (--flat and --dark; in Python flat= and dark=) or take "
+                     "-ln(I/I0) first");
   }
+}
+
+std::optional<std::string> transmission_note(const Scan& scan) {
+  const Array& m = scan.measurement;
+  const std::size_t n_u = scan.geometry.n_u;
+  if (m.size() == 0 || n_u < 8) return std::nullopt;
+  std::vector<double> all;
+  std::vector<double> edges;
+  // The outer 2% of columns at either end (two at least).
+  const std::size_t outer = std::max<std::size_t>(2, n_u / 50);
+  look_at_some(m, [&](std::size_t i) {
+    const float v = m.data[i];
+    if (!std::isfinite(v)) return;
+    all.push_back(v);
+    const std::size_t u = i % n_u;
+    if (u < outer || u >= n_u - outer) edges.push_back(v);
+  });
+  if (all.size() < 100 || edges.size() < 10) return std::nullopt;
+  const double least = util::quantile(all, kLeastShare);
+  const double most = util::quantile(all, 1.0 - kLeastShare);
+  const double edge = util::quantile(edges, 0.5);
+  if (least < -kTransmissionNoise || most > kLargestTransmission || edge < kAirTransmissionLow ||
+      edge > kAirTransmissionHigh || least > kTransmissionObjectShare * edge) {
+    return std::nullopt;
+  }
+  char line[320];
+  std::snprintf(line, sizeof(line),
+                "note: the readings look like transmissions I/I0, not -ln(I/I0): all within "
+                "%.2f..%.2f, the detector's outer columns at %.2f (air reads 0 as a line "
+                "integral); take -ln of them first",
+                least, most, edge);
+  return std::string(line);
 }
 
 std::filesystem::path find_geometry(const std::filesystem::path& measurement,

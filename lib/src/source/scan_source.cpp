@@ -105,6 +105,9 @@ LoadedScan load_scan_source(ScanSource source) {
     loaded.notes.push_back(file.layout + " file: " + flat_field_line(report));
   } else if (source.flat.empty()) {
     loaded.scan = load_scan(source.path, source.geometry, source.row);
+    if (std::optional<std::string> note = transmission_note(loaded.scan)) {
+      loaded.notes.push_back(std::move(*note));
+    }
   } else {
     loaded.scan = load_raw_scan(source.path, source.flat, source.dark, source.geometry, &report,
                                 source.row, source.flat_after);
