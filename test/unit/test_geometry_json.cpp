@@ -95,6 +95,22 @@ TEST_SUITE("geometry_json") {
     riner::Geometry bad = g;
     bad.grid_centre_z_mm = NAN;
     CHECK_THROWS_WITH_AS(bad.validate(), "volume.centre_z_mm must be finite", riner::InputError);
+    // A grid far up the axis, or rows offset far up: no row's rays pass its height (FBP gave
+    // zeros). The highest row sits 197 mm up the detector; its rays climb to 158 mm within the
+    // grid's circle, so a grid 100 mm high centred 140 mm up is crossed, one at 250 mm is not.
+    const std::string kRows = "no detector row's rays cross the reconstruction grid";
+    riner::Geometry high = g;
+    high.grid_centre_z_mm = 140.0;
+    CHECK_NOTHROW(high.validate());
+    high.grid_centre_z_mm = 250.0;
+    CHECK_THROWS_WITH_AS(high.validate(), doctest::Contains(kRows.c_str()), riner::InputError);
+    riner::Geometry lifted = riner::Geometry::from_json(kCone);
+    lifted.offset_v = 1e4;
+    CHECK_THROWS_WITH_AS(lifted.validate(), doctest::Contains(kRows.c_str()), riner::InputError);
+    lifted.type = riner::GeometryType::kParallel3d;
+    CHECK_THROWS_WITH_AS(lifted.validate(), doctest::Contains(kRows.c_str()), riner::InputError);
+    lifted.offset_v = 0.0;
+    CHECK_NOTHROW(lifted.validate());
   }
 
   TEST_CASE("every bad field is named") {

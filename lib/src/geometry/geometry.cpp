@@ -17,6 +17,26 @@ std::vector<std::size_t> Geometry::measurement_shape() const {
   return {n_views(), n_u};
 }
 
+namespace {
+
+// Whether the line of `ray` passes through the cylinder of radius `reach` about the axis within
+// |z| <= half_height (the grid's extent; z counts from the grid's centre in detector_ray).
+bool meets_grid(const Ray& ray, double reach, double half_height) {
+  const Vec3& o = ray.origin;
+  const Vec3& d = ray.direction;
+  const double a = d.x * d.x + d.y * d.y;
+  if (a <= 0.0) return std::hypot(o.x, o.y) <= reach;  // along the axis
+  const double b = o.x * d.x + o.y * d.y;
+  const double c = o.x * o.x + o.y * o.y - reach * reach;
+  const double disc = b * b - a * c;
+  if (disc < 0.0) return false;
+  const double z1 = o.z + d.z * (-b - std::sqrt(disc)) / a;
+  const double z2 = o.z + d.z * (-b + std::sqrt(disc)) / a;
+  return std::min(z1, z2) <= half_height && std::max(z1, z2) >= -half_height;
+}
+
+}  // namespace
+
 void Geometry::validate() const {
   auto fail = [](const std::string& what) { throw InputError(what); };
   if (n_u < 1) fail("detector.count must be >= 1");
@@ -65,6 +85,26 @@ void Geometry::validate() const {
   const std::vector<double> d = column_ray_distances(*this);
   const auto [low, high] = std::minmax_element(d.begin(), d.end());
   const double nearest = *low > 0.0 ? *low : (*high < 0.0 ? -*high : 0.0);
+  if (is_3d() && nearest < reach) {
+    // And some row's rays must pass the grid's height (rows offset far up, or a grid far along
+    // the axis, gave FBP zeros too): through the column nearest the axis, every row.
+    const auto nearest_column = static_cast<std::size_t>(
+        std::min_element(d.begin(), d.end(),
+                         [](double x, double y) { return std::fabs(x) < std::fabs(y); }) -
+        d.begin());
+    const double half_height = 0.5 * voxel_mm * static_cast<double>(volume_shape[0]);
+    bool seen = false;
+    for (std::size_t v = 0; v < n_v && !seen; ++v) {
+      seen = meets_grid(
+          detector_ray(*this, 0, static_cast<double>(nearest_column), static_cast<double>(v)),
+          reach, half_height);
+    }
+    if (!seen) {
+      fail(
+          "no detector row's rays cross the reconstruction grid: the rows see above or below it "
+          "(check detector.offset_px's row offset, pitch_mm and volume.centre_z_mm)");
+    }
+  }
   if (nearest >= reach) {
     char line[240];
     std::snprintf(line, sizeof(line),
