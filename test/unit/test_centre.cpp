@@ -221,5 +221,17 @@ TEST_SUITE("centre") {
       CHECK(e.method == "conjugate rays");
       CHECK(std::fabs(e.offset_px - offset) < 0.2);
     }
+    // The rows about the source's plane unread (NaN): said so, not "views that step evenly".
+    riner::Scan blind = scan_with_offset(cone, 2.2);
+    const std::size_t rows = cone.n_v;
+    const std::size_t n_u = cone.n_u;
+    for (std::size_t i = 0; i < blind.measurement.size(); ++i) {
+      const std::size_t row = i / n_u % rows;
+      if (row + 2 >= rows / 2 && row <= rows / 2 + 1) blind.measurement.data[i] = NAN;
+    }
+    CHECK_THROWS_WITH_AS(riner::estimate_centre(blind),
+                         doctest::Contains("the detector rows through the source's plane, where "
+                                           "conjugate rays meet, read no two different finite"),
+                         riner::InputError);
   }
 }

@@ -310,8 +310,17 @@ CentreEstimate estimate_from(const Scan& scan) {
   const Geometry& g = scan.geometry;
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   if (g.is_divergent()) {
-    const std::optional<preprocessing::ConjugateAxis> axis =
-        preprocessing::conjugate_axis(g.type == GeometryType::kCone3d ? midplane_fan(scan) : scan);
+    const Scan fan = g.type == GeometryType::kCone3d ? midplane_fan(scan) : scan;
+    const std::optional<preprocessing::ConjugateAxis> axis = preprocessing::conjugate_axis(fan);
+    // A cone's rows about the source's plane unread or flat (the rest of the scan may not be),
+    // after the geometry's own reasons.
+    if (g.type == GeometryType::kCone3d && (axis || (g.n_u >= 8 && covers_full_turn(g))) &&
+        !holds_structure(fan.measurement)) {
+      throw InputError(
+          "the detector rows through the source's plane, where conjugate rays meet, read no two "
+          "different finite values: nothing to find the centre from; pass the offset with "
+          "--offset-px");
+    }
     if (!axis) {
       throw InputError(
           "centre finding in a fan or cone beam needs views that step evenly over a full turn "
