@@ -3,6 +3,7 @@
 
 #include <cmath>
 
+#include "riner/error.hpp"
 #include "riner/phantom.hpp"
 #include "support/geometries.hpp"
 
@@ -59,6 +60,11 @@ TEST_SUITE("phantom") {
     // Skull at x = 0 between the brain's top (52.0 mm) and the head's (55.9 mm): 1.0 * 0.1.
     CHECK(p.value_at({0.0, 54.0, 0.0}) == doctest::Approx(0.1));
     CHECK(p.value_at({64.0, 0.0, 0.0}) == 0.0);  // outside the head
+    // A negative scale simulated a beam brightened past float's range (64 319 non-finite).
+    CHECK_THROWS_WITH_AS(riner::shepp_logan(g, -1.0),
+                         "the Shepp-Logan's mu scale must be finite and > 0 (got -1)",
+                         riner::InputError);
+    CHECK_THROWS_AS(riner::shepp_logan(g, NAN), riner::InputError);
   }
 
   TEST_CASE("the tube wall: its wall about the axis, its content and the water around it") {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <utility>
 
@@ -111,6 +112,13 @@ double Phantom::line_integral(const Ray& ray) const {
 
 Phantom shepp_logan(const Geometry& g, double mu_scale) {
   g.validate();
+  // A negative attenuation brightens the beam: exp(+mu L) overflows the counts.
+  if (!(mu_scale > 0.0) || !std::isfinite(mu_scale)) {
+    char line[120];
+    std::snprintf(line, sizeof(line), "the Shepp-Logan's mu scale must be finite and > 0 (got %g)",
+                  mu_scale);
+    throw InputError(line);
+  }
   const std::size_t rank = g.volume_shape.size();
   const double radius =
       0.95 * 0.5 * g.voxel_mm *
