@@ -24,8 +24,6 @@ nlohmann::json warm_start_json(const std::optional<WarmStartStats>& w) {
 
 // Axial slices of a volume the quality report measures, spread over it.
 constexpr std::size_t kQualitySlices = 16;
-// The quality report's smallest slice side (riner/quality.hpp).
-constexpr std::size_t kSmallestQualitySide = 16;
 
 nlohmann::json ring_summary(const std::optional<RingCorrection>& rings) {
   if (!rings) return {{"applied", false}};
@@ -102,11 +100,11 @@ void require_quality_grid(const Geometry& g) {
   const std::size_t rank = g.volume_shape.size();
   const std::size_t ny = g.volume_shape[rank - 2];
   const std::size_t nx = g.volume_shape[rank - 1];
-  if (ny < kSmallestQualitySide || nx < kSmallestQualitySide) {
+  if (ny < kQualitySmallestSide || nx < kQualitySmallestSide) {
     throw InputError("the grid's slices are " + std::to_string(ny) + " x " + std::to_string(nx) +
                      " pixels: the quality report against FBP needs at least " +
-                     std::to_string(kSmallestQualitySide) + " x " +
-                     std::to_string(kSmallestQualitySide) + " (volume.shape)");
+                     std::to_string(kQualitySmallestSide) + " x " +
+                     std::to_string(kQualitySmallestSide) + " (volume.shape)");
   }
 }
 

@@ -31,8 +31,8 @@ struct QualityCheck {
 
 QualityCheck check_quality(const Reconstructor& r, const ReconstructionResult& result,
                            const std::optional<Device>& device);
-// InputError when the grid's slices are too small for check_quality (16 x 16): called before
-// training, so that a run does not end in that error after it.
+// InputError when the grid's slices are too small for check_quality (kQualitySmallestSide):
+// called before training, so that a run does not end in that error after it.
 void require_quality_grid(const Geometry& g);
 // summary.json's "quality".
 nlohmann::json quality_summary(const QualityCheck& check);

@@ -89,7 +89,11 @@ struct QualityReport {
   CentreDeviation centre;
 };
 
-// InputError unless both are 2D images or volumes of the same shape, slices at least 16 x 16.
+// The smallest side of an image (or a volume's slice) the report measures.
+constexpr std::size_t kQualitySmallestSide = 16;
+
+// InputError unless both are 2D images or volumes of the same shape, slices at least
+// kQualitySmallestSide on a side.
 // Of a volume, `centre` stays zero.
 QualityReport quality_against_fbp(const Array& image, const Array& fbp,
                                   double field_radius_px = kWholeDisc);

@@ -61,6 +61,10 @@ void Geometry::validate() const {
   if (!(voxel_mm > 0.0) || !std::isfinite(voxel_mm)) fail("volume.voxel_mm must be finite and > 0");
   if (!std::isfinite(grid_centre_z_mm)) fail("volume.centre_z_mm must be finite");
   if (!is_3d() && grid_centre_z_mm != 0.0) fail("volume.centre_z_mm belongs to a 3D geometry");
+  // How far the grid reaches from the axis, in the axial plane.
+  const double half_diagonal = 0.5 * voxel_mm *
+                               std::hypot(static_cast<double>(volume_shape[rank - 1]),
+                                          static_cast<double>(volume_shape[rank - 2]));
   if (is_divergent()) {
     if (!(source_origin_mm > 0.0) || !std::isfinite(source_origin_mm)) {
       fail("source_origin_mm must be finite and > 0");
@@ -69,9 +73,6 @@ void Geometry::validate() const {
       fail("origin_detector_mm must be finite and > 0");
     }
     // The source circles the rotation axis; inside the grid every ray would start in the object.
-    const double nx = static_cast<double>(volume_shape[rank - 1]);
-    const double ny = static_cast<double>(volume_shape[rank - 2]);
-    const double half_diagonal = 0.5 * voxel_mm * std::hypot(nx, ny);
     if (source_origin_mm <= half_diagonal) {
       fail("source_origin_mm (" + std::to_string(source_origin_mm) +
            ") puts the source inside the reconstruction grid (half-diagonal " +
@@ -79,41 +80,33 @@ void Geometry::validate() const {
     }
   }
   // A detector beside the grid reads none of it: FBP would give zeros and training nothing.
-  const double nx = static_cast<double>(volume_shape[rank - 1]);
-  const double ny = static_cast<double>(volume_shape[rank - 2]);
-  const double reach = 0.5 * voxel_mm * std::hypot(nx, ny);
   const std::vector<double> d = column_ray_distances(*this);
   const auto [low, high] = std::minmax_element(d.begin(), d.end());
   const double nearest = *low > 0.0 ? *low : (*high < 0.0 ? -*high : 0.0);
-  if (is_3d() && nearest < reach) {
-    // And some row's rays must pass the grid's height (rows offset far up, or a grid far along
-    // the axis, gave FBP zeros too): through the column nearest the axis, every row.
-    const auto nearest_column = static_cast<std::size_t>(
-        std::min_element(d.begin(), d.end(),
-                         [](double x, double y) { return std::fabs(x) < std::fabs(y); }) -
-        d.begin());
-    const double half_height = 0.5 * voxel_mm * static_cast<double>(volume_shape[0]);
-    bool seen = false;
-    for (std::size_t v = 0; v < n_v && !seen; ++v) {
-      seen = meets_grid(
-          detector_ray(*this, 0, static_cast<double>(nearest_column), static_cast<double>(v)),
-          reach, half_height);
-    }
-    if (!seen) {
-      fail(
-          "no detector row's rays cross the reconstruction grid: the rows see above or below it "
-          "(check detector.offset_px's row offset, pitch_mm and volume.centre_z_mm)");
-    }
-  }
-  if (nearest >= reach) {
+  if (nearest >= half_diagonal) {
     char line[240];
     std::snprintf(line, sizeof(line),
                   "no detector ray crosses the reconstruction grid: the rays pass %.4g mm or more "
                   "from the axis, the grid reaches %.4g mm (check detector.offset_px, pitch_mm "
                   "and volume.voxel_mm)",
-                  nearest, reach);
+                  nearest, half_diagonal);
     fail(line);
   }
+  if (!is_3d()) return;
+  // And some row's rays must pass the grid's height (rows offset far up, or a grid far along
+  // the axis, gave FBP zeros too): through the column nearest the axis, every row.
+  const auto nearest_column = static_cast<double>(
+      std::min_element(d.begin(), d.end(),
+                       [](double x, double y) { return std::fabs(x) < std::fabs(y); }) -
+      d.begin());
+  const double half_height = 0.5 * voxel_mm * static_cast<double>(volume_shape[0]);
+  for (std::size_t v = 0; v < n_v; ++v) {
+    const Ray ray = detector_ray(*this, 0, nearest_column, static_cast<double>(v));
+    if (meets_grid(ray, half_diagonal, half_height)) return;
+  }
+  fail(
+      "no detector row's rays cross the reconstruction grid: the rows see above or below it "
+      "(check detector.offset_px's row offset, pitch_mm and volume.centre_z_mm)");
 }
 
 void Geometry::check_measurement_shape(const std::vector<std::size_t>& shape,

@@ -26,17 +26,24 @@ constexpr double kLostObjectSigmas = 5.0;
 constexpr double kLostShownShare = 0.25;  // of what the FBP shows
 constexpr std::size_t kLostMinAirPixels = 100;
 
+// "at least 16 x 16"
+std::string smallest_sides() {
+  const std::string side = std::to_string(kQualitySmallestSide);
+  return "at least " + side + " x " + side;
+}
+
 void require_2d(const Array& a, const char* what) {
-  if (a.rank() != 2 || a.shape[0] < 16 || a.shape[1] < 16)
-    throw InputError(std::string(what) + " must be a 2D image of at least 16 x 16");
+  if (a.rank() != 2 || a.shape[0] < kQualitySmallestSide || a.shape[1] < kQualitySmallestSide)
+    throw InputError(std::string(what) + " must be a 2D image of " + smallest_sides());
 }
 
 // A 2D image, or a volume whose axial slices are images.
 void require_2d_or_slices(const Array& a, const char* what) {
   const std::size_t r = a.rank();
-  if ((r != 2 && r != 3) || a.shape[r - 2] < 16 || a.shape[r - 1] < 16 || a.size() == 0)
-    throw InputError(std::string(what) +
-                     " must be a 2D image or a volume of slices, at least 16 x 16");
+  if ((r != 2 && r != 3) || a.shape[r - 2] < kQualitySmallestSide ||
+      a.shape[r - 1] < kQualitySmallestSide || a.size() == 0)
+    throw InputError(std::string(what) + " must be a 2D image or a volume of slices, " +
+                     smallest_sides());
 }
 
 double disc_radius(const Array& a) {

@@ -11,6 +11,7 @@
 #include "preprocessing/centre_conjugate.hpp"
 #include "preprocessing/centre_sinogram.hpp"
 #include "preprocessing/mismatch_sums.hpp"
+#include "riner/array.hpp"
 #include "riner/error.hpp"
 #include "riner/rays.hpp"
 
@@ -21,14 +22,8 @@ namespace {
 // Whether the finite readings differ at all (a constant scan would match itself at every
 // offset, and the search would report the edge of its range).
 bool holds_structure(const Array& measurement) {
-  float low = std::numeric_limits<float>::infinity();
-  float high = -low;
-  for (float v : measurement.data) {
-    if (!std::isfinite(v)) continue;
-    low = std::min(low, v);
-    high = std::max(high, v);
-  }
-  return high > low;
+  const ArrayStats stats = compute_stats(measurement);
+  return stats.max > stats.min;
 }
 
 // Enough pairs and rows for a stable sum, few enough to stay a fraction of a second.
@@ -310,11 +305,14 @@ CentreEstimate estimate_from(const Scan& scan) {
   const Geometry& g = scan.geometry;
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   if (g.is_divergent()) {
-    const Scan fan = g.type == GeometryType::kCone3d ? midplane_fan(scan) : scan;
+    const bool cone = g.type == GeometryType::kCone3d;
+    const std::optional<Scan> midplane =
+        cone ? std::optional<Scan>(midplane_fan(scan)) : std::nullopt;
+    const Scan& fan = cone ? *midplane : scan;
     const std::optional<preprocessing::ConjugateAxis> axis = preprocessing::conjugate_axis(fan);
     // A cone's rows about the source's plane unread or flat (the rest of the scan may not be),
     // after the geometry's own reasons.
-    if (g.type == GeometryType::kCone3d && (axis || (g.n_u >= 8 && covers_full_turn(g))) &&
+    if (cone && (axis || (g.n_u >= 8 && covers_full_turn(g))) &&
         !holds_structure(fan.measurement)) {
       throw InputError(
           "the detector rows through the source's plane, where conjugate rays meet, read no two "
