@@ -138,6 +138,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   Scan& scan = loaded.scan;
   require_quality_grid(scan.geometry);
   const RinerConfig config = config_from(args);
+  require_training(config);
   const std::string format = output_format(args);
   if (format == "h5" && !scan.geometry.is_3d()) {
     throw UsageError("--format h5 writes volumes; write a 2D image as nii, npy, tif or raw");

@@ -195,6 +195,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   ScanRows source(source_from(args));
   if (source.centre() && speak) console.line(centre_line(*source.centre()));
   require_quality_grid(source.geometry());
+  require_training(settings);
   const std::filesystem::path out = make_output_dir(args.get("out"));
   const std::optional<Device> device = rank_device(args, settings.engine, ranks);
   // On a CPU the plan splits the gradient's sums by the device's threads, and a rank has only

@@ -108,6 +108,14 @@ void require_quality_grid(const Geometry& g) {
   }
 }
 
+void require_training(const RinerConfig& c) {
+  if (c.training.steps == 0 && c.training.warm_start == "off") {
+    throw InputError(
+        "training.steps is 0 and there is no warm start: the image would be the untrained "
+        "field's noise; give 1 or more steps (-1: the scan's)");
+  }
+}
+
 QualityCheck check_quality(const Reconstructor& r, const ReconstructionResult& result,
                            const std::optional<Device>& device) {
   FbpOptions options;

@@ -708,6 +708,11 @@ TEST_SUITE("cli") {
                            dir),
                  2, "config: training.steps must be in -1..10000000 (training steps; -1: the scan's, "
            "24000 in 2D and 12000 in 3D or more (min_draws_per_ray, min_samples_per_voxel))");
+    expect_error(
+        riner_cli("reconstruct " + sim + "/sino.npy --steps 0 --out " + (dir / "s").string(), dir),
+        2,
+        "training.steps is 0 and there is no warm start: the image would be the untrained field's "
+        "noise; give 1 or more steps (-1: the scan's)");
     expect_error(riner_cli("reconstruct " + sim + "/sino.npy --set training.stepz=4 --out " +
                                (dir / "s").string(),
                            dir),

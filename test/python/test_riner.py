@@ -246,6 +246,7 @@ def test_bad_measurements_raise(fan_scan, sino, error, message):
     ({"steps": -3}, "training.steps must be in"),
     ({"settings": {"training.sampler": "sideways"}}, "training.sampler"),
     ({"device": "no such device anywhere"}, "no such device"),
+    ({"steps": 0}, "training.steps is 0 and there is no warm start"),
 ])
 def test_bad_settings_raise(fan_scan, kwargs, message):
     sim, g = fan_scan
@@ -274,6 +275,22 @@ def test_flat_field_and_center_on_raw_parallel_projections():
     found = riner.center(raw, g, flat=flat, dark=dark)
     assert found["axis_column"] == pytest.approx(41.5, abs=0.1)
     assert found["offset_px"] == pytest.approx(g["detector"]["offset_px"], abs=0.1)
+
+
+def test_messages_name_python_keywords_not_cli_options(fan_scan):
+    # The library words its hints as the CLI's options; Python's errors and notes name the
+    # keyword that does the same.
+    sim, g = fan_scan
+    with pytest.raises(riner.Error, match=r"^device=no such device anywhere: .*riner\.devices\(\)"):
+        riner.reconstruct(sim["sino"], g, device="no such device anywhere")
+    counts = 1e6 * np.exp(-sim["sino"])
+    with pytest.raises(riner.InputError, match=r"give their flat field \(flat= and dark=\)") as e:
+        riner.fbp(counts, g)
+    assert "--" not in str(e.value)
+    angles = np.linspace(0, np.pi, 121)
+    flat_readings = np.zeros((121, 80))
+    with pytest.raises(riner.InputError, match="pass the axis's column with center=$"):
+        riner.center(flat_readings, riner.parallel_beam(angles, columns=80))
 
 
 def test_a_small_cone_beam_volume():

@@ -81,6 +81,28 @@ TEST_SUITE("flat_field") {
     CHECK(rho.data[5] == doctest::Approx(-std::log(70.0 / 100.0)));
     CHECK(report.invalid_readings == 4);
     CHECK(report.pixels_without_beam == 1);
+    CHECK(report.pixels == 3);
+  }
+
+  TEST_CASE("a flat field with beam on few of the pixels is named; one dead pixel is not") {
+    // 40 pixels; the flat's beam on the first 20 only (a flat of another region, say).
+    Array raw({2, 40});
+    Array flat({40});
+    for (std::size_t p = 0; p < 40; ++p) {
+      flat.data[p] = p < 20 ? 1000.0f : 0.0f;
+      raw.data[p] = raw.data[40 + p] = 500.0f;
+    }
+    FlatFieldReport report;
+    riner::flat_field_normalise(raw, flat, Array{}, &report);
+    CHECK(riner::pixels_without_beam_line(report) ==
+          "note: 20 of the detector's 40 pixels (50.0%) have no beam in the flat field (at or "
+          "below the dark): riner takes them for dead elements; check that the flat and dark "
+          "fields are of this detector's region, binning and exposure");
+    flat.data.assign(40, 1000.0f);
+    flat.data[7] = 0.0f;  // 2.5%: a dead pixel
+    riner::flat_field_normalise(raw, flat, Array{}, &report);
+    CHECK(report.pixels_without_beam == 1);
+    CHECK(riner::pixels_without_beam_line(report).empty());
   }
 
   TEST_CASE("a frame of the wrong shape, or nothing valid, is an InputError saying which") {

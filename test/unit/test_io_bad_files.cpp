@@ -247,8 +247,8 @@ TEST_SUITE("io_bad_files") {
         riner::load_scan(dir / "counts.npy"),
         ((dir / "counts.npy").string() +
          ": 99% of the readings exceed 20 (the 1st percentile: 2050), beyond any line integral "
-         "-ln(I/I0): these look like raw intensities; give their flat field (--flat and --dark; "
-         "in Python flat= and dark=) or take -ln(I/I0) first")
+         "-ln(I/I0): these look like raw intensities; give their flat field (--flat and --dark) "
+         "or take -ln(I/I0) first")
             .c_str(),
         riner::InputError);
     // Their logarithm passes, and so do large line integrals beside air (a dense object).
@@ -257,9 +257,16 @@ TEST_SUITE("io_bad_files") {
     riner::write_array(dir / "rho.npy", rho);
     CHECK_NOTHROW(riner::load_scan(dir / "rho.npy"));
     riner::Array dense = rho;
-    for (float& v : dense.data) v *= 10.0f;  // up to 34
+    for (float& v : dense.data) v *= 5.0f;  // 16-17 on the object, beyond a 16-bit detector's 11
     riner::write_array(dir / "dense.npy", dense);
     CHECK_NOTHROW(riner::load_scan(dir / "dense.npy"));
+    // Dead elements read 0 counts: a few dead columns do not hide the intensities.
+    for (std::size_t i = 0; i < counts.size(); i += 40) counts.data[i + 20] = 0.0f;
+    riner::write_array(dir / "dead.npy", counts);
+    CHECK_THROWS_WITH_AS(riner::load_scan(dir / "dead.npy"),
+                         doctest::Contains("dead.npy: 99% of the readings exceed 20 (the 1st "
+                                           "percentile: 2050)"),
+                         riner::InputError);
     // 95% of the readings corrupt (1e30): FBP would interpolate an image from the rest.
     riner::Array corrupt = rho;
     for (std::size_t i = 0; i < corrupt.size(); ++i) {

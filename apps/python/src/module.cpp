@@ -1,10 +1,12 @@
 // _riner: the C++ half of the `riner` Python package (apps/python/riner/__init__.py is the
 // other). riner's exceptions become Python exceptions with the same one-line message:
 // riner.InputError (also a ValueError) for bad input, riner.OpenCLError for device failures,
-// riner.Error (a RuntimeError) as their base.
+// riner.Error (a RuntimeError) as their base; options the message names are worded as
+// Python's keywords (python_wording.hpp).
 #include <pybind11/stl.h>
 
 #include "bindings.hpp"
+#include "python_wording.hpp"
 #include "riner/error.hpp"
 #include "riner/geometry.hpp"
 #include "riner/riner_config.hpp"
@@ -64,11 +66,11 @@ PYBIND11_MODULE(_riner, m) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const riner::InputError& e) {
-      input_error(e.what());
+      input_error(riner::python::python_wording(e.what()).c_str());
     } catch (const riner::ClError& e) {
-      opencl_error(e.what());
+      opencl_error(riner::python::python_wording(e.what()).c_str());
     } catch (const riner::Error& e) {
-      error(e.what());
+      error(riner::python::python_wording(e.what()).c_str());
     }
   });
   riner::python::bind_environment(m);

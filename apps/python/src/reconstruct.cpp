@@ -11,6 +11,7 @@
 
 #include "bindings.hpp"
 #include "numpy_arrays.hpp"
+#include "python_wording.hpp"
 #include "riner/error.hpp"
 #include "riner/reconstructor.hpp"
 #include "summary_json.hpp"
@@ -79,6 +80,7 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
   if (progress_every < 1) throw InputError("progress_every must be >= 1");
   Scan scan = scan_from(measurement, geometry_json);
   const RinerConfig config = config_from(config_json, settings, engine);
+  app::require_training(config);
 
   std::unique_ptr<Reconstructor> reconstructor;
   std::optional<Device> dev;
@@ -109,7 +111,7 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
         quality ? app::check_quality(*reconstructor, result, dev) : app::QualityCheck{};
     nlohmann::json json = app::run_summary(*reconstructor, result, check);
     if (!quality) json["quality"] = nullptr;
-    summary = json.dump();
+    summary = python_wording(json.dump());
   }
   py::object alpha_by_view = py::none();
   if (result.alpha_by_view.size() > 0) alpha_by_view = to_numpy(std::move(result.alpha_by_view));

@@ -4,6 +4,7 @@
 
 #include "bindings.hpp"
 #include "numpy_arrays.hpp"
+#include "python_wording.hpp"
 #include "riner/centre.hpp"
 #include "riner/destripe.hpp"
 #include "riner/error.hpp"
@@ -12,8 +13,8 @@
 #include "riner/io.hpp"
 #include "riner/metrics.hpp"
 #include "riner/phantom.hpp"
-#include "riner/simulate.hpp"
 #include "riner/scan_source.hpp"
+#include "riner/simulate.hpp"
 #include "summary_json.hpp"
 
 namespace riner::python {
@@ -179,7 +180,8 @@ void bind_scan_functions(py::module_& m) {
       const FlatStack stack = flats_before_after(flat, after, projections.shape);
       rho = flat_field_normalise(projections, stack.frames, dark, &report, stack.positions);
     }
-    return py::make_tuple(to_numpy(std::move(rho)), app::flat_field_json(report).dump());
+    return py::make_tuple(to_numpy(std::move(rho)),
+                          python_wording(app::flat_field_json(report).dump()));
   });
   // A scan as the CLI's SCAN options name it -> (measurement, geometry JSON, notes JSON).
   m.def("load_scan", [](const std::string& path, const std::string& geometry,
@@ -196,7 +198,7 @@ void bind_scan_functions(py::module_& m) {
          loaded.flat_field ? app::flat_field_json(*loaded.flat_field) : nlohmann::json(nullptr)},
         {"centre", loaded.centre ? app::centre_json(*loaded.centre) : nlohmann::json(nullptr)}};
     return py::make_tuple(to_numpy(std::move(loaded.scan.measurement)),
-                          loaded.scan.geometry.to_json(), notes.dump());
+                          loaded.scan.geometry.to_json(), python_wording(notes.dump()));
   });
   m.def("read_array", [](const std::string& path) {
     ArrayFile file;

@@ -23,6 +23,7 @@ struct FlatFieldReport {
   std::size_t invalid_readings = 0;
   // Detector pixels with F - D <= 0 or no finite flat or dark frame: all their readings are NaN.
   std::size_t pixels_without_beam = 0;
+  std::size_t pixels = 0;  // of one view
   // Flat series taken at different times (before and after the scan, say) and the beam's
   // change from the first to the last, the median over pixels of (F - D) last / first - 1.
   std::size_t flat_series = 1;
@@ -43,6 +44,12 @@ constexpr double kAirDriftLeast = 0.005;
 bool air_drifts(const FlatFieldReport& report);
 // One line naming the drift and what to do about it (empty when air_drifts is false).
 std::string air_drift_line(const FlatFieldReport& report);
+
+// A real detector has a few dead pixels; past this share of pixels without beam the flat field
+// is more likely of another detector region, binning or exposure than the projections'.
+constexpr double kMostPixelsWithoutBeam = 0.05;
+// A note naming the pixels without beam past kMostPixelsWithoutBeam (empty below it).
+std::string pixels_without_beam_line(const FlatFieldReport& report);
 
 // projections: [views, elements] or [views, rows, columns]. flats and darks: one frame (the
 // shape of one view) or a stack of frames along a first axis, averaged per pixel over their

@@ -23,7 +23,9 @@ namespace {
 // is ln 65536 = 11, a simulation's 10^7 photons 16): where even the least of them exceeds this,
 // the file holds intensities, which riner would reconstruct into garbage without a word.
 constexpr double kLargestLeastReading = 20.0;
-constexpr double kLeastShare = 0.01;  // "the least": the 1st percentile
+// "The least": the 1st percentile of the positive ones, since raw counts read 0 on dead elements
+// (a few dead columns would otherwise hide a whole file of intensities).
+constexpr double kLeastShare = 0.01;
 // Beyond this share of unusable readings (NaN, infinite or beyond kLargestReading) what is
 // left cannot carry an image: FBP would interpolate it from the few.
 constexpr double kMostUnusableShare = 0.9;
@@ -39,7 +41,7 @@ constexpr double kTransmissionObjectShare = 0.6;
 
 struct ReadingsLook {
   double unusable_share = 0.0;
-  double least = 0.0;  // the 1st percentile of the usable ones (NaN: none)
+  double least = 0.0;  // the 1st percentile of the usable positive ones (NaN: none)
 };
 
 // Calls look(i) for at most kReadingsLooked indices of `measurement`, one at a scrambled place
@@ -54,15 +56,18 @@ std::size_t look_at_some(const Array& measurement, Look look) {
 }
 
 ReadingsLook look_at_readings(const Array& measurement) {
-  std::vector<double> usable;
+  std::size_t usable = 0;
+  std::vector<double> positive;
   const std::size_t looked = look_at_some(measurement, [&](std::size_t i) {
     const float v = measurement.data[i];
-    if (std::fabs(v) <= kLargestReading) usable.push_back(v);  // NaN fails it too
+    if (!(std::fabs(v) <= kLargestReading)) return;  // NaN fails it too
+    ++usable;
+    if (v > 0.0f) positive.push_back(v);
   });
   ReadingsLook out;
   if (looked == 0) return out;
-  out.unusable_share = 1.0 - static_cast<double>(usable.size()) / static_cast<double>(looked);
-  out.least = usable.empty() ? std::nan("") : util::quantile(usable, kLeastShare);
+  out.unusable_share = 1.0 - static_cast<double>(usable) / static_cast<double>(looked);
+  out.least = positive.empty() ? std::nan("") : util::quantile(positive, kLeastShare);
   return out;
 }
 
@@ -88,8 +93,7 @@ void check_scan(const Scan& scan, std::string_view what) {
                   kLargestLeastReading, look.least);
     throw InputError(std::string(what) + ": " + line +
                      ", beyond any line integral -ln(I/I0): these look like raw intensities; "
-                     "give their flat field (--flat and --dark; in Python flat= and dark=) or take "
-                     "-ln(I/I0) first");
+                     "give their flat field (--flat and --dark) or take -ln(I/I0) first");
   }
 }
 

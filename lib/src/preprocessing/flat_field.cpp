@@ -110,6 +110,21 @@ std::string air_drift_line(const FlatFieldReport& r) {
   return line;
 }
 
+std::string pixels_without_beam_line(const FlatFieldReport& r) {
+  const double share =
+      r.pixels > 0 ? static_cast<double>(r.pixels_without_beam) / static_cast<double>(r.pixels)
+                   : 0.0;
+  if (share <= kMostPixelsWithoutBeam) return "";
+  char line[400];
+  std::snprintf(
+      line, sizeof(line),
+      "note: %zu of the detector's %zu pixels (%.1f%%) have no beam in the flat field (at "
+      "or below the dark): riner takes them for dead elements; check that the flat and "
+      "dark fields are of this detector's region, binning and exposure",
+      r.pixels_without_beam, r.pixels, 100.0 * share);
+  return line;
+}
+
 void flat_field_drift(const Array& rho, FlatFieldReport& r) {
   r.air_first = r.air_last = std::numeric_limits<double>::quiet_NaN();
   r.air_drift_sigmas = 0.0;
@@ -203,6 +218,7 @@ Array flat_field_normalise(const Array& projections, const Array& flats, const A
   }
   r.flat_series = series.size();
   for (std::size_t p = 0; p < pixels; ++p) r.pixels_without_beam += no_beam[p];
+  r.pixels = pixels;
   if (beams.size() > 1) {
     std::vector<double> change;
     for (std::size_t p = 0; p < pixels; ++p) {

@@ -114,8 +114,11 @@ LoadedScan load_scan_source(ScanSource source) {
     loaded.flat_field = report;
     loaded.notes.push_back(flat_field_line(report));
   }
-  if (loaded.flat_field && air_drifts(*loaded.flat_field)) {
-    loaded.notes.push_back(air_drift_line(*loaded.flat_field));
+  if (loaded.flat_field) {
+    for (std::string note :
+         {pixels_without_beam_line(*loaded.flat_field), air_drift_line(*loaded.flat_field)}) {
+      if (!note.empty()) loaded.notes.push_back(std::move(note));
+    }
   }
   if (source.offset_px == "auto") {
     loaded.centre = estimate_centre(loaded.scan);
