@@ -64,6 +64,11 @@ TEST_SUITE("riner_config") {
            "c.json: config: network.width must be a multiple of 16");
     expect(R"({"training": {"steps": "many"}})",
            "c.json: config: training.steps must be an integer");
+    expect(R"({"training": {"steps": 3.5}})",
+           "c.json: config: training.steps must be an integer (got 3.5)");
+    expect(R"({"training": {"seed": 1180591620717411303424}})",
+           "c.json: config: training.seed must be an integer (got 1.1805916207174113e+21, beyond "
+           "64 bits)");
     expect(R"({"training": {"learning_rate": -1}})",
            "c.json: config: training.learning_rate must be in (0, 10) (Adam's learning rate)");
     expect(R"({"training": {"sampler": "random"}})",

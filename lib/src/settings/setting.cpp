@@ -1,5 +1,6 @@
 #include "settings/setting.hpp"
 
+#include <cmath>
 #include <cstdio>
 
 namespace riner::settings {
@@ -39,7 +40,14 @@ std::string type_mismatch(Type type, const std::vector<std::string>& choices,
     case Type::kBool:
       return value.is_boolean() ? "" : "must be true or false";
     case Type::kInteger:
-      return value.is_number_integer() ? "" : "must be an integer";
+      if (value.is_number_integer()) return "";
+      // JSON holds an integer past 64 bits (Python's 2**70) as a float: say which it was.
+      if (value.is_number_float()) {
+        const double v = value.get<double>();
+        return std::string("must be an integer (got ") + value.dump() +
+               (std::floor(v) == v && std::fabs(v) >= 9.2e18 ? ", beyond 64 bits)" : ")");
+      }
+      return "must be an integer";
     case Type::kNumber:
       return value.is_number() ? "" : "must be a number";
     case Type::kChoice: {
