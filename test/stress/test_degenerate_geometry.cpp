@@ -50,7 +50,11 @@ TEST_SUITE("degenerate_geometry") {
   TEST_CASE("tiny and huge pitch, an offset beyond the field of view") {
     using riner::GeometryType;
     survives(riner::test::make_geometry(GeometryType::kFan2d, 12, 32, 1, {16, 16}, 1e-6, 1.0));
-    survives(riner::test::make_geometry(GeometryType::kFan2d, 12, 32, 1, {16, 16}, 1e6, 1.0));
+    // A pitch of 1 km: the 16 mm grid lies behind one element.
+    CHECK_THROWS_WITH_AS(
+        riner::test::make_geometry(GeometryType::kFan2d, 12, 32, 1, {16, 16}, 1e6, 1.0),
+        doctest::Contains("narrower than one detector element at the axis"), riner::InputError);
+    survives(riner::test::make_geometry(GeometryType::kFan2d, 12, 32, 1, {16, 16}, 10.0, 1.0));
     riner::Geometry off =
         riner::test::make_geometry(GeometryType::kParallel2d, 12, 32, 1, {16, 16}, 1.0, 1.0);
     off.offset_u = 1000.0;
@@ -58,6 +62,27 @@ TEST_SUITE("degenerate_geometry") {
         riner::Reconstructor(ones(off), riner::RinerConfig(), riner::test::device()),
         doctest::Contains("no detector ray crosses the reconstruction grid"), riner::InputError);
     survives(off);
+  }
+
+  TEST_CASE("angles in degrees, a grid narrower than one element: refused with the reason") {
+    riner::Geometry g = riner::test::make_geometry(riner::GeometryType::kParallel2d, 180, 32, 1,
+                                                   {16, 16}, 1.0, 1.0);
+    for (std::size_t i = 0; i < g.angles.size(); ++i) g.angles[i] = static_cast<double>(i);
+    CHECK_THROWS_WITH_AS(g.validate(),
+                         "the angles reach 179 rad, 28.5 turns: angles are in radians (one turn "
+                         "is 6.2832); were degrees given?",
+                         riner::InputError);
+    g.angles[179] = 1e300;  // a start angle of 1e300 made every view the same
+    CHECK_THROWS_WITH_AS(g.validate(), doctest::Contains("the angles reach 1e+300 rad"),
+                         riner::InputError);
+    // 16 turns of a multi-turn scan pass.
+    for (std::size_t i = 0; i < g.angles.size(); ++i) g.angles[i] = 0.55 * static_cast<double>(i);
+    CHECK_NOTHROW(g.validate());
+    CHECK_THROWS_WITH_AS(
+        riner::test::make_geometry(riner::GeometryType::kFan2d, 12, 32, 1, {16, 16}, 2.0, 1e-9),
+        doctest::Contains("the grid is 1.6e-08 mm wide, narrower than one "
+                          "detector element at the axis"),
+        riner::InputError);
   }
 
   TEST_CASE("a source inside the volume is refused with the reason") {

@@ -19,6 +19,10 @@ std::vector<std::size_t> Geometry::measurement_shape() const {
 
 namespace {
 
+constexpr double kPi = 3.14159265358979323846;
+// Sixteen turns: beyond any scan's angles in radians, short of 180 or 360 read as radians.
+constexpr double kLargestAngleRad = 16.0 * 2.0 * kPi;
+
 // Whether the line of `ray` passes through the cylinder of radius `reach` about the axis within
 // |z| <= half_height (the grid's extent; z counts from the grid's centre in detector_ray).
 bool meets_grid(const Ray& ray, double reach, double half_height) {
@@ -48,8 +52,20 @@ void Geometry::validate() const {
   if (!std::isfinite(offset_u) || !std::isfinite(offset_v))
     fail("detector.offset_px must be finite");
   if (angles.empty()) fail("angles: there must be at least one view");
+  double widest = 0.0;
   for (double a : angles) {
     if (!std::isfinite(a)) fail("angles must be finite");
+    widest = std::max(widest, std::fabs(a));
+  }
+  // Degrees read as radians (a range of 180 or 360) would be 29 or 57 turns, reconstructed
+  // without a word into garbage; no scan turns more than a few times.
+  if (widest > kLargestAngleRad) {
+    char line[240];
+    std::snprintf(line, sizeof(line),
+                  "the angles reach %.6g rad, %.3g turns: angles are in radians (one turn is "
+                  "6.2832); were degrees given?",
+                  widest, widest / (2.0 * kPi));
+    fail(line);
   }
   const std::size_t rank = is_3d() ? 3 : 2;
   if (volume_shape.size() != rank) {
@@ -78,6 +94,19 @@ void Geometry::validate() const {
            ") puts the source inside the reconstruction grid (half-diagonal " +
            std::to_string(half_diagonal) + " mm)");
     }
+  }
+  // A grid narrower than one detector element at the axis: every voxel behind the same reading.
+  const double element_at_axis =
+      pitch_u * (is_divergent() ? source_origin_mm / (source_origin_mm + origin_detector_mm) : 1.0);
+  const double grid_width =
+      voxel_mm * static_cast<double>(std::max(volume_shape[rank - 1], volume_shape[rank - 2]));
+  if (grid_width < element_at_axis) {
+    char line[240];
+    std::snprintf(line, sizeof(line),
+                  "the grid is %.4g mm wide, narrower than one detector element at the axis "
+                  "(%.4g mm): check volume.voxel_mm (in mm, like detector.pitch_mm)",
+                  grid_width, element_at_axis);
+    fail(line);
   }
   // A detector beside the grid reads none of it: FBP would give zeros and training nothing.
   const std::vector<double> d = column_ray_distances(*this);
