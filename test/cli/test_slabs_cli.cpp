@@ -93,7 +93,12 @@ TEST_SUITE("cli") {
     const std::string scan = simulate_stack(dir);
     const std::string common = "reconstruct " + scan + " --slab-slices 4 --steps 600 --quiet";
     const std::filesystem::path whole = dir / "whole", killed = dir / "killed";
-    REQUIRE(riner_cli(common + " --format h5 --out " + whole.string(), dir).code == 0);
+    // --resume of a folder with no run says so, and starts one.
+    const Run first = riner_cli(common + " --format h5 --resume --out " + whole.string(), dir);
+    REQUIRE(first.code == 0);
+    CHECK(first.err.find("--resume: " + whole.string() +
+                         " holds no slabbed run (manifest.json): starting one") !=
+          std::string::npos);
     const nlohmann::json summary =
         nlohmann::json::parse(riner::test::read_bytes(whole / "summary.json"));
     CHECK(summary["slabs"] == 5);
@@ -137,7 +142,9 @@ TEST_SUITE("cli") {
     CHECK(refused.code != 0);
     CHECK(refused.err.find("another config") != std::string::npos);
 
-    REQUIRE(riner_cli(common + " --resume --out " + killed.string(), dir).code == 0);
+    const Run finished = riner_cli(common + " --resume --out " + killed.string(), dir);
+    REQUIRE(finished.code == 0);
+    CHECK(finished.err.find("holds no slabbed run") == std::string::npos);
     const nlohmann::json resumed =
         nlohmann::json::parse(riner::test::read_bytes(killed / "summary.json"));
     CHECK(resumed["slabs_done_before"] == done);

@@ -114,6 +114,10 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
   if (join_ && !held_run) {
     throw InputError(path.string() + ": no run to join (the leader writes it first)");
   }
+  // A mistyped folder would otherwise start the whole scan again without a word.
+  if (options.resume && !held_run && !join_) {
+    warn("--resume: " + out_.string() + " holds no slabbed run (manifest.json): starting one");
+  }
   if (held_run) {
     if (!options.resume && !join_) {
       throw InputError(out_.string() +
