@@ -247,6 +247,7 @@ def test_bad_measurements_raise(fan_scan, sino, error, message):
     ({"settings": {"training.sampler": "sideways"}}, "training.sampler"),
     ({"device": "no such device anywhere"}, "no such device"),
     ({"steps": 0}, "training.steps is 0 and there is no warm start"),
+    ({"learning_rate": float("nan")}, r'training.learning_rate must be a number \(got "NaN"\)'),
 ])
 def test_bad_settings_raise(fan_scan, kwargs, message):
     sim, g = fan_scan

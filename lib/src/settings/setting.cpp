@@ -49,7 +49,7 @@ std::string type_mismatch(Type type, const std::vector<std::string>& choices,
       }
       return "must be an integer";
     case Type::kNumber:
-      return value.is_number() ? "" : "must be a number";
+      return value.is_number() ? "" : "must be a number (got " + value.dump() + ")";
     case Type::kChoice: {
       if (!value.is_string()) return "must be a string: one of " + join_choices(choices);
       for (const std::string& c : choices) {
