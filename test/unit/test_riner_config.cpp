@@ -69,6 +69,9 @@ TEST_SUITE("riner_config") {
     expect(R"({"training": {"seed": 1180591620717411303424}})",
            "c.json: config: training.seed must be an integer (got 1.1805916207174113e+21, beyond "
            "64 bits)");
+    // 1e19 written as a float fits 64 bits (the seed's range is 0..2^64 - 1): only a float.
+    expect(R"({"training": {"seed": 1e19}})",
+           "c.json: config: training.seed must be an integer (got 1e+19)");
     expect(R"({"training": {"learning_rate": -1}})",
            "c.json: config: training.learning_rate must be in (0, 10) (Adam's learning rate)");
     expect(R"({"training": {"sampler": "random"}})",

@@ -19,9 +19,8 @@ std::vector<std::size_t> Geometry::measurement_shape() const {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 // Sixteen turns: beyond any scan's angles in radians, short of 180 or 360 read as radians.
-constexpr double kLargestAngleRad = 16.0 * 2.0 * kPi;
+constexpr double kLargestAngleRad = 16.0 * 2.0 * M_PI;
 
 // Whether the line of `ray` passes through the cylinder of radius `reach` about the axis within
 // |z| <= half_height (the grid's extent; z counts from the grid's centre in detector_ray).
@@ -64,7 +63,7 @@ void Geometry::validate() const {
     std::snprintf(line, sizeof(line),
                   "the angles reach %.6g rad, %.3g turns: angles are in radians (one turn is "
                   "6.2832); were degrees given?",
-                  widest, widest / (2.0 * kPi));
+                  widest, widest / (2.0 * M_PI));
     fail(line);
   }
   const std::size_t rank = is_3d() ? 3 : 2;

@@ -44,8 +44,10 @@ std::string type_mismatch(Type type, const std::vector<std::string>& choices,
       // JSON holds an integer past 64 bits (Python's 2**70) as a float: say which it was.
       if (value.is_number_float()) {
         const double v = value.get<double>();
+        const bool beyond =
+            std::floor(v) == v && (v >= std::ldexp(1.0, 64) || v < -std::ldexp(1.0, 63));
         return std::string("must be an integer (got ") + value.dump() +
-               (std::floor(v) == v && std::fabs(v) >= 9.2e18 ? ", beyond 64 bits)" : ")");
+               (beyond ? ", beyond 64 bits)" : ")");
       }
       return "must be an integer";
     case Type::kNumber:
