@@ -5,6 +5,7 @@
 #pragma once
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -170,7 +171,19 @@ struct TrainingConfig {
   // pattern's energy (model/factor_evidence.hpp).
   double alpha_factor_evidence = 0.9;
   double beta_lr_scale = 3.0;
-  int alpha_warmup_steps = 0;
+  // -1: the scan's: kWideAlphaWarmup steps on a slice whose detector row has at least
+  // kWideDetectorElements elements (not after a warm start), 0 otherwise. Before the field has
+  // drawn the object, every element whose rays cross it reads more than the field gives, and
+  // alpha takes that offset; its part that is even about the axis has the same readings as a
+  // radially symmetric image, so nothing in the data takes it back, and it stays a broad ring
+  // band. At 1024 columns that band was most of DeepLesion's error: 300 steps of a still alpha
+  // gave +0.87 and +1.23 dB (slices 0, 3); at 512 columns +0.02, on the ten 256^2 paper-protocol
+  // slices -0.21 on average (the field takes narrow rings meanwhile), so smaller detectors keep
+  // 0 (docs/history/RESULTS.md, issue 29).
+  static constexpr int kScanAlphaWarmup = -1;
+  static constexpr int kWideAlphaWarmup = 300;
+  static constexpr std::size_t kWideDetectorElements = 1000;
+  int alpha_warmup_steps = kScanAlphaWarmup;
   int beta_warmup_steps = -1;  // -1: the first learning-rate phase (decay_interval())
   // Coarse to fine: when > 0, level l >= 1 of the encoding fades in over steps
   // [(l - 1) k, l k] with k = level_warmup_steps (its features are scaled by 0 .. 1), so the

@@ -164,9 +164,10 @@ void add_training_schedule(Table& t) {
                        &C::training, &T::alpha_factor_evidence));
   t.push_back(field<C>("training", "beta_lr_scale", closed_open(0, 1000),
                        "beta's learning rate over the field's", &C::training, &T::beta_lr_scale));
-  t.push_back(field<C>("training", "alpha_warmup_steps", closed(0, kMaxSteps),
-                       "alpha stays at its initial value for these steps", &C::training,
-                       &T::alpha_warmup_steps));
+  t.push_back(field<C>("training", "alpha_warmup_steps", closed(-1, kMaxSteps),
+                       "alpha stays at its initial value for these steps; -1: 300 on a slice "
+                       "whose detector row has at least 1000 elements, else 0",
+                       &C::training, &T::alpha_warmup_steps));
   t.push_back(field<C>("training", "beta_warmup_steps", closed(-1, kMaxSteps),
                        "beta of elements with valid readings stays put for these steps; -1: the "
                        "first learning-rate phase",

@@ -53,6 +53,13 @@ void resolve_steps(TrainingConfig& t, const Geometry& g, double samples_per_voxe
   }
 }
 
+// TrainingConfig::kScanAlphaWarmup's rule.
+void resolve_alpha_warmup(TrainingConfig& t, const Geometry& g) {
+  if (t.alpha_warmup_steps != TrainingConfig::kScanAlphaWarmup) return;
+  const bool wide = !g.is_3d() && g.n_u >= TrainingConfig::kWideDetectorElements;
+  t.alpha_warmup_steps = wide && !warm_start_applies(t, g) ? TrainingConfig::kWideAlphaWarmup : 0;
+}
+
 }  // namespace
 
 TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device)
@@ -79,6 +86,7 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
   short_of_samples = g.is_3d() && config.training.min_samples_per_voxel > 0.0 &&
                      TrainingConfig::kSteps3d * per_voxel_step < config.training.min_samples_per_voxel;
   resolve_steps(config.training, g, per_voxel_step, short_of_samples);
+  resolve_alpha_warmup(config.training, g);
   config.encoding.log2_table_size = config.encoding.log2_table_for(short_of_samples);
   if (config.encoding.finest_resolution == 0) {
     const std::size_t largest = *std::max_element(g.volume_shape.begin(), g.volume_shape.end());
