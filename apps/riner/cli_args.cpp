@@ -21,6 +21,13 @@ Args& Args::option(const std::string& name, const std::string& value_name, const
   return *this;
 }
 
+Args& Args::list_option(const std::string& name, const std::string& value_name,
+                         const std::string& help) {
+  option(name, value_name, help, "");
+  options_.back().joins = true;
+  return *this;
+}
+
 Args& Args::flag(const std::string& name, const std::string& help) {
   options_.push_back({name, "", help, std::nullopt, false});
   return *this;
@@ -71,7 +78,11 @@ bool Args::parse(int argc, char** argv, int first) {
           throw UsageError("--" + name + " needs a value (" + spec->value_name + ")");
         value = argv[++i];
       }
-      values_[name] = *value;
+      if (auto it = values_.find(name); spec->joins && it != values_.end()) {
+        if (!value->empty()) it->second += it->second.empty() ? *value : "," + *value;
+      } else {
+        values_[name] = *value;
+      }
       continue;
     }
     if (next_positional >= positionals_.size())

@@ -24,6 +24,10 @@ class Args {
   Args& option(const std::string& name, const std::string& value_name, const std::string& help,
                std::optional<std::string> default_value = std::nullopt);
   Args& flag(const std::string& name, const std::string& help);
+  // An option whose value is a comma-separated list: given more than once, the lists join in
+  // order (--set a=1 --set b=2 is --set a=1,b=2), where another option's last value wins.
+  Args& list_option(const std::string& name, const std::string& value_name,
+                    const std::string& help);
   // --quiet, --json: every subcommand has them.
   Args& output_flags();
 
@@ -46,6 +50,7 @@ class Args {
     std::string help;
     std::optional<std::string> default_value;
     bool required = false;
+    bool joins = false;  // list_option
   };
   const Spec* find_option(const std::string& name) const;
 

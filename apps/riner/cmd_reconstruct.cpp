@@ -94,10 +94,9 @@ int run_reconstruct(int argc, char** argv, int first) {
               "volume.<format>",
               "nii")
       .option("config", "FILE", "settings JSON ({\"training\": {\"steps\": 4000}, ...})", "")
-      .option("set", "NAME=VALUE,...",
-              "change settings after --config (training.alpha_lr_scale=0.3; `riner settings` "
-              "lists them)",
-              "")
+      .list_option("set", "NAME=VALUE,...",
+                   "change settings after --config (training.alpha_lr_scale=0.3; `riner "
+                   "settings` lists them); given more than once, all of them in order")
       .option("steps", "N",
               "training steps (default " + std::to_string(TrainingConfig::kSteps2d) +
                   " for a slice, more for a large one so that each ray is drawn " +

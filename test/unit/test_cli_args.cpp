@@ -46,6 +46,26 @@ TEST_SUITE("cli_args") {
     CHECK(args3.integer("steps") == 100);
   }
 
+  TEST_CASE("a list option given more than once joins its lists; another option's last wins") {
+    Argv argv({"riner", "demo", "x.nii", "--set", "a=1,b=2", "--steps", "5", "--set=c=3",
+               "--set", "", "--steps", "6", "--set", "d=4"});
+    auto args = make_args();
+    args.list_option("set", "NAME=VALUE,...", "settings");
+    REQUIRE(args.parse(argv.argc(), argv.argv(), 2));
+    CHECK(args.get("set") == "a=1,b=2,c=3,d=4");
+    CHECK(args.integer("steps") == 6);
+    Argv none({"riner", "demo", "x.nii"});
+    auto defaults = make_args();
+    defaults.list_option("set", "NAME=VALUE,...", "settings");
+    REQUIRE(defaults.parse(none.argc(), none.argv(), 2));
+    CHECK(defaults.get("set").empty());
+    Argv empty_first({"riner", "demo", "x.nii", "--set", "", "--set", "a=1"});
+    auto joined = make_args();
+    joined.list_option("set", "NAME=VALUE,...", "settings");
+    REQUIRE(joined.parse(empty_first.argc(), empty_first.argv(), 2));
+    CHECK(joined.get("set") == "a=1");
+  }
+
   TEST_CASE("bad usage is a UsageError with a precise message") {
     using riner::app::UsageError;
     auto expect = [](std::vector<std::string> words, const std::string& message) {
