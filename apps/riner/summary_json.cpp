@@ -215,6 +215,8 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
           {"gradient_ring_correction", ring_summary(result.gradient_rings)},
           {"response_ring_correction", ring_summary(result.response_rings)},
           {"gradient_after_response_ring_correction", gradient_again},
+          {"gradient_after_detail_ring_correction",
+           ring_summary(result.gradient_after_detail_rings)},
           {"mirror_ring_correction", ring_summary(result.mirror_rings)},
           {"slice_ring_corrections", volume_ring_summary(result.volume_rings)},
           {"residual_detail",

@@ -177,8 +177,10 @@ nlohmann::json real_scan_run(const riner::Scan& scan, const riner::Array& fbp_im
   const std::optional<riner::RingCorrection>& gradient = result.gradient_rings;
   const std::optional<riner::RingCorrection>& response = result.response_rings;
   const std::optional<riner::RingCorrection>& again = result.gradient_after_response_rings;
+  const std::optional<riner::RingCorrection>& after_detail = result.gradient_after_detail_rings;
   const bool corrected = (rings && rings->applied) || (gradient && gradient->applied) ||
-                         (response && response->applied) || (again && again->applied);
+                         (response && response->applied) || (again && again->applied) ||
+                         (after_detail && after_detail->applied);
   const riner::Array beta = r.beta();
   int off = 0;
   for (float b : beta.data) off += b < 0.5f;
@@ -238,6 +240,9 @@ nlohmann::json real_scan_run(const riner::Scan& scan, const riner::Array& fbp_im
           {"response_correction_applied", response && response->applied},
           {"response_correction_response_change", response ? response->mean_response_change : 0.0},
           {"gradient_after_response_applied", again && again->applied},
+          {"gradient_after_detail_applied", after_detail && after_detail->applied},
+          {"gradient_after_detail_response_change",
+           after_detail ? after_detail->mean_response_change : 0.0},
           {"response_correction_even_to_odd",
            response && std::isfinite(response->even_to_odd) ? response->even_to_odd : 1e9},
           {"elements_switched_off", off},

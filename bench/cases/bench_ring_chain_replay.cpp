@@ -14,8 +14,6 @@
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
-#include <iterator>
 
 #include "harness.hpp"
 #include "riner/error.hpp"
@@ -27,6 +25,7 @@
 #include "riner/ring_chain.hpp"
 #include "riner/ring_correction.hpp"
 #include "riner/scan.hpp"
+#include "saved_training.hpp"
 #include "scenes.hpp"
 
 namespace {
@@ -37,12 +36,7 @@ namespace fs = std::filesystem;
 
 constexpr const char* kChain = "magrg";  // --order's default: riner::correct_rings_in_order's
 
-struct Saved {
-  riner::Geometry geometry;
-  riner::Array field, alpha, reference, keep;
-  std::vector<std::size_t> dead;
-  bool simulated = false;  // reference: ground truth (else the scan's FBP)
-};
+using Saved = riner::bench::SavedTraining;
 
 // What a step did, on one line (--verbose): whether it applied, what it moved.
 void describe(char step, const riner::RingCorrection& r) {
@@ -77,8 +71,7 @@ riner::Array replay(const std::string& order, const Saved& s, const riner::RingC
       r = riner::correct_rings_from_mirrors(image, alpha, s.geometry, s.dead, c.mirror);
       objects = r.object_radii_mm;
     } else {
-      throw riner::InputError(std::string("--order: unknown step '") + step +
-                              "' (a, g, r or m)");
+      throw riner::InputError(std::string("--order: unknown step '") + step + "' (a, g, r or m)");
     }
     if (verbose) describe(step, r);
     image = std::move(r.image);
@@ -87,47 +80,6 @@ riner::Array replay(const std::string& order, const Saved& s, const riner::RingC
     for (std::size_t p = 0; p < image.size(); ++p) image.data[p] *= s.keep.data[p];
   }
   return image;
-}
-
-void save(const fs::path& dir, riner::Reconstructor& r, const riner::Geometry& g,
-          const riner::Array& reference, bool simulated, const riner::RingCorrectionConfig& c) {
-  fs::create_directories(dir);
-  const riner::ReconstructionResult result = r.result();
-  Saved s{g, result.field_image, r.trained_alpha(), reference, {}, r.dead_elements(), simulated};
-  // The pixels the reconstruction zeroed after its corrections (air that training skipped).
-  s.keep = riner::Array(result.image.shape, 1.0f);
-  const riner::Array chain = riner::correct_rings_in_order(s.field, s.alpha, g, s.dead, c).image;
-  for (std::size_t p = 0; p < s.keep.size(); ++p) {
-    if (result.image.data[p] == 0.0f && chain.data[p] != 0.0f) s.keep.data[p] = 0.0f;
-  }
-  riner::write_array(dir / "field.npy", s.field);
-  riner::write_array(dir / "alpha.npy", s.alpha);
-  riner::write_array(dir / "reference.npy", s.reference);
-  riner::write_array(dir / "keep.npy", s.keep);
-  riner::Array dead({s.dead.size() + 1});  // a leading -1 keeps the array non-empty
-  dead.data[0] = -1.0f;
-  for (std::size_t i = 0; i < s.dead.size(); ++i) dead.data[i + 1] = static_cast<float>(s.dead[i]);
-  riner::write_array(dir / "dead.npy", dead);
-  std::ofstream(dir / "geometry.json") << g.to_json();
-  std::ofstream(dir / "kind") << (simulated ? "simulated" : "real");
-}
-
-Saved load(const fs::path& dir) {
-  Saved s;
-  std::ifstream geometry(dir / "geometry.json");
-  s.geometry =
-      riner::Geometry::from_json(std::string(std::istreambuf_iterator<char>(geometry), {}));
-  s.field = riner::read_array(dir / "field.npy").array;
-  s.alpha = riner::read_array(dir / "alpha.npy").array;
-  s.reference = riner::read_array(dir / "reference.npy").array;
-  s.keep = riner::read_array(dir / "keep.npy").array;
-  const riner::Array dead = riner::read_array(dir / "dead.npy").array;
-  for (std::size_t i = 1; i < dead.size(); ++i)
-    s.dead.push_back(static_cast<std::size_t>(dead.data[i]));
-  std::string kind;
-  std::ifstream(dir / "kind") >> kind;
-  s.simulated = kind == "simulated";
-  return s;
 }
 
 std::vector<Result> ring_chain_replay(const Options& o) {
@@ -150,8 +102,8 @@ std::vector<Result> ring_chain_replay(const Options& o) {
         riner::Reconstructor r(scene.sim.scan, config, device);
         r.run();
         const std::string name = "slice_" + std::to_string(i + o.get_int("seed-offset", 0));
-        save(fs::path(save_dir) / name, r, scene.sim.scan.geometry, scene.sim.ground_truth, true,
-             config.rings);
+        riner::bench::save_training(fs::path(save_dir) / name, r, scene.sim.scan.geometry,
+                                    scene.sim.ground_truth, true, config.rings);
         std::fprintf(stderr, "%s: saved after %.1f s of training\n", name.c_str(),
                      r.stats().seconds);
       }
@@ -162,8 +114,8 @@ std::vector<Result> ring_chain_replay(const Options& o) {
       const riner::Array fbp_image = riner::fbp(scan, fbp_options);
       riner::Reconstructor r(scan, config, device);
       r.run();
-      save(fs::path(save_dir) / o.get("tag", "scan"), r, scan.geometry, fbp_image, false,
-           config.rings);
+      riner::bench::save_training(fs::path(save_dir) / o.get("tag", "scan"), r, scan.geometry,
+                                  fbp_image, false, config.rings);
     }
     return results;
   }
@@ -178,7 +130,7 @@ std::vector<Result> ring_chain_replay(const Options& o) {
   double psnr = 0.0, ssim = 0.0;
   int simulated = 0;
   for (const fs::path& dir : dirs) {
-    const Saved s = load(dir);
+    const Saved s = riner::bench::load_training(dir);
     const riner::Array image = replay(order, s, config.rings, o.get_int("verbose", 0) != 0);
     const std::string name = dir.filename().string();
     if (!images_dir.empty()) {

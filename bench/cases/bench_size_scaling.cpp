@@ -7,15 +7,19 @@
 //
 //   riner_bench --case=size_scaling [--columns=512,1024,2048] [--scene=deeplesion|shepp-logan]
 //               [--first=3 --last=3] [--seed-offset=N] [--config=JSON] [--json=FILE]
-//               [--images=DIR]
-// --images: the truth, riner's image, the oracle FBP, the learned and the true alpha as .npy
-// per scene and size, for looking at where the error lies.
+//               [--images=DIR] [--save=DIR]
+// --images: the truth, riner's image, the oracle FBP, the learned and the true alpha, the trained
+// field and the image after each ring correction as .npy per scene and size, for looking at
+// where the error lies. --save: each trained result as DIR/SCENE_INDEX_COLUMNS/ for replaying the
+// ring corrections on it (ring_chain_replay --replay=DIR).
 // deeplesion: the shared slices (1 mm pixels) resampled bilinearly: no detail finer than 1 mm at
 // any size. shepp-logan: rasterised on each grid (4x supersampled): sharp at every size.
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <sstream>
+#include <utility>
 
 #include "harness.hpp"
 #include "riner/error.hpp"
@@ -27,6 +31,7 @@
 #include "riner/reconstructor.hpp"
 #include "riner/resample.hpp"
 #include "riner/simulate.hpp"
+#include "saved_training.hpp"
 #include "scenes.hpp"
 
 namespace {
@@ -125,9 +130,16 @@ std::vector<Result> size_scaling(const Options& o) {
       for (std::size_t e = 0; e < beta.size(); ++e) {
         const bool is_dead = sim.alpha.data[e] == 0.0f;
         dead += is_dead;
-        if (beta.data[e] < riner::Reconstructor::kDeadBelowBeta) (is_dead ? dead_found : live_off) += 1;
+        if (beta.data[e] < riner::Reconstructor::kDeadBelowBeta)
+          (is_dead ? dead_found : live_off) += 1;
       }
       const std::string name = scene + "/" + std::to_string(index);
+      if (const std::string dir = o.get("save", ""); !dir.empty()) {
+        riner::bench::save_training(
+            std::filesystem::path(dir) /
+                (scene + "_" + std::to_string(index) + "_" + std::to_string(c)),
+            r, g, truth, true, config.rings);
+      }
       if (const std::string dir = o.get("images", ""); !dir.empty()) {
         const std::filesystem::path stem =
             std::filesystem::path(dir) /
@@ -138,6 +150,30 @@ std::vector<Result> size_scaling(const Options& o) {
         riner::write_array(stem.string() + "oracle.npy", oracle_image);
         riner::write_array(stem.string() + "alpha.npy", r.alpha());
         riner::write_array(stem.string() + "alpha_true.npy", sim.alpha);
+        const riner::ReconstructionResult res = r.result();
+        riner::write_array(stem.string() + "field.npy", res.field_image);
+        // Each ring correction's image as it gave it (before the skipped air is set back to 0),
+        // in the chain's order, and what it did.
+        const std::pair<const char*, const std::optional<riner::RingCorrection>*> steps[] = {
+            {"mirror", &res.mirror_rings},
+            {"air", &res.air_rings},
+            {"gradient", &res.gradient_rings},
+            {"response", &res.response_rings},
+            {"gradient_again", &res.gradient_after_response_rings},
+            {"gradient_after_detail", &res.gradient_after_detail_rings}};
+        for (const auto& [step, correction] : steps) {
+          if (!correction->has_value()) continue;
+          const riner::RingCorrection& step_result = **correction;
+          riner::write_array(stem.string() + "after_" + step + ".npy", step_result.image);
+          std::fprintf(stderr,
+                       "  %s: applied %d, mean response change %.5f, even/odd %.2f, scale %.1f px\n",
+                      step, step_result.applied ? 1 : 0, step_result.mean_response_change,
+                      step_result.even_to_odd, step_result.scale_px);
+        }
+        std::fprintf(stderr,
+                     "  detail: applied %d, consistent share %.3f, held-out misfit %.6g -> %.6g\n",
+                    res.residual_detail.applied ? 1 : 0, res.residual_detail.consistent_share,
+                    res.residual_detail.misfit_before, res.residual_detail.misfit_after);
       }
       rows.push_back(
           {"size_scaling",

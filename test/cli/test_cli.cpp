@@ -819,5 +819,59 @@ TEST_SUITE("cli") {
       changed += c.data[p] != a.data[p];
     }
     CHECK(changed > c.size() / 4);
+
+    // After the detail the gradient correction runs once more (rings.gradient_after_detail),
+    // and only then. On this rough 300-step field the detail is large and the rings the step
+    // finds would move the responses by more than the step's cap (3%): the image is kept.
+    const auto after = nlohmann::json::parse(detail.out)["gradient_after_detail_ring_correction"];
+    CHECK(after["measured_radii"].get<int>() > 100);
+    CHECK(after["applied"] == false);
+    CHECK(after["mean_response_change"].get<double>() > 0.03);
+    // Without the detail the step does not run at all (no radii measured).
+    CHECK_FALSE(nlohmann::json::parse(with.out)["gradient_after_detail_ring_correction"].contains(
+        "measured_radii"));
+    const std::string detail_on = common + "--set detail.residual=true --format npy ";
+    const Run held = riner_cli(
+        detail_on + "--set rings.gradient_after_detail=false --out " + (dir / "d").string(), dir);
+    REQUIRE(held.code == 0);
+    CHECK_FALSE(nlohmann::json::parse(held.out)["gradient_after_detail_ring_correction"].contains(
+        "measured_radii"));
+    const riner::Array e = riner::read_array(dir / "d" / "image.npy").array;
+    CHECK(e.data == c.data);
+    // With the cap raised it applies: image and alpha change by rings alone, the air stays 0.
+    const Run raised = riner_cli(
+        detail_on + "--set rings.gradient_max_mean_response_change=0.2 --out " +
+            (dir / "e").string(),
+        dir);
+    const Run raised_held = riner_cli(detail_on +
+                                          "--set rings.gradient_max_mean_response_change=0.2 "
+                                          "--set rings.gradient_after_detail=false --out " +
+                                          (dir / "f").string(),
+                                      dir);
+    REQUIRE(raised.code == 0);
+    REQUIRE(raised_held.code == 0);
+    CHECK(nlohmann::json::parse(raised.out)["gradient_after_detail_ring_correction"]["applied"] ==
+          true);
+    const riner::Array ringed = riner::read_array(dir / "e" / "image.npy").array;
+    const riner::Array plain = riner::read_array(dir / "f" / "image.npy").array;
+    std::size_t moved = 0;
+    for (std::size_t p = 0; p < plain.size(); ++p) {
+      if (plain.data[p] == 0.0f && a.data[p] == 0.0f) CHECK(ringed.data[p] == 0.0f);
+      moved += ringed.data[p] != plain.data[p];
+    }
+    CHECK(moved > plain.size() / 4);
+    for (std::size_t i = 0; i < 256; i += 7) {
+      for (std::size_t k = 0; k < 256; k += 5) {
+        if (plain(i, k) == 0.0f || plain(k, 255 - i) == 0.0f || plain(255 - i, 255 - k) == 0.0f)
+          continue;
+        const float step = ringed(i, k) - plain(i, k);
+        CHECK(ringed(k, 255 - i) - plain(k, 255 - i) ==
+              doctest::Approx(step).epsilon(1e-3).scale(1e-5));
+        CHECK(ringed(255 - i, 255 - k) - plain(255 - i, 255 - k) ==
+              doctest::Approx(step).epsilon(1e-3).scale(1e-5));
+      }
+    }
+    CHECK(riner::read_array(dir / "e" / "alpha.npy").array.data !=
+          riner::read_array(dir / "f" / "alpha.npy").array.data);
   }
 }

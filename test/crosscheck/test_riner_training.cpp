@@ -243,6 +243,17 @@ TEST_SUITE("riner_training") {
     }
     const riner::Array by_view = on.alpha_by_view();
     REQUIRE(by_view.shape == std::vector<std::size_t>{240, elements});
+    // An element whose response holds over the scan reads, in every view, the response the
+    // corrections left it (alpha_by_view is formed after the last of them).
+    const riner::Array alpha = on.alpha();
+    std::vector<bool> changes(elements, false);
+    for (const riner::ChangingElement& e : changing) changes[e.element] = true;
+    for (std::size_t e = 0; e < elements; ++e) {
+      if (changes[e]) continue;
+      for (std::size_t v = 0; v < 240; v += 17) {
+        CHECK(by_view.data[v * elements + e] == doctest::Approx(alpha.data[e]).epsilon(1e-6));
+      }
+    }
   }
 
   TEST_CASE("bad inputs are InputErrors") {

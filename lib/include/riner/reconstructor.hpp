@@ -58,6 +58,9 @@ struct ReconstructionResult {
   std::optional<RingCorrection> gradient_rings;
   std::optional<RingCorrection> response_rings;
   std::optional<RingCorrection> gradient_after_response_rings;
+  // 2D: the gradient correction once more after the readings' detail
+  // (rings.gradient_after_detail; only when the detail was added).
+  std::optional<RingCorrection> gradient_after_detail_rings;
   std::optional<RingCorrection> mirror_rings;
   // 3D: the same corrections slice by slice (parallel beam; a cone beam gets a note).
   std::optional<VolumeRingCorrection> volume_rings;
@@ -225,6 +228,7 @@ class Reconstructor {
  private:
   ReconstructionResult evaluate_result() const;
   void evaluate_rings(ReconstructionResult& r) const;
+  void evaluate_rings_after_detail(ReconstructionResult& r) const;
   void evaluate_residual_detail(ReconstructionResult& r, const std::vector<float>& parameters,
                                 const Array& trained_alpha) const;
   struct Impl;

@@ -278,6 +278,10 @@ struct RingCorrectionConfig {
   // first pass keeps the edges of broad structure, so the narrow rings beside them wait until
   // the response correction has taken it (docs/history/RESULTS.md, issue 13).
   bool gradient_after_response = true;
+  // 2D: the gradient correction once more after the readings' detail is given back (when it
+  // was): the detail sharpens the edges that cross a circle, so the flattest half of its points
+  // holds fewer of them and the rings the field kept stand out (docs/history/RESULTS.md, issue 29).
+  bool gradient_after_detail = true;
   // Before all of them, objects centred on the axis that training put into alpha go back into
   // the image (correct_rings_from_mirrors): a tube's wall, a cylinder's edge
   // (docs/history/RESULTS.md, issue 32).

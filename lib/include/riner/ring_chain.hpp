@@ -1,7 +1,8 @@
 // The ring corrections of riner/ring_correction.hpp as a reconstruction runs them: mirror pairs,
 // air, radial gradient, detector response, radial gradient again, each that the settings turn
 // on, each fed the image and alpha the one before left. Used for a slice (Reconstructor) and for each slice of a
-// parallel-beam volume (riner/volume_ring_correction.hpp).
+// parallel-beam volume (riner/volume_ring_correction.hpp). A slice whose readings' detail is
+// given back gets the radial gradient once more after it (Reconstructor, rings.gradient_after_detail).
 #pragma once
 
 #include <cstddef>

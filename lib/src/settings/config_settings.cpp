@@ -246,6 +246,10 @@ void add_rings(Table& t) {
   t.push_back(field<C>("rings", "gradient_after_response", {},
                        "the gradient correction again after the response correction (both on)",
                        &C::rings, &R::gradient_after_response));
+  t.push_back(field<C>("rings", "gradient_after_detail", {},
+                       "2D: the gradient correction again after the readings' detail is added "
+                       "(when it is)",
+                       &C::rings, &R::gradient_after_detail));
   t.push_back(field<C>("rings", "mirror_reference", {},
                        "2D (3D: slice_by_slice): objects on the axis back from alpha's even "
                        "structure that its odd part does not share",

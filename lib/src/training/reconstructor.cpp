@@ -10,6 +10,7 @@
 #include "cl/buffer.hpp"
 #include "riner/error.hpp"
 #include "riner/ring_chain.hpp"
+#include "riner/ring_correction.hpp"
 #include "training/trainer.hpp"
 #include "training/warm_start.hpp"
 
@@ -252,9 +253,34 @@ ReconstructionResult Reconstructor::evaluate_result() const {
   r.alpha = alpha_per_element(impl_->setup, p);
   const Array trained = r.alpha;
   evaluate_rings(r);
-  r.alpha_by_view = responses_by_view(impl_->setup, p, trained, r.alpha);
   evaluate_residual_detail(r, p, trained);
+  evaluate_rings_after_detail(r);
+  r.alpha_by_view = responses_by_view(impl_->setup, p, trained, r.alpha);
   return r;
+}
+
+void Reconstructor::evaluate_rings_after_detail(ReconstructionResult& r) const {
+  const RinerConfig& c = impl_->setup.config;
+  const Geometry& g = impl_->setup.scan.geometry;
+  if (g.is_3d() || !r.residual_detail.applied || !c.rings.gradient_reference ||
+      !c.rings.gradient_after_detail) {
+    return;
+  }
+  static const std::vector<double> kNoObjects;
+  const std::vector<double>& objects =
+      r.mirror_rings ? r.mirror_rings->object_radii_mm : kNoObjects;
+  RingCorrection again =
+      correct_rings_from_gradient(r.image, r.alpha, g, c.rings.gradient, objects);
+  r.image = again.image;
+  r.alpha = again.alpha;
+  // As the chain does: what training skipped stays air (the profile is drawn on whole circles).
+  const model::Occupancy& occupancy = impl_->setup.occupancy;
+  if (occupancy.carved) {
+    for (std::size_t px = 0; px < occupancy.inside.size(); ++px) {
+      if (!occupancy.inside[px]) r.image.data[px] = 0.0f;
+    }
+  }
+  r.gradient_after_detail_rings = std::move(again);
 }
 
 void Reconstructor::evaluate_residual_detail(ReconstructionResult& r, const std::vector<float>& p,
