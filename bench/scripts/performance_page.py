@@ -18,14 +18,16 @@ import sys
 
 # The current measurement of each table: file under bench/results/ and what to take from it.
 SOURCES = {
-    "deeplesion_cpu": "issue29_residual_detail.jsonl",
+    "deeplesion_cpu": "issue29_gradient_after_detail.jsonl",
     "deeplesion_gpu": "issue30_throughput.jsonl",
     "deeplesion_gpu_h100": "issue12_gpu.jsonl",
     "classical": "issue31_destripe_device.jsonl",
     "classical_real": "issue31_destripe_real_specks.jsonl",
     "warm_start": "issue31_warm_smooth.jsonl",
     # newest first: a scene and size measured in a later file hides the earlier rows
-    "sizes_cpu": ("issue29_residual_detail_sizes.jsonl", "issue29_sl2048_family.jsonl",
+    "sizes_cpu": ("issue29_gradient_after_detail_sizes.jsonl",
+                  "issue29_alpha_warmup_sizes.jsonl", "issue29_residual_detail_sizes.jsonl",
+                  "issue29_sl2048_family.jsonl",
                   "issue29_sizes_gradient.jsonl", "issue29_draws10.jsonl"),
     "sizes_gpu": "issue29_sizes_gpu.jsonl",
     "real_trained": "issue29_beta_real.jsonl",
