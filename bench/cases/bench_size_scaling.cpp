@@ -145,12 +145,12 @@ std::vector<Result> size_scaling(const Options& o) {
             std::filesystem::path(dir) /
             (scene + "_" + std::to_string(index) + "_" + std::to_string(c) + "_");
         std::filesystem::create_directories(dir);
-        riner::write_array(stem.string() + "truth.npy", truth);
-        riner::write_array(stem.string() + "riner.npy", r.result().image);
-        riner::write_array(stem.string() + "oracle.npy", oracle_image);
-        riner::write_array(stem.string() + "alpha.npy", r.alpha());
-        riner::write_array(stem.string() + "alpha_true.npy", sim.alpha);
         const riner::ReconstructionResult res = r.result();
+        riner::write_array(stem.string() + "truth.npy", truth);
+        riner::write_array(stem.string() + "riner.npy", res.image);
+        riner::write_array(stem.string() + "oracle.npy", oracle_image);
+        riner::write_array(stem.string() + "alpha.npy", res.alpha);
+        riner::write_array(stem.string() + "alpha_true.npy", sim.alpha);
         riner::write_array(stem.string() + "field.npy", res.field_image);
         // Each ring correction's image as it gave it (before the skipped air is set back to 0),
         // in the chain's order, and what it did.
@@ -167,13 +167,13 @@ std::vector<Result> size_scaling(const Options& o) {
           riner::write_array(stem.string() + "after_" + step + ".npy", step_result.image);
           std::fprintf(stderr,
                        "  %s: applied %d, mean response change %.5f, even/odd %.2f, scale %.1f px\n",
-                      step, step_result.applied ? 1 : 0, step_result.mean_response_change,
-                      step_result.even_to_odd, step_result.scale_px);
+                       step, step_result.applied ? 1 : 0, step_result.mean_response_change,
+                       step_result.even_to_odd, step_result.scale_px);
         }
         std::fprintf(stderr,
                      "  detail: applied %d, consistent share %.3f, held-out misfit %.6g -> %.6g\n",
-                    res.residual_detail.applied ? 1 : 0, res.residual_detail.consistent_share,
-                    res.residual_detail.misfit_before, res.residual_detail.misfit_after);
+                     res.residual_detail.applied ? 1 : 0, res.residual_detail.consistent_share,
+                     res.residual_detail.misfit_before, res.residual_detail.misfit_after);
       }
       rows.push_back(
           {"size_scaling",

@@ -274,12 +274,7 @@ void Reconstructor::evaluate_rings_after_detail(ReconstructionResult& r) const {
   r.image = again.image;
   r.alpha = again.alpha;
   // As the chain does: what training skipped stays air (the profile is drawn on whole circles).
-  const model::Occupancy& occupancy = impl_->setup.occupancy;
-  if (occupancy.carved) {
-    for (std::size_t px = 0; px < occupancy.inside.size(); ++px) {
-      if (!occupancy.inside[px]) r.image.data[px] = 0.0f;
-    }
-  }
+  model::fade_into_skipped_air(impl_->setup.occupancy, r.image.shape, 0, r.image.data);
   r.gradient_after_detail_rings = std::move(again);
 }
 
