@@ -25,7 +25,8 @@ SOURCES = {
     "classical_real": "issue31_destripe_real_specks.jsonl",
     "warm_start": "issue31_warm_smooth.jsonl",
     # newest first: a scene and size measured in a later file hides the earlier rows
-    "sizes_cpu": ("issue29_gradient_after_detail_sizes.jsonl",
+    "sizes_cpu": ("issue29_broad_even_hold_sizes.jsonl",
+                  "issue29_gradient_after_detail_sizes.jsonl",
                   "issue29_alpha_warmup_sizes.jsonl", "issue29_residual_detail_sizes.jsonl",
                   "issue29_sl2048_family.jsonl",
                   "issue29_sizes_gradient.jsonl", "issue29_draws10.jsonl"),
@@ -594,6 +595,8 @@ quality report's measures; no ground truth):
 
 The paper's fan beam with the detector, the views and the grid resampled (`size_scaling`): a
 Shepp-Logan phantom and DeepLesion slice 3; the oracle is FBP with a perfect detector.
+`alpha_warmup_broad_px` 3 is today's default (α's broad even part held for 300 steps from
+1000 elements); DeepLesion at 2048 columns was measured before it, with all of α held.
 
 {sizes}
 

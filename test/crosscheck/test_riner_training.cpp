@@ -5,6 +5,7 @@
 #include <cmath>
 #include <vector>
 
+#include "model/broad_even_hold.hpp"
 #include "model/ray_segments.hpp"
 #include "riner/destripe.hpp"
 #include "riner/error.hpp"
@@ -81,6 +82,41 @@ TEST_SUITE("riner_training") {
       }
     }
     CHECK(dead == 1);
+  }
+
+  TEST_CASE("alpha's broad even hold: both engines agree; only alpha's narrow part learns") {
+    // 40 steps inside a warm-up holding alpha's part even about the axis and broader than
+    // 3 pixels: alpha moves (the rings' narrow offsets), its broad even part hardly.
+    const riner::test::TinyProblem t = riner::test::tiny_problem(2);
+    riner::RinerConfig c = riner::test::tiny_config();
+    c.rings.air_reference = c.rings.gradient_reference = c.rings.response_reference =
+        c.rings.mirror_reference = false;
+    c.training.alpha_warmup_steps = 1000;
+    c.training.alpha_warmup_broad_px = 3.0;
+    riner::Reconstructor device(t.scan, c, riner::test::device());
+    c.engine = riner::Engine::kReference;
+    riner::Reconstructor reference(t.scan, c);
+    device.step(40);
+    reference.step(40);
+    const riner::Array a = device.trained_alpha();
+    const riner::Array b = reference.trained_alpha();
+    const riner::model::BroadEvenHold hold(t.scan.geometry, 3.0,
+                                           std::vector<float>(a.size(), 1.0f));
+    std::vector<double> log_alpha(a.size());
+    double moved = 0.0;
+    for (std::size_t e = 0; e < a.size(); ++e) {
+      CAPTURE(e);
+      CHECK(a.data[e] == doctest::Approx(b.data[e]).epsilon(riner::test::tolerance::kTraining));
+      log_alpha[e] = std::log(a.data[e]);
+      moved += log_alpha[e] * log_alpha[e];
+    }
+    const std::vector<double> broad = hold.broad_even(log_alpha);
+    double broad_squares = 0.0;
+    for (double v : broad) broad_squares += v * v;
+    MESSAGE("alpha's change rms ", std::sqrt(moved / a.size()), ", its broad even part ",
+            std::sqrt(broad_squares / a.size()));
+    CHECK(std::sqrt(moved / a.size()) > 1e-3);
+    CHECK(broad_squares < 0.01 * moved);
   }
 
   TEST_CASE("tail averaging: alpha is the mean of the snapshots' alphas; training unchanged") {

@@ -184,6 +184,12 @@ struct TrainingConfig {
   static constexpr int kWideAlphaWarmup = 300;
   static constexpr std::size_t kWideDetectorElements = 1000;
   int alpha_warmup_steps = kScanAlphaWarmup;
+  // During alpha_warmup_steps: 0 holds all of alpha; > 0 holds only its part that is even about
+  // the axis and broader than a Gaussian of this sigma (grid pixels at the axis), and the rest
+  // learns from the first step (model/broad_even_hold.hpp). 2D only (3D holds all). 3 against
+  // all: DeepLesion at 1024 columns +0.19 / -0.28 / +0.31 dB (slices 3, 0, 1), the Shepp-Logan
+  // +0.18 (1024) and +0.37 (2048); sigma 1, 8 and 16 no better (docs/history/RESULTS.md).
+  double alpha_warmup_broad_px = 3.0;
   int beta_warmup_steps = -1;  // -1: the first learning-rate phase (decay_interval())
   // Coarse to fine: when > 0, level l >= 1 of the encoding fades in over steps
   // [(l - 1) k, l k] with k = level_warmup_steps (its features are scaled by 0 .. 1), so the

@@ -168,6 +168,10 @@ void add_training_schedule(Table& t) {
                        "alpha stays at its initial value for these steps; -1: 300 on a slice "
                        "whose detector row has at least 1000 elements, else 0",
                        &C::training, &T::alpha_warmup_steps));
+  t.push_back(field<C>("training", "alpha_warmup_broad_px", closed(0, 1e6),
+                       "alpha_warmup_steps hold only alpha's part even about the axis and "
+                       "broader than a Gaussian of this sigma (grid pixels); 0: all of alpha",
+                       &C::training, &T::alpha_warmup_broad_px));
   t.push_back(field<C>("training", "beta_warmup_steps", closed(-1, kMaxSteps),
                        "beta of elements with valid readings stays put for these steps; -1: the "
                        "first learning-rate phase",

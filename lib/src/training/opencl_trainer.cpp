@@ -48,6 +48,7 @@ class OpenclTrainer final : public Trainer {
                  model::BatchSampler(setup.scan.geometry, setup.config.training).rays_per_step()),
         adam_(ctx_, setup.layout.total) {
     if (setup.layout.factored_alpha()) factors_.emplace(ctx_, setup.layout);
+    hold_ = setup.broad_even_hold(setup.initial_parameters());
     if (setup.tail_average.steps > 0) {
       vector_ops_.emplace(ctx_);
       tail_sum_.emplace(ctx_, std::vector<float>(setup.layout.total, 0.0f));
@@ -81,6 +82,7 @@ class OpenclTrainer final : public Trainer {
                {&step_op_.mlp_partials(), setup_.layout.mlp_offset, setup_.layout.mlp_params,
                 step_op_.mlp_slices()});
     if (factors_) factors_->expand(params_);
+    if (hold_ && setup_.holds_broad_even_alpha(index)) hold_broad_even_alpha();
     if (setup_.tail_average.takes(index)) vector_ops_->axpy(1.0f, params_, *tail_sum_);
     pending_.push_back({index, 0.0, 0.0, adam.learning_rate});
     steps_ = index + 1;
@@ -128,6 +130,14 @@ class OpenclTrainer final : public Trainer {
     return *tail_mean_;
   }
 
+  // A few thousand values a step, for the hold's few hundred steps: on the host.
+  void hold_broad_even_alpha() {
+    std::vector<float> alpha(setup_.scan.geometry.n_u);
+    params_.read(std::span<float>(alpha), setup_.layout.alpha_offset);
+    hold_->apply(alpha);
+    params_.write(std::span<const float>(alpha), setup_.layout.alpha_offset);
+  }
+
   void read_history() {
     if (pending_.empty()) return;
     const std::vector<float> values = history_.read();
@@ -158,6 +168,7 @@ class OpenclTrainer final : public Trainer {
   std::optional<ops::VectorOps> vector_ops_;    // tail averaging (model/tail_average.hpp)
   std::optional<cl::Buffer<float>> tail_sum_;
   std::optional<cl::Buffer<float>> tail_mean_;
+  std::optional<model::BroadEvenHold> hold_;  // training.alpha_warmup_broad_px
   std::vector<LossRecord> pending_;
   std::vector<LossRecord> done_;
   int steps_ = 0;

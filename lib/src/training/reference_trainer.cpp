@@ -28,6 +28,7 @@ class ReferenceTrainer final : public Trainer {
     inputs_.data_weight = setup_.config.training.data_weight;
     inputs_.invalid_readings = &setup_.invalid_readings;
     inputs_.responses = setup_.responses.varies() ? &setup_.responses : nullptr;
+    hold_ = setup.broad_even_hold(init);
   }
 
   void step(int index, const model::Batch& batch) override {
@@ -39,6 +40,7 @@ class ReferenceTrainer final : public Trainer {
     const model::AdamSettings adam = setup_.adam_settings(index);
     ref::adam_step(adam, index + 1, r.grad, params_, m_, v_);
     if (setup_.layout.factored_alpha()) ref::alpha_factors_expand(setup_.layout, params_);
+    if (hold_ && setup_.holds_broad_even_alpha(index)) hold_broad_even_alpha();
     if (setup_.tail_average.takes(index)) {
       for (std::size_t i = 0; i < params_.size(); ++i) tail_sum_[i] += params_[i];
     }
@@ -67,6 +69,11 @@ class ReferenceTrainer final : public Trainer {
   std::optional<ExecutionPlan> plan() const override { return std::nullopt; }
 
  private:
+  void hold_broad_even_alpha() {
+    hold_->apply(std::span<double>(params_).subspan(setup_.layout.alpha_offset,
+                                                    setup_.scan.geometry.n_u));
+  }
+
   // The parameters the result is made of (model::TailAverage::snapshots): the snapshots' mean,
   // or the last step's.
   std::vector<double> result_parameters() const {
@@ -84,6 +91,7 @@ class ReferenceTrainer final : public Trainer {
   std::vector<double> v_;
   std::vector<LossRecord> losses_;
   std::vector<double> tail_sum_;  // tail averaging (model/tail_average.hpp)
+  std::optional<model::BroadEvenHold> hold_;  // training.alpha_warmup_broad_px
   int steps_ = 0;
 };
 

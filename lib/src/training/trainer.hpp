@@ -8,6 +8,7 @@
 
 #include "model/adam_settings.hpp"
 #include "model/batch_sampler.hpp"
+#include "model/broad_even_hold.hpp"
 #include "model/factor_evidence.hpp"
 #include "model/noise_evidence.hpp"
 #include "model/occupancy.hpp"
@@ -64,6 +65,13 @@ struct TrainingSetup {
   // Adam settings of a step, for both engines: the schedule for the field, alpha0 and beta0,
   // and the lazy range (training.sparse_adam).
   model::AdamSettings adam_settings(int step) const;
+  // Whether all of alpha is held at this step (training.alpha_warmup_steps), or only its broad
+  // even part (training.alpha_warmup_broad_px; the engines apply `broad_even_hold` after Adam).
+  bool holds_all_alpha(int step) const;
+  bool holds_broad_even_alpha(int step) const;
+  // The hold of alpha's broad even part from the engine's initial parameters; nullopt when the
+  // run holds none.
+  std::optional<model::BroadEvenHold> broad_even_hold(const std::vector<float>& start) const;
   // Whether beta0 of the elements without invalid readings is held at this step (warm-up).
   bool hold_valid_beta(int step) const { return step < config.training.beta_warmup(); }
   // Scale of each encoding level's features at a step (coarse to fine); all 1 when done.

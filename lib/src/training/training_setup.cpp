@@ -183,12 +183,31 @@ std::vector<float> TrainingSetup::level_weights(int step) const {
   return w;
 }
 
+bool TrainingSetup::holds_all_alpha(int step) const {
+  const TrainingConfig& t = config.training;
+  const bool broad_only = t.alpha_warmup_broad_px > 0.0 && !scan.geometry.is_3d();
+  return step < t.alpha_warmup_steps && !broad_only;
+}
+
+bool TrainingSetup::holds_broad_even_alpha(int step) const {
+  return step < config.training.alpha_warmup_steps && !holds_all_alpha(step);
+}
+
+std::optional<model::BroadEvenHold> TrainingSetup::broad_even_hold(
+    const std::vector<float>& start) const {
+  const Geometry& g = scan.geometry;
+  if (!holds_broad_even_alpha(0) || layout.factored_alpha()) return std::nullopt;
+  const auto first = start.begin() + static_cast<std::ptrdiff_t>(layout.alpha_offset);
+  return model::BroadEvenHold(g, config.training.alpha_warmup_broad_px,
+                              std::span<const float>(&*first, g.n_u));
+}
+
 model::AdamSettings TrainingSetup::adam_settings(int step) const {
   const TrainingConfig& t = config.training;
   const double lr = learning_rate(step);
   return {lr,
           layout.alpha_offset,
-          step < t.alpha_warmup_steps ? 0.0 : lr * alpha_rate,
+          holds_all_alpha(step) ? 0.0 : lr * alpha_rate,
           layout.beta_offset,
           lr * t.beta_lr_scale,
           t.adam_beta1,

@@ -1,0 +1,75 @@
+#include "model/broad_even_hold.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "riner/error.hpp"
+#include "riner/rays.hpp"
+#include "rings/radial.hpp"
+
+namespace riner::model {
+
+namespace {
+
+// Normalised Gaussian weights at x over the elements' ray distances, scaled by `share`.
+void add_gaussian(const std::vector<double>& distance, double x, double sigma, double share,
+                  std::map<std::size_t, double>& into) {
+  std::vector<std::pair<std::size_t, double>> w;
+  double sum = 0.0;
+  for (std::size_t f = 0; f < distance.size(); ++f) {
+    const double t = (distance[f] - x) / sigma;
+    if (std::fabs(t) > rings::kGaussianReach) continue;
+    w.emplace_back(f, std::exp(-0.5 * t * t));
+    sum += w.back().second;
+  }
+  for (const auto& [f, v] : w) into[f] += share * v / sum;
+}
+
+}  // namespace
+
+BroadEvenHold::BroadEvenHold(const Geometry& g, double sigma_px, std::span<const float> initial) {
+  if (g.is_3d()) throw InputError("alpha's broad even hold: a 2D geometry only");
+  if (!(sigma_px > 0.0)) throw InputError("alpha's broad even hold: sigma must be positive");
+  if (initial.size() != g.n_u) throw Error("alpha's broad even hold: one initial alpha per element");
+  const std::vector<double> distance = column_ray_distances(g);
+  const auto [lowest, highest] = std::minmax_element(distance.begin(), distance.end());
+  const double sigma = sigma_px * g.voxel_mm;
+  rows_.resize(distance.size());
+  for (std::size_t e = 0; e < distance.size(); ++e) {
+    std::map<std::size_t, double> w;
+    const double mirror = -distance[e];
+    const bool paired = mirror >= *lowest && mirror <= *highest;
+    add_gaussian(distance, distance[e], sigma, paired ? 0.5 : 1.0, w);
+    if (paired) add_gaussian(distance, mirror, sigma, 0.5, w);
+    rows_[e].reserve(w.size());
+    for (const auto& [f, v] : w) rows_[e].push_back({f, v});
+  }
+  log_initial_.resize(initial.size());
+  for (std::size_t e = 0; e < initial.size(); ++e)
+    log_initial_[e] = std::log(std::max(initial[e], 1e-8f));
+}
+
+std::vector<double> BroadEvenHold::broad_even(std::span<const double> values) const {
+  std::vector<double> out(rows_.size(), 0.0);
+  for (std::size_t e = 0; e < rows_.size(); ++e) {
+    for (const Weight& w : rows_[e]) out[e] += w.weight * values[w.element];
+  }
+  return out;
+}
+
+template <typename T>
+void BroadEvenHold::remove_broad_even(std::span<T> alpha) const {
+  if (alpha.size() != rows_.size()) throw Error("alpha's broad even hold: one alpha per element");
+  std::vector<double> change(alpha.size());
+  for (std::size_t e = 0; e < alpha.size(); ++e)
+    change[e] = std::log(std::max<double>(alpha[e], 1e-8)) - log_initial_[e];
+  const std::vector<double> broad = broad_even(change);
+  for (std::size_t e = 0; e < alpha.size(); ++e)
+    alpha[e] = static_cast<T>(alpha[e] * std::exp(-broad[e]));
+}
+
+void BroadEvenHold::apply(std::span<float> alpha) const { remove_broad_even(alpha); }
+void BroadEvenHold::apply(std::span<double> alpha) const { remove_broad_even(alpha); }
+
+}  // namespace riner::model
