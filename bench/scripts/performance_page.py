@@ -596,7 +596,7 @@ quality report's measures; no ground truth):
 The paper's fan beam with the detector, the views and the grid resampled (`size_scaling`): a
 Shepp-Logan phantom and DeepLesion slice 3; the oracle is FBP with a perfect detector.
 `alpha_warmup_broad_px` 3 is today's default (α's broad even part held for 300 steps from
-1000 elements); DeepLesion at 2048 columns was measured before it, with all of α held.
+1000 elements).
 
 {sizes}
 
