@@ -103,14 +103,14 @@ TEST_SUITE("alpha warm-up") {
     const riner::detail::TrainingSetup all(scan, config);
     CHECK(all.holds_all_alpha(9));
     CHECK_FALSE(all.holds_all_alpha(10));
-    CHECK_FALSE(all.broad_even_hold(all.initial_parameters()).has_value());
+    CHECK_FALSE(all.broad_even_hold(std::vector<float>(1000, 1.0f)).has_value());
     CHECK(all.adam_settings(9).alpha_learning_rate == 0.0);
     config.training.alpha_warmup_broad_px = 2.0;
     const riner::detail::TrainingSetup broad(scan, config);
     CHECK_FALSE(broad.holds_all_alpha(0));
     CHECK(broad.holds_broad_even_alpha(9));
     CHECK_FALSE(broad.holds_broad_even_alpha(10));
-    CHECK(broad.broad_even_hold(broad.initial_parameters()).has_value());
+    CHECK(broad.broad_even_hold(std::vector<float>(1000, 1.0f)).has_value());
     CHECK(broad.adam_settings(0).alpha_learning_rate > 0.0);
     config.training.alpha_warmup_broad_px = -1.0;
     CHECK_THROWS(config.validate());

@@ -2,31 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 
 #include "riner/error.hpp"
 #include "riner/rays.hpp"
 #include "rings/radial.hpp"
 
 namespace riner::model {
-
-namespace {
-
-// Normalised Gaussian weights at x over the elements' ray distances, scaled by `share`.
-void add_gaussian(const std::vector<double>& distance, double x, double sigma, double share,
-                  std::map<std::size_t, double>& into) {
-  std::vector<std::pair<std::size_t, double>> w;
-  double sum = 0.0;
-  for (std::size_t f = 0; f < distance.size(); ++f) {
-    const double t = (distance[f] - x) / sigma;
-    if (std::fabs(t) > rings::kGaussianReach) continue;
-    w.emplace_back(f, std::exp(-0.5 * t * t));
-    sum += w.back().second;
-  }
-  for (const auto& [f, v] : w) into[f] += share * v / sum;
-}
-
-}  // namespace
 
 BroadEvenHold::BroadEvenHold(const Geometry& g, double sigma_px, std::span<const float> initial) {
   if (g.is_3d()) throw InputError("alpha's broad even hold: a 2D geometry only");
@@ -36,14 +17,24 @@ BroadEvenHold::BroadEvenHold(const Geometry& g, double sigma_px, std::span<const
   const auto [lowest, highest] = std::minmax_element(distance.begin(), distance.end());
   const double sigma = sigma_px * g.voxel_mm;
   rows_.resize(distance.size());
+  std::vector<double> row(distance.size(), 0.0);
+  // Normalised Gaussian weights at x, scaled by `share`, into the row being built.
+  const auto add = [&](double x, double share) {
+    const auto weights = rings::gaussian_weights_at(distance, x, sigma);
+    double sum = 0.0;
+    for (const auto& [f, w] : weights) sum += w;
+    for (const auto& [f, w] : weights) row[f] += share * w / sum;
+  };
   for (std::size_t e = 0; e < distance.size(); ++e) {
-    std::map<std::size_t, double> w;
     const double mirror = -distance[e];
     const bool paired = mirror >= *lowest && mirror <= *highest;
-    add_gaussian(distance, distance[e], sigma, paired ? 0.5 : 1.0, w);
-    if (paired) add_gaussian(distance, mirror, sigma, 0.5, w);
-    rows_[e].reserve(w.size());
-    for (const auto& [f, v] : w) rows_[e].push_back({f, v});
+    add(distance[e], paired ? 0.5 : 1.0);
+    if (paired) add(mirror, 0.5);
+    for (std::size_t f = 0; f < row.size(); ++f) {
+      if (row[f] == 0.0) continue;
+      rows_[e].push_back({f, row[f]});
+      row[f] = 0.0;
+    }
   }
   log_initial_.resize(initial.size());
   for (std::size_t e = 0; e < initial.size(); ++e)

@@ -18,12 +18,10 @@ namespace riner::model {
 
 class BroadEvenHold {
  public:
-  BroadEvenHold() = default;
   // sigma_px: the Gaussian's sigma over ray distances, in grid pixels; initial: alpha's
   // starting value per element (n_u of them; a 2D geometry).
   BroadEvenHold(const Geometry& g, double sigma_px, std::span<const float> initial);
 
-  bool empty() const { return rows_.empty(); }
   // Takes the broad even part of ln(alpha / initial) out of alpha (n_u elements).
   void apply(std::span<float> alpha) const;
   void apply(std::span<double> alpha) const;  // the reference engine's

@@ -91,15 +91,23 @@ std::vector<double> gaussian_smooth(const std::vector<double>& values, double si
   return out;
 }
 
+std::vector<std::pair<std::size_t, double>> gaussian_weights_at(
+    const std::vector<double>& positions, double x, double sigma, const std::vector<char>* use) {
+  std::vector<std::pair<std::size_t, double>> out;
+  for (std::size_t f = 0; f < positions.size(); ++f) {
+    if (use && !(*use)[f]) continue;
+    const double t = (positions[f] - x) / sigma;
+    if (std::fabs(t) > kGaussianReach) continue;
+    out.emplace_back(f, std::exp(-0.5 * t * t));
+  }
+  return out;
+}
+
 double gaussian_mean_at(const std::vector<double>& positions, const std::vector<double>& values,
                         const std::vector<char>& use, double x, double sigma) {
   double sum = 0.0;
   double weight = 0.0;
-  for (std::size_t f = 0; f < positions.size(); ++f) {
-    if (!use[f]) continue;
-    const double t = (positions[f] - x) / sigma;
-    if (std::fabs(t) > kGaussianReach) continue;
-    const double w = std::exp(-0.5 * t * t);
+  for (const auto& [f, w] : gaussian_weights_at(positions, x, sigma, &use)) {
     sum += w * values[f];
     weight += w;
   }

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <utility>
 #include <vector>
 
 namespace riner::rings {
@@ -55,6 +56,12 @@ bool within_reach(const std::vector<double>& radii, double radius, double reach)
 // it marks enter, renormalised, and the others come out 0.
 std::vector<double> gaussian_smooth(const std::vector<double>& values, double sigma, Ends ends,
                                     const std::vector<char>* use = nullptr);
+
+// The Gaussian's weights (sigma in the positions' unit, not normalised) at x of the irregular
+// `positions` within reach, in position order; with `use`, only those it marks.
+std::vector<std::pair<std::size_t, double>> gaussian_weights_at(
+    const std::vector<double>& positions, double x, double sigma,
+    const std::vector<char>* use = nullptr);
 
 // The Gaussian-weighted mean (sigma in the positions' unit) at x of the values at irregular
 // `positions` that `use` marks; NaN when none lies within reach.

@@ -48,7 +48,7 @@ class OpenclTrainer final : public Trainer {
                  model::BatchSampler(setup.scan.geometry, setup.config.training).rays_per_step()),
         adam_(ctx_, setup.layout.total) {
     if (setup.layout.factored_alpha()) factors_.emplace(ctx_, setup.layout);
-    hold_ = setup.broad_even_hold(setup.initial_parameters());
+    hold_ = setup.broad_even_hold(read_alpha());
     if (setup.tail_average.steps > 0) {
       vector_ops_.emplace(ctx_);
       tail_sum_.emplace(ctx_, std::vector<float>(setup.layout.total, 0.0f));
@@ -130,10 +130,16 @@ class OpenclTrainer final : public Trainer {
     return *tail_mean_;
   }
 
-  // A few thousand values a step, for the hold's few hundred steps: on the host.
-  void hold_broad_even_alpha() {
+  // alpha0 of each element (its first segment's).
+  std::vector<float> read_alpha() const {
     std::vector<float> alpha(setup_.scan.geometry.n_u);
     params_.read(std::span<float>(alpha), setup_.layout.alpha_offset);
+    return alpha;
+  }
+
+  // A few thousand values a step, for the hold's few hundred steps: on the host.
+  void hold_broad_even_alpha() {
+    std::vector<float> alpha = read_alpha();
     hold_->apply(alpha);
     params_.write(std::span<const float>(alpha), setup_.layout.alpha_offset);
   }

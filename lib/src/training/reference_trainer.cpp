@@ -28,7 +28,8 @@ class ReferenceTrainer final : public Trainer {
     inputs_.data_weight = setup_.config.training.data_weight;
     inputs_.invalid_readings = &setup_.invalid_readings;
     inputs_.responses = setup_.responses.varies() ? &setup_.responses : nullptr;
-    hold_ = setup.broad_even_hold(init);
+    hold_ = setup.broad_even_hold(
+        std::span<const float>(init).subspan(setup.layout.alpha_offset, setup.scan.geometry.n_u));
   }
 
   void step(int index, const model::Batch& batch) override {

@@ -69,9 +69,9 @@ struct TrainingSetup {
   // even part (training.alpha_warmup_broad_px; the engines apply `broad_even_hold` after Adam).
   bool holds_all_alpha(int step) const;
   bool holds_broad_even_alpha(int step) const;
-  // The hold of alpha's broad even part from the engine's initial parameters; nullopt when the
-  // run holds none.
-  std::optional<model::BroadEvenHold> broad_even_hold(const std::vector<float>& start) const;
+  // The hold of alpha's broad even part from the engine's initial alpha0 (one per element);
+  // nullopt when the run holds none.
+  std::optional<model::BroadEvenHold> broad_even_hold(std::span<const float> initial_alpha) const;
   // Whether beta0 of the elements without invalid readings is held at this step (warm-up).
   bool hold_valid_beta(int step) const { return step < config.training.beta_warmup(); }
   // Scale of each encoding level's features at a step (coarse to fine); all 1 when done.

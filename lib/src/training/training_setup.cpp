@@ -194,12 +194,10 @@ bool TrainingSetup::holds_broad_even_alpha(int step) const {
 }
 
 std::optional<model::BroadEvenHold> TrainingSetup::broad_even_hold(
-    const std::vector<float>& start) const {
-  const Geometry& g = scan.geometry;
+    std::span<const float> initial_alpha) const {
   if (!holds_broad_even_alpha(0) || layout.factored_alpha()) return std::nullopt;
-  const auto first = start.begin() + static_cast<std::ptrdiff_t>(layout.alpha_offset);
-  return model::BroadEvenHold(g, config.training.alpha_warmup_broad_px,
-                              std::span<const float>(&*first, g.n_u));
+  return model::BroadEvenHold(scan.geometry, config.training.alpha_warmup_broad_px,
+                              initial_alpha);
 }
 
 model::AdamSettings TrainingSetup::adam_settings(int step) const {
