@@ -86,8 +86,9 @@ TEST_SUITE("riner_training") {
 
   TEST_CASE("alpha's broad even hold: both engines agree; only alpha's narrow part learns") {
     // 40 steps inside a warm-up holding alpha's part even about the axis and broader than
-    // 3 pixels: alpha moves (the rings' narrow offsets), its broad even part hardly.
-    const riner::test::TinyProblem t = riner::test::tiny_problem(2);
+    // 3 pixels: alpha moves (the rings' narrow offsets), its broad even part hardly. Over a
+    // full turn: a 180-degree scan holds all of alpha.
+    const riner::test::TinyProblem t = riner::test::tiny_problem(2, 1, 2.0 * M_PI);
     riner::RinerConfig c = riner::test::tiny_config();
     c.rings.air_reference = c.rings.gradient_reference = c.rings.response_reference =
         c.rings.mirror_reference = false;

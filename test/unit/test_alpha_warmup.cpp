@@ -18,14 +18,14 @@
 
 namespace {
 
-riner::Scan parallel_scan(std::size_t elements) {
+riner::Scan parallel_scan(std::size_t elements, double range_rad = M_PI) {
   riner::Geometry g;
   g.type = riner::GeometryType::kParallel2d;
   g.n_u = elements;
   g.pitch_u = 96.0 / static_cast<double>(elements);
   g.voxel_mm = 1.5;
   g.volume_shape = {64, 64};
-  g.uniform_angles = riner::UniformAngles{6, 0.0, M_PI};
+  g.uniform_angles = riner::UniformAngles{6, 0.0, range_rad};
   g.angles = riner::uniform_angles(*g.uniform_angles);
   const riner::Phantom p = riner::shepp_logan(g, 0.1);
   return riner::Scan{riner::exact_projections(p, g), g, 0};
@@ -94,12 +94,17 @@ TEST_SUITE("alpha warm-up") {
     CHECK(rms(bump_left) < 0.02 * rms(bump));
   }
 
-  TEST_CASE("the broad even hold in the setup: only while alpha_warmup_steps last, 2D only") {
+  TEST_CASE("the broad even hold in the setup: while alpha_warmup_steps last, on a full turn") {
     riner::RinerConfig config;
     CHECK(config.training.alpha_warmup_broad_px == 3.0);
     config.training.alpha_warmup_steps = 10;
+    // 180 degrees read each line once: all of alpha is held whatever alpha_warmup_broad_px.
+    const riner::detail::TrainingSetup half_turn(parallel_scan(1000), config);
+    CHECK(half_turn.holds_all_alpha(9));
+    CHECK_FALSE(half_turn.holds_broad_even_alpha(0));
+    CHECK_FALSE(half_turn.broad_even_hold(std::vector<float>(1000, 1.0f)).has_value());
     config.training.alpha_warmup_broad_px = 0.0;
-    const riner::Scan scan = parallel_scan(1000);
+    const riner::Scan scan = parallel_scan(1000, 2.0 * M_PI);
     const riner::detail::TrainingSetup all(scan, config);
     CHECK(all.holds_all_alpha(9));
     CHECK_FALSE(all.holds_all_alpha(10));

@@ -170,7 +170,9 @@ void add_training_schedule(Table& t) {
                        &C::training, &T::alpha_warmup_steps));
   t.push_back(field<C>("training", "alpha_warmup_broad_px", closed(0, 1e6),
                        "alpha_warmup_steps hold only alpha's part even about the axis and "
-                       "broader than a Gaussian of this sigma (grid pixels); 0: all of alpha",
+                       "broader than a Gaussian of this sigma (grid pixels) where the views "
+                       "read each line twice (a full turn); 0, a 180-degree scan or a volume: "
+                       "all of alpha",
                        &C::training, &T::alpha_warmup_broad_px));
   t.push_back(field<C>("training", "beta_warmup_steps", closed(-1, kMaxSteps),
                        "beta of elements with valid readings stays put for these steps; -1: the "

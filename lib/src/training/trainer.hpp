@@ -66,7 +66,8 @@ struct TrainingSetup {
   // and the lazy range (training.sparse_adam).
   model::AdamSettings adam_settings(int step) const;
   // Whether all of alpha is held at this step (training.alpha_warmup_steps), or only its broad
-  // even part (training.alpha_warmup_broad_px; the engines apply `broad_even_hold` after Adam).
+  // even part (training.alpha_warmup_broad_px on a 2D full turn; the engines apply
+  // `broad_even_hold` after Adam).
   bool holds_all_alpha(int step) const;
   bool holds_broad_even_alpha(int step) const;
   // The hold of alpha's broad even part from the engine's initial alpha0 (one per element);

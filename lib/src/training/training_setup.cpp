@@ -7,12 +7,22 @@
 #include "model/stuck_elements.hpp"
 #include "riner/error.hpp"
 #include "riner/execution_plan.hpp"
+#include "riner/geometry.hpp"
 #include "training/trainer.hpp"
 #include "training/warm_start.hpp"
 
 namespace riner::detail {
 
 namespace {
+
+// Whether the views read every line through the field twice, once from each side of the axis
+// (a full turn, not a half acquisition): the part of an element's offset that its mirror
+// element lacks then shows as a misfit between the two readings of each line, so alpha's
+// narrow part can learn before the field has drawn the object. A 180-degree scan reads each
+// line once: any offset reads like object there, and alpha learning early takes the object's
+// edges (the 1100-column faint square: all of alpha held 35.40 dB, its broad even part only
+// 33.95; over 360 degrees 34.24 and 34.93; docs/history/RESULTS.md, issue 29).
+bool reads_lines_twice(const Geometry& g) { return covers_full_turn(g) && !is_half_acquisition(g); }
 
 // A step's rays as the step rules count them: at most the CPU plan's 160 (the plan's when 0).
 double capped_batch(const TrainingConfig& t) {
@@ -185,7 +195,8 @@ std::vector<float> TrainingSetup::level_weights(int step) const {
 
 bool TrainingSetup::holds_all_alpha(int step) const {
   const TrainingConfig& t = config.training;
-  const bool broad_only = t.alpha_warmup_broad_px > 0.0 && !scan.geometry.is_3d();
+  const Geometry& g = scan.geometry;
+  const bool broad_only = t.alpha_warmup_broad_px > 0.0 && !g.is_3d() && reads_lines_twice(g);
   return step < t.alpha_warmup_steps && !broad_only;
 }
 
