@@ -31,7 +31,7 @@ SOURCES = {
                   "issue29_sl2048_family.jsonl",
                   "issue29_sizes_gradient.jsonl", "issue29_draws10.jsonl"),
     "sizes_gpu": "issue29_sizes_gpu.jsonl",
-    "real_trained": "issue29_beta_real.jsonl",
+    "real_trained": "issue29_real_scans_at_defaults.jsonl",
     "real_chain": "issue32_mirror_image_variation_real.jsonl",
     "throughput": "issue30_throughput.jsonl",
     "cores": "issue30_cores16.jsonl",
@@ -404,9 +404,9 @@ def real_scans(root):
     text = table(["scan", "ring index FBP → riner", "specks per 10⁴ px FBP / riner",
                   "edges (of FBP's)", "lost object", "time", "machine; date; revision",
                   "command"], rows)
-    text += ("\n\n(This table's specks predate the extremum rule of 2026-11-27: they count "
-             "every pixel over 6 σ from its 3 × 3 median, an edge's wavering pixels included, "
-             "about twice the number by today's rule on these scans.)")
+    text += ("\n\nThe bars of issue 29: ring index ≤ FBP's / 3, specks ≤ FBP's, edges ≥ 0.9 of "
+             "FBP's. The lost object left is, on each scan, an arc of a ring FBP shows and riner "
+             "removed (docs/history/RESULTS.md, \"nothing real carved away\").")
 
     chain = [r for r in records(root, SOURCES["real_chain"])
              if r.get("order") == CURRENT_CHAIN and "fbp_ring_index" in r]

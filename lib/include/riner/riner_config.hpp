@@ -190,7 +190,8 @@ struct TrainingConfig {
   // line twice (a full turn, not a half acquisition); a 180-degree scan and a volume hold all.
   // 3 against all: DeepLesion at 1024 columns +0.19 / -0.28 / +0.31 dB (slices 3, 0, 1), the
   // Shepp-Logan +0.18 (1024) and +0.37 (2048), the 1100-column faint square over 360 degrees
-  // +0.70, over 180 -1.45; sigma 1, 8 and 16 no better (docs/history/RESULTS.md).
+  // +0.70, over 180 -1.45 (a 180-degree Shepp-Logan +0.30); sigma 1, 8 and 16 no better
+  // (docs/history/RESULTS.md).
   double alpha_warmup_broad_px = 3.0;
   int beta_warmup_steps = -1;  // -1: the first learning-rate phase (decay_interval())
   // Coarse to fine: when > 0, level l >= 1 of the encoding fades in over steps

@@ -20,8 +20,9 @@ namespace {
 // element lacks then shows as a misfit between the two readings of each line, so alpha's
 // narrow part can learn before the field has drawn the object. A 180-degree scan reads each
 // line once: any offset reads like object there, and alpha learning early takes the object's
-// edges (the 1100-column faint square: all of alpha held 35.40 dB, its broad even part only
-// 33.95; over 360 degrees 34.24 and 34.93; docs/history/RESULTS.md, issue 29).
+// edges (the 1100-column faint square: all of alpha held 35.40 dB and no object lost, its broad
+// even part only 33.95 and 12 pixels lost; over 360 degrees 34.24 and 34.93). A dense 180-degree
+// Shepp-Logan keeps 0.30 dB less this way (docs/history/RESULTS.md, issue 29).
 bool reads_lines_twice(const Geometry& g) { return covers_full_turn(g) && !is_half_acquisition(g); }
 
 // A step's rays as the step rules count them: at most the CPU plan's 160 (the plan's when 0).
