@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 #include "model/broad_even_hold.hpp"
@@ -18,6 +19,22 @@
 #include "support/tiny_problem.hpp"
 #include "support/tolerances.hpp"
 
+namespace {
+
+// One configuration built on the OpenCL device and on the reference engine.
+struct BothEngines {
+  riner::Reconstructor device;
+  riner::Reconstructor reference;
+};
+
+BothEngines both_engines(const riner::Scan& scan, riner::RinerConfig c) {
+  riner::Reconstructor device(scan, c, riner::test::device());
+  c.engine = riner::Engine::kReference;
+  return {std::move(device), riner::Reconstructor(scan, c)};
+}
+
+}  // namespace
+
 TEST_SUITE("riner_training") {
   TEST_CASE("the first 20 steps' losses agree between OpenCL and the reference to 1e-3") {
     const riner::test::TinyProblem t = riner::test::tiny_problem(2);
@@ -29,9 +46,7 @@ TEST_SUITE("riner_training") {
       c.training.jitter = true;
       c.training.ring_lambda = sampler == riner::Sampler::kMixed ? 5.0 : 0.0;
       c.training.level_warmup_steps = 5;
-      riner::Reconstructor device(t.scan, c, riner::test::device());
-      c.engine = riner::Engine::kReference;
-      riner::Reconstructor reference(t.scan, c);
+      auto [device, reference] = both_engines(t.scan, c);
       device.step(20);
       reference.step(20);
       const auto a = device.history();
@@ -61,9 +76,7 @@ TEST_SUITE("riner_training") {
     const riner::test::TinyProblem t = riner::test::tiny_problem(5);
     riner::RinerConfig c = riner::test::tiny_config();
     c.training.beta_warmup_steps = 1000;
-    riner::Reconstructor device(t.scan, c, riner::test::device());
-    c.engine = riner::Engine::kReference;
-    riner::Reconstructor reference(t.scan, c);
+    auto [device, reference] = both_engines(t.scan, c);
     const riner::Array before = device.beta();
     device.step(40);
     reference.step(40);
@@ -94,9 +107,7 @@ TEST_SUITE("riner_training") {
         c.rings.mirror_reference = false;
     c.training.alpha_warmup_steps = 1000;
     c.training.alpha_warmup_broad_px = 3.0;
-    riner::Reconstructor device(t.scan, c, riner::test::device());
-    c.engine = riner::Engine::kReference;
-    riner::Reconstructor reference(t.scan, c);
+    auto [device, reference] = both_engines(t.scan, c);
     device.step(40);
     reference.step(40);
     const riner::Array a = device.trained_alpha();
@@ -436,9 +447,7 @@ TEST_SUITE("riner_training") {
     c.training.steps = 0;
     c.training.warm_start = "normalise";
     c.training.warm_start_steps = 400;
-    riner::Reconstructor device(t.scan, c, riner::test::device());
-    c.engine = riner::Engine::kReference;
-    riner::Reconstructor reference(t.scan, c);
+    auto [device, reference] = both_engines(t.scan, c);
     REQUIRE(device.stats().warm_start.has_value());
     REQUIRE(reference.stats().warm_start.has_value());
     CHECK(device.stats().warm_start->method == "normalise");

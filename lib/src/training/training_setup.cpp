@@ -196,9 +196,10 @@ std::vector<float> TrainingSetup::level_weights(int step) const {
 
 bool TrainingSetup::holds_all_alpha(int step) const {
   const TrainingConfig& t = config.training;
+  // Asked every step (adam_settings): past the warm-up, before the views are looked at.
+  if (step >= t.alpha_warmup_steps) return false;
   const Geometry& g = scan.geometry;
-  const bool broad_only = t.alpha_warmup_broad_px > 0.0 && !g.is_3d() && reads_lines_twice(g);
-  return step < t.alpha_warmup_steps && !broad_only;
+  return !(t.alpha_warmup_broad_px > 0.0 && !g.is_3d() && reads_lines_twice(g));
 }
 
 bool TrainingSetup::holds_broad_even_alpha(int step) const {
