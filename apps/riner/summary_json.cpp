@@ -200,6 +200,8 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
            {{"steps", stats.level_warmup_steps}, {"relative_noise", stats.relative_noise}}},
           {"tail_average",
            {{"steps", stats.tail_average_steps}, {"snapshots", stats.tail_average_snapshots}}},
+          {"lr_decay",
+           {{"smooth", stats.lr_decay_smooth}, {"voxels_per_ray", stats.voxels_per_ray}}},
           {"warm_start", warm_start_json(stats.warm_start)},
           {"coverage",
            {{"rays", stats.coverage.rays},

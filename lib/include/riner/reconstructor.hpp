@@ -171,6 +171,10 @@ struct TrainingStats {
   // training has gone past the planned steps).
   int tail_average_steps = 0;
   int tail_average_snapshots = 0;
+  // The rate's decay as trained (training.lr_decay_smooth, in steps where the scan's rays each
+  // cross more than training.smooth_decay_max_voxels_per_ray sampled voxels) and that count.
+  bool lr_decay_smooth = true;
+  double voxels_per_ray = 0.0;
   // Memory, so far: the process's peak resident set (host) and the most bytes of device
   // buffers it held at once (0 on the reference engine).
   std::size_t peak_host_bytes = 0;

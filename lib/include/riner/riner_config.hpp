@@ -132,6 +132,15 @@ struct TrainingConfig {
   // mark the phases (beta's warm-up, tail averaging, the plateau test). On DeepLesion slices
   // 0-3 at 24 000 steps: 39.18 dB in steps, 39.62 smooth (docs/history/RESULTS.md, issue 29).
   bool lr_decay_smooth = true;
+  // ... but not on a scan with too few readings for its unknowns: where each ray crosses more
+  // than this many sampled voxels on average (few views for the grid) the rate halves in steps,
+  // whose higher rate keeps such a scan's edges. Measured (docs/history/RESULTS.md, issue 29):
+  // the 1100-column faint square of 343 views (1.56 voxels per ray) 35.40 dB smooth, 37.14 in
+  // steps; a 400-view Shepp-Logan over 180 degrees (1.52) 39.72, 41.19; DeepLesion from 60
+  // fan-beam views (3.1) 34.40, 35.15; from 90 (2.1) 37.96 both; from 180 (1.03) 43.09, 42.38;
+  // the paper's protocols (0.51) and the shared real scans (0.29-1.18) stay smooth. 0: smooth on
+  // every scan.
+  double smooth_decay_max_voxels_per_ray = 1.25;
   double adam_beta1 = 0.9;
   double adam_beta2 = 0.99;
   double adam_epsilon = 1e-15;

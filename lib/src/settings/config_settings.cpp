@@ -125,6 +125,11 @@ void add_training_schedule(Table& t) {
                        "the rate decays continuously (lr_decay per lr_decay_steps) instead of "
                        "in steps",
                        &C::training, &T::lr_decay_smooth));
+  t.push_back(field<C>("training", "smooth_decay_max_voxels_per_ray", closed_open(0, 1e9),
+                       "lr_decay_smooth: only where each ray crosses at most this many sampled "
+                       "voxels on average (a scan with fewer views than its grid needs decays in "
+                       "steps); 0: smooth on every scan",
+                       &C::training, &T::smooth_decay_max_voxels_per_ray));
   t.push_back(field<C>("training", "adam_beta1", closed_open(0, 1), "Adam's beta1", &C::training,
                        &T::adam_beta1));
   t.push_back(field<C>("training", "adam_beta2", closed_open(0, 1), "Adam's beta2", &C::training,

@@ -446,6 +446,8 @@ TrainingStats Reconstructor::stats() const {
   s.relative_noise = setup.noise.relative;
   s.tail_average_steps = setup.tail_average.steps;
   s.tail_average_snapshots = setup.tail_average.snapshots(impl_->steps);
+  s.lr_decay_smooth = setup.config.training.lr_decay_smooth;
+  s.voxels_per_ray = setup.voxels_per_ray;
   rusage usage{};
   if (getrusage(RUSAGE_SELF, &usage) == 0) {
     s.peak_host_bytes = static_cast<std::size_t>(usage.ru_maxrss) * 1024;  // kB on Linux

@@ -44,6 +44,9 @@ struct TrainingSetup {
   // training.min_samples_per_voxel times a voxel: more steps, the volume's table.
   bool short_of_samples = false;
   double samples_kept = 0.0;                    // of those, inside the occupied region
+  // The sampled voxels per ray that crosses them; over training.smooth_decay_max_voxels_per_ray
+  // the rate decays in steps (config.training.lr_decay_smooth resolved to false).
+  double voxels_per_ray = 0.0;
   double stripe_rms = 0.0;                      // model/stripe_evidence.hpp
   double alpha_rate = 1.0;                      // alpha_lr_scale times the stripe evidence's factor
   model::NoiseEvidence noise;       // model/noise_evidence.hpp; sets level_warmup_steps -1

@@ -64,6 +64,16 @@ void resolve_steps(TrainingConfig& t, const Geometry& g, double samples_per_voxe
   }
 }
 
+// How many unknowns each reading has to pin down: the voxels training samples (the region left
+// by the air carving) over the rays that cross them (segments as clipped to it).
+double sampled_voxels_per_ray(const model::Occupancy& occupancy, const model::RaySegments& segments) {
+  const auto voxels = static_cast<double>(
+      std::count(occupancy.inside.begin(), occupancy.inside.end(), std::uint8_t{1}));
+  std::size_t rays = 0;
+  for (std::size_t r = 0; r < segments.size(); ++r) rays += segments.count(r) > 0;
+  return rays > 0 ? voxels / static_cast<double>(rays) : 0.0;
+}
+
 // TrainingConfig::kScanAlphaWarmup's rule.
 void resolve_alpha_warmup(TrainingConfig& t, const Geometry& g) {
   if (t.alpha_warmup_steps != TrainingConfig::kScanAlphaWarmup) return;
@@ -156,6 +166,9 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
         model::occupancy_settings(config.training, g, config.engine, std::move(device)));
     if (occupancy.carved) samples_kept = occupancy.samples_kept;
   }
+  voxels_per_ray = sampled_voxels_per_ray(occupancy, segments);
+  const double most_voxels = config.training.smooth_decay_max_voxels_per_ray;
+  if (most_voxels > 0.0 && voxels_per_ray > most_voxels) config.training.lr_decay_smooth = false;
   alpha_rate = config.training.alpha_lr_scale;
   if (config.training.alpha_stripe_scale > 0) {
     alpha_rate *= std::min(1.0, stripe_rms / config.training.alpha_stripe_scale);
