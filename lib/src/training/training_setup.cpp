@@ -66,7 +66,8 @@ void resolve_steps(TrainingConfig& t, const Geometry& g, double samples_per_voxe
 
 // How many unknowns each reading has to pin down: the voxels training samples (the region left
 // by the air carving) over the rays that cross them (segments as clipped to it).
-double sampled_voxels_per_ray(const model::Occupancy& occupancy, const model::RaySegments& segments) {
+double sampled_voxels_per_ray(const model::Occupancy& occupancy,
+                              const model::RaySegments& segments) {
   const auto voxels = static_cast<double>(
       std::count(occupancy.inside.begin(), occupancy.inside.end(), std::uint8_t{1}));
   std::size_t rays = 0;
