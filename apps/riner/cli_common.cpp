@@ -84,9 +84,9 @@ void print_quality_doubts(Console& console, const QualityReport& q) {
   }
   if (q.edge_strength < kSoftEdgeRatio * q.fbp_edge_strength) {
     std::snprintf(line, sizeof(line),
-                  "note: edges at %.0f%% of FBP's strength (99th percentile of the gradient): "
-                  "the image may be blurred",
-                  100.0 * q.edge_strength / q.fbp_edge_strength);
+                  "note: edges at %.0f%% of FBP's strength (99th percentile of the gradient "
+                  "after a %.0f-px Gaussian): the image may be blurred",
+                  100.0 * q.edge_strength / q.fbp_edge_strength, q.edge_scale_px);
     console.line(line);
   }
 }

@@ -78,6 +78,7 @@ nlohmann::json quality_summary(const QualityCheck& check) {
                         {"fbp_specks_per_10k_pixels", q.fbp_specks_per_10k},
                         {"edge_strength_per_mm", q.edge_strength},
                         {"fbp_edge_strength_per_mm", q.fbp_edge_strength},
+                        {"edge_scale_px", q.edge_scale_px},
                         {"lost_object",
                          {{"share", q.lost.share},
                           {"pixels", q.lost.pixels},

@@ -223,6 +223,7 @@ nlohmann::json real_scan_run(const riner::Scan& scan, const riner::Array& fbp_im
           {"fbp_edge_strength", quality.fbp_edge_strength},
           {"riner_edge_strength", quality.edge_strength},
           {"edge_ratio", quality.edge_strength / quality.fbp_edge_strength},
+          {"edge_scale_px", quality.edge_scale_px},
           {"lost_object_pixels", quality.lost.pixels},
           {"lost_object_share", quality.lost.share},
           {"centre_deviation", quality.centre.deviation},

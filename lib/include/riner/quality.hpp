@@ -15,8 +15,11 @@
 //                show stands out as more than one such sigma
 //   edges        the 99th percentile of the gradient magnitude inside the disc (Sobel after a
 //                Gaussian of 1 px, so that pixel noise does not pass for edges), of the image and
-//                of the FBP: well below the FBP's, the image is blurred. Fewer specks and rings
-//                can come from blur alone (docs/history/RESULTS.md), so these read beside it
+//                of the FBP: well below the FBP's, the image is blurred. Where the FBP's pixel
+//                noise hides its edges at 1 px (its 99th percentile under 10 times its median),
+//                both are measured after the same wider Gaussian, 2, 4 or 8 px, the first at
+//                which the FBP's edges stand out (edge_scale_px). Fewer specks and rings can come
+//                from blur alone (docs/history/RESULTS.md), so these read beside it
 //   lost object  the share of the disc where the FBP clearly sees object and the image shows air
 //                (issue 29): both blurred by a Gaussian of 2 px; the FBP's air level and noise
 //                are the median and MAD of its blurred values where the image reads air (below
@@ -48,9 +51,13 @@ struct CentreDeviation {
   double sigmas = 0.0;     // deviation / fbp_noise
 };
 
-// The 99th percentile of |gradient| (1/mm per pixel) inside the inscribed disc, of each axial
-// slice of a volume together.
-double edge_strength(const Array& image);
+// The 99th percentile of |gradient| (1/mm per pixel) inside the inscribed disc after a Gaussian
+// of smoothing_px, of each axial slice of a volume together.
+double edge_strength(const Array& image, double smoothing_px = 1.0);
+
+// The smallest Gaussian (1, 2, 4 or 8 px) at which the FBP's edges stand out of its noise: the
+// 99th percentile of its gradient at least 10 times the median; 8 when none does.
+double edge_scale_px(const Array& fbp);
 
 // Below this fraction of the FBP's edge strength an image reads as blurred: the shared real scans
 // give 0.92-1.01 at the defaults and 0.40-0.76 after 2000 steps (docs/history/RESULTS.md).
@@ -85,6 +92,7 @@ struct QualityReport {
   double fbp_specks_per_10k = 0.0;
   double edge_strength = 0.0;
   double fbp_edge_strength = 0.0;
+  double edge_scale_px = 1.0;  // the Gaussian both edge strengths are measured after
   LostObject lost;
   CentreDeviation centre;
 };
