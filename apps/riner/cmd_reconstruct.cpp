@@ -104,8 +104,8 @@ int run_reconstruct(int argc, char** argv, int first) {
                   " times, " + std::to_string(TrainingConfig::kSteps3d) +
                   " or more for a volume so that each voxel is sampled " +
                   std::to_string(static_cast<int>(TrainingConfig{}.min_samples_per_voxel)) +
-                  " times; the learning rate falls smoothly to 1/16 over them, or halves every quarter "
-                  "of them on a scan with fewer readings than unknowns)",
+                  " times; the learning rate falls smoothly to 1/16 over them, or halves every "
+                  "quarter of them on a scan with fewer readings than unknowns)",
               "")
       .option("seed", "N", "random seed", "")
       .option("rays-per-step", "N",

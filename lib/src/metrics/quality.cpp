@@ -210,16 +210,30 @@ double edge_strength(const Array& image, double smoothing_px) {
   return quantile(g, kEdgePercentile);
 }
 
-double edge_scale_px(const Array& fbp) {
+namespace {
+
+struct FbpEdges {
+  double scale_px = 1.0;
+  double strength = 0.0;  // edge_strength(fbp, scale_px)
+};
+
+// edge_scale_px's search, keeping the FBP's edge strength at the scale it chose.
+FbpEdges fbp_edges(const Array& fbp) {
   require_2d_or_slices(fbp, "the FBP");
+  FbpEdges e;
   for (double scale : kEdgeScalesPx) {
     std::vector<double> g = disc_gradients(fbp, scale);
-    if (g.empty()) return kEdgeScalesPx.front();
+    if (g.empty()) return {kEdgeScalesPx.front(), 0.0};
     const double median = quantile(g, 0.5);
-    if (quantile(g, kEdgePercentile) >= kEdgesOverNoise * median) return scale;
+    e = {scale, quantile(g, kEdgePercentile)};
+    if (e.strength >= kEdgesOverNoise * median) break;
   }
-  return kEdgeScalesPx.back();
+  return e;
 }
+
+}  // namespace
+
+double edge_scale_px(const Array& fbp) { return fbp_edges(fbp).scale_px; }
 
 double residual_noise(const Array& image) {
   require_2d_or_slices(image, "the image");
@@ -292,9 +306,10 @@ QualityReport quality_against_fbp(const Array& image, const Array& fbp, double f
   q.fbp_ring_index = ring_index(fbp);
   q.specks_per_10k = specks_per_10k(image, q.noise);
   q.fbp_specks_per_10k = specks_per_10k(fbp, q.noise);
-  q.edge_scale_px = edge_scale_px(fbp);
-  q.edge_strength = edge_strength(image, q.edge_scale_px);
-  q.fbp_edge_strength = edge_strength(fbp, q.edge_scale_px);
+  const FbpEdges edges = fbp_edges(fbp);
+  q.edge_scale_px = edges.scale_px;
+  q.edge_strength = edge_strength(image, edges.scale_px);
+  q.fbp_edge_strength = edges.strength;
   q.lost = lost_object(image, fbp, field_radius_px);
   if (image.rank() == 2) q.centre = centre_deviation(image, fbp);
   return q;

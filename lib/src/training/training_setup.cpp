@@ -68,8 +68,7 @@ void resolve_steps(TrainingConfig& t, const Geometry& g, double samples_per_voxe
 // by the air carving) over the rays that cross them (segments as clipped to it).
 double sampled_voxels_per_ray(const model::Occupancy& occupancy,
                               const model::RaySegments& segments) {
-  const auto voxels = static_cast<double>(
-      std::count(occupancy.inside.begin(), occupancy.inside.end(), std::uint8_t{1}));
+  const double voxels = occupancy.inside_fraction * static_cast<double>(occupancy.inside.size());
   std::size_t rays = 0;
   for (std::size_t r = 0; r < segments.size(); ++r) rays += segments.count(r) > 0;
   return rays > 0 ? voxels / static_cast<double>(rays) : 0.0;
