@@ -58,8 +58,8 @@ DestripeOptions destripe_options_from(const Args& args, const std::string& metho
 
 void add_destripe_tuning(Args& args) {
   args.option("size", "N",
-              "median window across columns for small stripes (odd; default 21: wider for wide "
-              "stripes, narrower where the object's detail is finer)",
+              "median window across columns for small stripes (odd; default 21, in all 5: "
+              "wider for wide stripes, narrower where the object's detail is finer)",
               "")
       .option("large-size", "N",
               "the window for large and dead stripes (default 51)", "")

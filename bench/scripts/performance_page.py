@@ -21,8 +21,8 @@ SOURCES = {
     "deeplesion_cpu": "issue29_gradient_after_detail.jsonl",
     "deeplesion_gpu": "issue30_throughput.jsonl",
     "deeplesion_gpu_h100": "issue12_gpu.jsonl",
-    "classical": "issue31_destripe_device.jsonl",
-    "classical_real": "issue31_destripe_real_specks.jsonl",
+    "classical": "issue31_combination_window.jsonl",
+    "classical_real": "issue31_combination_window_real.jsonl",
     "warm_start": "issue31_warm_smooth.jsonl",
     # newest first: a scene and size measured in a later file hides the earlier rows
     "sizes_cpu": ("issue29_broad_even_hold_sizes.jsonl",

@@ -91,7 +91,7 @@ TEST_CASE("each method takes most of a ringed sinogram's offsets away and report
       norm_b += r.offsets[c] * r.offsets[c];
     }
     CHECK(agree / std::sqrt(norm_a * norm_b) > 0.85);
-    CHECK(report.size == 21);
+    CHECK(report.size == (method == riner::DestripeMethod::kAll ? 5u : 21u));
   }
 }
 
