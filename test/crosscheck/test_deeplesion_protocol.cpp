@@ -3,12 +3,36 @@
 // 13.81 dB FBP row; the classical filters reach the paper's rows for them.
 #include <doctest/doctest.h>
 
+#include <string>
+
 #include "riner/destripe.hpp"
 #include "riner/fbp.hpp"
 #include "riner/io.hpp"
 #include "riner/metrics.hpp"
 #include "riner/simulate.hpp"
 #include "support/fixture.hpp"
+
+namespace {
+
+struct PaperSlice {
+  riner::Array truth;  // mm^-1
+  riner::SimulatedScan sim;
+};
+
+// Slice `index` of the shared DeepLesion slices through the paper's simulation (seed: index).
+PaperSlice paper_slice(int index, const riner::Projector& projector) {
+  PaperSlice out;
+  out.truth = riner::read_array(riner::test::shared_data("deeplesion/slice_" +
+                                                         std::to_string(index) + ".nii"))
+                  .array;
+  for (float& v : out.truth.data) v *= 0.1f;  // cm^-1 -> mm^-1 (METHOD.md §4)
+  riner::RingModel model;
+  model.seed = static_cast<std::uint64_t>(index);
+  out.sim = riner::simulate(out.truth, projector, model);
+  return out;
+}
+
+}  // namespace
 
 TEST_SUITE("deeplesion_protocol") {
   TEST_CASE("FBP on fan2d-paper simulations of the ten slices") {
@@ -23,14 +47,7 @@ TEST_SUITE("deeplesion_protocol") {
     double clean_psnr = 0.0, ring_psnr = 0.0, clean_ssim = 0.0, ring_ssim = 0.0;
     for (int slice = 0; slice < 10; ++slice) {
       CAPTURE(slice);
-      riner::Array truth =
-          riner::read_array(
-              riner::test::shared_data("deeplesion/slice_" + std::to_string(slice) + ".nii"))
-              .array;
-      for (float& v : truth.data) v *= 0.1f;  // cm^-1 -> mm^-1 (METHOD.md §4)
-      riner::RingModel model;
-      model.seed = static_cast<std::uint64_t>(slice);
-      const riner::SimulatedScan sim = riner::simulate(truth, projector, model);
+      const auto [truth, sim] = paper_slice(slice, projector);
       const riner::ImageMetrics clean =
           riner::compare_images(riner::fbp(riner::Scan{sim.clean, g, 0}, options), truth);
       const riner::ImageMetrics rings = riner::compare_images(riner::fbp(sim.scan, options), truth);
@@ -59,28 +76,22 @@ TEST_SUITE("deeplesion_protocol") {
     const riner::Projector projector(g, riner::Engine::kOpenCL, riner::test::device());
     riner::FbpOptions fbp_options;
     fbp_options.device = riner::test::device();
-    const auto filtered_psnr = [&](const riner::SimulatedScan& sim, const riner::Array& truth,
-                                   riner::DestripeMethod method, std::size_t size) {
+    const auto filtered_psnr = [&](const PaperSlice& slice, riner::DestripeMethod method,
+                                   std::size_t size) {
       riner::DestripeOptions options;
       options.method = method;
       options.size = size;
       options.device = riner::test::device();
-      const riner::Array clean = riner::destripe(sim.scan.measurement, g, options);
-      return riner::compare_images(riner::fbp(riner::Scan{clean, g, 0}, fbp_options), truth).psnr;
+      const riner::Array clean = riner::destripe(slice.sim.scan.measurement, g, options);
+      return riner::compare_images(riner::fbp(riner::Scan{clean, g, 0}, fbp_options), slice.truth)
+          .psnr;
     };
     double all = 0.0, all_21 = 0.0, normalise = 0.0;
-    for (int slice = 0; slice < 10; ++slice) {
-      riner::Array truth =
-          riner::read_array(
-              riner::test::shared_data("deeplesion/slice_" + std::to_string(slice) + ".nii"))
-              .array;
-      for (float& v : truth.data) v *= 0.1f;
-      riner::RingModel model;
-      model.seed = static_cast<std::uint64_t>(slice);
-      const riner::SimulatedScan sim = riner::simulate(truth, projector, model);
-      all += filtered_psnr(sim, truth, riner::DestripeMethod::kAll, 0) / 10;
-      all_21 += filtered_psnr(sim, truth, riner::DestripeMethod::kAll, 21) / 10;
-      normalise += filtered_psnr(sim, truth, riner::DestripeMethod::kNormalise, 0) / 10;
+    for (int index = 0; index < 10; ++index) {
+      const PaperSlice slice = paper_slice(index, projector);
+      all += filtered_psnr(slice, riner::DestripeMethod::kAll, 0) / 10;
+      all_21 += filtered_psnr(slice, riner::DestripeMethod::kAll, 21) / 10;
+      normalise += filtered_psnr(slice, riner::DestripeMethod::kNormalise, 0) / 10;
     }
     MESSAGE("mean PSNR: all " << all << " dB (window 21: " << all_21 << "), normalise "
                                << normalise);
