@@ -9,6 +9,13 @@
 //     columns around c at rank k, mirrored at the ends (d c b a | a b c d | d c b a).
 //   unsort_columns(views, columns, filtered, order, out)
 //     out[order[k][c]][c] = filtered[k][c].
+// A CPU's shapes of the first two (the same results to the bit; a barrier per bitonic stage and
+// a quickselect per element are what a CPU runs slowest):
+//   sort_columns_merge(views, columns, in, sorted, order, keys_a, views_a, keys_b, views_b)
+//     one work-item per column: a stable merge sort (runs of 8 by insertion, then merges) in
+//     the scratch [columns][views] of keys_a/views_a and keys_b/views_b.
+//   median_across_columns_sliding(views, columns, size, sorted, filtered)
+//     one work-item per rank k: the window kept sorted while it slides along the columns.
 // Needs common.cl (mirrored). No -D constants.
 
 #define kMostWindow 255
@@ -93,4 +100,97 @@ __kernel void unsort_columns(const uint views, const uint columns, __global cons
   if (gid >= views * columns) return;
   const uint c = gid % columns;
   out[order[gid] * columns + c] = filtered[gid];
+}
+
+// Merges the sorted runs [first, middle) and [middle, last) of keys/views into out_keys/out_views,
+// the left first among equals (stable).
+inline void merge_runs(__global const float* keys, __global const uint* views,
+                       __global float* out_keys, __global uint* out_views, const uint first,
+                       const uint middle, const uint last) {
+  uint i = first, j = middle;
+  for (uint o = first; o < last; ++o) {
+    const int take_left = j >= last || (i < middle && !(keys[j] < keys[i]));
+    const uint from = take_left ? i++ : j++;
+    out_keys[o] = keys[from];
+    out_views[o] = views[from];
+  }
+}
+
+__kernel void sort_columns_merge(const uint views, const uint columns, __global const float* in,
+                                 __global float* sorted, __global uint* order,
+                                 __global float* keys_a, __global uint* views_a,
+                                 __global float* keys_b, __global uint* views_b) {
+  const uint c = get_global_id(0);
+  if (c >= columns) return;
+  __global float* keys = keys_a + (size_t)c * views;
+  __global uint* view_of = views_a + (size_t)c * views;
+  __global float* other_keys = keys_b + (size_t)c * views;
+  __global uint* other_views = views_b + (size_t)c * views;
+  const uint run = 8;
+  for (uint first = 0; first < views; first += run) {
+    const uint last = min(first + run, views);
+    for (uint i = first; i < last; ++i) {
+      const float x = in[i * columns + c];
+      uint j = i;
+      for (; j > first && keys[j - 1] > x; --j) {  // strictly greater: equal readings keep views' order
+        keys[j] = keys[j - 1];
+        view_of[j] = view_of[j - 1];
+      }
+      keys[j] = x;
+      view_of[j] = i;
+    }
+  }
+  for (uint width = run; width < views; width *= 2) {
+    for (uint first = 0; first < views; first += 2 * width) {
+      const uint middle = min(first + width, views), last = min(first + 2 * width, views);
+      merge_runs(keys, view_of, other_keys, other_views, first, middle, last);
+    }
+    __global float* k = keys;
+    keys = other_keys;
+    other_keys = k;
+    __global uint* v = view_of;
+    view_of = other_views;
+    other_views = v;
+  }
+  for (uint k = 0; k < views; ++k) {
+    sorted[k * columns + c] = keys[k];
+    order[k * columns + c] = view_of[k];
+  }
+}
+
+__kernel void median_across_columns_sliding(const uint views, const uint columns, const uint size,
+                                            __global const float* sorted,
+                                            __global float* filtered) {
+  const uint k = get_global_id(0);
+  if (k >= views) return;
+  __global const float* row = sorted + (size_t)k * columns;
+  __global float* out = filtered + (size_t)k * columns;
+  const int n = columns;
+  const int reach = size / 2;
+  float window[kMostWindow];
+  for (int d = -reach; d <= reach; ++d) {  // insertion sort of the first window
+    const float x = row[mirrored(d, n)];
+    int j = d + reach;
+    for (; j > 0 && window[j - 1] > x; --j) window[j] = window[j - 1];
+    window[j] = x;
+  }
+  for (int c = 0; c < n; ++c) {
+    out[c] = window[reach];
+    if (c + 1 == n) break;
+    // One reading leaves at the window's left end and one enters at its right: the leaving one's
+    // slot is found, the entering one slid into place from there.
+    const float leaving = row[mirrored(c - reach, n)];
+    const float entering = row[mirrored(c + reach + 1, n)];
+    int i = 0;
+    while (i + 1 < (int)size && window[i] != leaving) ++i;
+    while (i > 0 && window[i - 1] > entering) {
+      window[i] = window[i - 1];
+      --i;
+    }
+    while (i + 1 < (int)size && window[i + 1] < entering) {
+      window[i] = window[i + 1];
+      ++i;
+    }
+    window[i] = entering;
+  }
 }

@@ -21,11 +21,13 @@ std::size_t local_bytes(std::size_t views) {
   return power_of_two_at_least(views) * (sizeof(float) + sizeof(cl_uint));
 }
 
+bool on_cpu(const cl::Context& context) { return context.info().type == "CPU"; }
+
 }  // namespace
 
 bool StripeSortingOp::supported(const cl::Context& context, std::size_t views, std::size_t size) {
   return size % 2 == 1 && size <= kMostWindow && views >= 2 &&
-         local_bytes(views) + 1024 <= context.info().local_mem_bytes;
+         (on_cpu(context) || local_bytes(views) + 1024 <= context.info().local_mem_bytes);
 }
 
 StripeSortingOp::StripeSortingOp(cl::Context& context, std::size_t views, std::size_t columns)
@@ -37,13 +39,26 @@ StripeSortingOp::StripeSortingOp(cl::Context& context, std::size_t views, std::s
       sort_(*program_, "sort_columns"),
       median_(*program_, "median_across_columns"),
       unsort_(*program_, "unsort_columns"),
+      sort_merge_(*program_, "sort_columns_merge"),
+      median_sliding_(*program_, "median_across_columns_sliding"),
+      // Measured on PoCL (docs/history/RESULTS.md, "the sorting step on a CPU").
+      shape_(on_cpu(context) ? Shape::kSerial : Shape::kBitonic),
       sorted_(context, views * columns),
       filtered_(context, views * columns),
       order_(context, views * columns) {
-  if (!supported(context, views, 1)) {
+  if (views < 2) throw Error("stripe sorting: a column needs at least 2 views");
+  if (shape_ == Shape::kBitonic && !supported(context, views, 1)) {
     throw Error("stripe sorting: a column of " + std::to_string(views) +
                 " views does not fit the device's local memory");
   }
+}
+
+void StripeSortingOp::use_shape(Shape shape) {
+  if (shape == Shape::kBitonic && local_bytes(views_) + 1024 > context_.info().local_mem_bytes) {
+    throw Error("stripe sorting: a column of " + std::to_string(views_) +
+                " views does not fit the device's local memory");
+  }
+  shape_ = shape;
 }
 
 void StripeSortingOp::apply(const cl::Buffer<float>& in, cl::Buffer<float>& out, std::size_t size) {
@@ -54,6 +69,17 @@ void StripeSortingOp::apply(const cl::Buffer<float>& in, cl::Buffer<float>& out,
 
 void StripeSortingOp::sort(const cl::Buffer<float>& in) {
   if (in.size() != sorted_.size()) throw Error("stripe sorting: size mismatch");
+  if (shape_ == Shape::kSerial) {
+    if (keys_.size() != sorted_.size()) {
+      keys_ = cl::Buffer<float>(context_, sorted_.size());
+      views_a_ = cl::Buffer<cl_uint>(context_, sorted_.size());
+      views_b_ = cl::Buffer<cl_uint>(context_, sorted_.size());
+    }
+    // filtered_ is the second scratch of keys: median() overwrites it before anyone reads it.
+    sort_merge_.set_args(views_, columns_, in, sorted_, order_, keys_, views_a_, filtered_, views_b_);
+    context_.launch(sort_merge_, std::size_t{columns_});
+    return;
+  }
   const std::size_t group = std::min({kSortGroup, static_cast<std::size_t>(padded_) / 2 + 1,
                                       sort_.max_work_group_size(context_.device())});
   sort_.set_args(views_, columns_, padded_, in, sorted_, order_,
@@ -63,6 +89,11 @@ void StripeSortingOp::sort(const cl::Buffer<float>& in) {
 
 void StripeSortingOp::median(std::size_t size) {
   if (size % 2 == 0 || size > kMostWindow) throw Error("stripe sorting: an even or too wide window");
+  if (shape_ == Shape::kSerial) {
+    median_sliding_.set_args(views_, columns_, static_cast<cl_uint>(size), sorted_, filtered_);
+    context_.launch(median_sliding_, std::size_t{views_});
+    return;
+  }
   median_.set_args(views_, columns_, static_cast<cl_uint>(size), sorted_, filtered_);
   context_.launch(median_, sorted_.size());
 }

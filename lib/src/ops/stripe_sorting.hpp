@@ -30,13 +30,24 @@ class StripeSortingOp {
   const cl::Buffer<float>& sorted() const { return sorted_; }
   const cl::Buffer<float>& filtered() const { return filtered_; }
 
+  // How sort() and median() lay their work out (kernels/stripe_sorting.cl): a bitonic sort in
+  // local memory per column and a quickselect per element (a GPU's shape), or a merge sort per
+  // column and a sliding window per rank (a CPU's, the default on a CPU device). The same
+  // results to the bit; the tests run both on one device.
+  enum class Shape { kBitonic, kSerial };
+  void use_shape(Shape shape);
+  Shape shape() const { return shape_; }
+
  private:
   cl::Context& context_;
   cl_uint views_, columns_, padded_;
   std::shared_ptr<const cl::Program> program_;
-  cl::Kernel sort_, median_, unsort_;
+  cl::Kernel sort_, median_, unsort_, sort_merge_, median_sliding_;
+  Shape shape_;
   cl::Buffer<float> sorted_, filtered_;
   cl::Buffer<cl_uint> order_;
+  cl::Buffer<float> keys_;  // the merge sort's scratch (kSerial only), with filtered_
+  cl::Buffer<cl_uint> views_a_, views_b_;
 };
 
 }  // namespace riner::ops
