@@ -69,7 +69,8 @@ std::shared_ptr<const Program> Context::program(const std::vector<std::string>& 
   }
   const std::string device_key =
       info_.platform + "|" + info_.platform_version + "|" + info_.name + "|" + info_.driver_version;
-  BuiltProgram built = build_program(context_.get(), device_, sources, options, device_key);
+  BuiltProgram built = build_program(context_.get(), device_, sources, options, device_key,
+                                     disk_cache_serves(info_.platform));
   ++(built.from_disk ? cache_stats_.disk_hits : cache_stats_.source_builds);
   auto program = std::make_shared<const Program>(std::move(built.program), sources.back());
   programs_.emplace(key, program);

@@ -1,5 +1,6 @@
 #include "cl/program_builder.hpp"
 
+#include <atomic>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
@@ -142,9 +143,19 @@ std::optional<std::filesystem::path> binary_cache_dir() {
   return std::nullopt;
 }
 
+namespace {
+std::atomic<bool> every_platform{false};
+}  // namespace
+
+bool disk_cache_serves(const std::string& platform) {
+  return every_platform.load() || platform.find("Portable Computing Language") == std::string::npos;
+}
+
+void serve_every_platform_for_tests(bool on) { every_platform.store(on); }
+
 BuiltProgram build_program(cl_context context, cl_device_id device,
                            const std::vector<std::string>& sources, const std::string& options,
-                           const std::string& device_key) {
+                           const std::string& device_key, bool use_disk_cache) {
   std::vector<std::string> texts;
   std::string key = "riner-program-cache-v1\n" + device_key + "\n";
   for (const std::string& name : sources) {
@@ -165,7 +176,7 @@ BuiltProgram build_program(cl_context context, cl_device_id device,
   key += full_options;
 
   std::optional<std::filesystem::path> entry;
-  if (auto dir = binary_cache_dir()) {
+  if (auto dir = use_disk_cache ? binary_cache_dir() : std::nullopt) {
     entry = *dir / (sources.back() + "-" + hex64(util::fnv1a64(key)) + ".clbin");
     if (auto binary = load_entry(*entry, key)) {
       if (Handle<cl_program> program = from_binary(context, device, *binary, full_options)) {

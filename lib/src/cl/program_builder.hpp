@@ -6,6 +6,10 @@
 // and a checksum of the binary, so a collision, a truncated write or a corrupt file is noticed,
 // the entry discarded and the program built from source. Entries are written to a unique
 // temporary file and renamed into place, so concurrent processes never see a partial entry.
+//
+// A driver that keeps its own cache of compiled kernels (PoCL: ~/.cache/pocl) gets no entries:
+// asking PoCL for a program's binary compiles every kernel in it once more, which doubled a
+// first run (docs/history/RESULTS.md, "the program cache on PoCL") and saved 0.2 s on the next.
 #pragma once
 
 #include <CL/cl.h>
@@ -26,10 +30,15 @@ struct BuiltProgram {
   bool from_disk = false;
 };
 
+// Whether riner's cache serves a device of this platform (false for PoCL, see above).
+bool disk_cache_serves(const std::string& platform);
+// The tests' way to exercise the cache on PoCL: every platform served while on.
+void serve_every_platform_for_tests(bool on);
+
 // sources are kernel file stems; the option string is used verbatim after "-cl-std=CL1.2" and
-// before $RINER_CL_BUILD_OPTIONS.
+// before $RINER_CL_BUILD_OPTIONS. use_disk_cache false: built from source, nothing stored.
 BuiltProgram build_program(cl_context context, cl_device_id device,
                            const std::vector<std::string>& sources, const std::string& options,
-                           const std::string& device_key);
+                           const std::string& device_key, bool use_disk_cache = true);
 
 }  // namespace riner::cl
