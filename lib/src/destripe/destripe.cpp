@@ -46,12 +46,12 @@ constexpr std::size_t kLargeWindow = 51;
 // tooth) and neutron360 loses 43 pixels of object instead of 361 (docs/history/RESULTS.md).
 constexpr std::size_t kCombinationWindow = 5;
 
-// The literature's window unless one is given, odd and within the detector. Widening them by
-// the widest stripe the column means show was tried: on a sinogram of smooth blobs 20-25
-// columns wide the blobs' peaks read as stripes 25 wide, and normalise's error went from 0.019
-// to 0.034.
-std::size_t window(std::size_t given, std::size_t literature, std::size_t columns) {
-  const std::size_t size = given ? given : literature;
+// The method's window (the literature's, or the combination's) unless one is given, odd and
+// within the detector. Widening it by the widest stripe the column means show was tried: on a
+// sinogram of smooth blobs 20-25 columns wide the blobs' peaks read as stripes 25 wide, and
+// normalise's error went from 0.019 to 0.034.
+std::size_t window(std::size_t given, std::size_t method_default, std::size_t columns) {
+  const std::size_t size = given ? given : method_default;
   const std::size_t most = columns % 2 == 1 ? columns : columns - 1;
   return std::max<std::size_t>(std::min(size | 1, most), 1);
 }
