@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "ops/stripe_steps.hpp"
 #include "riner/error.hpp"
 
 namespace riner::ops {
@@ -35,7 +36,7 @@ StripeSortingOp::StripeSortingOp(cl::Context& context, std::size_t views, std::s
       views_(static_cast<cl_uint>(views)),
       columns_(static_cast<cl_uint>(columns)),
       padded_(static_cast<cl_uint>(power_of_two_at_least(views))),
-      program_(context.program({"common", "stripe_sorting"})),
+      program_(context.program(stripe_program_sources())),
       sort_(*program_, "sort_columns"),
       median_(*program_, "median_across_columns"),
       unsort_(*program_, "unsort_columns"),

@@ -20,9 +20,15 @@ std::size_t extent(const LineLayout& lines, std::size_t n) {
 
 }  // namespace
 
+const std::vector<std::string>& stripe_program_sources() {
+  static const std::vector<std::string> sources{"common", "stripe_columns", "wavelet",
+                                                "stripe_sorting"};
+  return sources;
+}
+
 StripeStepsOp::StripeStepsOp(cl::Context& context)
     : context_(context),
-      program_(context.program({"common", "stripe_columns", "wavelet"})),
+      program_(context.program(stripe_program_sources())),
       column_means_(*program_, "column_means"),
       subtract_offsets_(*program_, "subtract_column_offsets"),
       fluctuation_(*program_, "column_fluctuation"),

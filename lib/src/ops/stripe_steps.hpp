@@ -4,6 +4,7 @@
 #pragma once
 
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "cl/buffer.hpp"
@@ -12,6 +13,10 @@
 #include "ops/line_filter.hpp"
 
 namespace riner::ops {
+
+// The stripe filters' kernels as one program, which StripeStepsOp and StripeSortingOp share: a
+// process builds it once (on PoCL every program built costs about 30 ms even from PoCL's cache).
+const std::vector<std::string>& stripe_program_sources();
 
 class StripeStepsOp {
  public:
