@@ -12,8 +12,9 @@ namespace riner::ops {
 
 class StripeSortingOp {
  public:
-  // Error when a column of `views` readings does not fit the device's local memory, or `size`
-  // is even or past the kernel's window (supported() says so beforehand).
+  // Error when there are fewer than 2 views, or (a GPU's shape) a column of `views` readings
+  // does not fit the device's local memory; supported() also says whether a window `size` is
+  // odd and within the kernels' widest.
   StripeSortingOp(cl::Context& context, std::size_t views, std::size_t columns);
   static bool supported(const cl::Context& context, std::size_t views, std::size_t size);
 
