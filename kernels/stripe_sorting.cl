@@ -132,7 +132,8 @@ __kernel void sort_columns_merge(const uint views, const uint columns, __global 
     for (uint i = first; i < last; ++i) {
       const float x = in[i * columns + c];
       uint j = i;
-      for (; j > first && keys[j - 1] > x; --j) {  // strictly greater: equal readings keep views' order
+      // Strictly greater: equal readings keep their views' order.
+      for (; j > first && keys[j - 1] > x; --j) {
         keys[j] = keys[j - 1];
         view_of[j] = view_of[j - 1];
       }

@@ -41,8 +41,8 @@ std::vector<Result> build_once(const Options& options) {
 
 double run_child(const Options& options, const std::filesystem::path& cache, bool* from_disk) {
   const std::string command = "RINER_CACHE_DIR='" + cache.string() + "' POCL_CACHE_DIR='" +
-                              (cache / "pocl").string() + "' '" + options.self + "' --case=program_build_once --device='" +
-                              options.device + "'";
+                              (cache / "pocl").string() + "' '" + options.self +
+                              "' --case=program_build_once --device='" + options.device + "'";
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) throw std::runtime_error("cannot start " + command);
   double ms = -1;
@@ -68,7 +68,10 @@ std::vector<Result> program_cache(const Options& options) {
     cold.push_back(run_child(options, cache, &disk));
     if (disk) throw std::runtime_error("first build claimed a cache hit");
     warm.push_back(run_child(options, cache, &disk));
-    if (disk != served) throw std::runtime_error("riner's cache served a driver it should not, or not one it should");
+    if (disk != served) {
+      throw std::runtime_error(served ? "second process did not hit riner's cache"
+                                      : "riner's cache served PoCL, which it should leave alone");
+    }
     std::filesystem::remove_all(cache);
   }
   const auto c = riner::bench::Stats::of(cold);

@@ -184,8 +184,9 @@ def destripe(sino, geometry, flat=None, dark=None, center=None, method="all", si
     "sorting", "filtering", "fitting", "wavelet" (Münch et al.'s wavelet-Fourier filter),
     "large", "dead" or "all" (Vo et al.'s combination); size and large_size 0 for the
     literature's 21 (5 in "all", after its large-stripe step) and 51, sigma 0 for the method's
-    own width, levels 0 for as many as fit (up to 4), wavelet the Daubechies order. Returns a dict: sino (the destriped measurement),
-    stripes (each element's mean removed, rho; exp(-stripes) reads as alpha), dead_elements,
+    own width, levels 0 for as many as fit (up to 4), wavelet the Daubechies order. Returns a
+    dict: sino (the destriped measurement), stripes (each element's mean removed, rho;
+    exp(-stripes) reads as alpha), dead_elements,
     large_stripe_elements, size, large_size, sigma, wavelet_levels, non_finite_replaced.
     engine "opencl" runs every step as a kernel on device (None: the first GPU, else the first
     device), "reference" on the CPU twins. flat_after: as flat_field's."""

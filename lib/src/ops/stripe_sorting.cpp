@@ -24,11 +24,23 @@ std::size_t local_bytes(std::size_t views) {
 
 bool on_cpu(const cl::Context& context) { return context.info().type == "CPU"; }
 
+// Whether the bitonic sort's column of `views` fits the device's local memory.
+bool bitonic_fits(const cl::Context& context, std::size_t views) {
+  return local_bytes(views) + 1024 <= context.info().local_mem_bytes;
+}
+
+void require_bitonic_fits(const cl::Context& context, std::size_t views) {
+  if (!bitonic_fits(context, views)) {
+    throw Error("stripe sorting: a column of " + std::to_string(views) +
+                " views does not fit the device's local memory");
+  }
+}
+
 }  // namespace
 
 bool StripeSortingOp::supported(const cl::Context& context, std::size_t views, std::size_t size) {
   return size % 2 == 1 && size <= kMostWindow && views >= 2 &&
-         (on_cpu(context) || local_bytes(views) + 1024 <= context.info().local_mem_bytes);
+         (on_cpu(context) || bitonic_fits(context, views));
 }
 
 StripeSortingOp::StripeSortingOp(cl::Context& context, std::size_t views, std::size_t columns)
@@ -48,17 +60,11 @@ StripeSortingOp::StripeSortingOp(cl::Context& context, std::size_t views, std::s
       filtered_(context, views * columns),
       order_(context, views * columns) {
   if (views < 2) throw Error("stripe sorting: a column needs at least 2 views");
-  if (shape_ == Shape::kBitonic && !supported(context, views, 1)) {
-    throw Error("stripe sorting: a column of " + std::to_string(views) +
-                " views does not fit the device's local memory");
-  }
+  if (shape_ == Shape::kBitonic) require_bitonic_fits(context, views);
 }
 
 void StripeSortingOp::use_shape(Shape shape) {
-  if (shape == Shape::kBitonic && local_bytes(views_) + 1024 > context_.info().local_mem_bytes) {
-    throw Error("stripe sorting: a column of " + std::to_string(views_) +
-                " views does not fit the device's local memory");
-  }
+  if (shape == Shape::kBitonic) require_bitonic_fits(context_, views_);
   shape_ = shape;
 }
 
@@ -77,7 +83,8 @@ void StripeSortingOp::sort(const cl::Buffer<float>& in) {
       views_b_ = cl::Buffer<cl_uint>(context_, sorted_.size());
     }
     // filtered_ is the second scratch of keys: median() overwrites it before anyone reads it.
-    sort_merge_.set_args(views_, columns_, in, sorted_, order_, keys_, views_a_, filtered_, views_b_);
+    sort_merge_.set_args(views_, columns_, in, sorted_, order_, keys_, views_a_, filtered_,
+                         views_b_);
     context_.launch(sort_merge_, std::size_t{columns_});
     return;
   }
