@@ -1,7 +1,10 @@
 // FBP/FDK: OpenCL against the reference, and both against phantoms.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "analytic/fbp_setup.hpp"
 #include "cl/buffer.hpp"
@@ -26,6 +29,66 @@ riner::Scan phantom_scan(const riner::Geometry& g, riner::Array* truth) {
   const riner::Phantom p = riner::shepp_logan(g);
   *truth = riner::rasterize(p, g, 4);
   return riner::Scan{riner::exact_projections(p, g), g, 0};
+}
+
+// Grids and detectors that put the backprojections' clamped reads at their edges.
+std::vector<riner::Geometry> backprojection_shape_geometries() {
+  riner::Geometry raised = riner::test::small_cone3d();  // a cone-beam slab's grid
+  raised.grid_centre_z_mm = 3.5 * raised.voxel_mm;
+  riner::Geometry between = riner::test::small_parallel3d();  // slices between two rows
+  between.offset_v = 0.37;
+  riner::Geometry narrow = riner::test::small_fan2d();  // the grid's corners off the detector
+  narrow.n_u = 41;
+  riner::Geometry tall = riner::test::small_cone3d();  // voxels above and below the rows
+  tall.n_v = 9;
+  return {riner::test::small_fan2d(),
+          riner::test::small_parallel2d(),
+          riner::test::small_cone3d(),
+          raised,
+          riner::test::small_parallel3d(),
+          between,
+          narrow,
+          tall};
+}
+
+// Both shapes against the reference on random filtered readings; the CPU's shape also by
+// chunks of `chunk_views` views (the last one shorter), added up.
+void check_backprojection_shapes(const std::vector<riner::Geometry>& geometries,
+                                 std::size_t chunk_views) {
+  riner::cl::Context& ctx = riner::cl::context_of(riner::test::device());
+  for (const riner::Geometry& g : geometries) {
+    CAPTURE(std::string(riner::geometry_type_name(g.type)));
+    CAPTURE(g.n_u);
+    const std::size_t readings = g.n_views() * g.n_u * (g.is_3d() ? g.n_v : 1);
+    const std::vector<float> filtered = riner::test::uniform(readings, -1.0f, 2.0f, g.n_u + 7);
+    const std::vector<float> weights_f = riner::test::uniform(g.n_views(), 0.5f, 1.5f, 3);
+    const std::vector<double> weights(weights_f.begin(), weights_f.end());
+    // 3D: every third slice from the second; 2D: the one slice.
+    const std::size_t first = g.is_3d() ? 1 : 0, step = g.is_3d() ? 3 : 1;
+    const std::size_t count = g.is_3d() ? (g.volume_shape[0] - 1 + step - 1) / step : 1;
+    const std::vector<double> expected = riner::ref::fbp_backproject(
+        g, std::vector<double>(filtered.begin(), filtered.end()), weights, first, step, count);
+    riner::ops::FbpOp op(
+        ctx, g, riner::analytic::filter_taps(g.n_u, 1.0, riner::FbpFilter::kRamLak), weights);
+    const riner::cl::Buffer<float> d_filtered(ctx, std::span<const float>(filtered));
+    using Shape = riner::ops::FbpOp::Shape;
+    const std::size_t chunk_bytes = chunk_views * (g.is_3d() ? g.n_v : 1) * (g.n_u + 3) * 8;
+    for (auto [shape, pairs_bytes] :
+         {std::pair{Shape::kPerVoxel, std::size_t{0}}, std::pair{Shape::kLanes, std::size_t{0}},
+          std::pair{Shape::kLanes, chunk_bytes}}) {
+      CAPTURE(static_cast<int>(shape));
+      CAPTURE(pairs_bytes);
+      op.use_shape(shape, pairs_bytes);
+      riner::cl::Buffer<float> d_volume(ctx, expected.size());
+      op.backproject(d_filtered, d_volume, first, step);
+      std::vector<float> volume(expected.size());
+      d_volume.read(std::span<float>(volume));
+      // One pass of float sums over the views, each a product of a few roundings.
+      const auto stats =
+          riner::test::compare(volume, std::vector<float>(expected.begin(), expected.end()));
+      CHECK_MESSAGE(stats.rms_rel < riner::test::tolerance::kOnePass, stats.describe());
+    }
+  }
 }
 
 }  // namespace
@@ -96,51 +159,19 @@ TEST_SUITE("fbp") {
   TEST_CASE(
       "both backprojection shapes (a GPU's, a CPU's) agree with the reference: partial tiles, "
       "voxels off the detector, slices between rows, a selection of slices") {
-    riner::cl::Context& ctx = riner::cl::context_of(riner::test::device());
-    riner::Geometry raised = riner::test::small_cone3d();  // a cone-beam slab's grid
-    raised.grid_centre_z_mm = 3.5 * raised.voxel_mm;
-    riner::Geometry between = riner::test::small_parallel3d();  // slices between two rows
-    between.offset_v = 0.37;
-    riner::Geometry narrow = riner::test::small_fan2d();  // the grid's corners off the detector
-    narrow.n_u = 41;
-    riner::Geometry tall = riner::test::small_cone3d();  // voxels above and below the rows
-    tall.n_v = 9;
-    for (const riner::Geometry& g :
-         {riner::test::small_fan2d(), riner::test::small_parallel2d(), riner::test::small_cone3d(),
-          raised, riner::test::small_parallel3d(), between, narrow, tall}) {
-      CAPTURE(std::string(riner::geometry_type_name(g.type)));
-      CAPTURE(g.n_u);
-      const std::size_t readings = g.n_views() * g.n_u * (g.is_3d() ? g.n_v : 1);
-      const std::vector<float> filtered = riner::test::uniform(readings, -1.0f, 2.0f, g.n_u + 7);
-      const std::vector<float> weights_f = riner::test::uniform(g.n_views(), 0.5f, 1.5f, 3);
-      const std::vector<double> weights(weights_f.begin(), weights_f.end());
-      // 3D: every third slice from the second; 2D: the one slice.
-      const std::size_t first = g.is_3d() ? 1 : 0, step = g.is_3d() ? 3 : 1;
-      const std::size_t count = g.is_3d() ? (g.volume_shape[0] - 1 + step - 1) / step : 1;
-      const std::vector<double> expected = riner::ref::fbp_backproject(
-          g, std::vector<double>(filtered.begin(), filtered.end()), weights, first, step, count);
-      riner::ops::FbpOp op(
-          ctx, g, riner::analytic::filter_taps(g.n_u, 1.0, riner::FbpFilter::kRamLak), weights);
-      const riner::cl::Buffer<float> d_filtered(ctx, std::span<const float>(filtered));
-      using Shape = riner::ops::FbpOp::Shape;
-      // The CPU's shape also by chunks of 7 views (the last one shorter), added up.
-      const std::size_t seven_views = 7 * (g.is_3d() ? g.n_v : 1) * (g.n_u + 3) * 8;
-      for (auto [shape, pairs_bytes] :
-           {std::pair{Shape::kPerVoxel, std::size_t{0}}, std::pair{Shape::kLanes, std::size_t{0}},
-            std::pair{Shape::kLanes, seven_views}}) {
-        CAPTURE(static_cast<int>(shape));
-        CAPTURE(pairs_bytes);
-        op.use_shape(shape, pairs_bytes);
-        riner::cl::Buffer<float> d_volume(ctx, expected.size());
-        op.backproject(d_filtered, d_volume, first, step);
-        std::vector<float> volume(expected.size());
-        d_volume.read(std::span<float>(volume));
-        // One pass of float sums over the views, each a product of a few roundings.
-        const auto stats =
-            riner::test::compare(volume, std::vector<float>(expected.begin(), expected.end()));
-        CHECK_MESSAGE(stats.rms_rel < riner::test::tolerance::kOnePass, stats.describe());
-      }
+    check_backprojection_shapes(backprojection_shape_geometries(), 7);
+  }
+
+  // The same on five views (chunks of 3 and 2), for oclgrind's out-of-bounds checks (ctest
+  // oclgrind_fbp_shapes): the clamped indices depend on the voxels and the angles, not on how
+  // many views are summed, and the interpreter's time on how many are.
+  TEST_CASE("both backprojection shapes on five views") {
+    std::vector<riner::Geometry> geometries = backprojection_shape_geometries();
+    for (riner::Geometry& g : geometries) {
+      g.uniform_angles.reset();
+      g.angles = {0.1, M_PI / 4 + 0.05, M_PI / 2, 2.0, 4.0};
     }
+    check_backprojection_shapes(geometries, 3);
   }
 
   TEST_CASE("a selection of slices gives exactly those slices of the whole volume") {
