@@ -21,7 +21,7 @@ ROOT = os.path.normpath(os.path.join(os.path.dirname(__file__), "..", ".."))
 W, H = 1000, 640
 LEFT, RIGHT, TOP, BOTTOM = 90, 250, 50, 70
 T_MIN, T_MAX = 0.05, 300.0
-P_MIN, P_MAX = 16.0, 42.0
+P_MIN, P_MAX = 16.0, 44.0
 
 
 def points():
