@@ -9,6 +9,7 @@
 #pragma once
 
 #include <cstdint>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <optional>
@@ -198,6 +199,15 @@ class Reconstructor {
   void run(const ProgressCallback& callback = {}, int report_every = 50);
 
   int steps_done() const;
+
+  // Training so far (the parameters, Adam's moments, the steps' records), written atomically
+  // to `path` between steps: a run killed later goes on from it with resume_from, to the same
+  // bits on the same device.
+  void save_checkpoint(const std::filesystem::path& path);
+  // Goes on from a checkpoint of this scan, these settings and this device, as after the steps
+  // it holds. InputError when the file is not a checkpoint or is truncated, or when it is of
+  // another scan, other settings or another device (the message says which).
+  void resume_from(const std::filesystem::path& path);
   // The result: mu in 1/mm on the geometry's grid and the response per element ([n_u] in 2D,
   // [n_v, n_u] in 3D). In 2D, after the ring corrections config.rings turns on, which change
   // the image and alpha together and keep the data fit.

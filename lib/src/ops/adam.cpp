@@ -25,6 +25,15 @@ void AdamOp::reset() {
   v_.write(zeros);
 }
 
+void AdamOp::set_moments(std::span<const float> m, std::span<const float> v) {
+  if (m.size() != n_params_ || v.size() != n_params_) {
+    throw Error("adam: moments of " + std::to_string(m.size()) + " values for " +
+                std::to_string(n_params_) + " parameters");
+  }
+  m_.write(m);
+  v_.write(v);
+}
+
 void AdamOp::step(const AdamSettings& s, int step, cl::Buffer<float>& params,
                   cl::Buffer<float>& grad, const GradientSlices& slices) {
   const bool sliced = slices.buffer != nullptr && slices.slices > 0;

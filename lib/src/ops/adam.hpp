@@ -3,6 +3,7 @@
 #pragma once
 
 #include <memory>
+#include <span>
 
 #include "cl/buffer.hpp"
 #include "cl/program.hpp"
@@ -50,6 +51,11 @@ class AdamOp {
 
   // Back to fresh moments.
   void reset();
+
+  // The first and second moments (a checkpoint's), and back from one.
+  const cl::Buffer<float>& first_moments() const { return m_; }
+  const cl::Buffer<float>& second_moments() const { return v_; }
+  void set_moments(std::span<const float> m, std::span<const float> v);
 
  private:
   cl::Context& context_;

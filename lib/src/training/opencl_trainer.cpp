@@ -118,6 +118,29 @@ class OpenclTrainer final : public Trainer {
   std::string device_name() const override { return device_.info().full_name(); }
   std::optional<ExecutionPlan> plan() const override { return plan_; }
 
+  void save_state(ByteWriter& out) override {
+    if (!pending_.empty()) throw Error("training state: losses not drained");
+    out.put_array(std::span<const float>(params_.read()));
+    out.put_array(std::span<const float>(adam_.first_moments().read()));
+    out.put_array(std::span<const float>(adam_.second_moments().read()));
+    out.put_array(std::span<const float>(tail_sum_ ? tail_sum_->read() : std::vector<float>()));
+  }
+
+  void restore_state(ByteReader& in, int steps) override {
+    const std::vector<float> params = in.get_array<float>();
+    const std::vector<float> m = in.get_array<float>();
+    const std::vector<float> v = in.get_array<float>();
+    const std::vector<float> tail = in.get_array<float>();
+    if (params.size() != params_.size() || tail.size() != (tail_sum_ ? tail_sum_->size() : 0)) {
+      throw InputError("training state: not this model's parameters");
+    }
+    params_.write(params);
+    adam_.set_moments(m, v);
+    if (tail_sum_) tail_sum_->write(tail);
+    pending_.clear();
+    steps_ = steps;
+  }
+
  private:
   // The parameters the result is made of (model::TailAverage::snapshots): the snapshots' mean,
   // or the last step's.

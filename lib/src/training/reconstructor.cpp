@@ -11,6 +11,7 @@
 #include "riner/error.hpp"
 #include "riner/ring_chain.hpp"
 #include "riner/ring_correction.hpp"
+#include "training/checkpoint.hpp"
 #include "training/trainer.hpp"
 #include "training/warm_start.hpp"
 
@@ -161,6 +162,64 @@ void Reconstructor::run(const ProgressCallback& callback, int report_every) {
 }
 
 int Reconstructor::steps_done() const { return impl_->steps; }
+
+namespace {
+
+std::uint64_t scan_fingerprint(const Scan& scan) {
+  const std::vector<float>& m = scan.measurement.data;
+  return detail::fingerprint(
+      scan.geometry.to_json(),
+      detail::fingerprint({reinterpret_cast<const char*>(m.data()), m.size() * sizeof(float)}));
+}
+
+}  // namespace
+
+void Reconstructor::save_checkpoint(const std::filesystem::path& path) {
+  impl_->drain();
+  detail::TrainingCheckpoint c;
+  c.scan_fingerprint = scan_fingerprint(impl_->setup.scan);
+  c.settings_fingerprint = detail::fingerprint(impl_->setup.config.to_json());
+  c.device = impl_->trainer->device_name();
+  c.steps = impl_->steps;
+  c.seconds = impl_->seconds;
+  c.samples = impl_->samples;
+  c.plateaued = impl_->plateaued;
+  c.element_rays = impl_->element_rays;
+  c.history = impl_->history;
+  detail::ByteWriter state;
+  impl_->trainer->save_state(state);
+  c.trainer_state = state.bytes();
+  detail::write_checkpoint(path, c);
+}
+
+void Reconstructor::resume_from(const std::filesystem::path& path) {
+  const detail::TrainingCheckpoint c = detail::read_checkpoint(path);
+  const std::string what = path.string() + ": ";
+  if (c.scan_fingerprint != scan_fingerprint(impl_->setup.scan)) {
+    throw InputError(what + "a checkpoint of another scan (other readings or geometry)");
+  }
+  if (c.settings_fingerprint != detail::fingerprint(impl_->setup.config.to_json())) {
+    throw InputError(what + "a checkpoint of other settings (config.json beside it has them)");
+  }
+  if (c.device != impl_->trainer->device_name()) {
+    throw InputError(what + "a checkpoint of training on " + c.device +
+                     ": resume it there (this run is on " + impl_->trainer->device_name() + ")");
+  }
+  if (c.element_rays.size() != impl_->element_rays.size() ||
+      c.history.size() > static_cast<std::size_t>(c.steps)) {
+    throw InputError(what + "truncated or corrupt");
+  }
+  detail::ByteReader state(c.trainer_state, path.string());
+  impl_->trainer->restore_state(state, c.steps);
+  impl_->steps = c.steps;
+  impl_->seconds = c.seconds;
+  impl_->samples = c.samples;
+  impl_->plateaued = c.plateaued;
+  impl_->element_rays = c.element_rays;
+  impl_->history = c.history;
+  impl_->result.reset();
+  impl_->result_steps = -1;
+}
 
 Array Reconstructor::field_image() const {
   const Geometry& g = impl_->setup.scan.geometry;

@@ -1,5 +1,6 @@
 // The reference engine: the whole step in double on the CPU (reference/riner_step_ref.cpp).
 #include "reference/adam_ref.hpp"
+#include "riner/error.hpp"
 #include "reference/alpha_factors_ref.hpp"
 #include "reference/riner_step_ref.hpp"
 #include "training/trainer.hpp"
@@ -68,6 +69,24 @@ class ReferenceTrainer final : public Trainer {
 
   std::string device_name() const override { return "CPU reference"; }
   std::optional<ExecutionPlan> plan() const override { return std::nullopt; }
+
+  void save_state(ByteWriter& out) override {
+    for (const std::vector<double>* v : {&params_, &m_, &v_, &tail_sum_}) {
+      out.put_array(std::span<const double>(*v));
+    }
+  }
+
+  void restore_state(ByteReader& in, int steps) override {
+    for (std::vector<double>* v : {&params_, &m_, &v_, &tail_sum_}) {
+      std::vector<double> values = in.get_array<double>();
+      if (values.size() != v->size()) {
+        throw InputError("training state: not this model's parameters");
+      }
+      *v = std::move(values);
+    }
+    losses_.clear();
+    steps_ = steps;
+  }
 
  private:
   void hold_broad_even_alpha() {

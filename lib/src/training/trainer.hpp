@@ -19,6 +19,7 @@
 #include "riner/device.hpp"
 #include "riner/execution_plan.hpp"
 #include "riner/reconstructor.hpp"
+#include "training/checkpoint_bytes.hpp"
 
 namespace riner::detail {
 
@@ -94,6 +95,11 @@ class Trainer {
   virtual std::string device_name() const = 0;
   // The execution plan the engine runs (none for the reference engine).
   virtual std::optional<ExecutionPlan> plan() const = 0;
+  // Everything the later steps depend on beyond the setup (the parameters, Adam's moments, the
+  // tail average's sum), for a checkpoint; call after drain_losses(). restore_state takes it
+  // back into a trainer made from the same setup, as after `steps` steps.
+  virtual void save_state(ByteWriter& out) = 0;
+  virtual void restore_state(ByteReader& in, int steps) = 0;
 };
 
 std::unique_ptr<Trainer> make_reference_trainer(const TrainingSetup& setup);
