@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 
 #include "cli_common.hpp"
 #include "commands.hpp"
@@ -67,6 +68,44 @@ RinerConfig config_from(const Args& args) {
   return config;
 }
 
+constexpr const char* kCheckpointName = "training.checkpoint";
+
+// --checkpoint-minutes in seconds (0: never).
+double checkpoint_seconds(const Args& args) {
+  const double minutes = args.number("checkpoint-minutes");
+  if (!std::isfinite(minutes) || minutes < 0.0) {
+    throw UsageError("--checkpoint-minutes must be 0 (never) or more");
+  }
+  return 60.0 * minutes;
+}
+
+// Without --resume, a checkpoint in the output folder is an unfinished run that a new one would
+// overwrite: refused before anything is trained.
+void refuse_unfinished(const Args& args, const std::filesystem::path& checkpoint) {
+  if (!args.is_set("resume") && std::filesystem::exists(checkpoint)) {
+    throw UsageError(checkpoint.string() +
+                     " holds an unfinished training: --resume goes on from it (remove it to "
+                     "start again)");
+  }
+}
+
+// --resume: go on from the folder's checkpoint, when there is one; the step it went on from.
+std::optional<int> resume_training(const Args& args, const Console& console,
+                                   Reconstructor& reconstructor,
+                                   const std::filesystem::path& checkpoint) {
+  if (!args.is_set("resume")) return std::nullopt;
+  if (!std::filesystem::exists(checkpoint)) {
+    console.line("--resume: no " + std::string(kCheckpointName) + " in " +
+                 checkpoint.parent_path().string() + ": training from the start");
+    return std::nullopt;
+  }
+  reconstructor.resume_from(checkpoint);
+  console.line("resuming the training at step " + std::to_string(reconstructor.steps_done()) +
+               " of " + std::to_string(reconstructor.config().training.steps) + " from " +
+               checkpoint.string());
+  return reconstructor.steps_done();
+}
+
 void write_history(const std::filesystem::path& path, const std::vector<LossRecord>& history) {
   std::string csv = "step,data_loss,penalty,learning_rate\n";
   char line[128];
@@ -114,6 +153,11 @@ int run_reconstruct(int argc, char** argv, int first) {
               "")
       .option("lr", "RATE", "initial learning rate", "")
       .option("report-every", "N", "steps between progress reports", "200")
+      .option("checkpoint-minutes", "M",
+              "save the training's state to the output folder's training.checkpoint every M "
+              "minutes of training (0: never), from which --resume goes on after a kill; a "
+              "slabbed run resumes by slabs instead",
+              "5")
       .flag("paper", "use the paper's settings (L=10, T=2^10, F=8, width 128, 4000 steps, ...)")
       .flag("no-ring-correction",
             "write the trained field and alpha as they are (no ring corrections, no residual "
@@ -151,7 +195,11 @@ int run_reconstruct(int argc, char** argv, int first) {
   }
 
   const std::optional<Device> device = device_from(args, config.engine);
+  const double checkpoint_every = checkpoint_seconds(args);
+  const std::filesystem::path checkpoint = out / kCheckpointName;
+  refuse_unfinished(args, checkpoint);
   Reconstructor reconstructor(std::move(scan), config, device);
+  const std::optional<int> resumed_at = resume_training(args, console, reconstructor, checkpoint);
   {
     const TrainingStats setup = reconstructor.stats();
     if (setup.plan) console.line(setup.plan->describe());
@@ -221,11 +269,17 @@ int run_reconstruct(int argc, char** argv, int first) {
     Progress progress("reconstruct",
                       static_cast<std::size_t>(reconstructor.config().training.steps),
                       console.quiet());
+    double saved_at = reconstructor.stats().seconds;
     reconstructor.run(
         [&](const TrainingProgress& p) {
           char status[64];
           std::snprintf(status, sizeof(status), "loss %.4g", p.loss);
           progress.update(static_cast<std::size_t>(p.step), status);
+          if (checkpoint_every > 0.0 && p.step < p.total &&
+              p.seconds - saved_at >= checkpoint_every) {
+            reconstructor.save_checkpoint(checkpoint);
+            saved_at = p.seconds;
+          }
           return true;
         },
         static_cast<int>(args.integer("report-every")));
@@ -255,8 +309,12 @@ int run_reconstruct(int argc, char** argv, int first) {
   summary["centre_check"] = centre_check ? centre_json(*centre_check) : nlohmann::json(nullptr);
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
-  summary["wall_seconds"] = wall;  // "seconds" is the training's
+  summary["wall_seconds"] = wall;  // "seconds" is the training's, before a resume included
+  // The step --resume went on from (training.checkpoint), null for a run in one go.
+  summary["resumed_at_step"] = resumed_at ? nlohmann::json(*resumed_at) : nlohmann::json(nullptr);
   write_text(out / "summary.json", summary.dump(1) + "\n");
+  std::error_code ignored;  // the run is done: its outputs stand in for the checkpoint
+  std::filesystem::remove(checkpoint, ignored);
   console.line("reconstructed " + shape_string(image.shape) + " in " + format_duration(wall) +
                " (training " + format_duration(stats.seconds) + "; " + std::to_string(stats.steps) +
                " steps, " + std::to_string(dead.size()) + " elements flagged dead) -> " +

@@ -122,7 +122,8 @@ void add_slab_options(Args& args) {
             "for slices under 256 x 256 voxels, and with --slab-slices)")
       .flag("resume",
             "finish a slabbed run the output folder holds: only the slabs its manifest does "
-            "not list as done are trained");
+            "not list as done are trained; on a slice, go on from the training's checkpoint "
+            "(--checkpoint-minutes)");
 }
 
 bool slices_2d_by_default(const Geometry& g) {
@@ -131,13 +132,15 @@ bool slices_2d_by_default(const Geometry& g) {
 }
 
 bool wants_slabs(const Args& args) {
-  if (args.is_set("resume") || args.is_set("slices-2d") || args.is_set("field-3d")) return true;
+  if (args.is_set("slices-2d") || args.is_set("field-3d")) return true;
   for (const char* name : {"slab-slices", "memory-limit", "workers", "processes", "join-run"}) {
     if (auto v = args.maybe(name); v && !v->empty()) return true;
   }
   // Left to the scan: by slabs when a volume does not fit whole, or when a parallel beam's
   // slices are large enough to train each alone.
   const std::optional<Geometry> g = stack_geometry(args);
+  // --resume on a slice goes on from its training's checkpoint (cmd_reconstruct.cpp).
+  if (args.is_set("resume")) return g && g->is_3d();
   return g && g->is_3d() &&
          (slices_2d_by_default(*g) || slab_bytes(*g, g->volume_shape[0]) > default_memory_limit());
 }

@@ -216,6 +216,31 @@ def test_an_exception_in_the_callback_aborts_training(fan_scan):
         riner.reconstruct(sim["sino"], g, steps=500, progress=fail, progress_every=50)
 
 
+def test_a_run_stopped_goes_on_from_its_checkpoint_to_the_same_result(fan_scan, tmp_path):
+    sim, g = fan_scan
+    whole = riner.reconstruct(sim["sino"], g, steps=500, quality=False)
+    checkpoint = tmp_path / "run.checkpoint"
+
+    def fail(progress):
+        if progress["step"] == 300:
+            raise ArithmeticError("killed")
+
+    # A checkpoint at every check (50 steps) of a run that dies at step 300.
+    with pytest.raises(ArithmeticError, match="killed"):
+        riner.reconstruct(sim["sino"], g, steps=500, quality=False, progress=fail,
+                          progress_every=50, checkpoint=checkpoint, checkpoint_minutes=1e-9)
+    assert checkpoint.exists()
+    with pytest.raises(riner.InputError, match="a checkpoint of other settings"):
+        riner.reconstruct(sim["sino"], g, steps=400, quality=False, checkpoint=checkpoint)
+    resumed = riner.reconstruct(sim["sino"], g, steps=500, quality=False, checkpoint=checkpoint)
+    assert resumed.summary["steps"] == 500
+    np.testing.assert_array_equal(resumed.image, whole.image)
+    np.testing.assert_array_equal(resumed.alpha, whole.alpha)
+    assert not checkpoint.exists()  # training finished: the result stands for it
+    with pytest.raises(riner.InputError, match="checkpoint_minutes must be"):
+        riner.reconstruct(sim["sino"], g, steps=50, checkpoint=checkpoint, checkpoint_minutes=0)
+
+
 def test_ctrl_c_cancels_training_cleanly(fan_scan):
     sim, g = fan_scan
     timer = threading.Timer(0.5, lambda: os.kill(os.getpid(), signal.SIGINT))

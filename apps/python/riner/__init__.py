@@ -260,7 +260,7 @@ def _settings_list(kwargs):
 
 def reconstruct(sino, geometry, flat=None, dark=None, center=None, config=None, settings=None,
                 progress=None, progress_every=200, quality=True, device=None, engine="opencl",
-                flat_after=None, **short_settings):
+                flat_after=None, checkpoint=None, checkpoint_minutes=5.0, **short_settings):
     """Riner on a scan: returns Reconstruction(image, alpha, beta, summary, field), with
     .alpha_by_view (each view's response when some change part-way, else None).
 
@@ -273,6 +273,9 @@ def reconstruct(sino, geometry, flat=None, dark=None, center=None, config=None, 
     progress: called with a dict (step, total, loss, seconds) every progress_every steps;
     returning False stops training early. quality: the no-reference quality report against
     FBP in the summary. Ctrl-C stops training and raises KeyboardInterrupt.
+    checkpoint: a file where training's state is saved every checkpoint_minutes minutes of
+    training; when it exists, training goes on from it (the same scan, settings and device: the
+    uninterrupted run's result to the bit), and it is removed once training has finished.
     """
     sino, geometry_json, notes = _scan(sino, geometry, flat, dark, center, flat_after)
     if config is None:
@@ -285,7 +288,8 @@ def reconstruct(sino, geometry, flat=None, dark=None, center=None, config=None, 
     pairs = _settings_list(dict(settings or {}, **short_settings))
     image, alpha, beta, summary, field, alpha_by_view = _riner.reconstruct(
         sino, geometry_json, config_json, pairs, engine, _device(device), progress,
-        int(progress_every), bool(quality))
+        int(progress_every), bool(quality), "" if checkpoint is None else os.fspath(checkpoint),
+        float(checkpoint_minutes))
     summary = json.loads(summary)
     summary.update(notes)
     return Reconstruction(image, alpha, beta, summary, field, alpha_by_view)

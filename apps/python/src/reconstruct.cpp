@@ -4,6 +4,8 @@
 // to stop early or raise to abort.
 #include <pybind11/stl.h>
 
+#include <cmath>
+#include <filesystem>
 #include <memory>
 #include <optional>
 #include <utility>
@@ -76,8 +78,12 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
                       const std::string& config_json,
                       const std::vector<std::pair<std::string, std::string>>& settings,
                       const std::string& engine, const std::string& device,
-                      const py::object& progress, int progress_every, bool quality) {
+                      const py::object& progress, int progress_every, bool quality,
+                      const std::string& checkpoint, double checkpoint_minutes) {
   if (progress_every < 1) throw InputError("progress_every must be >= 1");
+  if (!(checkpoint_minutes > 0.0) || !std::isfinite(checkpoint_minutes)) {
+    throw InputError("checkpoint_minutes must be a number above 0");
+  }
   Scan scan = scan_from(measurement, geometry_json);
   const RinerConfig config = config_from(config_json, settings, engine);
   app::require_training(config);
@@ -89,6 +95,9 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
     if (quality) app::require_quality_grid(scan.geometry);
     dev = device_for(config.engine, device);
     reconstructor = std::make_unique<Reconstructor>(std::move(scan), config, dev);
+    if (!checkpoint.empty() && std::filesystem::exists(checkpoint)) {
+      reconstructor->resume_from(checkpoint);
+    }
   }
   // Often enough for Ctrl-C to feel immediate on a CPU (50 steps: about 0.1 s), rarely enough
   // not to stall a GPU (each check drains the queue).
@@ -96,7 +105,18 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
   ProgressRelay relay(progress, progress_every);
   {
     py::gil_scoped_release release;
-    reconstructor->run(std::ref(relay), std::min(kCheckEvery, progress_every));
+    double saved_at = reconstructor->stats().seconds;
+    reconstructor->run(
+        [&](const TrainingProgress& p) {
+          if (!relay(p)) return false;
+          if (!checkpoint.empty() && p.step < p.total &&
+              p.seconds - saved_at >= 60.0 * checkpoint_minutes) {
+            reconstructor->save_checkpoint(checkpoint);
+            saved_at = p.seconds;
+          }
+          return true;
+        },
+        std::min(kCheckEvery, progress_every));
   }
   relay.raise_failure();
 
@@ -112,6 +132,11 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
     nlohmann::json json = app::run_summary(*reconstructor, result, check);
     if (!quality) json["quality"] = nullptr;
     summary = python_wording(json.dump());
+  }
+  const TrainingStats done = reconstructor->stats();
+  if (!checkpoint.empty() && (done.steps >= done.steps_planned || done.stopped_on_plateau)) {
+    std::error_code ignored;  // training is done: the result stands for the checkpoint
+    std::filesystem::remove(checkpoint, ignored);
   }
   py::object alpha_by_view = py::none();
   if (result.alpha_by_view.size() > 0) alpha_by_view = to_numpy(std::move(result.alpha_by_view));

@@ -1,0 +1,105 @@
+// `riner reconstruct` of a slice killed with SIGKILL mid-training and started again with
+// --resume goes on from its training.checkpoint to the uninterrupted run's bits; the checkpoint
+// is never overwritten unasked, nor taken up by other settings.
+#include <doctest/doctest.h>
+
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "cli/cli_run.hpp"
+#include "riner/io.hpp"
+#include "support/fixture.hpp"
+
+extern char** environ;
+
+using riner::test::riner_cli;
+using riner::test::Run;
+
+TEST_SUITE("cli") {
+  TEST_CASE("a slice's training killed mid-way and resumed from its checkpoint equals one run") {
+    riner::test::TempDir dir;
+    const std::string sim = riner::test::simulate_geometry(dir, "g2.json", R"({"type": "parallel2d",
+        "detector": {"count": 70, "pitch_mm": 1.0},
+        "angles": {"count": 90, "range_rad": 3.141592653589793},
+        "volume": {"shape": [64, 64], "voxel_mm": 1.0}})",
+                                                           "--seed 4");
+    const std::string common = "reconstruct " + sim + "/sino.npy --geometry " + sim +
+                               "/geometry.json --steps 4000 --quiet";
+    const std::filesystem::path whole = dir / "whole", killed = dir / "killed";
+    REQUIRE(riner_cli(common + " --out " + whole.string(), dir).code == 0);
+    CHECK(!std::filesystem::exists(whole / "training.checkpoint"));
+
+    // The same run saving every 0.3 s of training, killed once the first checkpoint is there.
+    std::vector<std::string> words = {RINER_CLI_PATH,
+                                      "reconstruct",
+                                      sim + "/sino.npy",
+                                      "--geometry",
+                                      sim + "/geometry.json",
+                                      "--steps",
+                                      "4000",
+                                      "--quiet",
+                                      "--checkpoint-minutes",
+                                      "0.005",
+                                      "--out",
+                                      killed.string()};
+    std::vector<char*> argv;
+    for (std::string& w : words) argv.push_back(w.data());
+    argv.push_back(nullptr);
+    pid_t pid = 0;
+    REQUIRE(posix_spawn(&pid, RINER_CLI_PATH, nullptr, nullptr, argv.data(), environ) == 0);
+    const std::filesystem::path checkpoint = killed / "training.checkpoint";
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (!std::filesystem::exists(checkpoint) && std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    kill(pid, SIGKILL);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    REQUIRE(std::filesystem::exists(checkpoint));
+    REQUIRE(!std::filesystem::exists(killed / "image.nii"));  // killed before the end
+
+    // Not overwritten without --resume; not taken up with other settings.
+    Run refused = riner_cli(common + " --out " + killed.string(), dir);
+    CHECK(refused.code != 0);
+    CHECK(refused.err.find("holds an unfinished training: --resume goes on from it") !=
+          std::string::npos);
+    refused = riner_cli("reconstruct " + sim + "/sino.npy --geometry " + sim +
+                            "/geometry.json --steps 3000 --quiet --resume --out " + killed.string(),
+                        dir);
+    CHECK(refused.code != 0);
+    CHECK(refused.err.find("a checkpoint of other settings") != std::string::npos);
+    CHECK(std::filesystem::exists(checkpoint));
+
+    const Run finished = riner_cli(common + " --resume --out " + killed.string(), dir);
+    REQUIRE(finished.code == 0);
+    const nlohmann::json summary =
+        nlohmann::json::parse(riner::test::read_bytes(killed / "summary.json"));
+    CAPTURE(summary["resumed_at_step"]);
+    CHECK(summary["resumed_at_step"] > 0);
+    CHECK(summary["resumed_at_step"] < 4000);
+    CHECK(summary["steps"] == 4000);
+    for (const char* file : {"image.nii", "alpha.npy", "beta.npy", "loss.csv"}) {
+      CAPTURE(file);
+      CHECK(riner::test::read_bytes(killed / file) == riner::test::read_bytes(whole / file));
+    }
+    CHECK(!std::filesystem::exists(checkpoint));  // a finished run's outputs stand for it
+
+    // --resume with no checkpoint says so and trains from the start.
+    const Run fresh =
+        riner_cli("reconstruct " + sim + "/sino.npy --geometry " + sim +
+                      "/geometry.json --steps 4000 --resume --out " + (dir / "fresh").string(),
+                  dir);
+    REQUIRE(fresh.code == 0);
+    CHECK(fresh.out.find("--resume: no training.checkpoint in") != std::string::npos);
+    CHECK(riner::test::read_bytes(dir / "fresh" / "image.nii") ==
+          riner::test::read_bytes(whole / "image.nii"));
+  }
+}
