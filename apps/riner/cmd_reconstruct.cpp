@@ -70,15 +70,6 @@ RinerConfig config_from(const Args& args) {
 
 constexpr const char* kCheckpointName = "training.checkpoint";
 
-// --checkpoint-minutes in seconds (0: never).
-double checkpoint_seconds(const Args& args) {
-  const double minutes = args.number("checkpoint-minutes");
-  if (!std::isfinite(minutes) || minutes < 0.0) {
-    throw UsageError("--checkpoint-minutes must be 0 (never) or more");
-  }
-  return 60.0 * minutes;
-}
-
 // Without --resume, a checkpoint in the output folder is an unfinished run that a new one would
 // overwrite: refused before anything is trained.
 void refuse_unfinished(const Args& args, const std::filesystem::path& checkpoint) {
@@ -89,21 +80,19 @@ void refuse_unfinished(const Args& args, const std::filesystem::path& checkpoint
   }
 }
 
-// --resume: go on from the folder's checkpoint, when there is one; the step it went on from.
-std::optional<int> resume_training(const Args& args, const Console& console,
-                                   Reconstructor& reconstructor,
-                                   const std::filesystem::path& checkpoint) {
-  if (!args.is_set("resume")) return std::nullopt;
+// --resume: go on from the folder's checkpoint, when there is one.
+void resume_training(const Args& args, const Console& console, Reconstructor& reconstructor,
+                     const std::filesystem::path& checkpoint) {
+  if (!args.is_set("resume")) return;
   if (!std::filesystem::exists(checkpoint)) {
     console.line("--resume: no " + std::string(kCheckpointName) + " in " +
                  checkpoint.parent_path().string() + ": training from the start");
-    return std::nullopt;
+    return;
   }
   reconstructor.resume_from(checkpoint);
   console.line("resuming the training at step " + std::to_string(reconstructor.steps_done()) +
                " of " + std::to_string(reconstructor.config().training.steps) + " from " +
                checkpoint.string());
-  return reconstructor.steps_done();
 }
 
 void write_history(const std::filesystem::path& path, const std::vector<LossRecord>& history) {
@@ -154,9 +143,9 @@ int run_reconstruct(int argc, char** argv, int first) {
       .option("lr", "RATE", "initial learning rate", "")
       .option("report-every", "N", "steps between progress reports", "200")
       .option("checkpoint-minutes", "M",
-              "save the training's state to the output folder's training.checkpoint every M "
-              "minutes of training (0: never), from which --resume goes on after a kill; a "
-              "slabbed run resumes by slabs instead",
+              "save the training's state to the output folder's training.checkpoint (a "
+              "slabbed run: each slab's to slabs/) every M minutes of training (0: never), "
+              "from which --resume goes on after a kill",
               "5")
       .flag("paper", "use the paper's settings (L=10, T=2^10, F=8, width 128, 4000 steps, ...)")
       .flag("no-ring-correction",
@@ -199,7 +188,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   const std::filesystem::path checkpoint = out / kCheckpointName;
   refuse_unfinished(args, checkpoint);
   Reconstructor reconstructor(std::move(scan), config, device);
-  const std::optional<int> resumed_at = resume_training(args, console, reconstructor, checkpoint);
+  resume_training(args, console, reconstructor, checkpoint);
   {
     const TrainingStats setup = reconstructor.stats();
     if (setup.plan) console.line(setup.plan->describe());
@@ -310,8 +299,6 @@ int run_reconstruct(int argc, char** argv, int first) {
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   summary["wall_seconds"] = wall;  // "seconds" is the training's, before a resume included
-  // The step --resume went on from (training.checkpoint), null for a run in one go.
-  summary["resumed_at_step"] = resumed_at ? nlohmann::json(*resumed_at) : nlohmann::json(nullptr);
   write_text(out / "summary.json", summary.dump(1) + "\n");
   std::error_code ignored;  // the run is done: its outputs stand in for the checkpoint
   std::filesystem::remove(checkpoint, ignored);

@@ -122,13 +122,21 @@ void add_slab_options(Args& args) {
             "for slices under 256 x 256 voxels, and with --slab-slices)")
       .flag("resume",
             "finish a slabbed run the output folder holds: only the slabs its manifest does "
-            "not list as done are trained; on a slice, go on from the training's checkpoint "
-            "(--checkpoint-minutes)");
+            "not list as done are trained, each from its checkpoint where it has one; on a "
+            "slice, go on from the training's checkpoint (--checkpoint-minutes)");
 }
 
 bool slices_2d_by_default(const Geometry& g) {
   return g.type == GeometryType::kParallel3d && g.volume_shape[1] >= kSlices2dFromPx &&
          g.volume_shape[2] >= kSlices2dFromPx;
+}
+
+double checkpoint_seconds(const Args& args) {
+  const double minutes = args.number("checkpoint-minutes");
+  if (!std::isfinite(minutes) || minutes < 0.0) {
+    throw UsageError("--checkpoint-minutes must be 0 (never) or more");
+  }
+  return 60.0 * minutes;
 }
 
 bool wants_slabs(const Args& args) {
@@ -189,6 +197,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
         "libopenmpi-dev and build again");
   }
   SlabOptions options = slab_options(args);
+  options.checkpoint_seconds = checkpoint_seconds(args);
   const int requested = requested_processes(args);
   const SlabRanks ranks;
   // A process riner started to share this run (slab_processes.hpp) joins like an MPI rank.

@@ -1,5 +1,5 @@
 // `riner reconstruct` on a projection stack by slabs of slices (riner/slab_run.hpp): asked for
-// with --slab-slices, --memory-limit, --slices-2d, --field-3d or --resume, or chosen when a
+// with --slab-slices, --memory-limit, --slices-2d, --field-3d or (on a stack) --resume, or chosen when a
 // parallel-beam volume does not fit in memory whole or its slices are large enough to train
 // each alone. Writes volume/ (one TIFF per axial slice), manifest.json, alpha.npy,
 // beta.npy, detector.png, image.png (the three central planes), config.json and summary.json.
@@ -29,6 +29,10 @@ SlabOptions slab_size_options(const Args& args);
 // most there.
 constexpr std::size_t kSlices2dFromPx = 256;
 bool slices_2d_by_default(const Geometry& g);
+
+// --checkpoint-minutes in seconds (0: never; UsageError below 0): a slice's training, or each
+// slab's, saves its state that often (Reconstructor::save_checkpoint).
+double checkpoint_seconds(const Args& args);
 
 // Whether this run goes by slabs (it reads the geometry and the data's header, no data).
 bool wants_slabs(const Args& args);

@@ -161,6 +161,9 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
           {"draws_per_ray_planned", stats.draws_per_ray_planned},
           {"samples_per_voxel_planned", stats.samples_per_voxel_planned},
           {"stopped_on_plateau", stats.stopped_on_plateau},
+          // The step --resume went on from (a checkpoint), null for a run in one go.
+          {"resumed_at_step", stats.resumed_at_step > 0 ? nlohmann::json(stats.resumed_at_step)
+                                                        : nlohmann::json(nullptr)},
           {"seconds", stats.seconds},
           {"samples", stats.samples},
           {"samples_per_second", stats.seconds > 0 ? stats.samples / stats.seconds : 0.0},

@@ -1,6 +1,6 @@
-// `riner reconstruct` of a slice killed with SIGKILL mid-training and started again with
-// --resume goes on from its training.checkpoint to the uninterrupted run's bits; the checkpoint
-// is never overwritten unasked, nor taken up by other settings.
+// `riner reconstruct` of a slice, or of a stack by slabs, killed with SIGKILL mid-training and
+// started again with --resume goes on from its checkpoint to the uninterrupted run's bits; the
+// checkpoint is never overwritten unasked, nor taken up by other settings.
 #include <doctest/doctest.h>
 
 #include <signal.h>
@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <thread>
@@ -22,6 +23,27 @@ extern char** environ;
 
 using riner::test::riner_cli;
 using riner::test::Run;
+
+namespace {
+
+// RINER_CLI_PATH WORDS... started, and killed with SIGKILL once `until` is true (or after 120 s).
+void run_until(std::vector<std::string> words, const std::function<bool()>& until) {
+  words.insert(words.begin(), RINER_CLI_PATH);
+  std::vector<char*> argv;
+  for (std::string& w : words) argv.push_back(w.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  REQUIRE(posix_spawn(&pid, RINER_CLI_PATH, nullptr, nullptr, argv.data(), environ) == 0);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (!until() && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  kill(pid, SIGKILL);
+  int status = 0;
+  waitpid(pid, &status, 0);
+}
+
+}  // namespace
 
 TEST_SUITE("cli") {
   TEST_CASE("a slice's training killed mid-way and resumed from its checkpoint equals one run") {
@@ -38,31 +60,10 @@ TEST_SUITE("cli") {
     CHECK(!std::filesystem::exists(whole / "training.checkpoint"));
 
     // The same run saving every 0.3 s of training, killed once the first checkpoint is there.
-    std::vector<std::string> words = {RINER_CLI_PATH,
-                                      "reconstruct",
-                                      sim + "/sino.npy",
-                                      "--geometry",
-                                      sim + "/geometry.json",
-                                      "--steps",
-                                      "4000",
-                                      "--quiet",
-                                      "--checkpoint-minutes",
-                                      "0.005",
-                                      "--out",
-                                      killed.string()};
-    std::vector<char*> argv;
-    for (std::string& w : words) argv.push_back(w.data());
-    argv.push_back(nullptr);
-    pid_t pid = 0;
-    REQUIRE(posix_spawn(&pid, RINER_CLI_PATH, nullptr, nullptr, argv.data(), environ) == 0);
     const std::filesystem::path checkpoint = killed / "training.checkpoint";
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-    while (!std::filesystem::exists(checkpoint) && std::chrono::steady_clock::now() < deadline) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    kill(pid, SIGKILL);
-    int status = 0;
-    waitpid(pid, &status, 0);
+    run_until({"reconstruct", sim + "/sino.npy", "--geometry", sim + "/geometry.json", "--steps",
+               "4000", "--quiet", "--checkpoint-minutes", "0.005", "--out", killed.string()},
+              [&] { return std::filesystem::exists(checkpoint); });
     REQUIRE(std::filesystem::exists(checkpoint));
     REQUIRE(!std::filesystem::exists(killed / "image.nii"));  // killed before the end
 
@@ -101,5 +102,38 @@ TEST_SUITE("cli") {
     CHECK(fresh.out.find("--resume: no training.checkpoint in") != std::string::npos);
     CHECK(riner::test::read_bytes(dir / "fresh" / "image.nii") ==
           riner::test::read_bytes(whole / "image.nii"));
+  }
+
+  TEST_CASE("a slabbed run killed mid-slab goes on from the slab's checkpoint") {
+    riner::test::TempDir dir;
+    const std::string sim = riner::test::simulate_small_parallel3d(dir);
+    const std::string common = "reconstruct " + sim + "/sino.npy --geometry " + sim +
+                               "/geometry.json --slab-slices 10 --steps 1500 --quiet";
+    const std::filesystem::path whole = dir / "whole", killed = dir / "killed";
+    REQUIRE(riner_cli(common + " --out " + whole.string(), dir).code == 0);
+
+    const std::filesystem::path checkpoint = killed / "slabs" / "slab_0000.checkpoint";
+    run_until({"reconstruct", sim + "/sino.npy", "--geometry", sim + "/geometry.json",
+               "--slab-slices", "10", "--steps", "1500", "--quiet", "--checkpoint-minutes", "0.003",
+               "--out", killed.string()},
+              [&] { return std::filesystem::exists(checkpoint); });
+    REQUIRE(std::filesystem::exists(checkpoint));
+    REQUIRE(!std::filesystem::exists(killed / "slabs" / "slab_0000.json"));  // mid-slab
+
+    const Run finished = riner_cli(common + " --resume --out " + killed.string(), dir);
+    REQUIRE(finished.code == 0);
+    const nlohmann::json summary =
+        nlohmann::json::parse(riner::test::read_bytes(killed / "summary.json"));
+    REQUIRE(summary["per_slab"].size() == 2);
+    const nlohmann::json first = summary["per_slab"][0]["summary"]["resumed_at_step"];
+    CAPTURE(first);
+    CHECK(first > 0);
+    CHECK(first < 1500);
+    CHECK(summary["per_slab"][1]["summary"]["resumed_at_step"].is_null());
+    CHECK(riner::read_array(killed / "volume").array.data ==
+          riner::read_array(whole / "volume").array.data);
+    CHECK(riner::test::read_bytes(killed / "alpha.npy") ==
+          riner::test::read_bytes(whole / "alpha.npy"));
+    CHECK(!std::filesystem::exists(checkpoint));
   }
 }

@@ -124,6 +124,9 @@ struct TrainingStats {
   // steps_planned x rays_per_step x the rays' mean samples inside the grid / the grid's voxels
   double samples_per_voxel_planned = 0.0;
   bool stopped_on_plateau = false;  // training.stop_on_plateau ended the run early
+  // The step training went on from (resume_from a checkpoint); 0 for a run in one go. seconds
+  // and samples count the steps before it too.
+  int resumed_at_step = 0;
   double seconds = 0.0;             // wall time inside step()/run()
   double samples = 0.0;             // field evaluations trained on (forward + backward)
   std::size_t non_finite = 0;       // measurements that were NaN/inf (treated as 0)

@@ -46,6 +46,9 @@ struct SlabOptions {
   // Processes of this machine training the run at once (MPI ranks on it, or the CLI's own
   // slab processes), each `workers` slabs: they share the memory limit, and each gets a slab.
   int processes = 1;
+  // Seconds of a slab's training between saves of its state (slabs/slab_NNNN.checkpoint,
+  // Reconstructor::save_checkpoint), from which a resumed run goes on; 0: none.
+  double checkpoint_seconds = 0.0;
 
   // memory_limit, or default_memory_limit() when it is 0.
   std::size_t limit() const { return memory_limit ? memory_limit : default_memory_limit(); }
@@ -123,6 +126,9 @@ class SlabRun {
  private:
   std::filesystem::path slab_file(const Slab& slab, const std::string& what) const;
   bool is_done(const Slab& slab) const;
+  // Its training's checkpoint (SlabOptions::checkpoint_seconds), and going on from it.
+  std::filesystem::path slab_checkpoint(const Slab& slab) const;
+  void resume_slab(Reconstructor& r, const std::filesystem::path& checkpoint) const;
   // The slab's slices, alpha, beta and preview planes, then its record.
   void write_slab(const Slab& slab, const Reconstructor& r, const Summarise& summarise,
                   const std::optional<Device>& device,
@@ -140,6 +146,7 @@ class SlabRun {
   std::size_t slices_per_slab_ = 0;
   int workers_ = 1;
   bool slices_2d_ = false;
+  double checkpoint_seconds_ = 0.0;
   std::vector<Slab> slabs_;
   nlohmann::json manifest_;
   bool join_ = false;

@@ -104,6 +104,7 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
   const SlabMemory memory{memory_limit_, device_memory_limit_,
                           device_memory_limit_ ? device_->info().max_alloc_bytes : 0};
   slices_2d_ = options.slices_2d;
+  checkpoint_seconds_ = options.checkpoint_seconds;
   if (slices_2d_) (void)axial_slice_geometry(g);  // InputError now, not in the first slab
   SlabSizing sizing = size_slabs(g, memory, wanted_workers, processes,
                                  slices_2d_ ? 1 : options.slices_per_slab);
@@ -192,6 +193,22 @@ std::filesystem::path SlabRun::slab_file(const Slab& slab, const std::string& wh
   return out_ / "slabs" / (numbered("slab_%04zu_", slab.index) + what + ".npy");
 }
 
+std::filesystem::path SlabRun::slab_checkpoint(const Slab& slab) const {
+  return out_ / "slabs" / numbered("slab_%04zu.checkpoint", slab.index);
+}
+
+void SlabRun::resume_slab(Reconstructor& r, const std::filesystem::path& checkpoint) const {
+  if (!std::filesystem::exists(checkpoint)) return;
+  // The run's settings and scan were checked against the manifest; a checkpoint that does not
+  // fit (a kill mid-write leaves the last whole one, so damage is from elsewhere) costs only
+  // the slab's training so far.
+  try {
+    r.resume_from(checkpoint);
+  } catch (const InputError& e) {
+    warn(std::string(e.what()) + ": the slab trains from the start");
+  }
+}
+
 std::filesystem::path SlabRun::slab_record(const Slab& slab) const {
   return out_ / "slabs" / numbered("slab_%04zu.json", slab.index);
 }
@@ -278,17 +295,27 @@ void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
                      scan.geometry = slab_geometry(g, slab);
                      if (slices_2d_) scan = slice_scan(scan);
                      Reconstructor r(std::move(scan), config_, device);
+                     const std::filesystem::path checkpoint = slab_checkpoint(slab);
+                     resume_slab(r, checkpoint);
                      const int steps = r.config().training.steps;
                      int reports = 0;
+                     double saved_at = r.stats().seconds;
                      r.run(
                          [&](const TrainingProgress& t) {
                            // Other processes' records, now and then (a stat per slab).
                            report(slab, worker, static_cast<double>(t.step) / std::max(1, t.total),
                                   t.step, steps, false, ++reports % 10 == 0);
+                           if (checkpoint_seconds_ > 0.0 && t.step < t.total &&
+                               t.seconds - saved_at >= checkpoint_seconds_) {
+                             r.save_checkpoint(checkpoint);
+                             saved_at = t.seconds;
+                           }
                            return true;
                          },
                          report_every);
                      write_slab(slab, r, summarise, device, slab_started);
+                     std::error_code ignored;  // the slab's record stands for it now
+                     std::filesystem::remove(checkpoint, ignored);
                      report(slab, worker, 1.0, steps, steps, true, true);
                    });
 }

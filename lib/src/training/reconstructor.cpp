@@ -26,6 +26,7 @@ struct Reconstructor::Impl {
   double samples = 0.0;
   std::vector<LossRecord> history;
   bool plateaued = false;
+  int resumed_at = 0;  // resume_from's step
   // Rays drawn so far per detector element (pixel in 3D): alpha and beta learn from these.
   std::vector<std::uint32_t> element_rays;
   // result() at `steps` training steps (it only changes with a step).
@@ -219,6 +220,7 @@ void Reconstructor::resume_from(const std::filesystem::path& path) {
   impl_->history = c.history;
   impl_->result.reset();
   impl_->result_steps = -1;
+  impl_->resumed_at = c.steps;
 }
 
 Array Reconstructor::field_image() const {
@@ -465,6 +467,7 @@ RayCoverage ray_coverage(std::vector<std::uint32_t> rays) {
 TrainingStats Reconstructor::stats() const {
   TrainingStats s;
   s.steps = impl_->steps;
+  s.resumed_at_step = impl_->resumed_at;
   s.seconds = impl_->seconds;
   s.samples = impl_->samples;
   s.non_finite = impl_->setup.scan.non_finite;
