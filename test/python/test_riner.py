@@ -234,6 +234,7 @@ def test_a_run_stopped_goes_on_from_its_checkpoint_to_the_same_result(fan_scan, 
         riner.reconstruct(sim["sino"], g, steps=400, quality=False, checkpoint=checkpoint)
     resumed = riner.reconstruct(sim["sino"], g, steps=500, quality=False, checkpoint=checkpoint)
     assert resumed.summary["steps"] == 500
+    assert resumed.summary["resumed_at_step"] == 250  # the last check before the abort
     np.testing.assert_array_equal(resumed.image, whole.image)
     np.testing.assert_array_equal(resumed.alpha, whole.alpha)
     assert not checkpoint.exists()  # training finished: the result stands for it
