@@ -131,7 +131,9 @@ class OpenclTrainer final : public Trainer {
     const std::vector<float> m = in.get_array<float>();
     const std::vector<float> v = in.get_array<float>();
     const std::vector<float> tail = in.get_array<float>();
-    if (params.size() != params_.size() || tail.size() != (tail_sum_ ? tail_sum_->size() : 0)) {
+    // Every size checked before anything is written: a refused state leaves the trainer as it was.
+    if (params.size() != params_.size() || m.size() != params.size() ||
+        v.size() != params.size() || tail.size() != (tail_sum_ ? tail_sum_->size() : 0)) {
       throw InputError("training state: not this model's parameters");
     }
     params_.write(params);

@@ -200,7 +200,7 @@ void Reconstructor::resume_from(const std::filesystem::path& path) {
     throw InputError(what + "a checkpoint of another scan (other readings or geometry)");
   }
   if (c.settings_fingerprint != detail::fingerprint(impl_->setup.config.to_json())) {
-    throw InputError(what + "a checkpoint of other settings (config.json beside it has them)");
+    throw InputError(what + "a checkpoint of other settings (steps, seed, --set, ... differ)");
   }
   if (c.device != impl_->trainer->device_name()) {
     throw InputError(what + "a checkpoint of training on " + c.device +

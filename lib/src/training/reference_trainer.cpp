@@ -77,13 +77,17 @@ class ReferenceTrainer final : public Trainer {
   }
 
   void restore_state(ByteReader& in, int steps) override {
-    for (std::vector<double>* v : {&params_, &m_, &v_, &tail_sum_}) {
-      std::vector<double> values = in.get_array<double>();
-      if (values.size() != v->size()) {
+    // Every part read and checked before any is taken: a refused state leaves the trainer as
+    // it was.
+    std::vector<std::vector<double>*> parts = {&params_, &m_, &v_, &tail_sum_};
+    std::vector<std::vector<double>> values;
+    for (std::vector<double>* part : parts) {
+      values.push_back(in.get_array<double>());
+      if (values.back().size() != part->size()) {
         throw InputError("training state: not this model's parameters");
       }
-      *v = std::move(values);
     }
+    for (std::size_t i = 0; i < parts.size(); ++i) *parts[i] = std::move(values[i]);
     losses_.clear();
     steps_ = steps;
   }
