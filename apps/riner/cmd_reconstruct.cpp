@@ -19,6 +19,7 @@
 #include "riner/scan.hpp"
 #include "riner/slab_ranks.hpp"
 #include "scan_options.hpp"
+#include "stop_signal.hpp"
 #include "summary_json.hpp"
 
 namespace riner::app {
@@ -187,6 +188,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   const double checkpoint_every = checkpoint_seconds(args);
   const std::filesystem::path checkpoint = out / kCheckpointName;
   refuse_unfinished(args, checkpoint);
+  if (checkpoint_every > 0.0) catch_stop_signals();
   Reconstructor reconstructor(std::move(scan), config, device);
   resume_training(args, console, reconstructor, checkpoint);
   {
@@ -264,15 +266,22 @@ int run_reconstruct(int argc, char** argv, int first) {
           char status[64];
           std::snprintf(status, sizeof(status), "loss %.4g", p.loss);
           progress.update(static_cast<std::size_t>(p.step), status);
+          const bool stopping = p.step < p.total && stop_signal() != 0;
           if (checkpoint_every > 0.0 && p.step < p.total &&
-              p.seconds - saved_at >= checkpoint_every) {
+              (stopping || p.seconds - saved_at >= checkpoint_every)) {
             reconstructor.save_checkpoint(checkpoint);
             saved_at = p.seconds;
           }
-          return true;
+          return !stopping;
         },
         static_cast<int>(args.integer("report-every")));
     progress.finish();
+  }
+  release_stop_signals();
+  if (reconstructor.steps_done() < reconstructor.config().training.steps && stop_signal() != 0) {
+    return stopped_by_signal(std::to_string(reconstructor.steps_done()) + " of " +
+                             std::to_string(reconstructor.config().training.steps) +
+                             " steps trained, " + checkpoint.string() + " saved");
   }
 
   const Geometry& g = reconstructor.scan().geometry;

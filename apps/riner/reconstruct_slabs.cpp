@@ -15,6 +15,7 @@
 #include "riner/volume_writer.hpp"
 #include "scan_options.hpp"
 #include "slab_processes.hpp"
+#include "stop_signal.hpp"
 #include "summary_json.hpp"
 
 namespace riner::app {
@@ -198,6 +199,10 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   }
   SlabOptions options = slab_options(args);
   options.checkpoint_seconds = checkpoint_seconds(args);
+  if (options.checkpoint_seconds > 0.0) {
+    catch_stop_signals();
+    options.stop = [] { return stop_signal() != 0; };
+  }
   const int requested = requested_processes(args);
   const SlabRanks ranks;
   // A process riner started to share this run (slab_processes.hpp) joins like an MPI rank.
@@ -331,6 +336,10 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
                              pinned);
         copies_pinned = copies.pinned();
         while (copies.running()) {
+          if (stop_signal() != 0) {
+            copies.stop();  // each saves its slab's checkpoint and ends
+            break;
+          }
           std::this_thread::sleep_for(std::chrono::milliseconds(500));
           const double done = run.slices_recorded(&slabs);
           const double seconds = std::chrono::duration<double>(
@@ -369,7 +378,17 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
     std::fprintf(stderr, "riner: error: rank %d: %s\n", ranks.rank(), e.what());
     ranks.abort(1);  // the other ranks would wait for this one forever
   }
-  ranks.all_ok(true);  // every rank's slabs are written
+  ranks.all_ok(true);  // every rank's slabs are written, or its checkpoints on a stop
+  release_stop_signals();
+  if (stop_signal() != 0 && run.slabs_done() < run.slabs().size()) {
+    if (!leader) return 128 + stop_signal();
+    std::size_t done = 0;
+    run.slices_recorded(&done);
+    return stopped_by_signal(std::to_string(done) + " of " +
+                             std::to_string(run.slabs().size()) +
+                             " slabs written, the checkpoints of those in training in " +
+                             (out / "slabs").string());
+  }
   const double training_wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - training_started).count();
   if (!leader) return 0;

@@ -7,6 +7,8 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
+#include <thread>
 #include <fstream>
 #include <iterator>
 
@@ -112,6 +114,18 @@ void SlabProcesses::stop_all() {
   children_.clear();
 }
 
+void SlabProcesses::stop(double grace) {
+  const auto deadline =
+      std::chrono::steady_clock::now() + std::chrono::duration<double>(grace);
+  while (!children_.empty() && std::chrono::steady_clock::now() < deadline) {
+    std::erase_if(children_, [](pid_t pid) { return waitpid(pid, nullptr, WNOHANG) != 0; });
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  for (pid_t pid : children_) kill(pid, SIGTERM);
+  for (pid_t pid : children_) waitpid(pid, nullptr, 0);
+  children_.clear();
+}
+
 bool SlabProcesses::running() {
   for (std::size_t i = 0; i < children_.size();) {
     int status = 0;
@@ -121,7 +135,10 @@ bool SlabProcesses::running() {
       continue;
     }
     children_.erase(children_.begin() + static_cast<std::ptrdiff_t>(i));
-    const bool ok = done > 0 && WIFEXITED(status) && WEXITSTATUS(status) == 0;
+    // A copy stopped by SIGTERM or SIGINT has saved its slab's checkpoint (stop_signal.hpp):
+    // not a failure, and the others must not be killed mid-save.
+    const int code = done > 0 && WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    const bool ok = code == 0 || code == 128 + SIGTERM || code == 128 + SIGINT;
     if (!ok && failure_.empty()) {
       failure_ = WIFSIGNALED(status)
                      ? "a slab process was killed (signal " + std::to_string(WTERMSIG(status)) + ")"

@@ -136,4 +136,57 @@ TEST_SUITE("cli") {
           riner::test::read_bytes(whole / "alpha.npy"));
     CHECK(!std::filesystem::exists(checkpoint));
   }
+
+  TEST_CASE("SIGTERM mid-training saves the checkpoint and exits 143; --resume goes on from it") {
+    riner::test::TempDir dir;
+    const std::string sim = riner::test::simulate_geometry(dir, "g2.json", R"({"type": "parallel2d",
+        "detector": {"count": 70, "pitch_mm": 1.0},
+        "angles": {"count": 90, "range_rad": 3.141592653589793},
+        "volume": {"shape": [64, 64], "voxel_mm": 1.0}})",
+                                                           "--seed 5");
+    const std::string common = "reconstruct " + sim + "/sino.npy --geometry " + sim +
+                               "/geometry.json --steps 5000 --quiet";
+    const std::filesystem::path whole = dir / "whole", stopped = dir / "stopped";
+    REQUIRE(riner_cli(common + " --out " + whole.string(), dir).code == 0);
+
+    // SIGTERM once training is under way (its first periodic checkpoint is there).
+    std::vector<std::string> words = {RINER_CLI_PATH,
+                                      "reconstruct",
+                                      sim + "/sino.npy",
+                                      "--geometry",
+                                      sim + "/geometry.json",
+                                      "--steps",
+                                      "5000",
+                                      "--quiet",
+                                      "--checkpoint-minutes",
+                                      "0.002",
+                                      "--out",
+                                      stopped.string()};
+    std::vector<char*> argv;
+    for (std::string& w : words) argv.push_back(w.data());
+    argv.push_back(nullptr);
+    pid_t pid = 0;
+    REQUIRE(posix_spawn(&pid, RINER_CLI_PATH, nullptr, nullptr, argv.data(), environ) == 0);
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+    while (!std::filesystem::exists(stopped / "training.checkpoint") &&
+           std::chrono::steady_clock::now() < deadline) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    kill(pid, SIGTERM);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    REQUIRE(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 128 + SIGTERM);
+    REQUIRE(std::filesystem::exists(stopped / "training.checkpoint"));
+    CHECK(!std::filesystem::exists(stopped / "image.nii"));
+
+    const Run finished = riner_cli(common + " --resume --out " + stopped.string(), dir);
+    REQUIRE(finished.code == 0);
+    const nlohmann::json summary =
+        nlohmann::json::parse(riner::test::read_bytes(stopped / "summary.json"));
+    CAPTURE(summary["resumed_at_step"]);
+    CHECK(summary["resumed_at_step"] > 0);
+    CHECK(riner::test::read_bytes(stopped / "image.nii") ==
+          riner::test::read_bytes(whole / "image.nii"));
+  }
 }

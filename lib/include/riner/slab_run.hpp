@@ -49,6 +49,10 @@ struct SlabOptions {
   // Seconds of a slab's training between saves of its state (slabs/slab_NNNN.checkpoint,
   // Reconstructor::save_checkpoint), from which a resumed run goes on; 0: none.
   double checkpoint_seconds = 0.0;
+  // Asked between a slab's steps and before each slab: true saves the checkpoint of every slab
+  // in training (with checkpoint_seconds > 0) and ends run() without writing them (a signal
+  // to stop, say); empty: never.
+  std::function<bool()> stop;
 
   // memory_limit, or default_memory_limit() when it is 0.
   std::size_t limit() const { return memory_limit ? memory_limit : default_memory_limit(); }
@@ -126,6 +130,7 @@ class SlabRun {
  private:
   std::filesystem::path slab_file(const Slab& slab, const std::string& what) const;
   bool is_done(const Slab& slab) const;
+  bool stopping() const;  // SlabOptions::stop
   // Its training's checkpoint (SlabOptions::checkpoint_seconds), and going on from it.
   std::filesystem::path slab_checkpoint(const Slab& slab) const;
   void resume_slab(Reconstructor& r, const std::filesystem::path& checkpoint) const;
@@ -147,6 +152,7 @@ class SlabRun {
   int workers_ = 1;
   bool slices_2d_ = false;
   double checkpoint_seconds_ = 0.0;
+  std::function<bool()> stop_;
   std::vector<Slab> slabs_;
   nlohmann::json manifest_;
   bool join_ = false;

@@ -105,6 +105,7 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
                           device_memory_limit_ ? device_->info().max_alloc_bytes : 0};
   slices_2d_ = options.slices_2d;
   checkpoint_seconds_ = options.checkpoint_seconds;
+  stop_ = options.stop;
   if (slices_2d_) (void)axial_slice_geometry(g);  // InputError now, not in the first slab
   SlabSizing sizing = size_slabs(g, memory, wanted_workers, processes,
                                  slices_2d_ ? 1 : options.slices_per_slab);
@@ -192,6 +193,8 @@ std::filesystem::path SlabRun::slice_path(std::size_t slice) const {
 std::filesystem::path SlabRun::slab_file(const Slab& slab, const std::string& what) const {
   return out_ / "slabs" / (numbered("slab_%04zu_", slab.index) + what + ".npy");
 }
+
+bool SlabRun::stopping() const { return stop_ && stop_(); }
 
 std::filesystem::path SlabRun::slab_checkpoint(const Slab& slab) const {
   return out_ / "slabs" / numbered("slab_%04zu.checkpoint", slab.index);
@@ -285,6 +288,7 @@ void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
   run_concurrently(pending.size(), workers_, device_,
                    [&](std::size_t index, int worker, const std::optional<Device>& device) {
                      const Slab& slab = *pending[index];
+                     if (stopping()) return;
                      if (claim && !claim(slab)) return;
                      const auto slab_started = std::chrono::steady_clock::now();
                      Scan scan;
@@ -300,19 +304,22 @@ void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
                      const int steps = r.config().training.steps;
                      int reports = 0;
                      double saved_at = r.stats().seconds;
+                     bool stopped = false;
                      r.run(
                          [&](const TrainingProgress& t) {
                            // Other processes' records, now and then (a stat per slab).
                            report(slab, worker, static_cast<double>(t.step) / std::max(1, t.total),
                                   t.step, steps, false, ++reports % 10 == 0);
+                           stopped = t.step < t.total && stopping();
                            if (checkpoint_seconds_ > 0.0 && t.step < t.total &&
-                               t.seconds - saved_at >= checkpoint_seconds_) {
+                               (stopped || t.seconds - saved_at >= checkpoint_seconds_)) {
                              r.save_checkpoint(checkpoint);
                              saved_at = t.seconds;
                            }
-                           return true;
+                           return !stopped;
                          },
                          report_every);
+                     if (stopped) return;  // its checkpoint, not a half-trained slab
                      write_slab(slab, r, summarise, device, slab_started);
                      std::error_code ignored;  // the slab's record stands for it now
                      std::filesystem::remove(checkpoint, ignored);
