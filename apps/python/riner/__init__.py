@@ -274,8 +274,9 @@ def reconstruct(sino, geometry, flat=None, dark=None, center=None, config=None, 
     returning False stops training early. quality: the no-reference quality report against
     FBP in the summary. Ctrl-C stops training and raises KeyboardInterrupt.
     checkpoint: a file where training's state is saved every checkpoint_minutes minutes of
-    training; when it exists, training goes on from it (the same scan, settings and device: the
-    uninterrupted run's result to the bit), and it is removed once training has finished.
+    training and where it stops early (Ctrl-C, the callback); when it exists, training goes on
+    from it (the same scan, settings and device: the uninterrupted run's result to the bit), and
+    it is removed once training has finished.
     """
     sino, geometry_json, notes = _scan(sino, geometry, flat, dark, center, flat_after)
     if config is None:

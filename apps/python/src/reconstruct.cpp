@@ -108,13 +108,14 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
     double saved_at = reconstructor->stats().seconds;
     reconstructor->run(
         [&](const TrainingProgress& p) {
-          if (!relay(p)) return false;
+          // Stopped (Ctrl-C, the callback's False or its exception): saved there too.
+          const bool go_on = relay(p);
           if (!checkpoint.empty() && p.step < p.total &&
-              p.seconds - saved_at >= 60.0 * checkpoint_minutes) {
+              (!go_on || p.seconds - saved_at >= 60.0 * checkpoint_minutes)) {
             reconstructor->save_checkpoint(checkpoint);
             saved_at = p.seconds;
           }
-          return true;
+          return go_on;
         },
         std::min(kCheckEvery, progress_every));
   }
