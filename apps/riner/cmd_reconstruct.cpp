@@ -191,6 +191,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   if (checkpoint_every > 0.0) catch_stop_signals();
   Reconstructor reconstructor(std::move(scan), config, device);
   resume_training(args, console, reconstructor, checkpoint);
+  CheckpointSaver saver(reconstructor, checkpoint, checkpoint_every);
   {
     const TrainingStats setup = reconstructor.stats();
     if (setup.plan) console.line(setup.plan->describe());
@@ -260,18 +261,13 @@ int run_reconstruct(int argc, char** argv, int first) {
     Progress progress("reconstruct",
                       static_cast<std::size_t>(reconstructor.config().training.steps),
                       console.quiet());
-    double saved_at = reconstructor.stats().seconds;
     reconstructor.run(
         [&](const TrainingProgress& p) {
           char status[64];
           std::snprintf(status, sizeof(status), "loss %.4g", p.loss);
           progress.update(static_cast<std::size_t>(p.step), status);
           const bool stopping = p.step < p.total && stop_signal() != 0;
-          if (checkpoint_every > 0.0 && p.step < p.total &&
-              (stopping || p.seconds - saved_at >= checkpoint_every)) {
-            reconstructor.save_checkpoint(checkpoint);
-            saved_at = p.seconds;
-          }
+          saver.after_report(p, stopping);
           return !stopping;
         },
         static_cast<int>(args.integer("report-every")));
@@ -309,8 +305,7 @@ int run_reconstruct(int argc, char** argv, int first) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   summary["wall_seconds"] = wall;  // "seconds" is the training's, before a resume included
   write_text(out / "summary.json", summary.dump(1) + "\n");
-  std::error_code ignored;  // the run is done: its outputs stand in for the checkpoint
-  std::filesystem::remove(checkpoint, ignored);
+  saver.discard();  // the run is done: its outputs stand in for the checkpoint
   console.line("reconstructed " + shape_string(image.shape) + " in " + format_duration(wall) +
                " (training " + format_duration(stats.seconds) + "; " + std::to_string(stats.steps) +
                " steps, " + std::to_string(dead.size()) + " elements flagged dead) -> " +

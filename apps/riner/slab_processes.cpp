@@ -8,9 +8,9 @@
 
 #include <algorithm>
 #include <chrono>
-#include <thread>
 #include <fstream>
 #include <iterator>
+#include <thread>
 
 #include "riner/cores.hpp"
 #include "riner/error.hpp"
@@ -108,8 +108,10 @@ SlabProcesses::SlabProcesses(int count, int threads, const std::vector<std::stri
 
 SlabProcesses::~SlabProcesses() { stop_all(); }
 
-void SlabProcesses::stop_all() {
-  for (pid_t pid : children_) kill(pid, SIGKILL);
+void SlabProcesses::stop_all() { signal_and_wait(SIGKILL); }
+
+void SlabProcesses::signal_and_wait(int sig) {
+  for (pid_t pid : children_) kill(pid, sig);
   for (pid_t pid : children_) waitpid(pid, nullptr, 0);
   children_.clear();
 }
@@ -121,9 +123,7 @@ void SlabProcesses::stop(double grace) {
     std::erase_if(children_, [](pid_t pid) { return waitpid(pid, nullptr, WNOHANG) != 0; });
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
-  for (pid_t pid : children_) kill(pid, SIGTERM);
-  for (pid_t pid : children_) waitpid(pid, nullptr, 0);
-  children_.clear();
+  signal_and_wait(SIGTERM);
 }
 
 bool SlabProcesses::running() {

@@ -38,6 +38,7 @@ class SlabProcesses {
 
  private:
   void stop_all();
+  void signal_and_wait(int sig);  // to every child still running
   std::vector<pid_t> children_;
   std::string failure_;
   bool pinned_ = false;

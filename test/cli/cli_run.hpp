@@ -4,13 +4,21 @@
 
 #include <doctest/doctest.h>
 
+#include <signal.h>
+#include <spawn.h>
 #include <sys/wait.h>
 
 #include <array>
+#include <chrono>
 #include <cstdio>
+#include <functional>
 #include <string>
+#include <thread>
+#include <vector>
 
 #include "support/fixture.hpp"
+
+extern char** environ;
 
 namespace riner::test {
 
@@ -36,6 +44,26 @@ inline Run riner_cli(const std::string& arguments, const TempDir& dir) {
   return run;
 }
 
+// RINER_CLI_PATH WORDS... started and sent `sig` once `until` is true (or after 120 s); the
+// process's wait status.
+inline int run_until(std::vector<std::string> words, const std::function<bool()>& until,
+                     int sig = SIGKILL) {
+  words.insert(words.begin(), RINER_CLI_PATH);
+  std::vector<char*> argv;
+  for (std::string& w : words) argv.push_back(w.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  REQUIRE(posix_spawn(&pid, RINER_CLI_PATH, nullptr, nullptr, argv.data(), environ) == 0);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  while (!until() && std::chrono::steady_clock::now() < deadline) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  kill(pid, sig);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return status;
+}
+
 // `geometry_json` written as dir/geometry_file and `riner simulate --quiet OPTIONS` of it into
 // dir/sim; returns dir/sim.
 inline std::string simulate_geometry(const TempDir& dir, const std::string& geometry_file,
@@ -47,6 +75,16 @@ inline std::string simulate_geometry(const TempDir& dir, const std::string& geom
                     dir)
               .code == 0);
   return sim;
+}
+
+// A small parallel-beam slice (90 views over 180 degrees, 70 elements, a 64 x 64 grid)
+// simulated into dir/sim with `seed`, its geometry in dir/g2.json; returns dir/sim.
+inline std::string simulate_small_parallel2d(const TempDir& dir, int seed) {
+  return simulate_geometry(dir, "g2.json", R"({"type": "parallel2d",
+      "detector": {"count": 70, "pitch_mm": 1.0},
+      "angles": {"count": 90, "range_rad": 3.141592653589793},
+      "volume": {"shape": [64, 64], "voxel_mm": 1.0}})",
+                           "--seed " + std::to_string(seed));
 }
 
 // A small parallel-beam stack (36 views, 30 x 20 detector, 20 x 24 x 24 volume) simulated into

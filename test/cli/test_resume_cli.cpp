@@ -3,56 +3,24 @@
 // checkpoint is never overwritten unasked, nor taken up by other settings.
 #include <doctest/doctest.h>
 
-#include <signal.h>
-#include <spawn.h>
 #include <sys/wait.h>
-#include <unistd.h>
 
-#include <chrono>
-#include <functional>
 #include <nlohmann/json.hpp>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "cli/cli_run.hpp"
 #include "riner/io.hpp"
 #include "support/fixture.hpp"
 
-extern char** environ;
-
 using riner::test::riner_cli;
 using riner::test::Run;
-
-namespace {
-
-// RINER_CLI_PATH WORDS... started, and killed with SIGKILL once `until` is true (or after 120 s).
-void run_until(std::vector<std::string> words, const std::function<bool()>& until) {
-  words.insert(words.begin(), RINER_CLI_PATH);
-  std::vector<char*> argv;
-  for (std::string& w : words) argv.push_back(w.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  REQUIRE(posix_spawn(&pid, RINER_CLI_PATH, nullptr, nullptr, argv.data(), environ) == 0);
-  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-  while (!until() && std::chrono::steady_clock::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
-  }
-  kill(pid, SIGKILL);
-  int status = 0;
-  waitpid(pid, &status, 0);
-}
-
-}  // namespace
+using riner::test::run_until;
 
 TEST_SUITE("cli") {
   TEST_CASE("a slice's training killed mid-way and resumed from its checkpoint equals one run") {
     riner::test::TempDir dir;
-    const std::string sim = riner::test::simulate_geometry(dir, "g2.json", R"({"type": "parallel2d",
-        "detector": {"count": 70, "pitch_mm": 1.0},
-        "angles": {"count": 90, "range_rad": 3.141592653589793},
-        "volume": {"shape": [64, 64], "voxel_mm": 1.0}})",
-                                                           "--seed 4");
+    const std::string sim = riner::test::simulate_small_parallel2d(dir, 4);
     const std::string common = "reconstruct " + sim + "/sino.npy --geometry " + sim +
                                "/geometry.json --steps 4000 --quiet";
     const std::filesystem::path whole = dir / "whole", killed = dir / "killed";
@@ -139,42 +107,17 @@ TEST_SUITE("cli") {
 
   TEST_CASE("SIGTERM mid-training saves the checkpoint and exits 143; --resume goes on from it") {
     riner::test::TempDir dir;
-    const std::string sim = riner::test::simulate_geometry(dir, "g2.json", R"({"type": "parallel2d",
-        "detector": {"count": 70, "pitch_mm": 1.0},
-        "angles": {"count": 90, "range_rad": 3.141592653589793},
-        "volume": {"shape": [64, 64], "voxel_mm": 1.0}})",
-                                                           "--seed 5");
+    const std::string sim = riner::test::simulate_small_parallel2d(dir, 5);
     const std::string common = "reconstruct " + sim + "/sino.npy --geometry " + sim +
                                "/geometry.json --steps 5000 --quiet";
     const std::filesystem::path whole = dir / "whole", stopped = dir / "stopped";
     REQUIRE(riner_cli(common + " --out " + whole.string(), dir).code == 0);
 
     // SIGTERM once training is under way (its first periodic checkpoint is there).
-    std::vector<std::string> words = {RINER_CLI_PATH,
-                                      "reconstruct",
-                                      sim + "/sino.npy",
-                                      "--geometry",
-                                      sim + "/geometry.json",
-                                      "--steps",
-                                      "5000",
-                                      "--quiet",
-                                      "--checkpoint-minutes",
-                                      "0.002",
-                                      "--out",
-                                      stopped.string()};
-    std::vector<char*> argv;
-    for (std::string& w : words) argv.push_back(w.data());
-    argv.push_back(nullptr);
-    pid_t pid = 0;
-    REQUIRE(posix_spawn(&pid, RINER_CLI_PATH, nullptr, nullptr, argv.data(), environ) == 0);
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-    while (!std::filesystem::exists(stopped / "training.checkpoint") &&
-           std::chrono::steady_clock::now() < deadline) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    kill(pid, SIGTERM);
-    int status = 0;
-    waitpid(pid, &status, 0);
+    const int status = run_until(
+        {"reconstruct", sim + "/sino.npy", "--geometry", sim + "/geometry.json", "--steps", "5000",
+         "--quiet", "--checkpoint-minutes", "0.002", "--out", stopped.string()},
+        [&] { return std::filesystem::exists(stopped / "training.checkpoint"); }, SIGTERM);
     REQUIRE(WIFEXITED(status));
     CHECK(WEXITSTATUS(status) == 128 + SIGTERM);
     REQUIRE(std::filesystem::exists(stopped / "training.checkpoint"));

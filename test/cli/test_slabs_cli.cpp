@@ -2,8 +2,6 @@
 // one, slice for slice and bit for bit; the output folder is never taken over unasked.
 #include <doctest/doctest.h>
 
-#include <signal.h>
-#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -21,8 +19,6 @@
 #include "riner/io.hpp"
 #include "riner/metrics.hpp"
 #include "support/fixture.hpp"
-
-extern char** environ;
 
 namespace {
 
@@ -111,23 +107,9 @@ TEST_SUITE("cli") {
     CHECK(gathered.data == slices.data);
 
     // The same run, killed as soon as its first slab is written.
-    std::vector<std::string> words = {RINER_CLI_PATH, "reconstruct",  scan,
-                                      "--slab-slices", "4",           "--steps",
-                                      "600",           "--quiet",     "--out",
-                                      killed.string()};
-    std::vector<char*> argv;
-    for (std::string& w : words) argv.push_back(w.data());
-    argv.push_back(nullptr);
-    pid_t pid = 0;
-    REQUIRE(posix_spawn(&pid, RINER_CLI_PATH, nullptr, nullptr, argv.data(), environ) == 0);
-    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
-    while (slabs_done(killed) == 0 &&
-           std::chrono::steady_clock::now() < deadline) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-    }
-    kill(pid, SIGKILL);
-    int status = 0;
-    waitpid(pid, &status, 0);
+    riner::test::run_until({"reconstruct", scan, "--slab-slices", "4", "--steps", "600", "--quiet",
+                            "--out", killed.string()},
+                           [&] { return slabs_done(killed) > 0; });
     const std::size_t done = slabs_done(killed);
     CAPTURE(done);
     REQUIRE(done >= 1);

@@ -103,18 +103,16 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
   // not to stall a GPU (each check drains the queue).
   constexpr int kCheckEvery = 50;
   ProgressRelay relay(progress, progress_every);
+  // No file named: no checkpoint (seconds 0).
+  CheckpointSaver saver(*reconstructor, checkpoint,
+                        checkpoint.empty() ? 0.0 : 60.0 * checkpoint_minutes);
   {
     py::gil_scoped_release release;
-    double saved_at = reconstructor->stats().seconds;
     reconstructor->run(
         [&](const TrainingProgress& p) {
           // Stopped (Ctrl-C, the callback's False or its exception): saved there too.
           const bool go_on = relay(p);
-          if (!checkpoint.empty() && p.step < p.total &&
-              (!go_on || p.seconds - saved_at >= 60.0 * checkpoint_minutes)) {
-            reconstructor->save_checkpoint(checkpoint);
-            saved_at = p.seconds;
-          }
+          saver.after_report(p, !go_on);
           return go_on;
         },
         std::min(kCheckEvery, progress_every));
@@ -136,8 +134,7 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
   }
   const TrainingStats done = reconstructor->stats();
   if (!checkpoint.empty() && (done.steps >= done.steps_planned || done.stopped_on_plateau)) {
-    std::error_code ignored;  // training is done: the result stands for the checkpoint
-    std::filesystem::remove(checkpoint, ignored);
+    saver.discard();  // training is done: the result stands for the checkpoint
   }
   py::object alpha_by_view = py::none();
   if (result.alpha_by_view.size() > 0) alpha_by_view = to_numpy(std::move(result.alpha_by_view));

@@ -252,4 +252,22 @@ class Reconstructor {
   std::unique_ptr<Impl> impl_;
 };
 
+// A run's checkpoints (Reconstructor::save_checkpoint) as the CLI, the slabs and Python take
+// them: call after_report() from run()'s callback; it saves every `seconds` of training and
+// where training stops early, and never when `seconds` is 0. discard() removes the file once
+// the run's outputs stand for it.
+class CheckpointSaver {
+ public:
+  CheckpointSaver(Reconstructor& reconstructor, std::filesystem::path path, double seconds);
+  // `stopping`: training ends at this report (a signal, the caller's choice).
+  void after_report(const TrainingProgress& progress, bool stopping);
+  void discard() const;
+
+ private:
+  Reconstructor& reconstructor_;
+  std::filesystem::path path_;
+  double seconds_;
+  double saved_at_;  // training seconds at the last save (or at the start)
+};
+
 }  // namespace riner

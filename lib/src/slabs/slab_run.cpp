@@ -303,7 +303,7 @@ void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
                      resume_slab(r, checkpoint);
                      const int steps = r.config().training.steps;
                      int reports = 0;
-                     double saved_at = r.stats().seconds;
+                     CheckpointSaver saver(r, checkpoint, checkpoint_seconds_);
                      bool stopped = false;
                      r.run(
                          [&](const TrainingProgress& t) {
@@ -311,18 +311,13 @@ void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
                            report(slab, worker, static_cast<double>(t.step) / std::max(1, t.total),
                                   t.step, steps, false, ++reports % 10 == 0);
                            stopped = t.step < t.total && stopping();
-                           if (checkpoint_seconds_ > 0.0 && t.step < t.total &&
-                               (stopped || t.seconds - saved_at >= checkpoint_seconds_)) {
-                             r.save_checkpoint(checkpoint);
-                             saved_at = t.seconds;
-                           }
+                           saver.after_report(t, stopped);
                            return !stopped;
                          },
                          report_every);
                      if (stopped) return;  // its checkpoint, not a half-trained slab
                      write_slab(slab, r, summarise, device, slab_started);
-                     std::error_code ignored;  // the slab's record stands for it now
-                     std::filesystem::remove(checkpoint, ignored);
+                     saver.discard();  // the slab's record stands for it now
                      report(slab, worker, 1.0, steps, steps, true, true);
                    });
 }

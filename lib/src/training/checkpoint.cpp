@@ -3,6 +3,8 @@
 #include <fstream>
 #include <iterator>
 #include <span>
+#include <system_error>
+#include <utility>
 
 #include "riner/error.hpp"
 #include "riner/io.hpp"
@@ -79,3 +81,26 @@ TrainingCheckpoint read_checkpoint(const std::filesystem::path& path) {
 }
 
 }  // namespace riner::detail
+
+namespace riner {
+
+CheckpointSaver::CheckpointSaver(Reconstructor& reconstructor, std::filesystem::path path,
+                                 double seconds)
+    : reconstructor_(reconstructor),
+      path_(std::move(path)),
+      seconds_(seconds),
+      saved_at_(reconstructor.stats().seconds) {}
+
+void CheckpointSaver::after_report(const TrainingProgress& p, bool stopping) {
+  if (seconds_ <= 0.0 || p.step >= p.total) return;
+  if (!stopping && p.seconds - saved_at_ < seconds_) return;
+  reconstructor_.save_checkpoint(path_);
+  saved_at_ = p.seconds;
+}
+
+void CheckpointSaver::discard() const {
+  std::error_code ignored;  // a file already gone is what was wanted
+  std::filesystem::remove(path_, ignored);
+}
+
+}  // namespace riner

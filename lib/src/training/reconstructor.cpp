@@ -27,6 +27,8 @@ struct Reconstructor::Impl {
   std::vector<LossRecord> history;
   bool plateaued = false;
   int resumed_at = 0;  // resume_from's step
+  // The scan's and the settings' checkpoint fingerprints, computed at the first save or resume.
+  std::optional<std::pair<std::uint64_t, std::uint64_t>> fingerprints;
   // Rays drawn so far per detector element (pixel in 3D): alpha and beta learn from these.
   std::vector<std::uint32_t> element_rays;
   // result() at `steps` training steps (it only changes with a step).
@@ -166,20 +168,24 @@ int Reconstructor::steps_done() const { return impl_->steps; }
 
 namespace {
 
-std::uint64_t scan_fingerprint(const Scan& scan) {
-  const std::vector<float>& m = scan.measurement.data;
-  return detail::fingerprint(
-      scan.geometry.to_json(),
-      detail::fingerprint({reinterpret_cast<const char*>(m.data()), m.size() * sizeof(float)}));
+// The run a checkpoint belongs to: the scan's fingerprint (readings and geometry) and the
+// settings'; Impl keeps them after the first use, since neither changes between saves.
+std::pair<std::uint64_t, std::uint64_t> run_fingerprints(const detail::TrainingSetup& setup) {
+  const std::vector<float>& m = setup.scan.measurement.data;
+  return {detail::fingerprint(setup.scan.geometry.to_json(),
+                              detail::fingerprint({reinterpret_cast<const char*>(m.data()),
+                                                   m.size() * sizeof(float)})),
+          detail::fingerprint(setup.config.to_json())};
 }
 
 }  // namespace
 
 void Reconstructor::save_checkpoint(const std::filesystem::path& path) {
   impl_->drain();
+  if (!impl_->fingerprints) impl_->fingerprints = run_fingerprints(impl_->setup);
   detail::TrainingCheckpoint c;
-  c.scan_fingerprint = scan_fingerprint(impl_->setup.scan);
-  c.settings_fingerprint = detail::fingerprint(impl_->setup.config.to_json());
+  c.scan_fingerprint = impl_->fingerprints->first;
+  c.settings_fingerprint = impl_->fingerprints->second;
   c.device = impl_->trainer->device_name();
   c.steps = impl_->steps;
   c.seconds = impl_->seconds;
@@ -196,18 +202,18 @@ void Reconstructor::save_checkpoint(const std::filesystem::path& path) {
 void Reconstructor::resume_from(const std::filesystem::path& path) {
   const detail::TrainingCheckpoint c = detail::read_checkpoint(path);
   const std::string what = path.string() + ": ";
-  if (c.scan_fingerprint != scan_fingerprint(impl_->setup.scan)) {
+  if (!impl_->fingerprints) impl_->fingerprints = run_fingerprints(impl_->setup);
+  if (c.scan_fingerprint != impl_->fingerprints->first) {
     throw InputError(what + "a checkpoint of another scan (other readings or geometry)");
   }
-  if (c.settings_fingerprint != detail::fingerprint(impl_->setup.config.to_json())) {
+  if (c.settings_fingerprint != impl_->fingerprints->second) {
     throw InputError(what + "a checkpoint of other settings (steps, seed, --set, ... differ)");
   }
   if (c.device != impl_->trainer->device_name()) {
     throw InputError(what + "a checkpoint of training on " + c.device +
                      ": resume it there (this run is on " + impl_->trainer->device_name() + ")");
   }
-  if (c.element_rays.size() != impl_->element_rays.size() ||
-      c.history.size() > static_cast<std::size_t>(c.steps)) {
+  if (c.element_rays.size() != impl_->element_rays.size()) {
     throw InputError(what + "truncated or corrupt");
   }
   detail::ByteReader state(c.trainer_state, path.string());
