@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "riner/error.hpp"
 #include "riner/version.hpp"
+#include "stop_signal.hpp"
 
 namespace {
 
@@ -68,6 +69,7 @@ int main(int argc, char** argv) {
   if (command == nullptr) {
     return fail(2, std::string("unknown command '") + argv[1] + "' (see riner --help)");
   }
+  riner::app::end_cleanly_on_signals();
   try {
     return command->run(argc, argv, 2);
   } catch (const riner::app::UsageError& e) {

@@ -5,30 +5,54 @@
 #include <csignal>
 #include <cstdio>
 
+#include "riner/io.hpp"
+
 namespace riner::app {
 
 namespace {
 
 volatile std::sig_atomic_t requested = 0;
 
+// Only async-signal-safe calls: unlink (in remove_unfinished_outputs), sigaction, raise.
+void end_now(int sig) {
+  remove_unfinished_outputs();
+  struct sigaction action {};
+  action.sa_handler = SIG_DFL;
+  sigemptyset(&action.sa_mask);
+  sigaction(sig, &action, nullptr);
+  raise(sig);  // pending until this handler returns, then the default action
+}
+
+// A signal the process was started ignoring (SIGHUP under nohup, SIGINT in a background job of
+// a script) stays ignored.
+void handle(int sig, void (*handler)(int)) {
+  struct sigaction current {};
+  if (sigaction(sig, nullptr, &current) == 0 && current.sa_handler == SIG_IGN) return;
+  struct sigaction action {};
+  action.sa_handler = handler;
+  sigemptyset(&action.sa_mask);
+  sigaction(sig, &action, nullptr);
+}
+
 void on_stop_signal(int sig) {
   requested = sig;
-  std::signal(sig, SIG_DFL);  // async-signal-safe; the second signal is not caught
+  handle(sig, end_now);  // the second signal is not waited on
 }
 
 }  // namespace
 
+void end_cleanly_on_signals() {
+  for (int sig : {SIGTERM, SIGINT, SIGHUP}) handle(sig, end_now);
+}
+
 void catch_stop_signals() {
-  struct sigaction action {};
-  action.sa_handler = on_stop_signal;
-  sigemptyset(&action.sa_mask);
-  sigaction(SIGTERM, &action, nullptr);
-  sigaction(SIGINT, &action, nullptr);
+  handle(SIGTERM, on_stop_signal);
+  handle(SIGINT, on_stop_signal);
 }
 
 void release_stop_signals() {
-  std::signal(SIGTERM, SIG_DFL);
-  std::signal(SIGINT, SIG_DFL);
+  handle(SIGTERM, end_now);
+  handle(SIGINT, end_now);
 }
 
 int stop_signal() { return requested; }

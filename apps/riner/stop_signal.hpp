@@ -1,14 +1,19 @@
 // SIGTERM (a batch scheduler's notice before its SIGKILL) and SIGINT (Ctrl-C) during training:
 // the training saves its checkpoint at the next report and stops, so `--resume` loses nothing.
-// A second signal ends the process at once.
+// A second signal, or one outside training, ends the process at once, and removes the
+// temporary files of the writes it interrupts (riner::remove_unfinished_outputs): a stopped
+// run leaves its outputs whole or absent, nothing half-written beside them.
 #pragma once
 
 #include <string>
 
 namespace riner::app {
 
-// Installs the handlers while a command trains; release_stop_signals() gives both signals
-// their default action back (a signal after training ends the process as usual).
+// For the whole process: SIGTERM, SIGINT and SIGHUP end it as their default action does, with
+// the unfinished outputs removed first.
+void end_cleanly_on_signals();
+// Installs the handlers while a command trains; release_stop_signals() hands SIGTERM and SIGINT
+// back to end_cleanly_on_signals' handler.
 void catch_stop_signals();
 void release_stop_signals();
 // The signal that asked to stop (SIGTERM or SIGINT), or 0.

@@ -44,24 +44,31 @@ inline Run riner_cli(const std::string& arguments, const TempDir& dir) {
   return run;
 }
 
-// RINER_CLI_PATH WORDS... started and sent `sig` once `until` is true (or after 120 s); the
-// process's wait status.
-inline int run_until(std::vector<std::string> words, const std::function<bool()>& until,
-                     int sig = SIGKILL) {
-  words.insert(words.begin(), RINER_CLI_PATH);
+// PROGRAM WORDS... (PROGRAM found on PATH) started and sent `sig` once `until` is true (or after
+// 120 s), unless it ended first; the process's wait status.
+inline int run_program_until(const std::string& program, std::vector<std::string> words,
+                             const std::function<bool()>& until, int sig = SIGKILL) {
+  words.insert(words.begin(), program);
   std::vector<char*> argv;
   for (std::string& w : words) argv.push_back(w.data());
   argv.push_back(nullptr);
   pid_t pid = 0;
-  REQUIRE(posix_spawn(&pid, RINER_CLI_PATH, nullptr, nullptr, argv.data(), environ) == 0);
+  REQUIRE(posix_spawnp(&pid, program.c_str(), nullptr, nullptr, argv.data(), environ) == 0);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
+  int status = 0;
   while (!until() && std::chrono::steady_clock::now() < deadline) {
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    if (waitpid(pid, &status, WNOHANG) == pid) return status;
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
   kill(pid, sig);
-  int status = 0;
   waitpid(pid, &status, 0);
   return status;
+}
+
+// The same for `riner WORDS...`.
+inline int run_until(std::vector<std::string> words, const std::function<bool()>& until,
+                     int sig = SIGKILL) {
+  return run_program_until(RINER_CLI_PATH, std::move(words), until, sig);
 }
 
 // `geometry_json` written as dir/geometry_file and `riner simulate --quiet OPTIONS` of it into

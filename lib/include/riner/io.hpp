@@ -31,6 +31,11 @@ enum class FileFormat { kNpy, kNifti, kTiff, kRaw, kPng, kJson, kHdf5 };
 FileFormat format_from_path(const std::filesystem::path& path);
 const char* format_name(FileFormat format);
 
+// Removes the temporary files of every write in progress (async-signal-safe: for a handler of
+// SIGTERM or SIGINT that then ends the process, so a stopped run leaves no half-written file
+// beside its outputs).
+void remove_unfinished_outputs() noexcept;
+
 struct ArrayFile {
   Array array;
   FileFormat format = FileFormat::kNpy;

@@ -3,11 +3,59 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cstring>
 #include <random>
 #include <string>
 #include <system_error>
 
 #include "riner/error.hpp"
+#include "riner/io.hpp"
+
+namespace riner {
+
+namespace {
+
+// The temporary files being written, for a signal handler to remove: a fixed table of paths
+// and lock-free states, so that the handler reads no memory that is being allocated.
+constexpr int kSlots = 64;
+constexpr std::size_t kPathBytes = 4096;
+enum SlotState : int { kFree = 0, kFilling = 1, kHeld = 2 };
+static_assert(std::atomic<int>::is_always_lock_free, "a signal handler reads the states");
+
+struct TempSlot {
+  std::atomic<int> state{kFree};
+  char path[kPathBytes];
+};
+TempSlot temp_slots[kSlots];
+
+// The slot that now holds `path`, or -1 when none is free (more writes at once than slots, or
+// a path too long): that file is not removed after a signal.
+int hold_temp_path(const std::filesystem::path& path) {
+  const std::string text = path.string();
+  if (text.size() >= kPathBytes) return -1;
+  for (int i = 0; i < kSlots; ++i) {
+    int expected = kFree;
+    if (!temp_slots[i].state.compare_exchange_strong(expected, kFilling)) continue;
+    std::memcpy(temp_slots[i].path, text.c_str(), text.size() + 1);
+    temp_slots[i].state.store(kHeld);
+    return i;
+  }
+  return -1;
+}
+
+void release_temp_path(int slot) {
+  if (slot >= 0) temp_slots[slot].state.store(kFree);
+}
+
+}  // namespace
+
+void remove_unfinished_outputs() noexcept {
+  for (TempSlot& slot : temp_slots) {
+    if (slot.state.load() == kHeld) ::unlink(slot.path);
+  }
+}
+
+}  // namespace riner
 
 namespace riner::util {
 
@@ -21,13 +69,14 @@ std::filesystem::path unique_sibling(const std::filesystem::path& target) {
 }
 
 AtomicFile::AtomicFile(std::filesystem::path target)
-    : target_(std::move(target)), temp_(unique_sibling(target_)) {}
+    : target_(std::move(target)), temp_(unique_sibling(target_)), slot_(hold_temp_path(temp_)) {}
 
 AtomicFile::~AtomicFile() {
   if (!committed_) {
     std::error_code ignored;
     std::filesystem::remove(temp_, ignored);
   }
+  release_temp_path(slot_);
 }
 
 void AtomicFile::commit() {
@@ -38,6 +87,8 @@ void AtomicFile::commit() {
                 error.message());
   }
   committed_ = true;
+  release_temp_path(slot_);
+  slot_ = -1;
 }
 
 }  // namespace riner::util

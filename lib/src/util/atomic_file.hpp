@@ -25,6 +25,7 @@ class AtomicFile {
   std::filesystem::path target_;
   std::filesystem::path temp_;
   bool committed_ = false;
+  int slot_ = -1;  // where riner::remove_unfinished_outputs finds temp_
 };
 
 // A name unique to this process and call, for temporary files.
