@@ -44,23 +44,37 @@ inline Run riner_cli(const std::string& arguments, const TempDir& dir) {
   return run;
 }
 
+// Who run_program_until's signal goes to: the process, or the process group it leads (what a
+// terminal's Ctrl-C reaches: the process and every process it started).
+enum class SignalTo { kProcess, kGroup };
+
 // PROGRAM WORDS... (PROGRAM found on PATH) started and sent `sig` once `until` is true (or after
 // 120 s), unless it ended first; the process's wait status.
 inline int run_program_until(const std::string& program, std::vector<std::string> words,
-                             const std::function<bool()>& until, int sig = SIGKILL) {
+                             const std::function<bool()>& until, int sig = SIGKILL,
+                             SignalTo to = SignalTo::kProcess) {
   words.insert(words.begin(), program);
   std::vector<char*> argv;
   for (std::string& w : words) argv.push_back(w.data());
   argv.push_back(nullptr);
+  posix_spawnattr_t attributes;
+  posix_spawnattr_init(&attributes);
+  if (to == SignalTo::kGroup) {
+    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
+    posix_spawnattr_setpgroup(&attributes, 0);  // a group of its own, led by it
+  }
   pid_t pid = 0;
-  REQUIRE(posix_spawnp(&pid, program.c_str(), nullptr, nullptr, argv.data(), environ) == 0);
+  const int spawned =
+      posix_spawnp(&pid, program.c_str(), nullptr, &attributes, argv.data(), environ);
+  posix_spawnattr_destroy(&attributes);
+  REQUIRE(spawned == 0);
   const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(120);
   int status = 0;
   while (!until() && std::chrono::steady_clock::now() < deadline) {
     if (waitpid(pid, &status, WNOHANG) == pid) return status;
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
-  kill(pid, sig);
+  kill(to == SignalTo::kGroup ? -pid : pid, sig);
   waitpid(pid, &status, 0);
   return status;
 }

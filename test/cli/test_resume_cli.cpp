@@ -227,4 +227,64 @@ TEST_SUITE("cli") {
     MESSAGE("riner was built without MPI (libopenmpi-dev): nothing to test");
 #endif
   }
+
+  TEST_CASE("Ctrl-C to riner's own --processes copies: each saves its slab; --resume finishes") {
+    riner::test::TempDir dir;
+    const std::string sim = riner::test::simulate_small_parallel3d(dir);
+    const std::vector<std::string> common = {
+        "reconstruct", sim + "/sino.npy", "--geometry", sim + "/geometry.json", "--slab-slices",
+        "10",          "--steps",         "4000",       "--processes",          "2",
+        "--quiet"};
+    const auto run = [&](const std::filesystem::path& out, std::vector<std::string> extra,
+                         const std::function<bool()>& until) {
+      std::vector<std::string> words = common;
+      words.insert(words.end(), extra.begin(), extra.end());
+      words.insert(words.end(), {"--out", out.string()});
+      return riner::test::run_program_until(RINER_CLI_PATH, words, until, SIGINT,
+                                            riner::test::SignalTo::kGroup);
+    };
+    const auto never = [] { return false; };
+    const std::filesystem::path whole = dir / "whole", stopped = dir / "stopped";
+    int status = run(whole, {}, never);
+    REQUIRE(WIFEXITED(status));
+    REQUIRE(WEXITSTATUS(status) == 0);
+
+    // Ctrl-C once a copy has saved its slab's first checkpoint.
+    const std::filesystem::path slabs = stopped / "slabs";
+    const auto checkpoints = [&] {
+      return static_cast<int>(std::filesystem::exists(slabs / "slab_0000.checkpoint")) +
+             static_cast<int>(std::filesystem::exists(slabs / "slab_0001.checkpoint"));
+    };
+    status = run(stopped, {"--checkpoint-minutes", "0.003"}, [&] { return checkpoints() > 0; });
+    REQUIRE(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 128 + SIGINT);
+    CHECK(checkpoints() > 0);
+    CHECK(!std::filesystem::exists(stopped / "summary.json"));
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(stopped)) {
+      CAPTURE(entry.path());
+      CHECK(entry.path().filename().string().find(".tmp.") == std::string::npos);
+    }
+
+    status = run(stopped, {"--resume"}, never);
+    REQUIRE(WIFEXITED(status));
+    REQUIRE(WEXITSTATUS(status) == 0);
+    const nlohmann::json summary =
+        nlohmann::json::parse(riner::test::read_bytes(stopped / "summary.json"));
+    REQUIRE(summary["per_slab"].size() == 2);
+    int resumed = 0;
+    for (int slab = 0; slab < 2; ++slab) {
+      const nlohmann::json step = summary["per_slab"][slab]["summary"]["resumed_at_step"];
+      CAPTURE(slab);
+      CAPTURE(step);
+      if (step.is_null()) continue;
+      ++resumed;
+      CHECK(step > 0);
+      CHECK(step < 4000);
+    }
+    CHECK(resumed > 0);
+    CHECK(riner::read_array(stopped / "volume").array.data ==
+          riner::read_array(whole / "volume").array.data);
+    CHECK(riner::test::read_bytes(stopped / "alpha.npy") ==
+          riner::test::read_bytes(whole / "alpha.npy"));
+  }
 }
