@@ -14,6 +14,7 @@
 
 #include "riner/cores.hpp"
 #include "riner/error.hpp"
+#include "stop_signal.hpp"
 
 extern char** environ;
 
@@ -116,15 +117,7 @@ void SlabProcesses::signal_and_wait(int sig) {
   children_.clear();
 }
 
-void SlabProcesses::stop(double grace) {
-  const auto deadline =
-      std::chrono::steady_clock::now() + std::chrono::duration<double>(grace);
-  while (!children_.empty() && std::chrono::steady_clock::now() < deadline) {
-    std::erase_if(children_, [](pid_t pid) { return waitpid(pid, nullptr, WNOHANG) != 0; });
-    std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  }
-  signal_and_wait(SIGTERM);
-}
+void SlabProcesses::stop() { signal_and_wait(stop_request_signal()); }
 
 bool SlabProcesses::running() {
   for (std::size_t i = 0; i < children_.size();) {

@@ -29,10 +29,10 @@ class SlabProcesses {
 
   // True while any is running; a failed one stops the others and is named by failure().
   bool running();
-  // A stop: waits up to `grace` seconds for them to end on their own (a signal to the process
-  // group reached them too: a second one would kill them mid-save), then sends the rest
-  // SIGTERM (each saves its slab's checkpoint and ends) and waits for them all.
-  void stop(double grace = 30.0);
+  // A stop: the stop request to each (stop_signal.hpp: it saves its slab's checkpoint at the
+  // next report and ends, as on SIGTERM, but a second request never ends it at once, so it is
+  // safe when the terminal's Ctrl-C reached the copies too), then waits for them all.
+  void stop();
   const std::string& failure() const { return failure_; }
   bool pinned() const { return pinned_; }
 

@@ -39,15 +39,26 @@ void on_stop_signal(int sig) {
   handle(sig, end_now);  // the second signal is not waited on
 }
 
+// A stop asked by the first process of a --processes run: as SIGTERM, but never at once.
+void on_forwarded_stop(int) {
+  if (requested == 0) requested = SIGTERM;
+}
+
 }  // namespace
+
+// Not SIGUSR1 or SIGUSR2: LLVM (in PoCL's compiler) takes both when the device is opened, and
+// its SIGUSR1 handler does not pass the signal on.
+int stop_request_signal() { return SIGRTMIN + 1; }
 
 void end_cleanly_on_signals() {
   for (int sig : {SIGTERM, SIGINT, SIGHUP}) handle(sig, end_now);
+  handle(stop_request_signal(), on_forwarded_stop);
 }
 
 void catch_stop_signals() {
   handle(SIGTERM, on_stop_signal);
   handle(SIGINT, on_stop_signal);
+  handle(stop_request_signal(), on_forwarded_stop);
 }
 
 void release_stop_signals() {

@@ -2,7 +2,9 @@
 // the training saves its checkpoint at the next report and stops, so `--resume` loses nothing.
 // A second signal, or one outside training, ends the process at once, and removes the
 // temporary files of the writes it interrupts (riner::remove_unfinished_outputs): a stopped
-// run leaves its outputs whole or absent, nothing half-written beside them.
+// run leaves its outputs whole or absent, nothing half-written beside them. A stop request
+// (stop_request_signal()) asks for the same stop as SIGTERM and never ends the process at
+// once: the first process of a --processes run sends it to its copies (slab_processes.hpp).
 #pragma once
 
 #include <string>
@@ -10,8 +12,10 @@
 namespace riner::app {
 
 // For the whole process: SIGTERM, SIGINT and SIGHUP end it as their default action does, with
-// the unfinished outputs removed first.
+// the unfinished outputs removed first; a stop request sets stop_signal() to SIGTERM.
 void end_cleanly_on_signals();
+// The stop request: a real-time signal, which no library here takes.
+int stop_request_signal();
 // Installs the handlers while a command trains; release_stop_signals() hands SIGTERM and SIGINT
 // back to end_cleanly_on_signals' handler.
 void catch_stop_signals();

@@ -227,8 +227,7 @@ TEST_SUITE("cli") {
     MESSAGE("riner was built without MPI (libopenmpi-dev): nothing to test");
 #endif
   }
-
-  TEST_CASE("Ctrl-C to riner's own --processes copies: each saves its slab; --resume finishes") {
+  TEST_CASE("riner's own --processes copies stop on SIGTERM or Ctrl-C; --resume finishes") {
     riner::test::TempDir dir;
     const std::string sim = riner::test::simulate_small_parallel3d(dir);
     const std::vector<std::string> common = {
@@ -236,36 +235,53 @@ TEST_SUITE("cli") {
         "10",          "--steps",         "4000",       "--processes",          "2",
         "--quiet"};
     const auto run = [&](const std::filesystem::path& out, std::vector<std::string> extra,
-                         const std::function<bool()>& until) {
+                         const std::function<bool()>& until, int sig, riner::test::SignalTo to) {
       std::vector<std::string> words = common;
       words.insert(words.end(), extra.begin(), extra.end());
       words.insert(words.end(), {"--out", out.string()});
-      return riner::test::run_program_until(RINER_CLI_PATH, words, until, SIGINT,
-                                            riner::test::SignalTo::kGroup);
+      return riner::test::run_program_until(RINER_CLI_PATH, words, until, sig, to);
     };
     const auto never = [] { return false; };
     const std::filesystem::path whole = dir / "whole", stopped = dir / "stopped";
-    int status = run(whole, {}, never);
+    int status = run(whole, {}, never, SIGKILL, riner::test::SignalTo::kProcess);
     REQUIRE(WIFEXITED(status));
     REQUIRE(WEXITSTATUS(status) == 0);
 
-    // Ctrl-C once a copy has saved its slab's first checkpoint.
+    // The slabs' checkpoints as last written (0 where none).
     const std::filesystem::path slabs = stopped / "slabs";
-    const auto checkpoints = [&] {
-      return static_cast<int>(std::filesystem::exists(slabs / "slab_0000.checkpoint")) +
-             static_cast<int>(std::filesystem::exists(slabs / "slab_0001.checkpoint"));
+    const auto saved = [&] {
+      std::vector<std::filesystem::file_time_type> times;
+      for (const char* name : {"slab_0000.checkpoint", "slab_0001.checkpoint"}) {
+        std::error_code none;
+        times.push_back(std::filesystem::last_write_time(slabs / name, none));
+      }
+      return times;
     };
-    status = run(stopped, {"--checkpoint-minutes", "0.003"}, [&] { return checkpoints() > 0; });
-    REQUIRE(WIFEXITED(status));
-    CHECK(WEXITSTATUS(status) == 128 + SIGINT);
-    CHECK(checkpoints() > 0);
-    CHECK(!std::filesystem::exists(stopped / "summary.json"));
-    for (const auto& entry : std::filesystem::recursive_directory_iterator(stopped)) {
-      CAPTURE(entry.path());
-      CHECK(entry.path().filename().string().find(".tmp.") == std::string::npos);
-    }
+    const auto stop = [&](int sig, riner::test::SignalTo to) {
+      const std::vector<std::filesystem::file_time_type> before = saved();
+      const int status = run(
+          stopped, {"--checkpoint-minutes", "0.003", "--resume"},
+          [&] {
+            const std::vector<std::filesystem::file_time_type> now = saved();
+            return (now[0] != before[0] && now[0] != std::filesystem::file_time_type::min()) ||
+                   (now[1] != before[1] && now[1] != std::filesystem::file_time_type::min());
+          },
+          sig, to);
+      CAPTURE(sig);
+      REQUIRE(WIFEXITED(status));
+      CHECK(WEXITSTATUS(status) == 128 + sig);
+      CHECK(!std::filesystem::exists(stopped / "summary.json"));
+      for (const auto& entry : std::filesystem::recursive_directory_iterator(stopped)) {
+        CAPTURE(entry.path());
+        CHECK(entry.path().filename().string().find(".tmp.") == std::string::npos);
+      }
+    };
+    // A scheduler's SIGTERM to the first process alone: it asks its copies to stop (SIGUSR1),
+    // each saves its slab. Then, resumed, Ctrl-C from a terminal: the whole process group.
+    stop(SIGTERM, riner::test::SignalTo::kProcess);
+    stop(SIGINT, riner::test::SignalTo::kGroup);
 
-    status = run(stopped, {"--resume"}, never);
+    status = run(stopped, {"--resume"}, never, SIGKILL, riner::test::SignalTo::kProcess);
     REQUIRE(WIFEXITED(status));
     REQUIRE(WEXITSTATUS(status) == 0);
     const nlohmann::json summary =
