@@ -85,6 +85,7 @@ void refuse_unfinished(const Args& args, const std::filesystem::path& checkpoint
 void resume_training(const Args& args, const Console& console, Reconstructor& reconstructor,
                      const std::filesystem::path& checkpoint) {
   if (!args.is_set("resume")) return;
+  remove_stale_temporaries(checkpoint.parent_path());  // a SIGKILL mid-write leaves them
   if (!std::filesystem::exists(checkpoint)) {
     console.line("--resume: no " + std::string(kCheckpointName) + " in " +
                  checkpoint.parent_path().string() + ": training from the start");

@@ -85,6 +85,16 @@ inline int run_until(std::vector<std::string> words, const std::function<bool()>
   return run_program_until(RINER_CLI_PATH, std::move(words), until, sig);
 }
 
+// The PID of a process that has ended (`true`, waited for): it names no running writer.
+inline pid_t ended_process_id() {
+  pid_t pid = 0;
+  char name[] = "true";
+  char* argv[] = {name, nullptr};
+  REQUIRE(posix_spawnp(&pid, "true", nullptr, nullptr, argv, environ) == 0);
+  waitpid(pid, nullptr, 0);
+  return pid;
+}
+
 // `geometry_json` written as dir/geometry_file and `riner simulate --quiet OPTIONS` of it into
 // dir/sim; returns dir/sim.
 inline std::string simulate_geometry(const TempDir& dir, const std::string& geometry_file,

@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <nlohmann/json.hpp>
 #include <string>
@@ -88,6 +89,11 @@ TEST_SUITE("cli") {
               [&] { return std::filesystem::exists(checkpoint); });
     REQUIRE(std::filesystem::exists(checkpoint));
     REQUIRE(!std::filesystem::exists(killed / "slabs" / "slab_0000.json"));  // mid-slab
+    // What a SIGKILL mid-write would leave.
+    const std::filesystem::path half_written =
+        killed / "slabs" /
+        ("slab_0000.checkpoint" + riner::temporary_marker(riner::test::ended_process_id()) + "1.0");
+    riner::test::write_bytes(half_written, "partial");
 
     const Run finished = riner_cli(common + " --resume --out " + killed.string(), dir);
     REQUIRE(finished.code == 0);
@@ -104,6 +110,7 @@ TEST_SUITE("cli") {
     CHECK(riner::test::read_bytes(killed / "alpha.npy") ==
           riner::test::read_bytes(whole / "alpha.npy"));
     CHECK(!std::filesystem::exists(checkpoint));
+    CHECK(!std::filesystem::exists(half_written));
   }
 
   TEST_CASE("SIGTERM mid-training saves the checkpoint and exits 143; --resume goes on from it") {
@@ -302,5 +309,27 @@ TEST_SUITE("cli") {
           riner::read_array(whole / "volume").array.data);
     CHECK(riner::test::read_bytes(stopped / "alpha.npy") ==
           riner::test::read_bytes(whole / "alpha.npy"));
+  }
+
+  TEST_CASE("--resume removes the temporary files a killed writer on this host left, no other") {
+    riner::test::TempDir dir;
+    const std::string sim = riner::test::simulate_small_parallel2d(dir, 6);
+    const pid_t ended = riner::test::ended_process_id();
+    const std::filesystem::path out = dir / "out";
+    std::filesystem::create_directories(out);
+    const std::filesystem::path dead = out / ("image.nii" + riner::temporary_marker(ended) + "1.0");
+    const std::filesystem::path alive =
+        out / ("alpha.npy" + riner::temporary_marker(getpid()) + "1.0");
+    const std::filesystem::path elsewhere = out / "beta.npy.tmp.0123456789abcdef-1.1.0";
+    for (const auto& file : {dead, alive, elsewhere}) riner::test::write_bytes(file, "partial");
+    const Run run =
+        riner_cli("reconstruct " + sim + "/sino.npy --geometry " + sim +
+                      "/geometry.json --steps 300 --quiet --resume --out " + out.string(),
+                  dir);
+    REQUIRE(run.code == 0);
+    CHECK(!std::filesystem::exists(dead));
+    CHECK(std::filesystem::exists(alive));      // its writer still runs
+    CHECK(std::filesystem::exists(elsewhere));  // another host's: its writer may run
+    CHECK(std::filesystem::exists(out / "image.nii"));
   }
 }

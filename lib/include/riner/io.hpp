@@ -35,6 +35,12 @@ const char* format_name(FileFormat format);
 // SIGTERM or SIGINT that then ends the process, so a stopped run leaves no half-written file
 // beside its outputs).
 void remove_unfinished_outputs() noexcept;
+// What the temporary file of a write by process `pid` on this host holds in its name
+// (".tmp.HOSTKEY-PID."), and the removal of those in `folder` whose writer on this host has
+// ended (a SIGKILL mid-write leaves one): their number. Another host's, and a running
+// process's, stay.
+std::string temporary_marker(long pid);
+std::size_t remove_stale_temporaries(const std::filesystem::path& folder);
 
 struct ArrayFile {
   Array array;

@@ -165,6 +165,13 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
       }
     }
   }
+  // What a killed run's writes left half-done (a SIGKILL mid-write) goes; the slabs' records
+  // and checkpoints stand on their own.
+  if (held_run && !join_) {
+    for (const std::filesystem::path& folder : {out_, out_ / "slabs", volume_dir()}) {
+      remove_stale_temporaries(folder);
+    }
+  }
   // The plan; done-ness is in the slabs' records.
   manifest_ = {{"version", kManifestVersion}, {"run", wanted}, {"slabs", nlohmann::json::array()}};
   for (const Slab& s : slabs_) {

@@ -1,8 +1,11 @@
 #include "util/atomic_file.hpp"
 
+#include <signal.h>
 #include <unistd.h>
 
 #include <atomic>
+#include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <random>
 #include <string>
@@ -10,6 +13,7 @@
 
 #include "riner/error.hpp"
 #include "riner/io.hpp"
+#include "util/hash.hpp"
 
 namespace riner {
 
@@ -55,6 +59,38 @@ void remove_unfinished_outputs() noexcept {
   }
 }
 
+std::string temporary_marker(long pid) {
+  char host[256] = {};
+  if (gethostname(host, sizeof(host) - 1) != 0) host[0] = '\0';
+  char key[17];
+  std::snprintf(key, sizeof(key), "%016llx",
+                static_cast<unsigned long long>(util::fnv1a64(std::string_view(host))));
+  return ".tmp." + std::string(key) + "-" + std::to_string(pid) + ".";
+}
+
+std::size_t remove_stale_temporaries(const std::filesystem::path& folder) {
+  const std::string here = temporary_marker(0);
+  const std::string prefix = here.substr(0, here.size() - 2);  // ".tmp.HOSTKEY-"
+  std::size_t removed = 0;
+  std::error_code error;
+  for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
+    const std::string name = entry.path().filename().string();
+    const std::size_t at = name.find(prefix);
+    if (at == std::string::npos) continue;
+    const std::size_t digits = at + prefix.size();
+    const std::size_t end = name.find('.', digits);
+    if (end == std::string::npos || end == digits) continue;
+    const std::string pid_text = name.substr(digits, end - digits);
+    if (pid_text.find_first_not_of("0123456789") != std::string::npos) continue;
+    const long pid = std::stol(pid_text);
+    // A writer that still runs (or a PID taken again since) keeps its file.
+    if (pid <= 0 || ::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
+    std::error_code ignored;
+    removed += std::filesystem::remove(entry.path(), ignored) ? 1 : 0;
+  }
+  return removed;
+}
+
 }  // namespace riner
 
 namespace riner::util {
@@ -63,8 +99,7 @@ std::filesystem::path unique_sibling(const std::filesystem::path& target) {
   static std::atomic<unsigned> counter{0};
   static const unsigned salt = std::random_device{}();
   std::filesystem::path temp = target;
-  temp += ".tmp." + std::to_string(::getpid()) + "." + std::to_string(salt) + "." +
-          std::to_string(counter++);
+  temp += temporary_marker(::getpid()) + std::to_string(salt) + "." + std::to_string(counter++);
   return temp;
 }
 
