@@ -331,7 +331,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       // This process plans and gathers; its copies train (none if every slab is done).
       std::size_t slabs = 0;
       slices_at_start = run.slices_recorded(&slabs);
-      if (slabs < run.slabs().size()) {
+      if (slabs < run.slabs().size() && stop_signal() == 0) {
         SlabProcesses copies(processes, threads_per_process, {"--join-run", token, "--quiet"},
                              pinned);
         copies_pinned = copies.pinned();

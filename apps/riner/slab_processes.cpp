@@ -7,6 +7,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <fstream>
 #include <iterator>
@@ -84,6 +85,11 @@ SlabProcesses::SlabProcesses(int count, int threads, const std::vector<std::stri
   static const char kExecFailed[] = "riner: error: cannot start a slab process (exec failed)\n";
   static const char kNotPinned[] = "riner: warning: a slab process runs unpinned\n";
   const pid_t parent = getpid();
+  // Blocked from fork to the copy's own handler (stop_signal.cpp's end_cleanly_on_signals): a
+  // stop request meanwhile waits instead of ending it.
+  sigset_t request;
+  sigemptyset(&request);
+  sigaddset(&request, stop_request_signal());
   for (int i = 0; i < count; ++i) {
     const pid_t pid = fork();
     if (pid < 0) {
@@ -99,6 +105,7 @@ SlabProcesses::SlabProcesses(int count, int threads, const std::vector<std::stri
           sched_setaffinity(0, sizeof(cpu_set_t), &masks[static_cast<std::size_t>(i)]) != 0) {
         (void)!write(2, kNotPinned, sizeof(kNotPinned) - 1);
       }
+      sigprocmask(SIG_BLOCK, &request, nullptr);
       execve(program.c_str(), argv.data(), envp.data());
       (void)!write(2, kExecFailed, sizeof(kExecFailed) - 1);
       _exit(127);
@@ -113,7 +120,10 @@ void SlabProcesses::stop_all() { signal_and_wait(SIGKILL); }
 
 void SlabProcesses::signal_and_wait(int sig) {
   for (pid_t pid : children_) kill(pid, sig);
-  for (pid_t pid : children_) waitpid(pid, nullptr, 0);
+  for (pid_t pid : children_) {
+    while (waitpid(pid, nullptr, 0) < 0 && errno == EINTR) {
+    }
+  }
   children_.clear();
 }
 

@@ -30,13 +30,16 @@ void handle(int sig, void (*handler)(int)) {
   if (sigaction(sig, nullptr, &current) == 0 && current.sa_handler == SIG_IGN) return;
   struct sigaction action {};
   action.sa_handler = handler;
+  action.sa_flags = SA_RESTART;  // a wait for the slab processes goes on through a signal
   sigemptyset(&action.sa_mask);
   sigaction(sig, &action, nullptr);
 }
 
 void on_stop_signal(int sig) {
   requested = sig;
-  handle(sig, end_now);  // the second signal is not waited on
+  // The second signal, either of the two, is not waited on.
+  handle(SIGTERM, end_now);
+  handle(SIGINT, end_now);
 }
 
 // A stop asked by the first process of a --processes run: as SIGTERM, but never at once.
@@ -53,6 +56,12 @@ int stop_request_signal() { return SIGRTMIN + 1; }
 void end_cleanly_on_signals() {
   for (int sig : {SIGTERM, SIGINT, SIGHUP}) handle(sig, end_now);
   handle(stop_request_signal(), on_forwarded_stop);
+  // A slab process starts with the request blocked (slab_processes.cpp): one sent before this
+  // handler existed waits for it here instead of ending the process.
+  sigset_t request;
+  sigemptyset(&request);
+  sigaddset(&request, stop_request_signal());
+  sigprocmask(SIG_UNBLOCK, &request, nullptr);
 }
 
 void catch_stop_signals() {

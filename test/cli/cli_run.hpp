@@ -59,10 +59,20 @@ inline int run_program_until(const std::string& program, std::vector<std::string
   argv.push_back(nullptr);
   posix_spawnattr_t attributes;
   posix_spawnattr_init(&attributes);
+  // The signals at their defaults and none blocked, whatever this process inherited (a job
+  // started in the background of a script ignores SIGINT, and so would its children).
+  sigset_t defaults, none;
+  sigemptyset(&defaults);
+  for (int s : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&defaults, s);
+  sigemptyset(&none);
+  posix_spawnattr_setsigdefault(&attributes, &defaults);
+  posix_spawnattr_setsigmask(&attributes, &none);
+  short flags = POSIX_SPAWN_SETSIGDEF | POSIX_SPAWN_SETSIGMASK;
   if (to == SignalTo::kGroup) {
-    posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
+    flags |= POSIX_SPAWN_SETPGROUP;
     posix_spawnattr_setpgroup(&attributes, 0);  // a group of its own, led by it
   }
+  posix_spawnattr_setflags(&attributes, flags);
   pid_t pid = 0;
   const int spawned =
       posix_spawnp(&pid, program.c_str(), nullptr, &attributes, argv.data(), environ);

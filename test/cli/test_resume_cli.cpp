@@ -283,7 +283,7 @@ TEST_SUITE("cli") {
         CHECK(entry.path().filename().string().find(".tmp.") == std::string::npos);
       }
     };
-    // A scheduler's SIGTERM to the first process alone: it asks its copies to stop (SIGUSR1),
+    // A scheduler's SIGTERM to the first process alone: it asks its copies to stop (a request),
     // each saves its slab. Then, resumed, Ctrl-C from a terminal: the whole process group.
     stop(SIGTERM, riner::test::SignalTo::kProcess);
     stop(SIGINT, riner::test::SignalTo::kGroup);

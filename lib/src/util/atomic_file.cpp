@@ -1,12 +1,16 @@
 #include "util/atomic_file.hpp"
 
 #include <signal.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
+#include <charconv>
+#include <climits>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 #include <random>
 #include <string>
 #include <system_error>
@@ -23,7 +27,8 @@ namespace {
 // and lock-free states, so that the handler reads no memory that is being allocated.
 constexpr int kSlots = 64;
 constexpr std::size_t kPathBytes = 4096;
-enum SlotState : int { kFree = 0, kFilling = 1, kHeld = 2 };
+// kRemoving: a handler took the slot (the process is ending): it is never written again.
+enum SlotState : int { kFree = 0, kFilling = 1, kHeld = 2, kRemoving = 3 };
 static_assert(std::atomic<int>::is_always_lock_free, "a signal handler reads the states");
 
 struct TempSlot {
@@ -48,23 +53,43 @@ int hold_temp_path(const std::filesystem::path& path) {
 }
 
 void release_temp_path(int slot) {
-  if (slot >= 0) temp_slots[slot].state.store(kFree);
+  if (slot < 0) return;
+  int expected = kHeld;  // a handler that took it keeps it
+  temp_slots[slot].state.compare_exchange_strong(expected, kFree);
 }
 
 }  // namespace
 
 void remove_unfinished_outputs() noexcept {
   for (TempSlot& slot : temp_slots) {
-    if (slot.state.load() == kHeld) ::unlink(slot.path);
+    // Taken, not read while another thread may reuse it (a torn path could name an output).
+    int expected = kHeld;
+    if (slot.state.compare_exchange_strong(expected, kRemoving)) ::unlink(slot.path);
   }
 }
 
-std::string temporary_marker(long pid) {
+namespace {
+
+// Which processes a PID can name: the host, its boot, and the PID namespace (containers that
+// share a host name keep theirs apart).
+std::string pid_space() {
   char host[256] = {};
   if (gethostname(host, sizeof(host) - 1) != 0) host[0] = '\0';
+  std::string space = host;
+  std::ifstream boot("/proc/sys/kernel/random/boot_id");
+  std::string boot_id;
+  if (std::getline(boot, boot_id)) space += "/" + boot_id;
+  struct stat ns {};
+  if (::stat("/proc/self/ns/pid", &ns) == 0) space += "/" + std::to_string(ns.st_ino);
+  return space;
+}
+
+}  // namespace
+
+std::string temporary_marker(long pid) {
+  static const std::string space = pid_space();
   char key[17];
-  std::snprintf(key, sizeof(key), "%016llx",
-                static_cast<unsigned long long>(util::fnv1a64(std::string_view(host))));
+  std::snprintf(key, sizeof(key), "%016llx", static_cast<unsigned long long>(util::fnv1a64(space)));
   return ".tmp." + std::string(key) + "-" + std::to_string(pid) + ".";
 }
 
@@ -80,11 +105,11 @@ std::size_t remove_stale_temporaries(const std::filesystem::path& folder) {
     const std::size_t digits = at + prefix.size();
     const std::size_t end = name.find('.', digits);
     if (end == std::string::npos || end == digits) continue;
-    const std::string pid_text = name.substr(digits, end - digits);
-    if (pid_text.find_first_not_of("0123456789") != std::string::npos) continue;
-    const long pid = std::stol(pid_text);
+    long pid = 0;
+    const auto [stop, failed] = std::from_chars(name.data() + digits, name.data() + end, pid);
+    if (failed != std::errc() || stop != name.data() + end || pid <= 0 || pid > INT_MAX) continue;
     // A writer that still runs (or a PID taken again since) keeps its file.
-    if (pid <= 0 || ::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
+    if (::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH) continue;
     std::error_code ignored;
     removed += std::filesystem::remove(entry.path(), ignored) ? 1 : 0;
   }
