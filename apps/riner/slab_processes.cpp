@@ -87,9 +87,7 @@ SlabProcesses::SlabProcesses(int count, int threads, const std::vector<std::stri
   const pid_t parent = getpid();
   // Blocked from fork to the copy's own handler (stop_signal.cpp's end_cleanly_on_signals): a
   // stop request meanwhile waits instead of ending it.
-  sigset_t request;
-  sigemptyset(&request);
-  sigaddset(&request, stop_request_signal());
+  const sigset_t request = stop_request_set();
   for (int i = 0; i < count; ++i) {
     const pid_t pid = fork();
     if (pid < 0) {

@@ -53,14 +53,19 @@ void on_forwarded_stop(int) {
 // its SIGUSR1 handler does not pass the signal on.
 int stop_request_signal() { return SIGRTMIN + 1; }
 
+sigset_t stop_request_set() {
+  sigset_t request;
+  sigemptyset(&request);
+  sigaddset(&request, stop_request_signal());
+  return request;
+}
+
 void end_cleanly_on_signals() {
   for (int sig : {SIGTERM, SIGINT, SIGHUP}) handle(sig, end_now);
   handle(stop_request_signal(), on_forwarded_stop);
   // A slab process starts with the request blocked (slab_processes.cpp): one sent before this
   // handler existed waits for it here instead of ending the process.
-  sigset_t request;
-  sigemptyset(&request);
-  sigaddset(&request, stop_request_signal());
+  const sigset_t request = stop_request_set();
   sigprocmask(SIG_UNBLOCK, &request, nullptr);
 }
 

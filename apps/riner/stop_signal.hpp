@@ -7,6 +7,8 @@
 // once: the first process of a --processes run sends it to its copies (slab_processes.hpp).
 #pragma once
 
+#include <signal.h>
+
 #include <string>
 
 namespace riner::app {
@@ -14,8 +16,9 @@ namespace riner::app {
 // For the whole process: SIGTERM, SIGINT and SIGHUP end it as their default action does, with
 // the unfinished outputs removed first; a stop request sets stop_signal() to SIGTERM.
 void end_cleanly_on_signals();
-// The stop request: a real-time signal, which no library here takes.
+// The stop request: a real-time signal, which no library here takes; the set of it alone.
 int stop_request_signal();
+sigset_t stop_request_set();
 // Installs the handlers while a command trains; release_stop_signals() hands SIGTERM and SIGINT
 // back to end_cleanly_on_signals' handler.
 void catch_stop_signals();

@@ -11,6 +11,7 @@
 #include <array>
 #include <chrono>
 #include <cstdio>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <thread>
@@ -103,6 +104,18 @@ inline pid_t ended_process_id() {
   REQUIRE(posix_spawnp(&pid, "true", nullptr, nullptr, argv, environ) == 0);
   waitpid(pid, nullptr, 0);
   return pid;
+}
+
+// The temporary files (".tmp." in the name) anywhere under `folder`.
+inline std::vector<std::string> temporary_files(const std::filesystem::path& folder) {
+  std::vector<std::string> found;
+  std::error_code ignored;
+  for (const auto& entry : std::filesystem::recursive_directory_iterator(folder, ignored)) {
+    if (entry.path().filename().string().find(".tmp.") != std::string::npos) {
+      found.push_back(entry.path().string());
+    }
+  }
+  return found;
 }
 
 // `geometry_json` written as dir/geometry_file and `riner simulate --quiet OPTIONS` of it into

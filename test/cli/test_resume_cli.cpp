@@ -148,14 +148,6 @@ TEST_SUITE("cli") {
         "detector": {"count": [256, 160], "pitch_mm": [1.0, 1.0]},
         "angles": {"count": 8, "range_rad": 3.141592653589793},
         "volume": {"shape": [160, 256, 256], "voxel_mm": 1.0}})");
-    const auto temporary_files = [](const std::filesystem::path& folder) {
-      int found = 0;
-      std::error_code ignored;
-      for (const auto& entry : std::filesystem::directory_iterator(folder, ignored)) {
-        found += entry.path().filename().string().find(".tmp.") != std::string::npos;
-      }
-      return found;
-    };
     int stopped_mid_write = 0;
     for (int attempt = 0; attempt < 8 && stopped_mid_write < 2; ++attempt) {
       const std::filesystem::path out = dir / ("out" + std::to_string(attempt));
@@ -163,13 +155,13 @@ TEST_SUITE("cli") {
       const int status = run_until(
           {"simulate", "--quiet", "--geometry", (dir / "g.json").string(), "--supersample", "1",
            "--out", out.string()},
-          [&] { return writing = temporary_files(out) > 0; }, SIGTERM);
+          [&] { return writing = !riner::test::temporary_files(out).empty(); }, SIGTERM);
       if (!writing) continue;  // it wrote everything before a temporary file was seen
       ++stopped_mid_write;
       CAPTURE(attempt);
       CHECK(WIFSIGNALED(status));
       CHECK(WTERMSIG(status) == SIGTERM);
-      CHECK(temporary_files(out) == 0);
+      CHECK(riner::test::temporary_files(out) == std::vector<std::string>{});
       const std::filesystem::path truth = out / "ground_truth.nii";
       if (std::filesystem::exists(truth)) {
         CHECK(riner::read_array(truth).array.size() == std::size_t{160} * 256 * 256);
@@ -210,10 +202,7 @@ TEST_SUITE("cli") {
     REQUIRE(std::filesystem::exists(checkpoint));
     CHECK(!(WIFEXITED(status) && WEXITSTATUS(status) == 0));  // mpirun says the job was stopped
     CHECK(!std::filesystem::exists(stopped / "summary.json"));
-    for (const auto& entry : std::filesystem::recursive_directory_iterator(stopped)) {
-      CAPTURE(entry.path());
-      CHECK(entry.path().filename().string().find(".tmp.") == std::string::npos);
-    }
+    CHECK(riner::test::temporary_files(stopped) == std::vector<std::string>{});
 
     status = run_mpi(stopped, {"--resume"}, never, SIGKILL);
     REQUIRE(WIFEXITED(status));
@@ -234,6 +223,7 @@ TEST_SUITE("cli") {
     MESSAGE("riner was built without MPI (libopenmpi-dev): nothing to test");
 #endif
   }
+
   TEST_CASE("riner's own --processes copies stop on SIGTERM or Ctrl-C; --resume finishes") {
     riner::test::TempDir dir;
     const std::string sim = riner::test::simulate_small_parallel3d(dir);
@@ -278,10 +268,7 @@ TEST_SUITE("cli") {
       REQUIRE(WIFEXITED(status));
       CHECK(WEXITSTATUS(status) == 128 + sig);
       CHECK(!std::filesystem::exists(stopped / "summary.json"));
-      for (const auto& entry : std::filesystem::recursive_directory_iterator(stopped)) {
-        CAPTURE(entry.path());
-        CHECK(entry.path().filename().string().find(".tmp.") == std::string::npos);
-      }
+      CHECK(riner::test::temporary_files(stopped) == std::vector<std::string>{});
     };
     // A scheduler's SIGTERM to the first process alone: it asks its copies to stop (a request),
     // each saves its slab. Then, resumed, Ctrl-C from a terminal: the whole process group.

@@ -84,18 +84,23 @@ std::string pid_space() {
   return space;
 }
 
-}  // namespace
-
-std::string temporary_marker(long pid) {
-  static const std::string space = pid_space();
-  char key[17];
-  std::snprintf(key, sizeof(key), "%016llx", static_cast<unsigned long long>(util::fnv1a64(space)));
-  return ".tmp." + std::string(key) + "-" + std::to_string(pid) + ".";
+// ".tmp.KEY-", KEY a hash of pid_space(): what every temporary file of this PID space begins with.
+const std::string& temporary_prefix() {
+  static const std::string prefix = [] {
+    char key[17];
+    std::snprintf(key, sizeof(key), "%016llx",
+                  static_cast<unsigned long long>(util::fnv1a64(pid_space())));
+    return ".tmp." + std::string(key) + "-";
+  }();
+  return prefix;
 }
 
+}  // namespace
+
+std::string temporary_marker(long pid) { return temporary_prefix() + std::to_string(pid) + "."; }
+
 std::size_t remove_stale_temporaries(const std::filesystem::path& folder) {
-  const std::string here = temporary_marker(0);
-  const std::string prefix = here.substr(0, here.size() - 2);  // ".tmp.HOSTKEY-"
+  const std::string& prefix = temporary_prefix();
   std::size_t removed = 0;
   std::error_code error;
   for (const auto& entry : std::filesystem::directory_iterator(folder, error)) {
