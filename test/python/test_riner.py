@@ -230,6 +230,14 @@ def test_a_run_stopped_goes_on_from_its_checkpoint_to_the_same_result(fan_scan, 
         riner.reconstruct(sim["sino"], g, steps=500, quality=False, progress=fail,
                           progress_every=50, checkpoint=checkpoint)
     assert checkpoint.exists()
+    # A SIGKILL while saving leaves the half-written file; an ended writer's goes on resuming,
+    # a running one's (this process's) stays.
+    ended = subprocess.Popen(["true"])
+    ended.wait()
+    dead = tmp_path / ("run.checkpoint" + riner._riner.temporary_marker(ended.pid) + "1.0")
+    live = tmp_path / ("run.checkpoint" + riner._riner.temporary_marker(os.getpid()) + "1.0")
+    dead.write_bytes(b"half")
+    live.write_bytes(b"half")
     with pytest.raises(riner.InputError, match="a checkpoint of other settings"):
         riner.reconstruct(sim["sino"], g, steps=400, quality=False, checkpoint=checkpoint)
     resumed = riner.reconstruct(sim["sino"], g, steps=500, quality=False, checkpoint=checkpoint)
@@ -238,6 +246,7 @@ def test_a_run_stopped_goes_on_from_its_checkpoint_to_the_same_result(fan_scan, 
     np.testing.assert_array_equal(resumed.image, whole.image)
     np.testing.assert_array_equal(resumed.alpha, whole.alpha)
     assert not checkpoint.exists()  # training finished: the result stands for it
+    assert not dead.exists() and live.exists()
     with pytest.raises(riner.InputError, match="checkpoint_minutes must be"):
         riner.reconstruct(sim["sino"], g, steps=50, checkpoint=checkpoint, checkpoint_minutes=0)
 

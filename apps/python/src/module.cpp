@@ -9,6 +9,7 @@
 #include "python_wording.hpp"
 #include "riner/error.hpp"
 #include "riner/geometry.hpp"
+#include "riner/io.hpp"
 #include "riner/riner_config.hpp"
 #include "riner/simulate.hpp"
 #include "summary_json.hpp"
@@ -51,6 +52,9 @@ void bind_environment(py::module_& m) {
   });
   m.def("load_geometry_json",
         [](const std::string& path) { return Geometry::load(path).to_json(); });
+  // What the temporary files of process `pid` on this host carry in their names (the tests
+  // plant a dead writer's file with it).
+  m.def("temporary_marker", [](long pid) { return temporary_marker(pid); });
 }
 
 }  // namespace riner::python

@@ -15,6 +15,7 @@
 #include "numpy_arrays.hpp"
 #include "python_wording.hpp"
 #include "riner/error.hpp"
+#include "riner/io.hpp"
 #include "riner/reconstructor.hpp"
 #include "summary_json.hpp"
 
@@ -95,8 +96,11 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
     if (quality) app::require_quality_grid(scan.geometry);
     dev = device_for(config.engine, device);
     reconstructor = std::make_unique<Reconstructor>(std::move(scan), config, dev);
-    if (!checkpoint.empty() && std::filesystem::exists(checkpoint)) {
-      reconstructor->resume_from(checkpoint);
+    if (!checkpoint.empty()) {
+      // What a SIGKILL in the middle of saving left beside the checkpoint, as the CLI's --resume.
+      const std::filesystem::path folder = std::filesystem::path(checkpoint).parent_path();
+      remove_stale_temporaries(folder.empty() ? "." : folder);
+      if (std::filesystem::exists(checkpoint)) reconstructor->resume_from(checkpoint);
     }
   }
   // Often enough for Ctrl-C to feel immediate on a CPU (50 steps: about 0.1 s), rarely enough
