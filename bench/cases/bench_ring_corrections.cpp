@@ -5,12 +5,16 @@
 // it, as reconstructions run it), so the differences are the corrections' only.
 //
 //   riner_bench --case=ring_corrections [--first=0] [--last=9] [--seed-offset=0] [--config=JSON]
-//               [--json=FILE]
+//               [--json=FILE] [--images=DIR]
+//   --images: per slice, DIR/SLICE_{result,field,truth}.npy and SLICE_{alpha,true_alpha}.npy
+//   (what `riner reconstruct` writes, the trained field and the responses), for analysis.
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 
 #include "harness.hpp"
+#include "riner/io.hpp"
 #include "riner/metrics.hpp"
 #include "riner/reconstructor.hpp"
 #include "riner/ring_correction.hpp"
@@ -56,6 +60,8 @@ std::vector<Result> ring_corrections(const Options& o) {
       {"air + gradient + response 32 px", true, 12.0, 32.0}};
   std::vector<Totals> totals(variants.size() + 1);  // the last: kReconstruct
   std::vector<Result> results;
+  const std::filesystem::path images_dir = o.get("images", "");
+  if (!images_dir.empty()) std::filesystem::create_directories(images_dir);
   int scenes = 0;
   for (int index = first; index <= last; ++index, ++scenes) {
     const riner::bench::RingScene scene = riner::bench::paper_scene(o, index, projector);
@@ -142,6 +148,17 @@ std::vector<Result> ring_corrections(const Options& o) {
       totals.back().alpha_error += alpha_error;
       row[kReconstruct] = {{"psnr", m.psnr}, {"ssim", m.ssim}, {"alpha_mae_live", alpha_error}};
       line += riner::bench::format(" | %s %.2f/%.3f", kReconstruct, m.psnr, m.ssim);
+      if (!images_dir.empty()) {
+        const std::string name = "slice_" + std::to_string(index);
+        const auto save = [&](const char* what, const riner::Array& a) {
+          riner::write_array(images_dir / (name + "_" + what + ".npy"), a);
+        };
+        save("result", result.image);
+        save("field", field);
+        save("truth", scene.sim.ground_truth);
+        save("alpha", result.alpha);
+        save("true_alpha", scene.sim.alpha);
+      }
     }
     std::fprintf(stderr, "%s\n", line.c_str());
     results.push_back({"ring_corrections", row, line});

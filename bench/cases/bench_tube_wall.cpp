@@ -7,7 +7,11 @@
 // means over the concentric parts in one-pixel bins) against the truth.
 //
 //   riner_bench --case=tube_wall [--spreads=0.25,0.05] [--seed=1] [--png=DIR] [--config=JSON]
-//               [--json=FILE]
+//               [--json=FILE] [--seeds=1,2,...] [--without-mirror=1]
+//   --seeds: several draws of the responses, dead elements and noise; per spread, each wall
+//   bin's error over the draws (mean: what the method takes from the wall on average; spread:
+//   what one detector's draw leaves, which no correction can tell from the wall)
+//   --without-mirror=0: Riner with the mirror-pair correction only
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -72,6 +76,7 @@ struct WallError {
   int worst_radius = 0;
   double worst_vs_perfect = 0.0;  // the largest |image - perfect detector's FBP| / truth
   double content = 0.0;           // the tube's content, 3 px inside the wall and more
+  std::vector<double> bins;       // each wall bin's relative error, inner to outer
 };
 
 WallError wall_error(const std::vector<double>& image, const std::vector<double>& truth,
@@ -84,6 +89,7 @@ WallError wall_error(const std::vector<double>& image, const std::vector<double>
     sum += image[i];
     sum_truth += truth[i];
     const double e = (image[i] - truth[i]) / truth[i];
+    w.bins.push_back(e);
     if (std::fabs(e) > std::fabs(w.worst)) {
       w.worst = e;
       w.worst_radius = b;
@@ -107,9 +113,54 @@ nlohmann::json to_json(const WallError& w, const riner::ImageMetrics& m) {
           {"wall_worst_radius_px", w.worst_radius},
           {"wall_worst_vs_perfect_fbp", w.worst_vs_perfect},
           {"content_error", w.content},
+          {"wall_bin_errors", w.bins},
           {"psnr", m.psnr},
           {"ssim", m.ssim},
           {"edges", m.edge_ratio}};
+}
+
+// Each wall bin's error over the seeds: its mean, its standard deviation, and how many seeds
+// keep it within kWallBar; and how many seeds keep every bin within it.
+constexpr double kWallBar = 0.02;  // issue 32: the wall's profile within 2% of the truth
+
+Result over_seeds(double spread, const std::vector<std::vector<double>>& seed_bins, int inner) {
+  const std::size_t bins = seed_bins.front().size();
+  const double n = static_cast<double>(seed_bins.size());
+  nlohmann::json per_bin = nlohmann::json::array();
+  std::string line = riner::bench::format(
+      "tube wall, responses +-%.0f%%, %zu seeds, per radius:", 100 * spread, seed_bins.size());
+  for (std::size_t b = 0; b < bins; ++b) {
+    double sum = 0.0, sum_sq = 0.0;
+    int within = 0;
+    for (const std::vector<double>& e : seed_bins) {
+      sum += e[b];
+      sum_sq += e[b] * e[b];
+      within += std::fabs(e[b]) <= kWallBar;
+    }
+    const double mean = sum / n;
+    const double sd = std::sqrt(std::max(0.0, (sum_sq - n * mean * mean) / (n - 1.0)));
+    per_bin.push_back({{"radius_px", inner + static_cast<int>(b)},
+                       {"mean_error", mean},
+                       {"sd_error", sd},
+                       {"seeds_within_bar", within}});
+    line += riner::bench::format(" %d px %+.1f%% +- %.1f%% (%d within 2%%);",
+                                 inner + static_cast<int>(b), 100 * mean, 100 * sd, within);
+  }
+  int all_within = 0;
+  for (const std::vector<double>& e : seed_bins) {
+    all_within +=
+        std::all_of(e.begin(), e.end(), [](double v) { return std::fabs(v) <= kWallBar; });
+  }
+  line +=
+      riner::bench::format(" every bin within 2%%: %d of %zu seeds", all_within, seed_bins.size());
+  std::fprintf(stderr, "%s\n", line.c_str());
+  return {"tube_wall",
+          {{"scene", "tube-wall over seeds"},
+           {"spread", spread},
+           {"seeds", seed_bins.size()},
+           {"per_radius", per_bin},
+           {"seeds_with_every_bin_within_bar", all_within}},
+          line};
 }
 
 std::vector<Result> tube_wall(const Options& o) {
@@ -125,62 +176,72 @@ std::vector<Result> tube_wall(const Options& o) {
   riner::FbpOptions fbp_options;
   fbp_options.device = device;
   std::vector<Result> results;
+  const std::vector<double> seeds = riner::bench::number_list(o.get("seeds", o.get("seed", "1")));
+  const bool without_mirror = o.get_int("without-mirror", 1) != 0;
   for (double spread :
        riner::bench::number_list(o.get("spreads", o.size == "tiny" ? "0.05" : "0.25,0.05"))) {
-    riner::RingModel model;
-    model.alpha_min = 1.0 - spread;
-    model.alpha_max = 1.0 + spread;
-    model.seed = static_cast<std::uint64_t>(o.get_int("seed", 1));
-    riner::SimulatedScan sim;
-    sim.scan.geometry = g;
-    sim.ground_truth = riner::rasterize(phantom, g);
-    sim.clean = riner::exact_projections(phantom, g);
-    sim.alpha = riner::draw_responses(g, model);
-    sim.scan.measurement = riner::corrupt_measurement(sim.clean, sim.alpha, model);
-    const std::vector<double> truth = radial.of(sim.ground_truth);
-    const riner::Array perfect_image = riner::fbp(riner::Scan{sim.clean, g, 0}, fbp_options);
-    const std::vector<double> perfect = radial.of(perfect_image);
-    const riner::Array fbp_image = riner::fbp(sim.scan, fbp_options);
-    nlohmann::json fields = {{"scene", "tube-wall"},
-                             {"spread", spread},
-                             {"seed", model.seed},
-                             {"wall_px", {inner, outer}}};
-    const auto measure = [&](const riner::Array& image) {
-      return to_json(wall_error(radial.of(image), truth, perfect, inner, outer),
-                     riner::compare_images(image, sim.ground_truth));
-    };
-    fields["fbp_perfect_detector"] = measure(perfect_image);
-    fields["fbp"] = measure(fbp_image);
-    std::vector<riner::Array> images{sim.ground_truth, fbp_image};
-    for (bool mirror : {false, true}) {
-      riner::RinerConfig config = riner::bench::config_from(o);
-      config.rings.mirror_reference = mirror;
-      riner::Reconstructor r(sim.scan, config, device);
-      r.run();
-      const riner::Array image = r.result().image;
-      fields[mirror ? "riner" : "riner_without_mirror"] = measure(image);
-      images.push_back(image);
+    std::vector<std::vector<double>> seed_bins;  // Riner's wall bin errors, per seed
+    for (double seed : seeds) {
+      riner::RingModel model;
+      model.alpha_min = 1.0 - spread;
+      model.alpha_max = 1.0 + spread;
+      model.seed = static_cast<std::uint64_t>(seed);
+      riner::SimulatedScan sim;
+      sim.scan.geometry = g;
+      sim.ground_truth = riner::rasterize(phantom, g);
+      sim.clean = riner::exact_projections(phantom, g);
+      sim.alpha = riner::draw_responses(g, model);
+      sim.scan.measurement = riner::corrupt_measurement(sim.clean, sim.alpha, model);
+      const std::vector<double> truth = radial.of(sim.ground_truth);
+      const riner::Array perfect_image = riner::fbp(riner::Scan{sim.clean, g, 0}, fbp_options);
+      const std::vector<double> perfect = radial.of(perfect_image);
+      const riner::Array fbp_image = riner::fbp(sim.scan, fbp_options);
+      nlohmann::json fields = {{"scene", "tube-wall"},
+                               {"spread", spread},
+                               {"seed", model.seed},
+                               {"wall_px", {inner, outer}}};
+      const auto measure = [&](const riner::Array& image) {
+        return to_json(wall_error(radial.of(image), truth, perfect, inner, outer),
+                       riner::compare_images(image, sim.ground_truth));
+      };
+      fields["fbp_perfect_detector"] = measure(perfect_image);
+      fields["fbp"] = measure(fbp_image);
+      std::vector<riner::Array> images{sim.ground_truth, fbp_image};
+      for (bool mirror : {false, true}) {
+        if (!mirror && !without_mirror) continue;
+        riner::RinerConfig config = riner::bench::config_from(o);
+        config.rings.mirror_reference = mirror;
+        riner::Reconstructor r(sim.scan, config, device);
+        r.run();
+        const riner::Array image = r.result().image;
+        fields[mirror ? "riner" : "riner_without_mirror"] = measure(image);
+        images.push_back(image);
+      }
+      const auto& on = fields["riner"];
+      seed_bins.push_back(on["wall_bin_errors"].get<std::vector<double>>());
+      std::fprintf(
+          stderr,
+          "tube wall, responses +-%.0f%%, seed %d: wall mean %+.1f%% (perfect FBP "
+          "%+.1f%%, without mirror %+.1f%%), worst radius %+.1f%% at %d px (perfect FBP "
+          "%+.1f%%), apart from perfect FBP %.1f%%; %.2f dB\n",
+          100 * spread, static_cast<int>(model.seed), 100 * on["wall_mean_error"].get<double>(),
+          100 * fields["fbp_perfect_detector"]["wall_mean_error"].get<double>(),
+          without_mirror ? 100 * fields["riner_without_mirror"]["wall_mean_error"].get<double>()
+                         : std::nan(""),
+          100 * on["wall_worst_error"].get<double>(), on["wall_worst_radius_px"].get<int>(),
+          100 * fields["fbp_perfect_detector"]["wall_worst_error"].get<double>(),
+          100 * on["wall_worst_vs_perfect_fbp"].get<double>(), on["psnr"].get<double>());
+      if (!png_dir.empty() && images.size() == 4) {
+        // truth | FBP | Riner without the mirror-pair correction | with it
+        char name[64];
+        std::snprintf(name, sizeof name, "/tube_wall_spread%02.0f.png", 100 * spread);
+        riner::bench::write_panel_png(png_dir + name,
+                                      {&images[0], &images[1], &images[2], &images[3]},
+                                      riner::Window{0.0f, 0.05f});
+      }
+      results.push_back({"tube_wall", fields});
     }
-    const auto& on = fields["riner"];
-    std::fprintf(stderr,
-                 "tube wall, responses +-%.0f%%: wall mean %+.1f%% (perfect FBP %+.1f%%, without "
-                 "mirror %+.1f%%), worst radius %+.1f%% at %d px (perfect FBP %+.1f%%), apart "
-                 "from perfect FBP %.1f%%; %.2f dB\n",
-                 100 * spread, 100 * on["wall_mean_error"].get<double>(),
-                 100 * fields["fbp_perfect_detector"]["wall_mean_error"].get<double>(),
-                 100 * fields["riner_without_mirror"]["wall_mean_error"].get<double>(),
-                 100 * on["wall_worst_error"].get<double>(), on["wall_worst_radius_px"].get<int>(),
-                 100 * fields["fbp_perfect_detector"]["wall_worst_error"].get<double>(),
-                 100 * on["wall_worst_vs_perfect_fbp"].get<double>(), on["psnr"].get<double>());
-    if (!png_dir.empty()) {
-      // truth | FBP | Riner without the mirror-pair correction | with it
-      char name[64];
-      std::snprintf(name, sizeof name, "/tube_wall_spread%02.0f.png", 100 * spread);
-      riner::bench::write_panel_png(png_dir + name,
-                                    {&images[0], &images[1], &images[2], &images[3]},
-                                    riner::Window{0.0f, 0.05f});
-    }
-    results.push_back({"tube_wall", fields});
+    if (seed_bins.size() > 1) results.push_back(over_seeds(spread, seed_bins, inner));
   }
   return results;
 }
