@@ -378,17 +378,22 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
     std::fprintf(stderr, "riner: error: rank %d: %s\n", ranks.rank(), e.what());
     ranks.abort(1);  // the other ranks would wait for this one forever
   }
-  ranks.all_ok(true);  // every rank's slabs are written, or its checkpoints on a stop
-  release_stop_signals();
-  if (stop_signal() != 0 && run.slabs_done() < run.slabs().size()) {
+  const bool stopped = stop_signal() != 0 && run.slabs_done() < run.slabs().size();
+  const auto stopped_here = [&] {
     if (!leader) return 128 + stop_signal();
     std::size_t done = 0;
     run.slices_recorded(&done);
-    return stopped_by_signal(std::to_string(done) + " of " +
-                             std::to_string(run.slabs().size()) +
+    return stopped_by_signal(std::to_string(done) + " of " + std::to_string(run.slabs().size()) +
                              " slabs written, the checkpoints of those in training in " +
                              (out / "slabs").string());
-  }
+  };
+  // A rank stopped alone (a signal to its process, a node drained) would wait below until the
+  // others had trained every slab they could take; ending it now, its checkpoints saved, has
+  // mpirun stop the others the same way.
+  if (stopped && ranks.size() > 1) ranks.leave(stopped_here());
+  ranks.all_ok(true);  // every rank's slabs are written
+  release_stop_signals();
+  if (stopped) return stopped_here();
   const double training_wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - training_started).count();
   if (!leader) return 0;

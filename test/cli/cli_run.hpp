@@ -106,6 +106,28 @@ inline pid_t ended_process_id() {
   return pid;
 }
 
+// The PID of riner running as MPI rank `rank` with `marker` among its arguments (its output
+// folder, say), from /proc; 0 when there is none.
+inline pid_t mpi_rank_process(int rank, const std::string& marker) {
+  const std::string wanted = "OMPI_COMM_WORLD_RANK=" + std::to_string(rank);
+  std::error_code ignored;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc", ignored)) {
+    const std::string name = entry.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    const std::string arguments = read_bytes(entry.path() / "cmdline");
+    if (arguments.rfind(std::string(RINER_CLI_PATH) + '\0', 0) != 0 ||
+        arguments.find(marker) == std::string::npos) {
+      continue;
+    }
+    const std::string environment = read_bytes(entry.path() / "environ");
+    std::size_t at = 0;
+    for (std::size_t end; (end = environment.find('\0', at)) != std::string::npos; at = end + 1) {
+      if (environment.compare(at, end - at, wanted) == 0) return std::stoi(name);
+    }
+  }
+  return 0;
+}
+
 // The temporary files (".tmp." in the name) anywhere under `folder`.
 inline std::vector<std::string> temporary_files(const std::filesystem::path& folder) {
   std::vector<std::string> found;

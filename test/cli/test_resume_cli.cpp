@@ -4,6 +4,7 @@
 // stops, by riner alone or through mpirun; one during a write leaves no half-written file.
 #include <doctest/doctest.h>
 
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -219,6 +220,45 @@ TEST_SUITE("cli") {
     CHECK(riner::test::read_bytes(stopped / "alpha.npy") ==
           riner::test::read_bytes(whole / "alpha.npy"));
     CHECK(!std::filesystem::exists(checkpoint));
+#else
+    MESSAGE("riner was built without MPI (libopenmpi-dev): nothing to test");
+#endif
+  }
+
+  TEST_CASE("SIGTERM to one MPI rank alone: mpirun stops the others at once, each saving") {
+#ifdef RINER_TEST_MPI
+    riner::test::TempDir dir;
+    const std::string sim = riner::test::simulate_small_parallel3d(dir);
+    const std::filesystem::path out = dir / "out", slabs = out / "slabs";
+    // Slabs of 20 000 steps, many seconds each: one rank stopped alone used to wait for the
+    // other to train its slab (and the next) to the end.
+    std::vector<std::string> words = {
+        "--allow-run-as-root", "--oversubscribe", "-n", "2", RINER_CLI_PATH,
+        "reconstruct",         sim + "/sino.npy"};
+    words.insert(words.end(), {"--geometry", sim + "/geometry.json", "--slab-slices", "10",
+                               "--steps", "20000", "--checkpoint-minutes", "0.003"});
+    words.insert(words.end(), {"--quiet", "--out", out.string()});
+    bool signalled = false;
+    const int status = riner::test::run_program_until(
+        "mpirun", words,
+        [&] {
+          if (!std::filesystem::exists(slabs / "slab_0000.checkpoint") ||
+              !std::filesystem::exists(slabs / "slab_0001.checkpoint")) {
+            return false;
+          }
+          const pid_t rank1 = riner::test::mpi_rank_process(1, out.string());
+          signalled = rank1 > 0 && kill(rank1, SIGTERM) == 0;
+          return true;
+        },
+        0);  // mpirun itself gets no signal (0 only checks that it runs)
+    REQUIRE(signalled);
+    CHECK(!(WIFEXITED(status) && WEXITSTATUS(status) == 0));
+    // Neither slab trained to its end: rank 0 was stopped too, not left to finish.
+    CHECK(!std::filesystem::exists(slabs / "slab_0000.json"));
+    CHECK(!std::filesystem::exists(slabs / "slab_0001.json"));
+    CHECK(std::filesystem::exists(slabs / "slab_0000.checkpoint"));
+    CHECK(std::filesystem::exists(slabs / "slab_0001.checkpoint"));
+    CHECK(riner::test::temporary_files(out) == std::vector<std::string>{});
 #else
     MESSAGE("riner was built without MPI (libopenmpi-dev): nothing to test");
 #endif
