@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <thread>
 
 #include "detector_outputs.hpp"
 #include "progress.hpp"
+#include "rank_stop.hpp"
 #include "riner/cores.hpp"
 #include "riner/error.hpp"
 #include "riner/io.hpp"
@@ -199,9 +201,11 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   }
   SlabOptions options = slab_options(args);
   options.checkpoint_seconds = checkpoint_seconds(args);
+  // Shared with every rank once the run's token is known.
+  const auto rank_stop = std::make_shared<RankStop>();
   if (options.checkpoint_seconds > 0.0) {
     catch_stop_signals();
-    options.stop = [] { return stop_signal() != 0; };
+    options.stop = [rank_stop] { return rank_stop->requested(); };
   }
   const int requested = requested_processes(args);
   const SlabRanks ranks;
@@ -264,6 +268,10 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
     planned.emplace(std::move(source), config, out, options, device);
   }
   SlabRun& run = *planned;
+  if (ranks.size() > 1) {
+    rank_stop->share(out / "slabs", token);
+    if (leader) RankStop::remove_others(out / "slabs", token);
+  }
   const Geometry& g = run.source().geometry();
   const std::size_t done_before = run.slabs_done();
   if (speak) {
@@ -378,22 +386,17 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
     std::fprintf(stderr, "riner: error: rank %d: %s\n", ranks.rank(), e.what());
     ranks.abort(1);  // the other ranks would wait for this one forever
   }
-  const bool stopped = stop_signal() != 0 && run.slabs_done() < run.slabs().size();
-  const auto stopped_here = [&] {
-    if (!leader) return 128 + stop_signal();
+  ranks.all_ok(true);  // every rank's slabs are written, or its checkpoints on a stop
+  release_stop_signals();
+  if (const int sig = rank_stop->signal(); sig != 0 && run.slabs_done() < run.slabs().size()) {
+    if (!leader) return 128 + sig;
     std::size_t done = 0;
     run.slices_recorded(&done);
     return stopped_by_signal(std::to_string(done) + " of " + std::to_string(run.slabs().size()) +
-                             " slabs written, the checkpoints of those in training in " +
-                             (out / "slabs").string());
-  };
-  // A rank stopped alone (a signal to its process, a node drained) would wait below until the
-  // others had trained every slab they could take; ending it now, its checkpoints saved, has
-  // mpirun stop the others the same way.
-  if (stopped && ranks.size() > 1) ranks.leave(stopped_here());
-  ranks.all_ok(true);  // every rank's slabs are written
-  release_stop_signals();
-  if (stopped) return stopped_here();
+                                 " slabs written, the checkpoints of those in training in " +
+                                 (out / "slabs").string(),
+                             sig);
+  }
   const double training_wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - training_started).count();
   if (!leader) return 0;

@@ -82,8 +82,9 @@ void release_stop_signals() {
 
 int stop_signal() { return requested; }
 
-int stopped_by_signal(const std::string& kept) {
-  const int sig = stop_signal();
+int stopped_by_signal(const std::string& kept) { return stopped_by_signal(kept, stop_signal()); }
+
+int stopped_by_signal(const std::string& kept, int sig) {
   std::fprintf(stderr, "riner: stopped by %s: %s; the same command with --resume goes on\n",
                sig == SIGINT    ? "SIGINT"
                : sig == SIGTERM ? "SIGTERM"

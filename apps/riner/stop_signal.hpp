@@ -28,5 +28,7 @@ int stop_signal();
 // After a stop: "riner: stopped by SIG...: <what was kept>; the same command with --resume goes
 // on" on stderr, and the exit code 128 + the signal's number.
 int stopped_by_signal(const std::string& kept);
+// The same for a stop by `sig` (another rank's, say).
+int stopped_by_signal(const std::string& kept, int sig);
 
 }  // namespace riner::app

@@ -276,8 +276,8 @@ def reconstruct(sino, geometry, flat=None, dark=None, center=None, config=None, 
     checkpoint: a file where training's state is saved every checkpoint_minutes minutes of
     training and where it stops early (Ctrl-C, the callback); when it exists, training goes on
     from it (the same scan, settings and device: the uninterrupted run's result to the bit), and
-    it is removed once training has finished. The temporary file that a kill in the middle of
-    a save left beside it (its writer on this host ended) is removed first.
+    it is removed once training has finished. The temporary files that a kill in the middle of
+    a save left in its folder (their writer on this host ended) are removed first.
     """
     sino, geometry_json, notes = _scan(sino, geometry, flat, dark, center, flat_after)
     if config is None:

@@ -39,9 +39,6 @@ class SlabRanks {
   bool all_ok(bool ok) const;
   // Ends the job at once on every rank (a rank that failed alone would hang the others).
   [[noreturn]] void abort(int code) const;
-  // Ends this rank alone with `code`, without the collective end of MPI (a rank that finalises
-  // waits for the others): mpirun then ends the job, each other rank by SIGTERM.
-  [[noreturn]] void leave(int code) const;
 
  private:
   bool mpi_ = false;

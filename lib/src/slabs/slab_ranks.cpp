@@ -107,12 +107,6 @@ void SlabRanks::abort(int code) const {
   std::exit(code);
 }
 
-void SlabRanks::leave(int code) const {
-  std::fflush(stdout);
-  std::fflush(stderr);
-  std::_Exit(code);
-}
-
 std::string new_claim_token() {
   const auto now = std::chrono::system_clock::now().time_since_epoch();
   char token[64];
