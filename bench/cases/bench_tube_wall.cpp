@@ -12,20 +12,28 @@
 //   bin's error over the draws (mean: what the method takes from the wall on average; spread:
 //   what one detector's draw leaves, which no correction can tell from the wall)
 //   --without-mirror=0: Riner with the mirror-pair correction only
+//   --save=DIR: each seed's training (with the mirror-pair correction) as DIR/spreadSS_seedNNN/
+//   --replay=DIR: the ring chain at --config replayed on those saved trainings instead of
+//   training (seconds a scan; the image before the readings' detail), the same statistics
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <limits>
+#include <map>
 
 #include "harness.hpp"
 #include "metrics/radial_profile.hpp"
+#include "riner/error.hpp"
 #include "riner/fbp.hpp"
 #include "riner/io.hpp"
 #include "riner/metrics.hpp"
 #include "riner/phantom.hpp"
 #include "riner/reconstructor.hpp"
+#include "riner/ring_chain.hpp"
 #include "riner/simulate.hpp"
 #include "rings/radial.hpp"
+#include "saved_training.hpp"
 #include "scenes.hpp"
 
 namespace {
@@ -163,25 +171,74 @@ Result over_seeds(double spread, const std::vector<std::vector<double>>& seed_bi
           line};
 }
 
+std::string saved_name(double spread, std::uint64_t seed) {
+  char name[64];
+  std::snprintf(name, sizeof name, "spread%02.0f_seed%03d", 100 * spread, static_cast<int>(seed));
+  return name;
+}
+
+// The bins whose whole pixel lies inside the wall.
+std::pair<int, int> wall_bins(const riner::Geometry& g) {
+  const riner::TubeWallShape shape = riner::tube_wall_shape(g);
+  return {static_cast<int>(std::ceil(shape.inner_mm / g.voxel_mm + 0.5)),
+          static_cast<int>(std::floor(shape.outer_mm / g.voxel_mm - 0.5))};
+}
+
+// --replay: the chain on each saved training, grouped by spread.
+std::vector<Result> tube_wall_replay(const Options& o, const std::filesystem::path& dir) {
+  const riner::RinerConfig config = riner::bench::config_from(o);
+  const riner::Geometry g = riner::preset_geometry("fan2d-paper");
+  const RadialProfile radial(riner::tube_wall(g), g);
+  const auto [inner, outer] = wall_bins(g);
+  std::vector<std::filesystem::path> saved;
+  for (const auto& entry : std::filesystem::directory_iterator(dir)) {
+    if (entry.is_directory()) saved.push_back(entry.path());
+  }
+  std::sort(saved.begin(), saved.end());
+  std::map<int, std::vector<std::vector<double>>> by_spread;  // percent -> seeds' bin errors
+  std::vector<Result> results;
+  for (const std::filesystem::path& path : saved) {
+    int percent = 0, seed = 0;
+    if (std::sscanf(path.filename().c_str(), "spread%d_seed%d", &percent, &seed) != 2) continue;
+    const riner::bench::SavedTraining s = riner::bench::load_training(path);
+    riner::Array image =
+        riner::correct_rings_in_order(s.field, s.alpha, s.geometry, s.dead, config.rings).image;
+    for (std::size_t p = 0; p < image.size(); ++p) image.data[p] *= s.keep.data[p];
+    const std::vector<double> truth = radial.of(s.reference);
+    const WallError w = wall_error(radial.of(image), truth, truth, inner, outer);
+    const riner::ImageMetrics m = riner::compare_images(image, s.reference);
+    by_spread[percent].push_back(w.bins);
+    std::fprintf(stderr,
+                 "replayed +-%d%% seed %d: wall mean %+.1f%%, worst %+.1f%% at %d px; %.2f dB\n",
+                 percent, seed, 100 * w.mean, 100 * w.worst, w.worst_radius, m.psnr);
+    nlohmann::json row = to_json(w, m);
+    row.update({{"scene", "tube-wall replayed"}, {"spread", percent / 100.0}, {"seed", seed}});
+    results.push_back({"tube_wall", row});
+  }
+  for (const auto& [percent, bins] : by_spread) {
+    if (bins.size() > 1) results.push_back(over_seeds(percent / 100.0, bins, inner));
+  }
+  return results;
+}
+
 std::vector<Result> tube_wall(const Options& o) {
+  if (const std::string dir = o.get("replay", ""); !dir.empty()) return tube_wall_replay(o, dir);
   riner::Device device = riner::Device::open(o.device);
   const riner::Geometry g = riner::preset_geometry("fan2d-paper");
   const riner::Phantom phantom = riner::tube_wall(g);
-  const riner::TubeWallShape shape = riner::tube_wall_shape(g);
-  // The bins whose whole pixel lies inside the wall.
-  const int inner = static_cast<int>(std::ceil(shape.inner_mm / g.voxel_mm + 0.5));
-  const int outer = static_cast<int>(std::floor(shape.outer_mm / g.voxel_mm - 0.5));
+  const auto [inner, outer] = wall_bins(g);
   const RadialProfile radial(phantom, g);
   const std::string png_dir = o.output_dir("png", "");
   riner::FbpOptions fbp_options;
   fbp_options.device = device;
   std::vector<Result> results;
-  const std::vector<double> seeds = riner::bench::number_list(o.get("seeds", o.get("seed", "1")));
+  const std::vector<int> seeds = riner::bench::int_list(o.get("seeds", o.get("seed", "1")));
   const bool without_mirror = o.get_int("without-mirror", 1) != 0;
   for (double spread :
        riner::bench::number_list(o.get("spreads", o.size == "tiny" ? "0.05" : "0.25,0.05"))) {
     std::vector<std::vector<double>> seed_bins;  // Riner's wall bin errors, per seed
-    for (double seed : seeds) {
+    for (int seed : seeds) {
+      if (seed < 0) throw riner::InputError("tube_wall: --seeds are numbers from 0");
       riner::RingModel model;
       model.alpha_min = 1.0 - spread;
       model.alpha_max = 1.0 + spread;
@@ -216,6 +273,10 @@ std::vector<Result> tube_wall(const Options& o) {
         const riner::Array image = r.result().image;
         fields[mirror ? "riner" : "riner_without_mirror"] = measure(image);
         images.push_back(image);
+        if (const std::string dir = o.get("save", ""); mirror && !dir.empty()) {
+          riner::bench::save_training(std::filesystem::path(dir) / saved_name(spread, model.seed),
+                                      r, g, sim.ground_truth, true, config.rings);
+        }
       }
       const auto& on = fields["riner"];
       seed_bins.push_back(on["wall_bin_errors"].get<std::vector<double>>());
@@ -234,7 +295,8 @@ std::vector<Result> tube_wall(const Options& o) {
       if (!png_dir.empty() && images.size() == 4) {
         // truth | FBP | Riner without the mirror-pair correction | with it
         char name[64];
-        std::snprintf(name, sizeof name, "/tube_wall_spread%02.0f.png", 100 * spread);
+        std::snprintf(name, sizeof name, "/tube_wall_spread%02.0f%s.png", 100 * spread,
+                      seeds.size() > 1 ? ("_seed" + std::to_string(seed)).c_str() : "");
         riner::bench::write_panel_png(png_dir + name,
                                       {&images[0], &images[1], &images[2], &images[3]},
                                       riner::Window{0.0f, 0.05f});
