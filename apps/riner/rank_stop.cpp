@@ -37,7 +37,8 @@ bool RankStop::requested() {
   return true;
 }
 
-int RankStop::signal() const {
+int RankStop::signal() {
+  if (!requested()) return 0;  // looks once more: the others may have stopped since
   const int own = stop_signal();
   return own != 0 ? own : from_other_.load();
 }

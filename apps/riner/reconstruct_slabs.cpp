@@ -268,7 +268,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
     planned.emplace(std::move(source), config, out, options, device);
   }
   SlabRun& run = *planned;
-  if (ranks.size() > 1) {
+  if (ranks.size() > 1 || !joined.empty() || processes > 1) {
     rank_stop->share(out / "slabs", token);
     if (leader) RankStop::remove_others(out / "slabs", token);
   }
@@ -344,7 +344,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
                              pinned);
         copies_pinned = copies.pinned();
         while (copies.running()) {
-          if (stop_signal() != 0) {
+          if (rank_stop->requested()) {  // this process's signal, or a copy's
             copies.stop();  // each saves its slab's checkpoint and ends
             break;
           }
@@ -361,7 +361,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
         }
         if (!copies.failure().empty()) throw Error(copies.failure());
       }
-      progress.finish();
+      if (rank_stop->signal() == 0) progress.finish();  // a stop leaves the last line drawn
     } else {
     run.run(
         [&](const SlabProgress& p) {
@@ -379,7 +379,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
         },
         static_cast<int>(args.integer("report-every")),
         ranks.size() > 1 || !joined.empty() ? claim_by_file(out, token) : SlabRun::Claim{});
-    progress.finish();
+    if (rank_stop->signal() == 0) progress.finish();
     }
   } catch (const std::exception& e) {
     if (ranks.size() == 1) throw;
@@ -401,6 +401,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       std::chrono::duration<double>(std::chrono::steady_clock::now() - training_started).count();
   if (!leader) return 0;
   run.finish();
+  RankStop::remove_others(out / "slabs", "");  // a stop that came after the last slab
 
   // The whole scan's outputs from the slabs' files (this run's and earlier runs').
   std::vector<std::size_t> dead;

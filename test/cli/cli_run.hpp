@@ -45,9 +45,24 @@ inline Run riner_cli(const std::string& arguments, const TempDir& dir) {
   return run;
 }
 
-// Who run_program_until's signal goes to: the process, or the process group it leads (what a
-// terminal's Ctrl-C reaches: the process and every process it started).
-enum class SignalTo { kProcess, kGroup };
+// Who run_program_until's signal goes to: the process, the process group it leads (what a
+// terminal's Ctrl-C reaches: the process and every process it started), or one of the
+// processes it started (the first found; a slabbed run's --processes copy, say).
+enum class SignalTo { kProcess, kGroup, kOneChild };
+
+// A running child of `parent` (from /proc), or 0 when it has none.
+inline pid_t child_process(pid_t parent) {
+  const std::string wanted = "PPid:\t" + std::to_string(parent) + "\n";
+  std::error_code ignored;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc", ignored)) {
+    const std::string name = entry.path().filename().string();
+    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    if (read_bytes(entry.path() / "status").find(wanted) != std::string::npos) {
+      return std::stoi(name);
+    }
+  }
+  return 0;
+}
 
 // PROGRAM WORDS... (PROGRAM found on PATH) started and sent `sig` once `until` is true (or after
 // 120 s), unless it ended first; the process's wait status.
@@ -85,7 +100,15 @@ inline int run_program_until(const std::string& program, std::vector<std::string
     if (waitpid(pid, &status, WNOHANG) == pid) return status;
     std::this_thread::sleep_for(std::chrono::milliseconds(2));
   }
-  kill(to == SignalTo::kGroup ? -pid : pid, sig);
+  if (to == SignalTo::kOneChild) {
+    pid_t child = 0;
+    while ((child = child_process(pid)) == 0 && waitpid(pid, &status, WNOHANG) == 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    }
+    if (child > 0) kill(child, sig);
+  } else {
+    kill(to == SignalTo::kGroup ? -pid : pid, sig);
+  }
   waitpid(pid, &status, 0);
   return status;
 }

@@ -317,9 +317,12 @@ TEST_SUITE("cli") {
       CHECK(riner::test::temporary_files(stopped) == std::vector<std::string>{});
     };
     // A scheduler's SIGTERM to the first process alone: it asks its copies to stop (a request),
-    // each saves its slab. Then, resumed, Ctrl-C from a terminal: the whole process group.
+    // each saves its slab. Then, resumed, Ctrl-C from a terminal: the whole process group. Then
+    // SIGTERM to one copy alone: its stop is every copy's (slabs/stop.TOKEN), the run's exit
+    // code SIGTERM's (it used to train the other slabs on and end "slab N is not done").
     stop(SIGTERM, riner::test::SignalTo::kProcess);
     stop(SIGINT, riner::test::SignalTo::kGroup);
+    stop(SIGTERM, riner::test::SignalTo::kOneChild);
 
     status = run(stopped, {"--resume"}, never, SIGKILL, riner::test::SignalTo::kProcess);
     REQUIRE(WIFEXITED(status));
