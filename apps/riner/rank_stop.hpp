@@ -12,18 +12,25 @@
 #include <filesystem>
 #include <mutex>
 #include <string>
+#include <thread>
 
 namespace riner::app {
 
 class RankStop {
  public:
-  // From now on this process's stop is every rank's of the run `token`, through `folder`.
-  // Before: its own signal only.
+  RankStop() = default;
+  ~RankStop();
+  RankStop(const RankStop&) = delete;
+  RankStop& operator=(const RankStop&) = delete;
+
+  // From now on this process's stop is every process's of the run `token`, through `folder`:
+  // a watcher leaves the file as soon as this process's signal comes, whatever it is doing (a
+  // rank with no slab left waits for the others in MPI, where no report looks). Before: its
+  // own signal only.
   void share(const std::filesystem::path& folder, const std::string& token);
-  // This process's signal (which it then leaves for the others), or another rank's file. Called
-  // by the training workers at each report.
+  // This process's signal, or another's file. Called by the training workers at each report.
   bool requested();
-  // The signal that stopped the run (this process's or another's), or 0.
+  // The signal that stopped the run (this process's or another's), or 0; looks once more.
   int signal();
 
   // The stop files in `folder` of runs other than `token` (a stopped run's, once resumed);
@@ -31,9 +38,12 @@ class RankStop {
   static void remove_others(const std::filesystem::path& folder, const std::string& token);
 
  private:
-  std::filesystem::path file_;  // empty until share()
+  void leave_file(int sig);     // once; never throws (a stop must not become an error)
+  std::filesystem::path file_;  // empty until share(), then fixed
   std::once_flag left_;
   std::atomic<int> from_other_{0};
+  std::atomic<bool> done_{false};
+  std::thread watcher_;
 };
 
 }  // namespace riner::app

@@ -45,6 +45,11 @@ SlabOptions slab_size_options(const Args& args) {
 
 namespace {
 
+// Stopped before every slab was written (a stop after the last one changes nothing).
+bool stopped_early(RankStop& stop, const SlabRun& run) {
+  return stop.signal() != 0 && run.slabs_done() < run.slabs().size();
+}
+
 SlabOptions slab_options(const Args& args) {
   SlabOptions options = slab_size_options(args);
   options.resume = args.is_set("resume");
@@ -361,7 +366,8 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
         }
         if (!copies.failure().empty()) throw Error(copies.failure());
       }
-      if (rank_stop->signal() == 0) progress.finish();  // a stop leaves the last line drawn
+      // A stopped run leaves its last line as drawn.
+      if (!stopped_early(*rank_stop, run)) progress.finish();
     } else {
     run.run(
         [&](const SlabProgress& p) {
@@ -379,7 +385,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
         },
         static_cast<int>(args.integer("report-every")),
         ranks.size() > 1 || !joined.empty() ? claim_by_file(out, token) : SlabRun::Claim{});
-    if (rank_stop->signal() == 0) progress.finish();
+    if (!stopped_early(*rank_stop, run)) progress.finish();
     }
   } catch (const std::exception& e) {
     if (ranks.size() == 1) throw;
@@ -388,7 +394,8 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   }
   ranks.all_ok(true);  // every rank's slabs are written, or its checkpoints on a stop
   release_stop_signals();
-  if (const int sig = rank_stop->signal(); sig != 0 && run.slabs_done() < run.slabs().size()) {
+  if (stopped_early(*rank_stop, run)) {
+    const int sig = rank_stop->signal();
     if (!leader) return 128 + sig;
     std::size_t done = 0;
     run.slices_recorded(&done);
