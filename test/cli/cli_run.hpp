@@ -50,18 +50,23 @@ inline Run riner_cli(const std::string& arguments, const TempDir& dir) {
 // processes it started (the first found; a slabbed run's --processes copy, say).
 enum class SignalTo { kProcess, kGroup, kOneChild };
 
-// A running child of `parent` (from /proc), or 0 when it has none.
-inline pid_t child_process(pid_t parent) {
-  const std::string wanted = "PPid:\t" + std::to_string(parent) + "\n";
+// The PID of the first running process whose /proc folder `matches`, or 0.
+inline pid_t first_process(const std::function<bool(const std::filesystem::path&)>& matches) {
   std::error_code ignored;
   for (const auto& entry : std::filesystem::directory_iterator("/proc", ignored)) {
     const std::string name = entry.path().filename().string();
     if (name.find_first_not_of("0123456789") != std::string::npos) continue;
-    if (read_bytes(entry.path() / "status").find(wanted) != std::string::npos) {
-      return std::stoi(name);
-    }
+    if (matches(entry.path())) return std::stoi(name);
   }
   return 0;
+}
+
+// A running child of `parent`, or 0 when it has none.
+inline pid_t child_process(pid_t parent) {
+  const std::string wanted = "PPid:\t" + std::to_string(parent) + "\n";
+  return first_process([&](const std::filesystem::path& proc) {
+    return read_bytes(proc / "status").find(wanted) != std::string::npos;
+  });
 }
 
 // PROGRAM WORDS... (PROGRAM found on PATH) started and sent `sig` once `until` is true (or after
@@ -133,22 +138,19 @@ inline pid_t ended_process_id() {
 // folder, say), from /proc; 0 when there is none.
 inline pid_t mpi_rank_process(int rank, const std::string& marker) {
   const std::string wanted = "OMPI_COMM_WORLD_RANK=" + std::to_string(rank);
-  std::error_code ignored;
-  for (const auto& entry : std::filesystem::directory_iterator("/proc", ignored)) {
-    const std::string name = entry.path().filename().string();
-    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
-    const std::string arguments = read_bytes(entry.path() / "cmdline");
+  return first_process([&](const std::filesystem::path& proc) {
+    const std::string arguments = read_bytes(proc / "cmdline");
     if (arguments.rfind(std::string(RINER_CLI_PATH) + '\0', 0) != 0 ||
         arguments.find(marker) == std::string::npos) {
-      continue;
+      return false;
     }
-    const std::string environment = read_bytes(entry.path() / "environ");
+    const std::string environment = read_bytes(proc / "environ");
     std::size_t at = 0;
     for (std::size_t end; (end = environment.find('\0', at)) != std::string::npos; at = end + 1) {
-      if (environment.compare(at, end - at, wanted) == 0) return std::stoi(name);
+      if (environment.compare(at, end - at, wanted) == 0) return true;
     }
-  }
-  return 0;
+    return false;
+  });
 }
 
 // The temporary files (".tmp." in the name) anywhere under `folder`.
