@@ -26,6 +26,12 @@ bool holds_structure(const Array& measurement) {
   return stats.max > stats.min;
 }
 
+[[noreturn]] void throw_without_structure() {
+  throw InputError(
+      "the readings are all equal: they hold nothing to find the centre from; pass the offset "
+      "with --offset-px");
+}
+
 // Enough pairs and rows for a stable sum, few enough to stay a fraction of a second.
 constexpr std::size_t kMostPairs = 32;
 constexpr std::size_t kMostRows = 24;
@@ -337,8 +343,19 @@ CentreEstimate estimate_from(const Scan& scan) {
   }
   if (g.n_u < 8) throw InputError("centre finding needs a detector of at least 8 elements");
   const std::optional<CentreEstimate> pairs = from_view_pairs(scan);
-  const std::optional<preprocessing::SinogramAxis> sinogram = preprocessing::sinogram_axis(scan);
+  std::optional<preprocessing::SinogramAxis> sinogram = preprocessing::sinogram_axis(scan);
+  const bool no_minimum = sinogram && sinogram->rows == 0;
+  if (no_minimum) sinogram.reset();
   if (!pairs && !sinogram) {
+    if (!holds_structure(scan.measurement)) throw_without_structure();
+    if (no_minimum) {
+      throw InputError(
+          "the whole sinogram matches its mirror image best at an end of the search (the axis "
+          "within " +
+          std::to_string(static_cast<int>(std::lround(kCentreSearchShare * 100))) +
+          "% of the detector's width of its middle): the axis lies beyond, or the readings do "
+          "not show the object turning; pass the offset with --offset-px");
+    }
     throw InputError(
         "the views cover no evenly spaced half-turn and no two are half a turn apart (or either "
         "side of it); pass the offset with --offset-px");
@@ -367,11 +384,7 @@ bool centre_search_covers(const Geometry& g) {
 
 CentreEstimate estimate_centre(const Scan& scan) {
   const CentreEstimate e = estimate_from(scan);
-  if (!holds_structure(scan.measurement)) {
-    throw InputError(
-        "the readings are all equal: they hold nothing to find the centre from; pass the offset "
-        "with --offset-px");
-  }
+  if (!holds_structure(scan.measurement)) throw_without_structure();
   return e;
 }
 

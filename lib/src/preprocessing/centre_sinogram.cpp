@@ -19,6 +19,10 @@ namespace {
 // The coarse search's sinogram: at most this many columns and views (binned).
 constexpr std::size_t kCoarseColumns = 256;
 constexpr std::size_t kMostViews = 256;
+// The spectral measure's best stands where it is this close to the filled measure's (px).
+constexpr double kAgreePx = 0.5;
+// The coarse search's measure takes a transform per candidate: fewer views.
+constexpr std::size_t kCoarseViews = 128;
 // The fine search at full width: this step (px) within one coarse column of the coarse minimum.
 constexpr double kFineStepPx = 0.25;
 constexpr std::size_t kMostRows = 8;
@@ -67,6 +71,41 @@ std::vector<Row> binned(const std::vector<Row>& s, std::size_t by_views, std::si
   return out;
 }
 
+// A row's spectrum, padded to `padded` by a straight line from its last value back to its
+// first (no step at the wrap).
+std::vector<std::complex<double>> padded_spectrum(const Row& r, std::size_t padded) {
+  const std::size_t n = r.size();
+  Row line(padded);
+  std::copy(r.begin(), r.end(), line.begin());
+  const std::size_t gap = padded - n;
+  for (std::size_t i = 0; i < gap; ++i) {
+    const double t = static_cast<double>(i + 1) / static_cast<double>(gap + 1);
+    line[n + i] = (1.0 - t) * r.back() + t * r.front();
+  }
+  Eigen::FFT<double> fft;
+  std::vector<std::complex<double>> out;
+  fft.fwd(out, line);
+  return out;
+}
+
+// The harmonics m (of a full turn of `turn` views) outside the double wedge at detector
+// frequency k (of a row padded to `padded` from `n` columns): harmonic m of a point at radius r
+// (px) has |m| <= 2 pi r k / padded, and r reaches half the detector. Empty past the last k
+// with any.
+std::vector<std::size_t> outside_wedge(std::size_t k, std::size_t n, std::size_t padded,
+                                       std::size_t turn) {
+  const double slope = M_PI * static_cast<double>(n) / static_cast<double>(padded);
+  const double wedge = slope * static_cast<double>(k) + 1.0;
+  std::vector<std::size_t> outside;
+  if (wedge >= 0.5 * static_cast<double>(turn)) return outside;
+  for (std::size_t m = 0; m < turn; ++m) {
+    const double signed_m =
+        m <= turn / 2 ? static_cast<double>(m) : static_cast<double>(m) - static_cast<double>(turn);
+    if (std::fabs(signed_m) > wedge) outside.push_back(m);
+  }
+  return outside;
+}
+
 // Mean magnitude of the stacked sinogram's spectrum outside the double wedge: the first half's
 // rows as they are, the second half's mirrored about `axis`. The mirror is taken in the rows'
 // spectra (r(2a - u) has the spectrum exp(-4 pi i k a / P) conj(R(k)) for a row of period P):
@@ -79,22 +118,13 @@ class WedgeEnergy {
   explicit WedgeEnergy(const std::vector<Row>& s)
       : n_(s[0].size()), padded_(smooth_length(2 * s[0].size())), views_(s.size()) {
     std::vector<std::vector<std::complex<double>>> rows;
-    for (const Row& r : s) rows.push_back(spectrum(r));
-    // Harmonic m of a point at radius r (px): |m| <= 2 pi r k / padded at detector frequency k;
-    // r reaches half the detector.
+    for (const Row& r : s) rows.push_back(padded_spectrum(r, padded_));
     const std::size_t turn = 2 * views_;
-    const double slope = M_PI * static_cast<double>(n_) / static_cast<double>(padded_);
     Eigen::FFT<double> fft;
     std::vector<std::complex<double>> column(turn), harmonics;
     for (std::size_t k = 1; k <= padded_ / 2; ++k) {
-      const double wedge = slope * static_cast<double>(k) + 1.0;
-      if (wedge >= 0.5 * static_cast<double>(turn)) break;
-      std::vector<std::size_t> outside;
-      for (std::size_t m = 0; m < turn; ++m) {
-        const double signed_m = m <= turn / 2 ? static_cast<double>(m)
-                                              : static_cast<double>(m) - static_cast<double>(turn);
-        if (std::fabs(signed_m) > wedge) outside.push_back(m);
-      }
+      const std::vector<std::size_t> outside = outside_wedge(k, n_, padded_, turn);
+      if (outside.empty()) break;
       Frequency f;
       f.k = static_cast<double>(k);
       std::fill(column.begin(), column.end(), std::complex<double>{});
@@ -131,27 +161,90 @@ class WedgeEnergy {
     std::vector<std::complex<double>> first, mirrored;
   };
 
-  // A row's spectrum, padded to `padded_` by a straight line from its last value back to its
-  // first (no step at the wrap).
-  std::vector<std::complex<double>> spectrum(const Row& r) const {
-    Row line(padded_);
-    std::copy(r.begin(), r.end(), line.begin());
-    const std::size_t gap = padded_ - n_;
-    for (std::size_t i = 0; i < gap; ++i) {
-      const double t = static_cast<double>(i + 1) / static_cast<double>(gap + 1);
-      line[n_ + i] = (1.0 - t) * r.back() + t * r.front();
-    }
-    Eigen::FFT<double> fft;
-    std::vector<std::complex<double>> out;
-    fft.fwd(out, line);
-    return out;
-  }
-
   std::size_t n_ = 0;
   std::size_t padded_ = 0;
   std::size_t views_ = 0;
   double count_ = 0.0;
   std::vector<Frequency> frequencies_;
+};
+
+// The same measure with the mirrored half built in real space, where the columns its mirror
+// image does not reach hold the first half-turn in reverse view order (as Vo's own code fills
+// them). An object wider than the field of view reads non-zero at the detector's ends; in the
+// spectral mirror those columns meet the padding's wrap, whose seam costs less the larger the
+// shift, and the search can end at its edge (a 200-column scan of a wider object, the axis 30 px
+// off: -50.75). Filled, the columns no mirror reaches continue the first half without a seam
+// at every axis (the search's best within a few tenths of a pixel of the axis where a wide
+// object biases the spectral measure by a pixel or more). One row transform per view and
+// candidate: the coarse search's measure.
+class FilledWedgeEnergy {
+ public:
+  explicit FilledWedgeEnergy(const std::vector<Row>& s)
+      : rows_(s), n_(s[0].size()), padded_(smooth_length(2 * s[0].size())), views_(s.size()) {
+    const std::size_t turn = 2 * views_;
+    Eigen::FFT<double> fft;
+    std::vector<std::vector<std::complex<double>>> spectra;
+    for (const Row& r : s) spectra.push_back(padded_spectrum(r, padded_));
+    std::vector<std::complex<double>> column(turn), harmonics;
+    for (std::size_t k = 1; k <= padded_ / 2; ++k) {
+      std::vector<std::size_t> outside = outside_wedge(k, n_, padded_, turn);
+      if (outside.empty()) break;
+      std::fill(column.begin(), column.end(), std::complex<double>{});
+      for (std::size_t v = 0; v < views_; ++v) column[v] = spectra[v][k];
+      fft.fwd(harmonics, column);
+      std::vector<std::complex<double>> first;
+      for (std::size_t m : outside) first.push_back(harmonics[m]);
+      count_ += static_cast<double>(outside.size());
+      outside_.push_back(std::move(outside));
+      first_.push_back(std::move(first));
+    }
+  }
+
+  double operator()(double axis) const {
+    const std::size_t turn = 2 * views_;
+    const std::size_t frequencies = first_.size();
+    // The mirrored half's spectra at the frequencies used, view by view.
+    std::vector<std::vector<std::complex<double>>> spectra(views_);
+    Eigen::FFT<double> fft;
+    Row mirrored(n_);
+    for (std::size_t v = 0; v < views_; ++v) {
+      const Row& r = rows_[v];
+      const Row& reverse = rows_[views_ - 1 - v];
+      for (std::size_t j = 0; j < n_; ++j) {
+        const double x = 2.0 * axis - static_cast<double>(j);
+        if (x < 0.0 || x > static_cast<double>(n_ - 1)) {
+          mirrored[j] = reverse[j];
+          continue;
+        }
+        const auto i = std::min(static_cast<std::size_t>(x), n_ - 2);
+        const double t = x - static_cast<double>(i);
+        mirrored[j] = (1.0 - t) * r[i] + t * r[i + 1];
+      }
+      spectra[v] = padded_spectrum(mirrored, padded_);
+    }
+    std::vector<std::complex<double>> column(turn), harmonics;
+    double sum = 0.0;
+    for (std::size_t f = 0; f < frequencies; ++f) {
+      std::fill(column.begin(), column.end(), std::complex<double>{});
+      for (std::size_t v = 0; v < views_; ++v) column[views_ + v] = spectra[v][f + 1];
+      fft.fwd(harmonics, column);
+      for (std::size_t i = 0; i < outside_[f].size(); ++i) {
+        sum += std::sqrt(std::norm(first_[f][i] + harmonics[outside_[f][i]]));
+      }
+    }
+    return count_ > 0.0 ? sum / count_ : 0.0;
+  }
+
+ private:
+  std::vector<Row> rows_;
+  std::size_t n_ = 0;
+  std::size_t padded_ = 0;
+  std::size_t views_ = 0;
+  double count_ = 0.0;
+  // Per detector frequency k = 1, 2, ...: the harmonics outside the wedge, and the first
+  // half's share of them.
+  std::vector<std::vector<std::size_t>> outside_;
+  std::vector<std::vector<std::complex<double>>> first_;
 };
 
 // The best of `candidates` (evaluated in parallel; the costs of every half-turn added) and its
@@ -160,13 +253,14 @@ struct Minimum {
   std::size_t index = 0;
   std::vector<double> costs;
 };
-Minimum minimise(const std::vector<WedgeEnergy>& costs, const std::vector<double>& candidates) {
+template <typename Cost>
+Minimum minimise(const std::vector<Cost>& costs, const std::vector<double>& candidates) {
   Minimum m;
   m.costs.resize(candidates.size());
   util::parallel_for(candidates.size(), [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) {
       m.costs[i] = 0.0;
-      for (const WedgeEnergy& cost : costs) m.costs[i] += cost(candidates[i]);
+      for (const Cost& cost : costs) m.costs[i] += cost(candidates[i]);
     }
   });
   m.index =
@@ -174,15 +268,27 @@ Minimum minimise(const std::vector<WedgeEnergy>& costs, const std::vector<double
   return m;
 }
 
+// A parabola's vertex through the best of `m` and its neighbours, on candidates `step` apart.
+double vertex(const Minimum& m, const std::vector<double>& candidates, double step) {
+  if (m.index == 0 || m.index + 1 == candidates.size()) return candidates[m.index];
+  const double y0 = m.costs[m.index - 1], y1 = m.costs[m.index], y2 = m.costs[m.index + 1];
+  const double curvature = y0 - 2.0 * y1 + y2;
+  const double shift = curvature > 0.0 ? 0.5 * (y0 - y2) / curvature : 0.0;
+  return candidates[m.index] + std::clamp(shift, -0.5, 0.5) * step;
+}
+
 // The axis of one detector row from its half-turn sinograms (one per half-turn the scan holds;
-// finite values).
-double row_axis(const std::vector<std::vector<Row>>& turns) {
+// finite values); nullopt where the coarse search's best is at the end of its range (no
+// minimum found: the true axis lies beyond, or the measure failed).
+std::optional<double> row_axis(const std::vector<std::vector<Row>>& turns) {
   const std::size_t n = turns[0][0].size();
   const std::size_t by_views = std::max<std::size_t>(1, turns[0].size() / kMostViews);
-  const std::size_t by_columns = std::max<std::size_t>(1, n / kCoarseColumns);
-  std::vector<WedgeEnergy> coarse, wide;
+  const std::size_t by_coarse_views = (turns[0].size() + kCoarseViews - 1) / kCoarseViews;
+  const std::size_t by_columns = (n + kCoarseColumns - 1) / kCoarseColumns;
+  std::vector<FilledWedgeEnergy> coarse;
+  std::vector<WedgeEnergy> wide;
   for (const std::vector<Row>& s : turns) {
-    coarse.emplace_back(binned(s, by_views, by_columns));
+    coarse.emplace_back(binned(s, by_coarse_views, by_columns));
     wide.emplace_back(binned(s, by_views, 1));
   }
   const double nb = static_cast<double>(n / by_columns);
@@ -192,18 +298,21 @@ double row_axis(const std::vector<std::vector<Row>>& turns) {
     candidates.push_back(a);
   }
   const Minimum c = minimise(coarse, candidates);
+  if (c.index == 0 || c.index + 1 == candidates.size()) return std::nullopt;
   // Binned column a covers columns by_columns a .. by_columns (a + 1) - 1.
   const double f = static_cast<double>(by_columns);
   const double centre = f * candidates[c.index] + 0.5 * (f - 1.0);
   std::vector<double> fine;
   for (double a = centre - f; a <= centre + f + 1e-9; a += kFineStepPx) fine.push_back(a);
   const Minimum m = minimise(wide, fine);
-  if (m.index == 0 || m.index + 1 == fine.size()) return fine[m.index];
-  // A parabola through the best and its neighbours.
-  const double y0 = m.costs[m.index - 1], y1 = m.costs[m.index], y2 = m.costs[m.index + 1];
-  const double curvature = y0 - 2.0 * y1 + y2;
-  const double step = curvature > 0.0 ? 0.5 * (y0 - y2) / curvature : 0.0;
-  return fine[m.index] + std::clamp(step, -0.5, 0.5) * kFineStepPx;
+  // The spectral measure's best where it has one inside its window near the filled one's (a
+  // few hundredths of a pixel where the object is within the field of view); else the filled.
+  const double coarse_axis = f * vertex(c, candidates, 0.5) + 0.5 * (f - 1.0);
+  if (m.index > 0 && m.index + 1 < fine.size()) {
+    const double fine_axis = vertex(m, fine, kFineStepPx);
+    if (std::fabs(fine_axis - coarse_axis) <= std::max(kAgreePx, 0.5 * f)) return fine_axis;
+  }
+  return coarse_axis;
 }
 
 // The scan's half-turns of evenly spaced views: the first view of each (the second starts at
@@ -257,8 +366,9 @@ std::optional<SinogramAxis> sinogram_axis(const Scan& scan) {
         std::copy_n(half.data.begin() + static_cast<long>(v * g.n_u), g.n_u, s[v].begin());
       }
     }
-    axes.push_back(row_axis(turns));
+    if (const std::optional<double> axis = row_axis(turns)) axes.push_back(*axis);
   }
+  if (axes.empty()) return SinogramAxis{std::numeric_limits<double>::quiet_NaN(), views, 0};
   return SinogramAxis{util::quantile(axes, 0.5), views * starts.size(), axes.size()};
 }
 

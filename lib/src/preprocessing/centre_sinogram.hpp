@@ -26,7 +26,8 @@ struct SinogramAxis {
 };
 
 // Parallel beam only. nullopt when the views do not cover a half-turn less 1.5 steps from the
-// first, or are not evenly spaced within it (within 10% of the step).
+// first, or are not evenly spaced within it (within 10% of the step). No rows (axis_column NaN)
+// when no row's measure has a minimum inside the search: its best at either end of it.
 std::optional<SinogramAxis> sinogram_axis(const Scan& scan);
 
 }  // namespace riner::preprocessing
