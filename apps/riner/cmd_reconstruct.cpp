@@ -189,6 +189,11 @@ int run_reconstruct(int argc, char** argv, int first) {
   const double checkpoint_every = checkpoint_seconds(args);
   const std::filesystem::path checkpoint = out / kCheckpointName;
   refuse_unfinished(args, checkpoint);
+  if (std::filesystem::exists(out / "manifest.json")) {
+    throw UsageError((out / "manifest.json").string() +
+                     ": the folder holds a slabbed run, which a single scan's outputs would mix "
+                     "with: choose another output folder");
+  }
   if (checkpoint_every > 0.0) catch_stop_signals();
   Reconstructor reconstructor(std::move(scan), config, device);
   resume_training(args, console, reconstructor, checkpoint);

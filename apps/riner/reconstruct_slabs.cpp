@@ -223,6 +223,11 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   require_quality_grid(source.geometry());
   require_training(settings);
   const std::filesystem::path out = make_output_dir(args.get("out"));
+  // Refused now, not after every slab is trained.
+  refuse_overwriting_input(out / "volume");
+  if (format == "h5" || format == "npy" || format == "raw") {
+    refuse_overwriting_input(out / ("volume." + format));
+  }
   const std::optional<Device> device = rank_device(args, settings.engine, ranks);
   // On a CPU the plan splits the gradient's sums by the device's threads, and a rank has only
   // its share of them: every rank plans for the whole machine, so the sums, and the volume,

@@ -18,6 +18,7 @@
 #include "riner/cores.hpp"
 #include "riner/io.hpp"
 #include "riner/metrics.hpp"
+#include "riner/volume_writer.hpp"
 #include "support/fixture.hpp"
 
 namespace {
@@ -494,5 +495,49 @@ TEST_SUITE("cli") {
     run = riner_cli("fbp " + scan + " --slab-slices 0 --out " + (dir / "z").string(), dir);
     CHECK(run.code != 0);
     CHECK(run.err.find("--slab-slices must be 1 or more") != std::string::npos);
+  }
+
+  TEST_CASE("by slabs, no output replaces an input or joins a folder of input TIFFs") {
+    // Slabs read their rows late; the outputs are opened first.
+    riner::test::TempDir dir;
+    const std::string scan = simulate_stack(dir);
+    const std::string geometry = (std::filesystem::path(scan).parent_path() / "geometry.json");
+    const std::string before = riner::test::read_bytes(scan);
+    Run run = riner_cli("fbp " + scan + " --slab-slices 4 --out " + scan, dir);
+    CHECK(run.code == 2);
+    CHECK(run.err.find(scan + ": refusing to overwrite an input file") != std::string::npos);
+    CHECK(riner::test::read_bytes(scan) == before);
+    // The stack as a folder of one TIFF per view, and slices asked into that folder.
+    const riner::Array views = riner::read_array(scan).array;
+    const std::size_t rows = views.shape[1], columns = views.shape[2];
+    std::filesystem::create_directories(dir / "tifs");
+    for (std::size_t v = 0; v < views.shape[0]; ++v) {
+      riner::Array view({rows, columns});
+      std::copy_n(views.data.begin() + static_cast<long>(v * rows * columns), rows * columns,
+                  view.data.begin());
+      char name[32];
+      std::snprintf(name, sizeof(name), "proj_%03zu.tif", v);
+      riner::write_array(dir / "tifs" / name, view);
+    }
+    run = riner_cli("fbp " + (dir / "tifs").string() + " --geometry " + geometry +
+                        " --slab-slices 4 --out " + (dir / "tifs").string(),
+                    dir);
+    CHECK(run.code == 2);
+    CHECK(run.err.find("refusing to overwrite an input file") != std::string::npos);
+    CHECK_FALSE(std::filesystem::exists(riner::VolumeWriter::slice_file(dir / "tifs", 0)));
+    // reconstruct's gathered volume file: refused before any slab is trained.
+    std::filesystem::create_directories(dir / "held");
+    std::filesystem::copy_file(scan, dir / "held" / "volume.npy");
+    run = riner_cli("reconstruct " + (dir / "held" / "volume.npy").string() + " --geometry " +
+                        geometry + " --slab-slices 4 --format npy --out " + (dir / "held").string(),
+                    dir);
+    CHECK(run.code == 2);
+    CHECK(run.err.find("volume.npy: refusing to overwrite an input file") != std::string::npos);
+    CHECK_FALSE(std::filesystem::exists(dir / "held" / "slabs"));
+    // A single scan's run into a slabbed run's folder would mix the two runs' outputs.
+    riner::test::write_bytes(dir / "held" / "manifest.json", "{}");
+    run = riner_cli("reconstruct " + scan + " --out " + (dir / "held").string(), dir);
+    CHECK(run.code != 0);
+    CHECK(run.err.find("the folder holds a slabbed run") != std::string::npos);
   }
 }

@@ -104,5 +104,8 @@ std::string read_text(const std::filesystem::path& path);
 // Marks a path as an input of this process: writers refuse to replace it. Readers call this
 // themselves; call it for inputs read by other means.
 void register_input(const std::filesystem::path& path);
+// InputError "refusing to overwrite an input file" when `path` is a registered input (the same
+// file by any name), or, for a folder, holds one: what writers check before they replace it.
+void refuse_overwriting_input(const std::filesystem::path& path);
 
 }  // namespace riner

@@ -39,6 +39,25 @@ void register_input(const std::filesystem::path& path) {
   registry().insert(canonical_or_absolute(path));
 }
 
+void refuse_overwriting_input(const std::filesystem::path& path) {
+  const std::filesystem::path target = canonical_or_absolute(path);
+  std::error_code error;
+  const bool folder = std::filesystem::is_directory(target, error);
+  std::lock_guard<std::mutex> lock(registry_mutex());
+  for (const std::filesystem::path& input : registry()) {
+    if (input == target || std::filesystem::equivalent(input, target, error)) {
+      throw InputError(path.string() + ": refusing to overwrite an input file");
+    }
+    // A folder that holds an input TIFF (a folder of TIFFs read as a stack) takes no slices:
+    // they would join the stack.
+    if (folder && input.parent_path() == target &&
+        (io::lower_extension(input) == ".tif" || io::lower_extension(input) == ".tiff")) {
+      throw InputError(path.string() + ": refusing to write into a folder that holds an input (" +
+                       input.filename().string() + ")");
+    }
+  }
+}
+
 namespace io {
 
 std::string prefix(const std::filesystem::path& path) { return path.string() + ": "; }
@@ -85,16 +104,8 @@ std::string read_file_bytes(const std::filesystem::path& path) {
 }
 
 void check_output_path(const std::filesystem::path& path) {
+  refuse_overwriting_input(path);
   const std::filesystem::path target = canonical_or_absolute(path);
-  {
-    std::lock_guard<std::mutex> lock(registry_mutex());
-    for (const std::filesystem::path& input : registry()) {
-      std::error_code error;
-      if (input == target || std::filesystem::equivalent(input, target, error)) {
-        throw InputError(prefix(path) + "refusing to overwrite an input file");
-      }
-    }
-  }
   const std::filesystem::path dir = target.parent_path();
   std::error_code error;
   if (!dir.empty() && !std::filesystem::is_directory(dir, error)) {

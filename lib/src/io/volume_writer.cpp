@@ -150,6 +150,7 @@ std::unique_ptr<VolumeWriter::Sink> open_sink(const std::string& target,
     return std::make_unique<Hdf5Sink>(path, "/volume", shape, voxel_mm);
   }
   if (path.extension().empty() || std::filesystem::is_directory(path)) {
+    refuse_overwriting_input(path);
     std::filesystem::create_directories(path);
     if (std::filesystem::exists(VolumeWriter::slice_file(path, 0))) {
       throw InputError(path.string() + " already holds slices (" +

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "io/stack.hpp"
 #include "riner/error.hpp"
 #include "riner/flat_field.hpp"
 #include "riner/io.hpp"
@@ -80,6 +81,20 @@ void require_flats(const TomoFile& file, const std::string& path) {
   }
 }
 
+// Marks the files `name` reads as inputs (a stack's files and its folder; an HDF5 dataset's
+// file), so that no output replaces them.
+void register_input_files(const std::string& name) {
+  if (name.empty()) return;
+  if (const auto h5 = split_hdf5_dataset(name)) {
+    register_input(h5->first);
+  } else if (io::is_stack_path(name)) {
+    if (std::filesystem::is_directory(name)) register_input(name);
+    for (const std::filesystem::path& file : io::stack_files(name)) register_input(file);
+  } else {
+    register_input(name);
+  }
+}
+
 double parse_offset(const std::string& text) {
   char* end = nullptr;
   const double value = std::strtod(text.c_str(), &end);
@@ -132,6 +147,11 @@ LoadedScan load_scan_source(ScanSource source) {
 
 ScanRows::ScanRows(ScanSource source) : source_(std::move(source)) {
   tomo_file_ = resolve_files(source_);
+  // Slabs read their rows late: outputs opened before then must already see the inputs.
+  for (const std::string* name :
+       {&source_.path, &source_.flat, &source_.dark, &source_.flat_after}) {
+    register_input_files(*name);
+  }
   if (source_.row) throw InputError("a single detector row is read whole: no slabs needed");
   geometry_ = Geometry::load(find_geometry(source_.path, source_.geometry));
   shape_ = read_array_shape(source_.path);
