@@ -442,6 +442,23 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       dying += c["dies"].get<bool>() ? 1 : 0;
     }
   }
+  // Slabs with nothing to reconstruct (a dead detector row): written as NaN, said here.
+  nlohmann::json without_readings = nlohmann::json::array();
+  for (const Slab& s : run.slabs()) {
+    const nlohmann::json& entry = run.manifest()["slabs"][s.index];
+    if (!entry.contains("no_readings")) continue;
+    without_readings.push_back({{"slices", {s.first_slice, s.slices}},
+                                {"rows", {s.rows.first, s.rows.count}},
+                                {"reason", entry["no_readings"]}});
+    const auto range = [](const char* one, const char* many, std::size_t first, std::size_t count) {
+      return count == 1 ? std::string(one) + " " + std::to_string(first)
+                        : std::string(many) + " " + std::to_string(first) + ".." +
+                              std::to_string(first + count - 1);
+    };
+    console.line(range("slice", "slices", s.first_slice, s.slices) + " written as NaN: " +
+                 range("detector row", "detector rows", s.rows.first, s.rows.count) +
+                 " read nothing to reconstruct (" + entry["no_readings"].get<std::string>() + ")");
+  }
   write_detector_outputs(out, run.alpha(), run.beta(), dead);
   std::string gathered;
   if (format == "h5" || format == "npy" || format == "raw") {
@@ -487,6 +504,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       {"training_seconds", training_wall},
       {"dead_elements", dead.size()},
       {"changing_elements", changing},
+      {"slabs_without_readings", without_readings},
       {"centre",
        run.source().centre() ? centre_json(*run.source().centre()) : nlohmann::json(nullptr)},
       {"wall_seconds", wall},

@@ -497,6 +497,42 @@ TEST_SUITE("cli") {
     CHECK(run.err.find("--slab-slices must be 1 or more") != std::string::npos);
   }
 
+  TEST_CASE("a dead detector row: its slice is NaN and said so, the rest of the scan goes on") {
+    riner::test::TempDir dir;
+    const std::string scan = simulate_stack(dir);
+    riner::Array views = riner::read_array(scan).array;
+    const std::size_t rows = views.shape[1], columns = views.shape[2];
+    for (std::size_t v = 0; v < views.shape[0]; ++v) {
+      std::fill_n(views.data.begin() + static_cast<long>((v * rows + 7) * columns), columns, NAN);
+    }
+    std::filesystem::create_directories(dir / "dead");
+    riner::write_array(dir / "dead" / "sino.npy", views);
+    std::filesystem::copy_file(std::filesystem::path(scan).parent_path() / "geometry.json",
+                               dir / "dead" / "geometry.json");
+    // Each slice trained as its row's 2D scan: row 7 has nothing (it stopped the run before).
+    const Run run = riner_cli("reconstruct " + (dir / "dead" / "sino.npy").string() +
+                                  " --slices-2d --steps 100 --out " + (dir / "out").string(),
+                              dir);
+    CAPTURE(run.err);
+    REQUIRE(run.code == 0);
+    CHECK(run.out.find("slice 7 written as NaN: detector row 7 read nothing to reconstruct") !=
+          std::string::npos);
+    const nlohmann::json summary =
+        nlohmann::json::parse(riner::test::read_bytes(dir / "out" / "summary.json"));
+    REQUIRE(summary["slabs_without_readings"].size() == 1);
+    CHECK(summary["slabs_without_readings"][0]["slices"] == nlohmann::json({7, 1}));
+    for (std::size_t k : {6, 7, 8}) {
+      CAPTURE(k);
+      const riner::Array slice =
+          riner::read_array(riner::VolumeWriter::slice_file(dir / "out" / "volume", k)).array;
+      std::size_t finite = 0;
+      for (float v : slice.data) finite += std::isfinite(v) ? 1 : 0;
+      CHECK(finite == (k == 7 ? 0 : slice.size()));
+    }
+    const riner::Array beta = riner::read_array(dir / "out" / "beta.npy").array;
+    CHECK(beta.data[7 * columns] == 0.0f);
+  }
+
   TEST_CASE("by slabs, no output replaces an input or joins a folder of input TIFFs") {
     // Slabs read their rows late; the outputs are opened first.
     riner::test::TempDir dir;

@@ -19,6 +19,13 @@ class InputError : public Error {
   using Error::Error;
 };
 
+// Readings that hold nothing to reconstruct (all NaN or infinite, or too few usable): a whole
+// scan's is refused; a slab of a larger one (a dead detector row) is written as NaN.
+class NoReadingsError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 // An OpenCL call failed. Carries the call, the status and its CL_* name.
 class ClError : public Error {
  public:

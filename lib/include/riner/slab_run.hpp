@@ -138,6 +138,9 @@ class SlabRun {
   void write_slab(const Slab& slab, const Reconstructor& r, const Summarise& summarise,
                   const std::optional<Device>& device,
                   std::chrono::steady_clock::time_point started) const;
+  // A slab whose readings hold nothing (a dead detector row): NaN slices and alpha, beta 0,
+  // and a record saying why, so that the rest of the scan goes on.
+  void write_empty_slab(const Slab& slab, const std::string& why) const;
   void write_manifest() const;
   Array detector_map(const std::string& what) const;
 

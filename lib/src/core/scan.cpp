@@ -76,8 +76,8 @@ ReadingsLook look_at_readings(const Array& measurement) {
 void check_scan(const Scan& scan, std::string_view what) {
   scan.geometry.check_measurement_shape(scan.measurement.shape, what);
   if (scan.measurement.size() > 0 && scan.non_finite >= scan.measurement.size()) {
-    throw InputError(std::string(what) + ": all " + std::to_string(scan.measurement.size()) +
-                     " values are NaN or infinite; there is nothing to reconstruct");
+    throw NoReadingsError(std::string(what) + ": all " + std::to_string(scan.measurement.size()) +
+                          " values are NaN or infinite; there is nothing to reconstruct");
   }
   const ReadingsLook look = look_at_readings(scan.measurement);
   char line[200];
@@ -86,7 +86,7 @@ void check_scan(const Scan& scan, std::string_view what) {
                   "%.1f%% of the readings are NaN, infinite or beyond %.0e: there is too little "
                   "left to reconstruct",
                   100.0 * look.unusable_share, static_cast<double>(kLargestReading));
-    throw InputError(std::string(what) + ": " + line);
+    throw NoReadingsError(std::string(what) + ": " + line);
   }
   if (look.least > kLargestLeastReading) {
     std::snprintf(line, sizeof(line), "99%% of the readings exceed %.0f (the 1st percentile: %.4g)",

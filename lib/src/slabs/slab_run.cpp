@@ -299,9 +299,13 @@ void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
                      if (claim && !claim(slab)) return;
                      const auto slab_started = std::chrono::steady_clock::now();
                      Scan scan;
-                     {
+                     try {
                        std::lock_guard<std::mutex> lock(read_mutex);
                        scan = source_.read(slab.rows);
+                     } catch (const NoReadingsError& e) {
+                       write_empty_slab(slab, e.what());
+                       report(slab, worker, 1.0, 0, 0, true, true);
+                       return;
                      }
                      scan.geometry = slab_geometry(g, slab);
                      if (slices_2d_) scan = slice_scan(scan);
@@ -377,6 +381,27 @@ void SlabRun::write_slab(const Slab& slab, const Reconstructor& r, const Summari
   entry["trained_as"] = slices_2d_ ? "slice_2d" : "field_3d";
   entry["summary"] = summarise ? summarise(r, result, device) : nlohmann::json(nullptr);
   write_text(slab_record(slab), entry.dump(1) + "\n");  // last: the slab is done
+}
+
+void SlabRun::write_empty_slab(const Slab& slab, const std::string& why) const {
+  const Geometry& g = source_.geometry();
+  const std::size_t ny = g.volume_shape[1], nx = g.volume_shape[2];
+  for (std::size_t k = 0; k < slab.slices; ++k) {
+    write_array(slice_path(slab.first_slice + k), Array({ny, nx}, NAN));
+  }
+  write_array(slab_file(slab, "alpha"), Array({slab.map_rows.count, g.n_u}, NAN));
+  write_array(slab_file(slab, "beta"), Array({slab.map_rows.count, g.n_u}, 0.0f));
+  write_array(slab_file(slab, "coronal"), Array({slab.slices, nx}, NAN));
+  write_array(slab_file(slab, "sagittal"), Array({slab.slices, ny}, NAN));
+  nlohmann::json entry = manifest_["slabs"][slab.index];
+  entry["done"] = true;
+  entry["seconds"] = 0.0;
+  entry["steps"] = 0;
+  entry["process"] = this_process_name();
+  entry["finished_unix"] = unix_seconds();
+  entry["no_readings"] = why;
+  entry["summary"] = nullptr;
+  write_text(slab_record(slab), entry.dump(1) + "\n");
 }
 
 void SlabRun::finish() {
