@@ -533,7 +533,7 @@ TEST_SUITE("cli") {
     CHECK(beta.data[7 * columns] == 0.0f);
   }
 
-  TEST_CASE("by slabs, no output replaces an input or joins a folder of input TIFFs") {
+  TEST_CASE("by slabs, inputs checked before the first slab: no output replaces one, flats fit") {
     // Slabs read their rows late; the outputs are opened first.
     riner::test::TempDir dir;
     const std::string scan = simulate_stack(dir);
@@ -570,6 +570,24 @@ TEST_SUITE("cli") {
     CHECK(run.code == 2);
     CHECK(run.err.find("volume.npy: refusing to overwrite an input file") != std::string::npos);
     CHECK_FALSE(std::filesystem::exists(dir / "held" / "slabs"));
+    // Flats of another detector: refused before the first slab (they were read a slab's rows
+    // at a time: too many rows passed, too few failed after slabs were written).
+    riner::Array intensities = riner::read_array(scan).array;
+    for (float& v : intensities.data) v = std::isfinite(v) ? 1000.0f * std::exp(-v) : 0.0f;
+    riner::write_array(dir / "raw.npy", intensities);
+    for (const std::size_t rows : {intensities.shape[1] + 2, intensities.shape[1] - 2}) {
+      CAPTURE(rows);
+      riner::write_array(dir / "flats.npy", riner::Array({2, rows, intensities.shape[2]}, 1000.0f));
+      run = riner_cli("reconstruct " + (dir / "raw.npy").string() + " --flat " +
+                          (dir / "flats.npy").string() + " --geometry " + geometry +
+                          " --slab-slices 4 --out " + (dir / "flat").string(),
+                      dir);
+      CHECK(run.code == 2);
+      CHECK(run.err.find("the flat field is [2, " + std::to_string(rows) +
+                         ", 30]; it must be one frame of a view's shape [20, 30]") !=
+            std::string::npos);
+      CHECK_FALSE(std::filesystem::exists(dir / "flat" / "slabs"));
+    }
     // A single scan's run into a slabbed run's folder would mix the two runs' outputs.
     riner::test::write_bytes(dir / "held" / "manifest.json", "{}");
     run = riner_cli("reconstruct " + scan + " --out " + (dir / "held").string(), dir);

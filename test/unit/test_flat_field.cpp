@@ -10,6 +10,7 @@
 
 #include "riner/error.hpp"
 #include "riner/flat_field.hpp"
+#include "support/geometries.hpp"
 
 namespace {
 
@@ -148,6 +149,38 @@ TEST_SUITE("flat_field") {
       }
     }
     return d;
+  }
+
+  TEST_CASE("one detector row of a stack: a flat of one frame or of several, frames checked") {
+    // 4 views of a 3 x 5 detector, a 2D geometry for row 1.
+    const riner::Geometry g = riner::test::make_geometry(riner::GeometryType::kParallel2d, 4, 5, 1,
+                                                         {5, 5}, 1.0, 1.0, M_PI);
+    Array raw({4, 3, 5}), frame({3, 5}), frames({2, 3, 5});
+    for (std::size_t i = 0; i < frame.size(); ++i) {
+      frame.data[i] = 1000.0f + static_cast<float>(i);
+      frames.data[i] = frame.data[i] - 1.0f;
+      frames.data[frame.size() + i] = frame.data[i] + 1.0f;
+    }
+    for (std::size_t i = 0; i < raw.size(); ++i) {
+      raw.data[i] = 0.5f * frame.data[i % frame.size()] * (1.0f + 0.01f * (i % 7));
+    }
+    // A single-TIFF flat is one frame, no stack axis: the same measurement as a stack of it.
+    const riner::Scan one = riner::raw_scan(g, raw, frame, Array(), 1, "p");
+    const riner::Scan two = riner::raw_scan(g, raw, frames, Array(), 1, "p");
+    REQUIRE(one.measurement.shape == std::vector<std::size_t>{4, 5});
+    for (std::size_t i = 0; i < one.measurement.size(); ++i) {
+      CHECK(one.measurement.data[i] == doctest::Approx(two.measurement.data[i]).epsilon(1e-6));
+    }
+    // Frames of another detector are refused even where the row exists in both.
+    const Array wrong({2, 4, 5}, 1000.0f);
+    CHECK_THROWS_WITH_AS(riner::raw_scan(g, raw, wrong, Array(), 1, "p"),
+                         "p: the flat field is [2, 4, 5]; it must be one frame of a view's shape "
+                         "[3, 5] or a stack of them",
+                         riner::InputError);
+    CHECK_THROWS_WITH_AS(riner::raw_scan(g, raw, frame, Array({5}, 10.0f), 1, "p"),
+                         "p: the dark field is [5]; it must be one frame of a view's shape [3, 5] "
+                         "or a stack of them",
+                         riner::InputError);
   }
 
   TEST_CASE("flats before and after: each view's flat interpolated, the drift measured") {

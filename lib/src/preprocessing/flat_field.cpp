@@ -299,8 +299,22 @@ Scan raw_scan(Geometry geometry, const Array& projections, const Array& flats, c
     if (row) {
       // The projections first: their rows are what the user asked for.
       const Array projection_row = detector_row(projections, *row);
-      const Array flat_row = detector_row(flats, *row);
-      const Array dark_row = darks.shape.empty() ? Array() : detector_row(darks, *row);
+      // A field's frames must be the views' frames (one frame, or a stack) before a row of
+      // them is taken: a row of the wrong frames would pass unnoticed.
+      const auto field_row = [&](const Array& frames, const char* field) {
+        Array stack = frames;
+        if (stack.rank() == 2) stack.shape.insert(stack.shape.begin(), 1);
+        if (stack.rank() != 3 || stack.shape[1] != projections.shape[1] ||
+            stack.shape[2] != projections.shape[2]) {
+          throw InputError(std::string(field) + " is " + shape_string(frames.shape) +
+                           "; it must be one frame of a view's shape " +
+                           shape_string({projections.shape[1], projections.shape[2]}) +
+                           " or a stack of them");
+        }
+        return detector_row(stack, *row);
+      };
+      const Array flat_row = field_row(flats, "the flat field");
+      const Array dark_row = darks.shape.empty() ? Array() : field_row(darks, "the dark field");
       scan.measurement =
           flat_field_normalise(projection_row, flat_row, dark_row, &r, flat_positions);
     } else {

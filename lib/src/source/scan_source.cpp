@@ -81,6 +81,18 @@ void require_flats(const TomoFile& file, const std::string& path) {
   }
 }
 
+// A flat or dark field's file holds one frame of `frame` or a stack of them.
+void check_frames_shape(const std::string& path, const char* what,
+                        const std::vector<std::size_t>& frame) {
+  std::vector<std::size_t> shape = read_array_shape(path);
+  if (shape.size() == 2) shape.insert(shape.begin(), 1);
+  if (shape.size() != 3 || shape[0] == 0 || shape[1] != frame[0] || shape[2] != frame[1]) {
+    throw InputError(path + ": " + what + " is " + shape_string(read_array_shape(path)) +
+                     "; it must be one frame of a view's shape " + shape_string(frame) +
+                     " or a stack of them");
+  }
+}
+
 // Marks the files `name` reads as inputs (a stack's files and its folder; an HDF5 dataset's
 // file), so that no output replaces them.
 void register_input_files(const std::string& name) {
@@ -165,6 +177,12 @@ ScanRows::ScanRows(ScanSource source) : source_(std::move(source)) {
                      "; slabs of detector rows need a 3D geometry");
   }
   geometry_.check_measurement_shape(shape_, source_.path);
+  // Slabs read the fields' rows late: their frames checked now, not after slabs are written.
+  for (const auto& [name, what] :
+       {std::pair{&source_.flat, "the flat field"}, std::pair{&source_.dark, "the dark field"},
+        std::pair{&source_.flat_after, "the flats after the scan"}}) {
+    if (!name->empty()) check_frames_shape(*name, what, {shape_[1], shape_[2]});
+  }
   if (source_.offset_px == "auto") {
     const std::size_t count = std::min(kCentreRows, rows());
     const Scan middle = read({(rows() - count) / 2, count});
