@@ -150,7 +150,22 @@ TEST_SUITE("geometry_json") {
                 "g.json: volume.shape must be [n_y, n_x] for a 2D geometry");
     check_error(fan_with("\"voxel_mm\": 1.0", "\"voxel_mm\": 0"),
                 "g.json: volume.voxel_mm must be > 0 (got 0)");
-    check_error(fan_with("\"volume\"", "\"volumes\""), "g.json: volume is missing");
+    // A misspelt field is named, not left out (the offset would silently be 0).
+    check_error(fan_with("\"volume\"", "\"volumes\""),
+                "g.json: volumes is not a geometry field (the file takes type, detector, "
+                "source_origin_mm, origin_detector_mm, angles, angles_rad, volume)");
+    check_error(fan_with("\"offset_px\"", "\"offset\""),
+                "g.json: detector.offset is not a geometry field (detector takes count, "
+                "pitch_mm, offset_px)");
+    check_error(fan_with("\"voxel_mm\": 1.0", "\"voxel_mm\": 1.0, \"center_z_mm\": 20"),
+                "g.json: volume.center_z_mm is not a geometry field (volume takes shape, "
+                "voxel_mm, centre_z_mm)");
+    check_error(fan_with("\"start_rad\"", "\"start\""),
+                "g.json: angles.start is not a geometry field (angles takes count, start_rad, "
+                "range_rad)");
+    // Documentation is not a field.
+    CHECK_NOTHROW(riner::Geometry::from_json(
+        fan_with("\"type\"", "\"comment\": \"scanner A\", \"_source\": 1, \"type\""), "g.json"));
     // The detector shifted off the grid: every ray misses it (FBP gave an image of zeros).
     check_error(
         fan_with("\"offset_px\": 0.0", "\"offset_px\": 600"),

@@ -1,6 +1,7 @@
 // The scan-contract geometry file (METHOD.md §3): parsing with a precise message for every bad
 // field, validation, and writing back in the same form.
 #include <cmath>
+#include <initializer_list>
 #include <nlohmann/json.hpp>
 
 #include "riner/error.hpp"
@@ -47,6 +48,30 @@ class Parser {
     if (v < 1.0) fail(field, "must be >= 1 (got " + format(v) + ")");
     if (v > 1e7) fail(field, "is absurdly large (" + format(v) + ")");
     return static_cast<std::size_t>(v);
+  }
+
+  // A misspelt field ("center_z_mm", "offset") would otherwise be left out without a word:
+  // every key is one the object takes, or documentation ("comment", "description", "notes",
+  // or a name starting with '_').
+  void known_keys(const json& object, const std::string& field,
+                  std::initializer_list<const char*> keys) const {
+    for (const auto& [key, value] : object.items()) {
+      if (key.empty() || key[0] == '_' || key == "comment" || key == "description" ||
+          key == "notes") {
+        continue;
+      }
+      bool known = false;
+      std::string list;
+      for (const char* k : keys) {
+        known = known || key == k;
+        list += (list.empty() ? "" : ", ") + std::string(k);
+      }
+      if (!known) {
+        fail((field.empty() ? "" : field + ".") + key,
+             "is not a geometry field (" + (field.empty() ? std::string("the file") : field) +
+                 " takes " + list + ")");
+      }
+    }
   }
 
   // A scalar in 2D, an [u, v] pair in 3D.
@@ -113,6 +138,9 @@ Geometry Geometry::from_json(std::string_view json_text, std::string_view source
   }
   if (!root.is_object()) p.fail("top level", "must be a JSON object");
 
+  p.known_keys(root, "",
+               {"type", "detector", "source_origin_mm", "origin_detector_mm", "angles",
+                "angles_rad", "volume"});
   Geometry g;
   const json& type = p.member(root, "type", "type");
   if (!type.is_string()) p.fail("type", "must be a string");
@@ -121,6 +149,7 @@ Geometry Geometry::from_json(std::string_view json_text, std::string_view source
 
   const json& detector = p.member(root, "detector", "detector");
   if (!detector.is_object()) p.fail("detector", "must be an object");
+  p.known_keys(detector, "detector", {"count", "pitch_mm", "offset_px"});
   auto counts = p.per_axis(p.member(detector, "count", "detector.count"), is_3d, "detector.count");
   g.n_u = p.count(counts[0], "detector.count");
   if (is_3d) g.n_v = p.count(counts[1], "detector.count[1]");
@@ -148,6 +177,7 @@ Geometry Geometry::from_json(std::string_view json_text, std::string_view source
   if (has_uniform) {
     const json& a = root["angles"];
     if (!a.is_object()) p.fail("angles", "must be an object {count, start_rad, range_rad}");
+    p.known_keys(a, "angles", {"count", "start_rad", "range_rad"});
     UniformAngles spec;
     spec.count = p.count(p.member(a, "count", "angles.count"), "angles.count");
     spec.start_rad = a.contains("start_rad") ? p.number(a["start_rad"], "angles.start_rad") : 0.0;
@@ -165,6 +195,7 @@ Geometry Geometry::from_json(std::string_view json_text, std::string_view source
 
   const json& volume = p.member(root, "volume", "volume");
   if (!volume.is_object()) p.fail("volume", "must be an object");
+  p.known_keys(volume, "volume", {"shape", "voxel_mm", "centre_z_mm"});
   const json& shape = p.member(volume, "shape", "volume.shape");
   const std::size_t rank = is_3d ? 3 : 2;
   if (!shape.is_array() || shape.size() != rank) {
