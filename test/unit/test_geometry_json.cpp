@@ -153,7 +153,7 @@ TEST_SUITE("geometry_json") {
     // A misspelt field is named, not left out (the offset would silently be 0).
     check_error(fan_with("\"volume\"", "\"volumes\""),
                 "g.json: volumes is not a geometry field (the file takes type, detector, "
-                "source_origin_mm, origin_detector_mm, angles, angles_rad, volume)");
+                "source_origin_mm, origin_detector_mm, angles, angles_rad, volume, files)");
     check_error(fan_with("\"offset_px\"", "\"offset\""),
                 "g.json: detector.offset is not a geometry field (detector takes count, "
                 "pitch_mm, offset_px)");

@@ -138,9 +138,10 @@ Geometry Geometry::from_json(std::string_view json_text, std::string_view source
   }
   if (!root.is_object()) p.fail("top level", "must be a JSON object");
 
+  // "files": a scan JSON is its geometry with the files it names (riner/scan.hpp).
   p.known_keys(root, "",
                {"type", "detector", "source_origin_mm", "origin_detector_mm", "angles",
-                "angles_rad", "volume"});
+                "angles_rad", "volume", "files"});
   Geometry g;
   const json& type = p.member(root, "type", "type");
   if (!type.is_string()) p.fail("type", "must be a string");
