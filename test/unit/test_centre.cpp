@@ -127,6 +127,26 @@ TEST_SUITE("centre") {
     }
   }
 
+  TEST_CASE("a hot or dead column reading one value does not pull the axis onto itself") {
+    // A steady column matches its own mirror image only about itself: the axis went there.
+    for (const auto& [views, range] : {std::pair{60, M_PI}, std::pair{90, 2.0 * M_PI}}) {
+      const riner::Geometry g =
+          with_angles(riner::test::small_parallel2d(), static_cast<std::size_t>(views), range,
+                      false);
+      riner::Scan scan = scan_with_offset(g, 3.4);
+      double top = 0.0;
+      for (float v : scan.measurement.data) top = std::max(top, static_cast<double>(v));
+      for (std::size_t v = 0; v < g.n_views(); ++v) {
+        scan.measurement.data[v * g.n_u + 20] = static_cast<float>(5.0 * top);  // hot
+        scan.measurement.data[v * g.n_u + 70] = 0.0f;                          // dead
+      }
+      CAPTURE(views);
+      const riner::CentreEstimate e = riner::estimate_centre(scan);
+      CHECK(std::fabs(e.offset_px - 3.4) < 0.15);
+      if (e.pairs > 1) CHECK(std::fabs(e.pairs_offset_px - 3.4) < 0.15);
+    }
+  }
+
   TEST_CASE("one noisy, dim view (a detector's hiccup) barely moves the sinogram's answer") {
     const riner::Geometry g = with_angles(riner::test::small_parallel2d(), 61, M_PI, true);
     riner::Scan scan = scan_with_offset(g, 3.4);
@@ -229,6 +249,16 @@ TEST_SUITE("centre") {
       CHECK(e.half_acquisition);
       CHECK(e.method == "conjugate rays, half acquisition");
       CHECK(std::fabs(e.offset_px - offset) < 0.5);
+      // The geometry already telling the half acquisition, exactly or a few pixels off: the
+      // search around it compares the few conjugates relatively too (it was pulled inwards).
+      for (const double told : {offset, offset - 3.0, offset + 2.5}) {
+        CAPTURE(told);
+        riner::Scan scan = scan_with_offset(g, offset);
+        scan.geometry.offset_u = told;
+        const riner::CentreEstimate again = riner::estimate_centre(scan);
+        CHECK(again.half_acquisition);
+        CHECK(std::fabs(again.offset_px - offset) < 0.5);
+      }
     }
     const riner::CentreEstimate centred = riner::estimate_centre(scan_with_offset(g, 2.2));
     CHECK_FALSE(centred.half_acquisition);

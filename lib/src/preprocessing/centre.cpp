@@ -2,12 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <optional>
 #include <span>
 #include <utility>
 #include <vector>
 
+#include "model/noise_evidence.hpp"
+#include "model/stuck_elements.hpp"
 #include "preprocessing/centre_conjugate.hpp"
 #include "preprocessing/centre_sinogram.hpp"
 #include "preprocessing/mismatch_sums.hpp"
@@ -383,7 +386,24 @@ bool centre_search_covers(const Geometry& g) {
 }
 
 CentreEstimate estimate_centre(const Scan& scan) {
-  const CentreEstimate e = estimate_from(scan);
+  // A hot or dead element reading a steady value matches its own mirror image only about
+  // itself, and pulls the axis onto it (a 180-degree scan with one column at 50: the axis at
+  // that column): such elements are left out, as non-finite ones are.
+  const std::vector<std::uint8_t> stuck =
+      model::stuck_elements(scan, model::reading_noise(scan).sigma);
+  if (std::find(stuck.begin(), stuck.end(), 1) == stuck.end()) {
+    const CentreEstimate e = estimate_from(scan);
+    if (!holds_structure(scan.measurement)) throw_without_structure();
+    return e;
+  }
+  Scan without = scan;
+  std::vector<float>& rho = without.measurement.data;
+  for (std::size_t e = 0; e < stuck.size(); ++e) {
+    if (!stuck[e]) continue;
+    for (std::size_t i = e; i < rho.size(); i += stuck.size()) rho[i] = NAN;
+  }
+  without.non_finite = compute_stats(without.measurement).non_finite();
+  const CentreEstimate e = estimate_from(without);
   if (!holds_structure(scan.measurement)) throw_without_structure();
   return e;
 }

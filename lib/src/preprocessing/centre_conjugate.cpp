@@ -118,11 +118,15 @@ Cost conjugate_cost(const Scan& scan, const Turn& turn, double offset_px, RaySam
 // for a twentieth of its elements (16 at least) around the axis. Every 2 px on 30 views by 128
 // elements by the relative cost (4 px missed a 64-element detector's axis); the best and that
 // cost.
+double farthest_outer_offset(std::size_t n_u) {
+  const double n = static_cast<double>(n_u);
+  return 0.5 * (n - 1.0) - 0.5 * std::max(16.0, n / 20.0);
+}
+
 std::optional<std::pair<double, double>> outer_offset(const Scan& scan, const Turn& turn) {
   const Geometry& g = scan.geometry;
   const double n = static_cast<double>(g.n_u);
-  const double reach = 0.5 * std::max(16.0, n / 20.0);
-  const double inner = kCentreSearchShare * n, outer = 0.5 * (n - 1.0) - reach;
+  const double inner = kCentreSearchShare * n, outer = farthest_outer_offset(g.n_u);
   constexpr double kCoarseStep = 2.0;
   std::optional<std::pair<double, double>> best;
   for (double magnitude = inner; magnitude <= outer; magnitude += kCoarseStep) {
@@ -152,12 +156,21 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, double search_px) 
   constexpr double kCoarseStep = 2.0;
   constexpr double kStep = 0.5;
   const auto coarse_steps = static_cast<long>(std::ceil(search_px / kCoarseStep));
+  // A geometry that already puts the axis beyond the detector's central half is a half
+  // acquisition: around its offset only the few rays near the axis have conjugates, and the
+  // absolute mismatch, which counts only offsets with most rays paired, would pull the axis
+  // inwards (-19.6 for -35 on 100 elements); the relative one counts every offset.
+  const bool declared_half =
+      std::fabs(g.offset_u) >= kCentreSearchShare * static_cast<double>(g.n_u);
   std::vector<double> coarse_at;
   std::vector<Cost> coarse;
   std::size_t most_rays = 0;
   for (long k = -coarse_steps; k <= coarse_steps; ++k) {
-    coarse_at.push_back(g.offset_u + static_cast<double>(k) * kCoarseStep);
-    coarse.push_back(conjugate_cost(scan, *turn, coarse_at.back(), kCoarse));
+    const double offset = g.offset_u + static_cast<double>(k) * kCoarseStep;
+    if (declared_half && std::fabs(offset) > farthest_outer_offset(g.n_u)) continue;
+    coarse_at.push_back(offset);
+    coarse.push_back(
+        conjugate_cost(scan, *turn, coarse_at.back(), declared_half ? kOuter : kCoarse));
     most_rays = std::max(most_rays, coarse.back().rays);
   }
   // An offset that leaves most conjugates off the detector compares only the few rays left
@@ -166,16 +179,18 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, double search_px) 
   double coarse_best = g.offset_u;
   double coarse_least = std::numeric_limits<double>::infinity();
   for (std::size_t k = 0; k < coarse.size(); ++k) {
-    if (enough(coarse[k], most_rays) && coarse[k].mean < coarse_least) {
-      coarse_least = coarse[k].mean;
+    const double cost = declared_half ? coarse[k].relative : coarse[k].mean;
+    if ((declared_half || enough(coarse[k], most_rays)) && std::isfinite(cost) &&
+        cost < coarse_least) {
+      coarse_least = cost;
       coarse_best = coarse_at[k];
     }
   }
   // A half acquisition's axis beyond the detector's central half: where its conjugates meet
   // far better than at the best offset around the geometry's, relatively, the fine search
   // goes there, and every offset around it counts (its few pairs are all the scan has).
-  bool half_acquisition = false;
-  if (std::fabs(g.offset_u) < kCentreSearchShare * static_cast<double>(g.n_u)) {
+  bool half_acquisition = declared_half;
+  if (!declared_half) {
     const std::optional<std::pair<double, double>> far = outer_offset(scan, *turn);
     const double central = std::isfinite(coarse_least)
                                ? conjugate_cost(scan, *turn, coarse_best, kOuter).relative
