@@ -124,8 +124,28 @@ TEST_SUITE("cli") {
                         " --out " + killed.string(), dir);
     CHECK(refused.code != 0);
     CHECK(refused.err.find("another config") != std::string::npos);
+    // The data is what must match, not its path: a copy elsewhere resumes; the same name with
+    // other readings does not.
+    const std::filesystem::path from = std::filesystem::path(scan).parent_path();
+    for (const char* folder : {"moved", "changed"}) {
+      std::filesystem::create_directories(dir / folder);
+      std::filesystem::copy_file(scan, dir / folder / "sino.npy");
+      std::filesystem::copy_file(from / "geometry.json", dir / folder / "geometry.json");
+    }
+    riner::Array readings = riner::read_array(scan).array;
+    readings.data[readings.size() / 2] += 0.01f;
+    riner::write_array(dir / "changed" / "sino.npy", readings);
+    refused =
+        riner_cli("reconstruct " + (dir / "changed" / "sino.npy").string() +
+                      " --slab-slices 4 --steps 600 --quiet --resume --out " + killed.string(),
+                  dir);
+    CHECK(refused.code != 0);
+    CHECK(refused.err.find("another data") != std::string::npos);
 
-    const Run finished = riner_cli(common + " --resume --out " + killed.string(), dir);
+    const Run finished =
+        riner_cli("reconstruct " + (dir / "moved" / "sino.npy").string() +
+                      " --slab-slices 4 --steps 600 --quiet --resume --out " + killed.string(),
+                  dir);
     REQUIRE(finished.code == 0);
     CHECK(finished.err.find("holds no slabbed run") == std::string::npos);
     const nlohmann::json resumed =

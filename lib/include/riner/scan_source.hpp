@@ -52,6 +52,7 @@ class ScanRows {
   const std::vector<std::size_t>& shape() const { return shape_; }  // [views, rows, columns]
   const std::optional<CentreEstimate>& centre() const { return centre_; }
   const std::string& what() const { return source_.path; }
+  const ScanSource& files() const { return source_; }  // the names, a scan JSON resolved
   bool raw() const { return !source_.flat.empty() || tomo_file_; }
   // Rows `rows` as a scan: measurement [views, count, columns], geometry with the detector cut to
   // those rows (detector_rows_geometry). InputError naming the data for bad readings.

@@ -8,6 +8,7 @@
 #include <mutex>
 #include <unistd.h>
 
+#include "io/data_fingerprint.hpp"
 #include "riner/error.hpp"
 #include "riner/io.hpp"
 #include "riner/log.hpp"
@@ -36,6 +37,19 @@ nlohmann::json identity(const ScanRows& source, const RinerConfig& config,
       {"config", nlohmann::json::parse(config.to_json())},
       {"slices_per_slab", slices_per_slab}};
   if (slices_2d) id["slices_2d"] = true;  // absent otherwise, as in earlier runs' manifests
+  // The data itself: a resumed run reads the same bytes wherever the files are now.
+  const ScanSource& files = source.files();
+  nlohmann::json data = nlohmann::json::object();
+  for (const auto& [key, name] :
+       {std::pair{"scan", &files.path}, std::pair{"flat", &files.flat},
+        std::pair{"dark", &files.dark}, std::pair{"flat_after", &files.flat_after}}) {
+    if (name->empty()) continue;
+    const io::DataFingerprint f = io::data_fingerprint(*name);
+    char hash[24];
+    std::snprintf(hash, sizeof(hash), "%016llx", static_cast<unsigned long long>(f.hash));
+    data[key] = {{"bytes", f.bytes}, {"files", f.files}, {"sampled_hash", hash}};
+  }
+  id["data"] = data;
   return id;
 }
 
@@ -156,10 +170,17 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
   }
   const nlohmann::json wanted = identity(source_, config_, slices_per_slab_, slices_2d_);
   if (held_run) {
+    // A run of before the data's fingerprint names its scan by path alone.
+    const bool by_path = !manifest_["run"].contains("data");
     for (const char* key :
-         {"scan", "shape", "geometry", "config", "slices_per_slab", "slices_2d"}) {
+         {"scan", "data", "shape", "geometry", "config", "slices_per_slab", "slices_2d"}) {
+      if (std::string(key) == (by_path ? "data" : "scan")) continue;
       if (manifest_["run"].value(key, nlohmann::json()) != wanted.value(key, nlohmann::json())) {
-        throw InputError(path.string() + ": the run there has another " + key +
+        const std::string what = std::string(key) == "data"
+                                     ? "data (the scan's or a flat or dark field's files differ "
+                                       "in size or in sampled bytes)"
+                                     : key;
+        throw InputError(path.string() + ": the run there has another " + what +
                          " than this one; resume it with the same scan and settings, or choose "
                          "another output folder");
       }
