@@ -418,30 +418,40 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   // The whole scan's outputs from the slabs' files (this run's and earlier runs').
   std::vector<std::size_t> dead;
   // Partial rings: each changing element with the detector rows it stands for (a 2D slice's
-  // column stands for its slab's rows; a 3D slab's pixel for its own row).
+  // column stands for its slab's rows; a 3D slab's pixel for its own row). A cone beam's slabs
+  // read rows their neighbours read too: each counts only the rows it maps (map_rows), so that
+  // an element is listed once.
   nlohmann::json changing = nlohmann::json::array();
   std::size_t dying = 0;
   for (const Slab& s : run.slabs()) {
     const nlohmann::json& summary = run.manifest()["slabs"][s.index]["summary"];
     if (!summary.is_object() || !summary.contains("dead_elements")) continue;
     const bool by_column = run.manifest()["slabs"][s.index].value("trained_as", "") == "slice_2d";
+    const auto mapped = [&](std::size_t row) {
+      return row >= s.map_rows.first && row < s.map_rows.end();
+    };
     for (std::size_t e : summary["dead_elements"].get<std::vector<std::size_t>>()) {
       if (!by_column) {
-        dead.push_back(s.rows.first * g.n_u + e);
+        if (mapped(s.rows.first + e / g.n_u)) dead.push_back(s.rows.first * g.n_u + e);
         continue;
       }
-      for (std::size_t r = 0; r < s.rows.count; ++r) dead.push_back((s.rows.first + r) * g.n_u + e);
+      for (std::size_t r = s.map_rows.first; r < s.map_rows.end(); ++r) {
+        dead.push_back(r * g.n_u + e);
+      }
     }
     for (const nlohmann::json& c : summary.value("changing_elements", nlohmann::json::array())) {
       const auto e = c["element"].get<std::size_t>();
-      const std::size_t first_row = by_column ? s.rows.first : s.rows.first + e / g.n_u;
-      changing.push_back({{"rows", {first_row, by_column ? s.rows.count : 1}},
+      const std::size_t first_row = by_column ? s.map_rows.first : s.rows.first + e / g.n_u;
+      if (!by_column && !mapped(first_row)) continue;
+      changing.push_back({{"rows", {first_row, by_column ? s.map_rows.count : 1}},
                           {"column", by_column ? e : e % g.n_u},
                           {"dies", c["dies"]},
                           {"segments", c["segments"]}});
       dying += c["dies"].get<bool>() ? 1 : 0;
     }
   }
+  std::sort(dead.begin(), dead.end());
+  dead.erase(std::unique(dead.begin(), dead.end()), dead.end());
   // Slabs with nothing to reconstruct (a dead detector row): written as NaN, said here.
   nlohmann::json without_readings = nlohmann::json::array();
   for (const Slab& s : run.slabs()) {

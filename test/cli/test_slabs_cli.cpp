@@ -431,6 +431,12 @@ TEST_SUITE("cli") {
       mapped += slab.value("map_rows", slab["rows"])[1].get<std::size_t>();
     }
     CHECK(mapped == 40);
+    // A dead element read by two slabs is listed once, as the whole volume's run lists it.
+    const nlohmann::json whole_summary =
+        nlohmann::json::parse(riner::test::read_bytes(dir / "whole" / "summary.json"));
+    const nlohmann::json slabs_summary =
+        nlohmann::json::parse(riner::test::read_bytes(dir / "slabs" / "summary.json"));
+    CHECK(slabs_summary["dead_elements"] == whole_summary["dead_elements"].size());
     const riner::Array alpha = riner::read_array(dir / "slabs" / "alpha.npy").array;
     CHECK(
         std::none_of(alpha.data.begin(), alpha.data.end(), [](float a) { return std::isnan(a); }));
