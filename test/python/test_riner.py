@@ -418,3 +418,13 @@ def test_load_scan_interpolates_flats_before_and_after_a_drifting_beam(tmp_path)
     assert r.summary["flat_field"]["flat_series"] == 2
     with pytest.raises(riner.InputError, match="flat_after needs flat"):
         riner.fbp(raw, g, flat_after=after)
+
+
+def test_a_file_read_in_the_session_can_be_written_back(tmp_path):
+    # Read, edit, write back: a read guards its file during that call only (the CLI's
+    # "refusing to overwrite an input file" is for one run reading and writing).
+    a = np.arange(12, dtype=np.float32).reshape(3, 4)
+    riner.write_array(tmp_path / "p.npy", a)
+    b = riner.read_array(tmp_path / "p.npy")
+    riner.write_array(tmp_path / "p.npy", b + 1)
+    assert np.array_equal(riner.read_array(tmp_path / "p.npy"), a + 1)

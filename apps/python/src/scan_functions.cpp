@@ -191,6 +191,7 @@ void bind_scan_functions(py::module_& m) {
     LoadedScan loaded;
     {
       py::gil_scoped_release release;
+      const InputScope read_only;
       loaded = load_scan_source({path, geometry, flat, dark, row, offset_px, flat_after});
     }
     const nlohmann::json notes = {
@@ -204,6 +205,7 @@ void bind_scan_functions(py::module_& m) {
     ArrayFile file;
     {
       py::gil_scoped_release release;
+      const InputScope read_only;  // a later write_array of the same path is the user's
       file = read_array(path);
     }
     return py::make_tuple(to_numpy(std::move(file.array)), file.voxel_size, file.dtype);

@@ -39,6 +39,16 @@ void register_input(const std::filesystem::path& path) {
   registry().insert(canonical_or_absolute(path));
 }
 
+InputScope::InputScope() {
+  std::lock_guard<std::mutex> lock(registry_mutex());
+  before_.assign(registry().begin(), registry().end());
+}
+
+InputScope::~InputScope() {
+  std::lock_guard<std::mutex> lock(registry_mutex());
+  registry() = std::set<std::filesystem::path>(before_.begin(), before_.end());
+}
+
 void refuse_overwriting_input(const std::filesystem::path& path) {
   const std::filesystem::path target = canonical_or_absolute(path);
   std::error_code error;
