@@ -62,6 +62,19 @@ std::optional<DestripeOptions> destripe_from(const Args& args) {
   return destripe_options_from(args, args.get("destripe"));
 }
 
+// A short scan: weighted (a fan or cone beam over half a turn plus the fan), or missing lines.
+void note_short_scan(const Console& console, const FbpReport& report) {
+  if (report.parker_weighted) {
+    console.line(
+        "a short scan (less than a full turn, at least half a turn plus the fan): Parker "
+        "weights, each line counted once");
+  } else if (report.short_scan) {
+    console.line(
+        "warning: the views miss part of the circle (a parallel beam's half turn, a fan's half "
+        "turn plus the fan): the lines never measured leave streaks");
+  }
+}
+
 int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions& options) {
   const ScanRows source(source_from(args));
   if (source.centre()) console.line(centre_line(*source.centre()));
@@ -99,11 +112,7 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
     png = png.extension().empty() ? png / "middle_slice.png" : png.replace_extension(".png");
     write_png(png, middle);
   }
-  if (report.fbp.short_scan) {
-    console.line(
-        "warning: the views do not cover the full circle; without Parker weights the "
-        "image will show streaks");
-  }
+  note_short_scan(console, report.fbp);
   note_half_acquisition(console, report.fbp.half_acquisition_overlap_mm);
   console.line("fbp (" + std::string(fbp_filter_name(options.filter)) + ", " +
                engine_name(options.engine) + "): " + shape_string(g.volume_shape) + " in " +
@@ -111,20 +120,21 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
                std::to_string(report.slices_per_slab) + " slices in " + std::to_string(seconds) +
                " s, " + std::to_string(report.fbp.non_finite_replaced) +
                " non-finite or absurd (beyond 1e20) measurements interpolated -> " + out);
-  console.summary({{"out", out},
-                   {"shape", g.volume_shape},
-                   {"filter", fbp_filter_name(options.filter)},
-                   {"engine", engine_name(options.engine)},
-                   {"seconds", seconds},
-                   {"slabs", report.slabs},
-                   {"slices_per_slab", report.slices_per_slab},
-                   {"memory_limit_bytes", limit},
-                   {"slab_bytes_estimated", fbp_slab_bytes(g, report.slices_per_slab)},
-                   {"non_finite_replaced", report.fbp.non_finite_replaced},
-                   {"short_scan", report.fbp.short_scan},
-                   {"half_acquisition_overlap_mm", report.fbp.half_acquisition_overlap_mm},
-                   {"centre", source.centre() ? centre_json(*source.centre())
-                                              : nlohmann::json(nullptr)}});
+  console.summary(
+      {{"out", out},
+       {"shape", g.volume_shape},
+       {"filter", fbp_filter_name(options.filter)},
+       {"engine", engine_name(options.engine)},
+       {"seconds", seconds},
+       {"slabs", report.slabs},
+       {"slices_per_slab", report.slices_per_slab},
+       {"memory_limit_bytes", limit},
+       {"slab_bytes_estimated", fbp_slab_bytes(g, report.slices_per_slab)},
+       {"non_finite_replaced", report.fbp.non_finite_replaced},
+       {"short_scan", report.fbp.short_scan},
+       {"parker_weighted", report.fbp.parker_weighted},
+       {"half_acquisition_overlap_mm", report.fbp.half_acquisition_overlap_mm},
+       {"centre", source.centre() ? centre_json(*source.centre()) : nlohmann::json(nullptr)}});
   return 0;
 }
 
@@ -198,11 +208,7 @@ int run_fbp(int argc, char** argv, int first) {
     png.replace_extension(".png");
     write_png(png, image);
   }
-  if (report.short_scan) {
-    console.line(
-        "warning: the views do not cover the full circle; without Parker weights the "
-        "image will show streaks");
-  }
+  note_short_scan(console, report);
   note_half_acquisition(console, report.half_acquisition_overlap_mm);
   console.line("fbp (" + std::string(fbp_filter_name(options.filter)) + ", " +
                engine_name(options.engine) + "): " + shape_string(image.shape) + " in " +
@@ -216,9 +222,10 @@ int run_fbp(int argc, char** argv, int first) {
        {"seconds", seconds},
        {"non_finite_replaced", report.non_finite_replaced},
        {"short_scan", report.short_scan},
+       {"parker_weighted", report.parker_weighted},
        {"half_acquisition_overlap_mm", report.half_acquisition_overlap_mm},
-       {"destripe", stripes ? nlohmann::json(destripe_method_name(stripes->method))
-                            : nlohmann::json(nullptr)},
+       {"destripe",
+        stripes ? nlohmann::json(destripe_method_name(stripes->method)) : nlohmann::json(nullptr)},
        {"flat_field",
         loaded.flat_field ? flat_field_json(*loaded.flat_field) : nlohmann::json(nullptr)},
        {"centre", loaded.centre ? centre_json(*loaded.centre) : nlohmann::json(nullptr)}});

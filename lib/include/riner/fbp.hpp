@@ -44,8 +44,10 @@ struct FbpOptions {
 
 struct FbpReport {
   std::size_t non_finite_replaced = 0;  // NaN/inf measurements interpolated from neighbours
-  bool short_scan = false;  // views miss part of the circle (half-circle for parallel beams);
-                            // no Parker weighting is applied, so expect streaks
+  bool short_scan = false;  // views miss part of the circle (half-circle for parallel beams)
+  // A fan or cone beam's short scan (half a turn plus the fan, or more) weighted by Parker's
+  // weights, each line counted once; a short scan without it misses lines: expect streaks.
+  bool parker_weighted = false;
   // A full turn with the axis near one end of the detector (half acquisition): the overlap
   // around the axis, +- this many mm, blended between conjugate rays; 0 for a centred detector.
   double half_acquisition_overlap_mm = 0.0;

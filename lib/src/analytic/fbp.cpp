@@ -58,10 +58,13 @@ Array fbp(const Scan& scan, const FbpOptions& options, FbpReport* report) {
   FbpReport local;
   local.non_finite_replaced = analytic::repair_non_finite(weighted, g.n_u);
   analytic::cosine_weight(weighted, g);
+  std::vector<double> view_weights = analytic::view_weights(g, &local.short_scan);
+  if (local.short_scan) {
+    local.parker_weighted = analytic::parker_weight(weighted, g, view_weights);
+  }
   local.half_acquisition_overlap_mm = analytic::extend_half_acquisition(weighted, g);
   const std::vector<double> taps =
       analytic::filter_taps(g.n_u, analytic::filter_spacing(g), options.filter);
-  const std::vector<double> view_weights = analytic::view_weights(g, &local.short_scan);
   if (report != nullptr) *report = local;
 
   std::vector<std::size_t> shape = g.volume_shape;

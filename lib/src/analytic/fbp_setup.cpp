@@ -172,4 +172,71 @@ std::vector<double> view_weights(const Geometry& g, bool* short_scan) {
   return weights;
 }
 
+namespace {
+
+// The fan angle of each detector column's ray at view 0 in Parker's sense: its conjugate ray
+// leaves from the source position pi + 2 gamma further along the scan. From the geometry's own
+// rays (the second crossing of the column's line with the source circle), so the detector's
+// orientation and the direction of rotation need no convention here.
+std::vector<double> conjugate_fan_angles(const Geometry& g, double direction) {
+  const double mid_row = g.is_3d() ? 0.5 * (static_cast<double>(g.n_v) - 1.0) : 0.0;
+  std::vector<double> gamma(g.n_u);
+  for (std::size_t j = 0; j < g.n_u; ++j) {
+    const Ray ray = detector_ray(g, 0, static_cast<double>(j), mid_row);
+    const Vec3& s = ray.origin;
+    // In the axial plane: |s + t d| = |s| again at t = -2 (s . d) / |d|^2.
+    const double dx = ray.direction.x, dy = ray.direction.y;
+    const double t = -2.0 * (s.x * dx + s.y * dy) / (dx * dx + dy * dy);
+    const double a0 = std::atan2(s.y, s.x);
+    const double a1 = std::atan2(s.y + t * dy, s.x + t * dx);
+    double turn = std::fmod(direction * (a1 - a0), 2.0 * M_PI);
+    if (turn < 0.0) turn += 2.0 * M_PI;
+    gamma[j] = 0.5 * (turn - M_PI);
+  }
+  return gamma;
+}
+
+}  // namespace
+
+bool parker_weight(Array& measurement, const Geometry& g, std::vector<double>& view_weights) {
+  const std::size_t n = g.n_views();
+  if (!g.is_divergent() || n < 3) return false;
+  // Evenly stepping views, in either direction.
+  const double step = (g.angles[n - 1] - g.angles[0]) / static_cast<double>(n - 1);
+  for (std::size_t i = 1; i < n; ++i) {
+    if (std::fabs(g.angles[i] - g.angles[i - 1] - step) > 0.1 * std::fabs(step)) return false;
+  }
+  const double last = std::fabs(step) * static_cast<double>(n - 1);  // the last view's beta
+  if (last + std::fabs(step) >= 2.0 * M_PI - 0.5 * std::fabs(step)) return false;  // a full turn
+  // Which way the source moves as beta grows, from the first two views' sources.
+  const Vec3 s0 = detector_ray(g, 0, 0.0).origin, s1 = detector_ray(g, 1, 0.0).origin;
+  const double moved = std::remainder(std::atan2(s1.y, s1.x) - std::atan2(s0.y, s0.x), 2.0 * M_PI);
+  const std::vector<double> gamma = conjugate_fan_angles(g, moved >= 0.0 ? 1.0 : -1.0);
+  double fan = 0.0;  // the largest |gamma|
+  for (double v : gamma) fan = std::max(fan, std::fabs(v));
+  const double delta = 0.5 * (last - M_PI);  // Parker's half fan, stretched to the range
+  if (delta < fan - 1e-9) return false;      // lines the scan never measured
+  const std::size_t rows = g.is_3d() ? g.n_v : 1;
+  const auto weight = [&](double beta, double gam) {
+    if (beta < 2.0 * (delta - gam)) {
+      const double s = std::sin(0.25 * M_PI * beta / (delta - gam));
+      return s * s;
+    }
+    if (beta <= M_PI - 2.0 * gam) return 1.0;
+    const double s = std::sin(0.25 * M_PI * (M_PI + 2.0 * delta - beta) / (delta + gam));
+    return beta <= M_PI + 2.0 * delta ? s * s : 0.0;
+  };
+  for (std::size_t i = 0; i < n; ++i) {
+    const double beta = std::fabs(step) * static_cast<double>(i);
+    for (std::size_t r = 0; r < rows; ++r) {
+      float* line = measurement.ptr() + (i * rows + r) * g.n_u;
+      for (std::size_t j = 0; j < g.n_u; ++j) {
+        line[j] = static_cast<float>(line[j] * weight(beta, gamma[j]));
+      }
+    }
+  }
+  view_weights.assign(n, std::fabs(step));
+  return true;
+}
+
 }  // namespace riner::analytic

@@ -47,4 +47,13 @@ std::vector<double> filter_taps(std::size_t n_u, double tau, FbpFilter filter);
 // that sum(weights) = pi either way. Sets *short_scan when part of the period was never seen.
 std::vector<double> view_weights(const Geometry& g, bool* short_scan);
 
+// Parker's weights (Parker 1982, with the overscan of a range beyond half a turn plus the fan)
+// for a fan or cone beam whose views step evenly over less than a full turn but at least half
+// a turn plus the fan: every line is measured once or twice, and each pair of conjugate rays
+// (beta, gamma) and (beta + pi + 2 gamma, -gamma) gets weights that sum to 1, falling smoothly
+// to 0 at the ends of the range. Multiplies the readings and makes `view_weights` each view's
+// step, counted once (a full turn's halves count each line twice). False, and nothing changed,
+// for a parallel beam, a full turn, uneven views or too short a range.
+bool parker_weight(Array& measurement, const Geometry& g, std::vector<double>& view_weights);
+
 }  // namespace riner::analytic

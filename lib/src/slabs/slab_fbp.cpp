@@ -133,6 +133,7 @@ SlabFbpReport fbp_by_slabs(const ScanRows& source, const FbpOptions& options, Vo
       slices = fbp(scan, slab, &part);
       report.fbp.non_finite_replaced += part.non_finite_replaced;
       report.fbp.short_scan = report.fbp.short_scan || part.short_scan;
+      report.fbp.parker_weighted = report.fbp.parker_weighted || part.parker_weighted;
       report.fbp.half_acquisition_overlap_mm = part.half_acquisition_overlap_mm;
     }
     out.write(first, slices);
