@@ -104,6 +104,17 @@ TEST_SUITE("centre") {
     CHECK(e.method == "sinogram");
     CHECK(e.pairs == 0);
     CHECK(std::isnan(e.pairs_offset_px));
+    // Scans a little short of half a turn (179.5 degrees of 180 views ended 0.001 degrees
+    // short of the rule's 1.5 steps and were refused).
+    for (const auto& [views, degrees] : {std::pair{180, 179.5}, std::pair{100, 178.0}}) {
+      CAPTURE(views);
+      const riner::Geometry shorter =
+          with_angles(riner::test::small_parallel2d(), static_cast<std::size_t>(views),
+                      degrees * M_PI / 180.0, false);
+      const riner::CentreEstimate s = riner::estimate_centre(scan_with_offset(shorter, 2.6));
+      CHECK(s.method == "sinogram");
+      CHECK(std::fabs(s.offset_px - 2.6) < 0.1);
+    }
   }
 
   TEST_CASE("a head wider than the detector, the axis 15% off its middle: the sinogram") {

@@ -33,11 +33,11 @@ struct CentreEstimate {
 };
 
 // Parallel beam (2D or 3D). The sinogram where the views cover an evenly spaced half-turn less
-// 1.5 steps; else view pairs half a turn apart: exactly (within a quarter of the mean angular
-// step) or between two views (interpolated in angle; a 360-degree scan with an odd number of
-// views). Non-finite readings are left out (pairs) or interpolated along the row (sinogram).
-// InputError for a divergent beam or a scan where neither works.
-// Fan beam (2D) over a full turn: from conjugate rays (method "conjugate rays",
+// 4 steps (179.5 degrees of 180 views; 178 of 100); else view pairs half a turn apart: exactly
+// (within a quarter of the mean angular step) or between two views (interpolated in angle; a
+// 360-degree scan with an odd number of views). Non-finite readings are left out (pairs) or
+// interpolated along the row (sinogram). InputError for a divergent beam or a scan where neither
+// works. Fan beam (2D) over a full turn: from conjugate rays (method "conjugate rays",
 // preprocessing/centre_conjugate.hpp), within 32 px of the geometry's offset, or a half
 // acquisition's beyond the detector's central half ("conjugate rays, half acquisition"); a cone
 // beam likewise from the fan of its rays through the source's plane.

@@ -28,6 +28,9 @@ constexpr double kFineStepPx = 0.25;
 constexpr std::size_t kMostRows = 8;
 // Angles evenly spaced within this share of the step.
 constexpr double kEvenSpacing = 0.1;
+// The half-turn may end this many steps short of pi (a 179.5-degree scan of 180 views ends
+// 1.5 steps and a hair short).
+constexpr double kMostGapSteps = 4.0;
 
 using Row = std::vector<double>;
 
@@ -330,7 +333,7 @@ std::vector<std::size_t> half_turns(const std::vector<double>& angles, std::size
       }
       ++end;
     }
-    if (std::fabs(angles[end - 1] - angles[start]) < M_PI - 1.5 * step) return starts;
+    if (std::fabs(angles[end - 1] - angles[start]) < M_PI - kMostGapSteps * step) return starts;
     if (starts.empty()) *views = end - start;
     if (end - start != *views) return starts;
     starts.push_back(start);

@@ -25,7 +25,7 @@ struct SinogramAxis {
   std::size_t rows = 0;      // detector rows searched (their median)
 };
 
-// Parallel beam only. nullopt when the views do not cover a half-turn less 1.5 steps from the
+// Parallel beam only. nullopt when the views do not cover a half-turn less 4 steps from the
 // first, or are not evenly spaced within it (within 10% of the step). No rows (axis_column NaN)
 // when no row's measure has a minimum inside the search: its best at either end of it.
 std::optional<SinogramAxis> sinogram_axis(const Scan& scan);
