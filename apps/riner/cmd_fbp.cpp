@@ -7,6 +7,8 @@
 
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "progress.hpp"
+#include "reconstruct_slabs.hpp"
 #include "riner/destripe.hpp"
 #include "riner/error.hpp"
 #include "riner/fbp.hpp"
@@ -14,8 +16,7 @@
 #include "riner/scan.hpp"
 #include "riner/slab_fbp.hpp"
 #include "riner/slab_plan.hpp"
-#include "progress.hpp"
-#include "reconstruct_slabs.hpp"
+#include "riner/tomo_file.hpp"
 #include "scan_options.hpp"
 #include "summary_json.hpp"
 
@@ -62,6 +63,16 @@ std::optional<DestripeOptions> destripe_from(const Args& args) {
   return destripe_options_from(args, args.get("destripe"));
 }
 
+// What a killed earlier write of the output left beside it (a SIGKILL mid-write: riner's
+// temporary files whose writer on this host has ended) goes before this one's.
+void remove_stale_beside(const std::string& out) {
+  std::filesystem::path target = out;
+  if (const auto h5 = split_hdf5_dataset(target)) target = h5->first;
+  if (target.extension().empty()) remove_stale_temporaries(target);  // a folder of slices
+  const std::filesystem::path folder = target.parent_path();
+  remove_stale_temporaries(folder.empty() ? "." : folder);
+}
+
 // A short scan: weighted (a fan or cone beam over half a turn plus the fan), or missing lines.
 void note_short_scan(const Console& console, const FbpReport& report) {
   if (report.parker_weighted) {
@@ -86,6 +97,7 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
           ? asked.slices_per_slab
           : std::min(fbp_slices_within(g, limit), fbp_device_slices(g, asked, options));
   const std::string out = args.get("out");
+  remove_stale_beside(out);
   VolumeWriter writer(out, g.volume_shape, g.voxel_mm);
   const auto start = std::chrono::steady_clock::now();
   const std::size_t nz = g.volume_shape[0];
@@ -187,6 +199,7 @@ int run_fbp(int argc, char** argv, int first) {
   Scan scan = std::move(loaded.scan);  // the stripe filter may replace its measurement
   const std::filesystem::path out = args.get("out");
   format_from_path(out);  // reject an unknown extension before the work
+  remove_stale_beside(out.string());
   const FbpOptions& options = fbp_options();
   const std::optional<DestripeOptions> stripes = destripe_from(args);
   if (stripes) {

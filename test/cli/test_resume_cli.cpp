@@ -368,7 +368,7 @@ TEST_SUITE("cli") {
           riner::test::read_bytes(whole / "alpha.npy"));
   }
 
-  TEST_CASE("--resume removes the temporary files a killed writer on this host left, no other") {
+  TEST_CASE("--resume (and fbp) removes the temporary files a killed writer on this host left") {
     riner::test::TempDir dir;
     const std::string sim = riner::test::simulate_small_parallel2d(dir, 6);
     const pid_t ended = riner::test::ended_process_id();
@@ -388,5 +388,13 @@ TEST_SUITE("cli") {
     CHECK(std::filesystem::exists(alive));      // its writer still runs
     CHECK(std::filesystem::exists(elsewhere));  // another host's: its writer may run
     CHECK(std::filesystem::exists(out / "image.nii"));
+    // fbp has no --resume: it removes what a killed earlier write left beside its output.
+    const std::filesystem::path fbp_dead =
+        dir / ("fbp.npy" + riner::temporary_marker(ended) + "1.0");
+    riner::test::write_bytes(fbp_dead, "partial");
+    REQUIRE(riner_cli("fbp " + sim + "/sino.npy --quiet --out " + (dir / "fbp.npy").string(), dir)
+                .code == 0);
+    CHECK(!std::filesystem::exists(fbp_dead));
+    CHECK(std::filesystem::exists(dir / "fbp.npy"));
   }
 }
