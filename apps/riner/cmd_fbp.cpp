@@ -124,6 +124,13 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
     png = png.extension().empty() ? png / "middle_slice.png" : png.replace_extension(".png");
     write_png(png, middle);
   }
+  if (report.flat_field) {
+    for (const std::string& line :
+         {flat_field_line(*report.flat_field), pixels_without_beam_line(*report.flat_field),
+          air_drift_line(*report.flat_field)}) {
+      if (!line.empty()) console.line(line);
+    }
+  }
   note_short_scan(console, report.fbp);
   note_half_acquisition(console, report.fbp.half_acquisition_overlap_mm);
   console.line("fbp (" + std::string(fbp_filter_name(options.filter)) + ", " +
@@ -146,6 +153,8 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
        {"short_scan", report.fbp.short_scan},
        {"parker_weighted", report.fbp.parker_weighted},
        {"half_acquisition_overlap_mm", report.fbp.half_acquisition_overlap_mm},
+       {"flat_field",
+        report.flat_field ? flat_field_json(*report.flat_field) : nlohmann::json(nullptr)},
        {"centre", source.centre() ? centre_json(*source.centre()) : nlohmann::json(nullptr)}});
   return 0;
 }

@@ -452,6 +452,47 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   }
   std::sort(dead.begin(), dead.end());
   dead.erase(std::unique(dead.begin(), dead.end()), dead.end());
+  // The readings, as a whole scan's run reports them: its slabs' non-finite readings and raw
+  // projections' normalisation (the drift of the slab where the air moved most).
+  std::size_t non_finite = 0;
+  std::optional<FlatFieldReport> flat;
+  for (const nlohmann::json& entry : run.manifest()["slabs"]) {
+    const nlohmann::json readings = entry.value("readings", nlohmann::json());
+    if (!readings.is_object()) continue;
+    non_finite += readings.value("non_finite", std::size_t{0});
+    if (!readings.contains("flat_field")) continue;
+    const nlohmann::json& f = readings["flat_field"];
+    if (!flat) {
+      flat = FlatFieldReport{};
+      flat->flat_frames = f["flat_frames"];
+      flat->dark_frames = f["dark_frames"];
+      flat->flat_series = f["flat_series"];
+      flat->flat_change = f["flat_change"];
+      flat->air_drift_sigmas = -1.0;
+    }
+    flat->invalid_readings += f["invalid_readings"].get<std::size_t>();
+    flat->pixels_without_beam += f["pixels_without_beam"].get<std::size_t>();
+    flat->pixels += f["pixels"].get<std::size_t>();
+    const double sigmas = f["air_drift_sigmas"];
+    if (sigmas > flat->air_drift_sigmas && f["air_first"].is_number() &&
+        f["air_last"].is_number()) {
+      flat->air_drift_sigmas = sigmas;
+      flat->air_first = f["air_first"];
+      flat->air_last = f["air_last"];
+    }
+  }
+  if (flat) {
+    flat->air_drift_sigmas = std::max(0.0, flat->air_drift_sigmas);
+    for (const std::string& line :
+         {flat_field_line(*flat), pixels_without_beam_line(*flat), air_drift_line(*flat)}) {
+      if (!line.empty()) console.line(line);
+    }
+  }
+  if (non_finite > 0) {
+    console.line(std::to_string(non_finite) +
+                 " measurements are NaN/inf (dead elements?): they count as 0 and their "
+                 "elements' beta learns to switch them off");
+  }
   // Slabs with nothing to reconstruct (a dead detector row): written as NaN, said here.
   nlohmann::json without_readings = nlohmann::json::array();
   for (const Slab& s : run.slabs()) {
@@ -515,6 +556,8 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       {"dead_elements", dead.size()},
       {"changing_elements", changing},
       {"slabs_without_readings", without_readings},
+      {"non_finite_measurements", non_finite},
+      {"flat_field", flat ? flat_field_json(*flat) : nlohmann::json(nullptr)},
       {"centre",
        run.source().centre() ? centre_json(*run.source().centre()) : nlohmann::json(nullptr)},
       {"wall_seconds", wall},

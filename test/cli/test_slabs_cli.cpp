@@ -523,6 +523,51 @@ TEST_SUITE("cli") {
     CHECK(run.err.find("--slab-slices must be 1 or more") != std::string::npos);
   }
 
+  TEST_CASE("by slabs, raw projections are reported as a whole scan's: normalisation, drift") {
+    // The beam fades 10% over the views: the flat from before the scan no longer fits.
+    riner::test::TempDir dir;
+    const std::string scan = simulate_stack(dir);
+    const std::string geometry = (std::filesystem::path(scan).parent_path() / "geometry.json");
+    riner::Array intensities = riner::read_array(scan).array;
+    const std::size_t views = intensities.shape[0];
+    const std::size_t per_view = intensities.size() / views;
+    for (std::size_t i = 0; i < intensities.size(); ++i) {
+      const float fade = 1.0f - 0.1f * static_cast<float>(i / per_view) / (views - 1.0f);
+      const float v = intensities.data[i];
+      intensities.data[i] = std::isfinite(v) ? 1000.0f * fade * std::exp(-v) : 0.0f;
+    }
+    riner::write_array(dir / "raw.npy", intensities);
+    riner::write_array(dir / "flats.npy",
+                       riner::Array({2, intensities.shape[1], intensities.shape[2]}, 1000.0f));
+    const std::string raw = (dir / "raw.npy").string() + " --flat " + (dir / "flats.npy").string() +
+                            " --geometry " + geometry;
+    Run run =
+        riner_cli("reconstruct " + raw + " --steps 100 --out " + (dir / "whole").string(), dir);
+    REQUIRE(run.code == 0);
+    run = riner_cli(
+        "reconstruct " + raw + " --slab-slices 4 --steps 100 --out " + (dir / "slabs").string(),
+        dir);
+    CAPTURE(run.out);
+    REQUIRE(run.code == 0);
+    CHECK(run.out.find("raw projections: flat field of 2 frame(s)") != std::string::npos);
+    CHECK(run.out.find("the beam or the detector drifted during the scan") != std::string::npos);
+    const nlohmann::json whole =
+        nlohmann::json::parse(riner::test::read_bytes(dir / "whole" / "summary.json"));
+    const nlohmann::json slabs =
+        nlohmann::json::parse(riner::test::read_bytes(dir / "slabs" / "summary.json"));
+    REQUIRE(slabs["flat_field"].is_object());
+    CHECK(slabs["flat_field"]["air_drifts"] == true);
+    CHECK(slabs["flat_field"]["invalid_readings"] == whole["flat_field"]["invalid_readings"]);
+    CHECK(slabs["non_finite_measurements"] == whole["non_finite_measurements"]);
+    run =
+        riner_cli("fbp " + raw + " --slab-slices 4 --json --out " + (dir / "f.npy").string(), dir);
+    REQUIRE(run.code == 0);
+    const nlohmann::json fbp = nlohmann::json::parse(run.out);
+    REQUIRE(fbp["flat_field"].is_object());
+    CHECK(fbp["flat_field"]["air_drifts"] == true);
+    CHECK(fbp["flat_field"]["invalid_readings"] == whole["flat_field"]["invalid_readings"]);
+  }
+
   TEST_CASE("a dead detector row: its slice is NaN and said so, the rest of the scan goes on") {
     riner::test::TempDir dir;
     const std::string scan = simulate_stack(dir);

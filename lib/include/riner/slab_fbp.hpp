@@ -9,6 +9,7 @@
 
 #include <cstddef>
 #include <functional>
+#include <optional>
 
 #include "riner/fbp.hpp"
 #include "riner/scan_source.hpp"
@@ -19,7 +20,10 @@ namespace riner {
 struct SlabFbpReport {
   std::size_t slabs = 0;
   std::size_t slices_per_slab = 0;
-  FbpReport fbp;  // summed over the slabs
+  FbpReport fbp;  // summed over the slabs (each detector row's readings counted once)
+  // Raw projections' normalisation over the slabs: counts of each row once, the drift of the
+  // slab where the air moved most.
+  std::optional<FlatFieldReport> flat_field;
 };
 
 // The detector rows slices [first, first + count) of g's volume project to, with the row

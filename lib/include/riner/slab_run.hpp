@@ -135,9 +135,11 @@ class SlabRun {
   std::filesystem::path slab_checkpoint(const Slab& slab) const;
   void resume_slab(Reconstructor& r, const std::filesystem::path& checkpoint) const;
   // The slab's slices, alpha, beta and preview planes, then its record.
+  // `readings`: what its readings were (non-finite ones, raw projections' normalisation).
   void write_slab(const Slab& slab, const Reconstructor& r, const Summarise& summarise,
                   const std::optional<Device>& device,
-                  std::chrono::steady_clock::time_point started) const;
+                  std::chrono::steady_clock::time_point started,
+                  const nlohmann::json& readings) const;
   // A slab whose readings hold nothing (a dead detector row): NaN slices and alpha, beta 0,
   // and a record saying why, so that the rest of the scan goes on.
   void write_empty_slab(const Slab& slab, const std::string& why) const;

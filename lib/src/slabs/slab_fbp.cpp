@@ -104,6 +104,36 @@ std::size_t fbp_device_slices_within(const Geometry& g, std::size_t device_limit
   return slices;
 }
 
+namespace {
+
+// A slab's normalisation into the run's: its counts scaled to the rows no earlier slab read.
+// Its invalid readings are the rows' non-finite ones after normalisation (`non_finite`).
+void merge_flat_report(SlabFbpReport& report, const FlatFieldReport& slab, std::size_t new_rows,
+                       std::size_t rows, std::size_t non_finite) {
+  const double share = static_cast<double>(new_rows) / static_cast<double>(rows);
+  const auto scaled = [&](std::size_t n) {
+    return static_cast<std::size_t>(std::lround(share * static_cast<double>(n)));
+  };
+  if (!report.flat_field) {
+    report.flat_field = slab;
+    report.flat_field->invalid_readings = 0;
+    report.flat_field->pixels_without_beam = 0;
+    report.flat_field->pixels = 0;
+  }
+  FlatFieldReport& all = *report.flat_field;
+  all.invalid_readings += non_finite;
+  all.pixels_without_beam += scaled(slab.pixels_without_beam);
+  all.pixels += scaled(slab.pixels);
+  if (std::isfinite(slab.air_first) && std::isfinite(slab.air_last) &&
+      (!std::isfinite(all.air_first) || slab.air_drift_sigmas > all.air_drift_sigmas)) {
+    all.air_first = slab.air_first;
+    all.air_last = slab.air_last;
+    all.air_drift_sigmas = slab.air_drift_sigmas;
+  }
+}
+
+}  // namespace
+
 SlabFbpReport fbp_by_slabs(const ScanRows& source, const FbpOptions& options, VolumeWriter& out,
                            std::size_t slices_per_slab,
                            const std::function<void(std::size_t, const Array&)>& written,
@@ -116,6 +146,7 @@ SlabFbpReport fbp_by_slabs(const ScanRows& source, const FbpOptions& options, Vo
   SlabFbpReport report;
   report.slabs = slab_count(nz, slices_per_slab);
   report.slices_per_slab = (nz + report.slabs - 1) / report.slabs;
+  std::size_t counted_end = 0;  // rows before it were counted by an earlier slab
   for (std::size_t i = 0; i < report.slabs; ++i) {
     const std::size_t first = i * nz / report.slabs;
     const std::size_t count = (i + 1) * nz / report.slabs - first;
@@ -124,14 +155,27 @@ SlabFbpReport fbp_by_slabs(const ScanRows& source, const FbpOptions& options, Vo
     if (rows.count > 0) {
       // The rows in their place on the whole detector, the whole volume's grid: the slab's
       // slices selected from it sample exactly what the whole FBP's would.
-      Scan scan = source.read(rows);
+      FlatFieldReport flat;
+      Scan scan = source.read(rows, &flat);
+      const std::size_t new_first = std::max(rows.first, counted_end);
+      const std::size_t new_rows = rows.end() > new_first ? rows.end() - new_first : 0;
+      counted_end = std::max(counted_end, rows.end());
+      std::size_t non_finite = 0;
+      for (std::size_t v = 0; v < g.n_views(); ++v) {
+        const float* line =
+            scan.measurement.ptr() + (v * rows.count + (new_first - rows.first)) * g.n_u;
+        for (std::size_t k = 0; k < new_rows * g.n_u; ++k) {
+          non_finite += std::fabs(line[k]) <= kLargestReading ? 0 : 1;
+        }
+      }
+      report.fbp.non_finite_replaced += non_finite;
+      if (flat.flat_frames > 0) merge_flat_report(report, flat, new_rows, rows.count, non_finite);
       scan.geometry = detector_rows_geometry(g, rows.first, rows.count);
       if (prepare) prepare(scan);
       FbpOptions slab = options;
       slab.slices = {first, 1, count};
       FbpReport part;
       slices = fbp(scan, slab, &part);
-      report.fbp.non_finite_replaced += part.non_finite_replaced;
       report.fbp.short_scan = report.fbp.short_scan || part.short_scan;
       report.fbp.parker_weighted = report.fbp.parker_weighted || part.parker_weighted;
       report.fbp.half_acquisition_overlap_mm = part.half_acquisition_overlap_mm;

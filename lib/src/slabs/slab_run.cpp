@@ -53,6 +53,41 @@ nlohmann::json identity(const ScanRows& source, const RinerConfig& config,
   return id;
 }
 
+// What the slab's readings were, for the whole run's report: the non-finite readings of the
+// rows it maps (a cone beam's slabs read their neighbours' rows too), and raw projections'
+// normalisation (its counts scaled to the rows it maps).
+nlohmann::json readings_record(const Scan& scan, const Slab& slab, const FlatFieldReport& flat) {
+  const std::size_t n_u = scan.geometry.n_u, rows = slab.rows.count;
+  const std::size_t first = slab.map_rows.first - slab.rows.first;
+  std::size_t non_finite = 0;
+  for (std::size_t v = 0; v < scan.geometry.n_views(); ++v) {
+    const float* line = scan.measurement.ptr() + (v * rows + first) * n_u;
+    for (std::size_t i = 0; i < slab.map_rows.count * n_u; ++i) {
+      non_finite += std::isfinite(line[i]) ? 0 : 1;
+    }
+  }
+  nlohmann::json out = {{"non_finite", non_finite}};
+  if (flat.flat_frames == 0) return out;
+  const double share = static_cast<double>(slab.map_rows.count) / static_cast<double>(rows);
+  const auto scaled = [&](std::size_t n) {
+    return static_cast<std::size_t>(std::lround(share * static_cast<double>(n)));
+  };
+  const auto number = [](double v) {
+    return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr);
+  };
+  out["flat_field"] = {{"flat_frames", flat.flat_frames},
+                       {"dark_frames", flat.dark_frames},
+                       {"invalid_readings", scaled(flat.invalid_readings)},
+                       {"pixels_without_beam", scaled(flat.pixels_without_beam)},
+                       {"pixels", scaled(flat.pixels)},
+                       {"flat_series", flat.flat_series},
+                       {"flat_change", flat.flat_change},
+                       {"air_first", number(flat.air_first)},
+                       {"air_last", number(flat.air_last)},
+                       {"air_drift_sigmas", flat.air_drift_sigmas}};
+  return out;
+}
+
 // A one-slice slab's scan as the slice's own 2D scan: the mean of its detector rows (of the
 // finite readings; NaN where a column reads none).
 Scan slice_scan(const Scan& slab) {
@@ -320,14 +355,16 @@ void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
                      if (claim && !claim(slab)) return;
                      const auto slab_started = std::chrono::steady_clock::now();
                      Scan scan;
+                     FlatFieldReport flat;
                      try {
                        std::lock_guard<std::mutex> lock(read_mutex);
-                       scan = source_.read(slab.rows);
+                       scan = source_.read(slab.rows, &flat);
                      } catch (const NoReadingsError& e) {
                        write_empty_slab(slab, e.what());
                        report(slab, worker, 1.0, 0, 0, true, true);
                        return;
                      }
+                     const nlohmann::json readings = readings_record(scan, slab, flat);
                      scan.geometry = slab_geometry(g, slab);
                      if (slices_2d_) scan = slice_scan(scan);
                      Reconstructor r(std::move(scan), config_, device);
@@ -348,7 +385,7 @@ void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
                          },
                          report_every);
                      if (stopped) return;  // its checkpoint, not a half-trained slab
-                     write_slab(slab, r, summarise, device, slab_started);
+                     write_slab(slab, r, summarise, device, slab_started, readings);
                      saver.discard();  // the slab's record stands for it now
                      report(slab, worker, 1.0, steps, steps, true, true);
                    });
@@ -356,7 +393,8 @@ void SlabRun::run(const std::function<void(const SlabProgress&)>& progress,
 
 void SlabRun::write_slab(const Slab& slab, const Reconstructor& r, const Summarise& summarise,
                          const std::optional<Device>& device,
-                         std::chrono::steady_clock::time_point started) const {
+                         std::chrono::steady_clock::time_point started,
+                         const nlohmann::json& readings) const {
   const Geometry& g = source_.geometry();
   const ReconstructionResult result = r.result();
   Array image = result.image;
@@ -401,6 +439,7 @@ void SlabRun::write_slab(const Slab& slab, const Reconstructor& r, const Summari
   // A slice trained in 2D names its dead elements by column, for every row of the slab.
   entry["trained_as"] = slices_2d_ ? "slice_2d" : "field_3d";
   entry["summary"] = summarise ? summarise(r, result, device) : nlohmann::json(nullptr);
+  entry["readings"] = readings;
   write_text(slab_record(slab), entry.dump(1) + "\n");  // last: the slab is done
 }
 
