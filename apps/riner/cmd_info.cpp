@@ -83,16 +83,20 @@ int run_info(int argc, char** argv, int first) {
 
   const ArrayFile file = read_array(path);
   const ArrayStats stats = compute_stats(file.array);
+  // Without a finite value there is no minimum, maximum, mean or spread (not 0).
+  const auto over_finite = [&](double v) {
+    return stats.finite > 0 ? nlohmann::json(v) : nlohmann::json(nullptr);
+  };
   if (json) {
     nlohmann::json out = {{"file", path},
                           {"kind", "array"},
                           {"format", format_name(file.format)},
                           {"dtype", file.dtype},
                           {"shape", file.array.shape},
-                          {"min", stats.min},
-                          {"max", stats.max},
-                          {"mean", stats.mean},
-                          {"stddev", stats.stddev},
+                          {"min", over_finite(stats.min)},
+                          {"max", over_finite(stats.max)},
+                          {"mean", over_finite(stats.mean)},
+                          {"stddev", over_finite(stats.stddev)},
                           {"finite", stats.finite},
                           {"nan", stats.nan},
                           {"pos_inf", stats.pos_inf},
@@ -102,8 +106,12 @@ int run_info(int argc, char** argv, int first) {
   } else if (!quiet) {
     std::printf("%s: %s %s %s\n", path.c_str(), format_name(file.format), file.dtype.c_str(),
                 shape_string(file.array.shape).c_str());
-    std::printf("  min %.6g  max %.6g  mean %.6g  std %.6g (over %zu finite values)\n", stats.min,
-                stats.max, stats.mean, stats.stddev, stats.finite);
+    if (stats.finite > 0) {
+      std::printf("  min %.6g  max %.6g  mean %.6g  std %.6g (over %zu finite values)\n", stats.min,
+                  stats.max, stats.mean, stats.stddev, stats.finite);
+    } else {
+      std::printf("  no finite value\n");
+    }
     std::printf("  non-finite         %zu (NaN %zu, +inf %zu, -inf %zu)\n", stats.non_finite(),
                 stats.nan, stats.pos_inf, stats.neg_inf);
     if (!file.voxel_size.empty()) {

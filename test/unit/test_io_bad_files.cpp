@@ -81,6 +81,13 @@ TEST_SUITE("io_bad_files") {
                  "header has no simple 'descr' (structured dtypes are not supported)");
     expect_error(dir, "scalar.npy", riner::test::make_npy("<f4", false, {}, floats(1)),
                  "holds a scalar, not an array");
+    // A negative dimension was read as its digits ([4, 5] here).
+    std::string negative = good;
+    const std::size_t at = negative.find("(4, 5)");
+    REQUIRE(at != std::string::npos);
+    negative.replace(at, 6, "(-4,5)");
+    expect_error(dir, "negative.npy", negative,
+                 "header's shape (-4,5) is not a tuple of non-negative whole numbers");
     expect_error(dir, "version.npy", std::string("\x93NUMPY\x09\x00\x10\x00", 10) + good.substr(10),
                  "unsupported .npy version 9");
   }

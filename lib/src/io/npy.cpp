@@ -63,12 +63,21 @@ NpyHeader parse_header(const std::string& dict, const std::filesystem::path& pat
   if (!std::regex_search(dict, m, shape_re))
     throw InputError(prefix(path) + "header has no 'shape'");
   const std::string dims = m[1].str();
-  static const std::regex int_re(R"(\s*(\d+)\s*(,|$))");
-  for (auto it = std::sregex_iterator(dims.begin(), dims.end(), int_re);
-       it != std::sregex_iterator(); ++it) {
-    const std::string digits = (*it)[1].str();
-    if (digits.size() > 12) throw InputError(prefix(path) + "absurd dimension " + digits);
-    header.shape.push_back(std::stoull(digits));
+  // Each entry a whole number: "(-5, 60)" read as [5, 60] before.
+  std::size_t start = 0;
+  while (start <= dims.size()) {
+    const std::size_t comma = std::min(dims.find(',', start), dims.size());
+    std::string entry = dims.substr(start, comma - start);
+    entry.erase(0, entry.find_first_not_of(" \t"));
+    entry.erase(entry.find_last_not_of(" \t") + 1);
+    start = comma + 1;
+    if (entry.empty() && comma == dims.size()) break;  // "(n,)" or "()"
+    if (entry.empty() || entry.find_first_not_of("0123456789") != std::string::npos) {
+      throw InputError(prefix(path) + "header's shape (" + dims +
+                       ") is not a tuple of non-negative whole numbers");
+    }
+    if (entry.size() > 12) throw InputError(prefix(path) + "absurd dimension " + entry);
+    header.shape.push_back(std::stoull(entry));
   }
   if (header.shape.empty()) throw InputError(prefix(path) + "holds a scalar, not an array");
   return header;

@@ -309,15 +309,34 @@ Scan midplane_fan(const Scan& cone) {
   return fan;
 }
 
+// A 2D scan's views in order of angle (a shuffled or interleaved acquisition): the conjugate
+// rays are read between neighbouring views. The same scan where its angles already run one way.
+Scan in_angle_order(Scan scan) {
+  const std::vector<double>& a = scan.geometry.angles;
+  const bool rising = std::is_sorted(a.begin(), a.end());
+  const bool falling = std::is_sorted(a.rbegin(), a.rend());
+  if (rising || falling || scan.geometry.is_3d()) return scan;
+  std::vector<std::size_t> order(a.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t x, std::size_t y) { return a[x] < a[y]; });
+  const std::size_t n_u = scan.geometry.n_u;
+  Scan sorted = scan;
+  sorted.geometry.uniform_angles.reset();
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    sorted.geometry.angles[i] = a[order[i]];
+    std::copy_n(scan.measurement.ptr() + order[i] * n_u, n_u, sorted.measurement.ptr() + i * n_u);
+  }
+  return sorted;
+}
+
 // estimate_centre before the check of the readings (the geometry's reasons come first).
 CentreEstimate estimate_from(const Scan& scan) {
   const Geometry& g = scan.geometry;
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   if (g.is_divergent()) {
     const bool cone = g.type == GeometryType::kCone3d;
-    const std::optional<Scan> midplane =
-        cone ? std::optional<Scan>(midplane_fan(scan)) : std::nullopt;
-    const Scan& fan = cone ? *midplane : scan;
+    const Scan fan = in_angle_order(cone ? midplane_fan(scan) : scan);
     const std::optional<preprocessing::ConjugateAxis> axis = preprocessing::conjugate_axis(fan);
     // A cone's rows about the source's plane unread or flat (the rest of the scan may not be),
     // after the geometry's own reasons.
