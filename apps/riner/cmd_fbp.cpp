@@ -173,7 +173,8 @@ int run_fbp(int argc, char** argv, int first) {
       .option("filter", "NAME", "ram-lak, shepp-logan or hann", "ram-lak")
       .flag("png", "also write a PNG preview beside the output")
       .option("slab-slices", "N",
-              "a projection stack (parallel or cone beam) in slabs of N axial slices, each read, "
+              "a projection stack (parallel or cone beam) in slabs of up to N axial slices (evened "
+              "out: 16 slices at N=5 are 4 slabs of 4), each read, "
               "reconstructed and written alone (default: as many as --memory-limit allows)",
               "")
       .option("memory-limit", "SIZE",

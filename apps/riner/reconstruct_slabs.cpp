@@ -96,7 +96,8 @@ std::string bytes_string(double bytes) {
 
 void add_slab_options(Args& args) {
   args.option("slab-slices", "N",
-              "a projection stack in slabs of N axial slices, each trained alone (a cone "
+              "a projection stack in slabs of up to N axial slices (evened out: 16 slices at N=5 "
+              "are 4 slabs of 4), each trained alone (a cone "
               "beam's with the slices around it that its rays cross) and written as it "
               "finishes (volume/slice_NNNNN.tif, manifest.json); default: as many as "
               "--memory-limit allows",
