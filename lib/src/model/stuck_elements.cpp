@@ -1,5 +1,6 @@
 #include "model/stuck_elements.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -10,6 +11,8 @@ namespace {
 constexpr double kSteadyFraction = 0.05;
 constexpr double kJudgedNoiseSigmas = 10.0;
 constexpr long kFarthestNeighbour = 2;
+// A band of steady columns (a dead detector module) up to this share of the detector's width.
+constexpr double kWidestBandShare = 0.25;
 
 }  // namespace
 
@@ -59,6 +62,40 @@ std::vector<std::uint8_t> stuck_elements(const Scan& scan, double noise_sigma) {
         }
       }
       stuck[static_cast<std::size_t>(r * columns + c)] = found;
+    }
+  }
+  // Wider bands along a row (a dead module of 20 columns): columns steady against the varying
+  // columns either side of the band. Real matter cannot make one: a column reads lines at one
+  // distance from the axis in every direction, so an off-centre part that makes the columns
+  // beyond the band vary crosses the band's lines too; columns steady over the views lie beyond
+  // every such part, out to the detector's end, where a band has no second side.
+  const long widest =
+      std::max(3L, static_cast<long>(kWidestBandShare * static_cast<double>(columns)));
+  const auto varies = [&](long r, long c) {
+    const double v = at(r, c);
+    return std::isfinite(v) && v > judged;
+  };
+  for (long r = 0; r < rows; ++r) {
+    long c = 0;
+    while (c < columns) {
+      if (varies(r, c)) {
+        ++c;
+        continue;
+      }
+      long end = c;  // the band [c, end)
+      while (end < columns && !varies(r, end)) ++end;
+      if (c > 0 && end < columns && end - c <= widest) {
+        const double bound = std::fmin(at(r, c - 1), at(r, end));
+        bool steady = true;
+        for (long k = c; k < end && steady; ++k) {
+          const double own = at(r, k);
+          steady = !std::isfinite(own) || own < kSteadyFraction * bound;
+        }
+        for (long k = c; k < end && steady; ++k) {
+          if (std::isfinite(at(r, k))) stuck[static_cast<std::size_t>(r * columns + k)] = 1;
+        }
+      }
+      c = end;
     }
   }
   return stuck;

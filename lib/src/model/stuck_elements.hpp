@@ -9,6 +9,10 @@
 // distance 1 or 2, so bands up to three wide are seen), and those neighbours vary well above
 // the noise (10 sigma). One-sided silhouettes (air beside the object's edge) have only one
 // varying neighbour; an element on the axis of a centred object has steady neighbours too.
+// Wider bands along a detector row (a dead module), up to a quarter of its width, are stuck
+// where every column in them is steady against the varying columns that bound the band on both
+// sides (a column steady over a full turn lies beyond all off-centre matter, out to the
+// detector's end).
 #pragma once
 
 #include <cstdint>
