@@ -131,6 +131,11 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
       if (!line.empty()) console.line(line);
     }
   }
+  if (report.slices_without_readings > 0) {
+    console.line(std::to_string(report.slices_without_readings) +
+                 " slice(s) written as NaN: their detector rows read nothing to reconstruct (a "
+                 "dead row?)");
+  }
   note_short_scan(console, report.fbp);
   note_half_acquisition(console, report.fbp.half_acquisition_overlap_mm);
   console.line("fbp (" + std::string(fbp_filter_name(options.filter)) + ", " +
@@ -155,6 +160,7 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
        {"half_acquisition_overlap_mm", report.fbp.half_acquisition_overlap_mm},
        {"flat_field",
         report.flat_field ? flat_field_json(*report.flat_field) : nlohmann::json(nullptr)},
+       {"slices_without_readings", report.slices_without_readings},
        {"centre", source.centre() ? centre_json(*source.centre()) : nlohmann::json(nullptr)}});
   return 0;
 }

@@ -474,7 +474,9 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
     flat->invalid_readings += f["invalid_readings"].get<std::size_t>();
     flat->pixels_without_beam += f["pixels_without_beam"].get<std::size_t>();
     flat->pixels += f["pixels"].get<std::size_t>();
-    const double sigmas = f["air_drift_sigmas"];
+    // null where the air read nothing finite at the scan's start or end (NaN in JSON).
+    const double sigmas =
+        f["air_drift_sigmas"].is_number() ? f["air_drift_sigmas"].get<double>() : -1.0;
     if (sigmas > flat->air_drift_sigmas && f["air_first"].is_number() &&
         f["air_last"].is_number()) {
       flat->air_drift_sigmas = sigmas;

@@ -602,6 +602,28 @@ TEST_SUITE("cli") {
     }
     const riner::Array beta = riner::read_array(dir / "out" / "beta.npy").array;
     CHECK(beta.data[7 * columns] == 0.0f);
+    // fbp by slabs of one slice reads each slice's row and two rows either side: with rows
+    // 4-13 dead, slices 6-11 read nothing (the run stopped at the first of them).
+    for (std::size_t v = 0; v < views.shape[0]; ++v) {
+      std::fill_n(views.data.begin() + static_cast<long>((v * rows + 4) * columns), 10 * columns,
+                  NAN);
+    }
+    riner::write_array(dir / "dead" / "block.npy", views);
+    const Run fbp = riner_cli("fbp " + (dir / "dead" / "block.npy").string() + " --geometry " +
+                                  (dir / "dead" / "geometry.json").string() +
+                                  " --slab-slices 1 --json --out " + (dir / "fbp").string(),
+                              dir);
+    CAPTURE(fbp.err);
+    REQUIRE(fbp.code == 0);
+    CHECK(nlohmann::json::parse(fbp.out)["slices_without_readings"] == 6);
+    for (std::size_t k = 3; k < 15; ++k) {
+      CAPTURE(k);
+      const riner::Array slice =
+          riner::read_array(riner::VolumeWriter::slice_file(dir / "fbp", k)).array;
+      const bool nan =
+          std::all_of(slice.data.begin(), slice.data.end(), [](float v) { return std::isnan(v); });
+      CHECK(nan == (k >= 6 && k <= 11));
+    }
   }
 
   TEST_CASE("by slabs, inputs checked before the first slab: no output replaces one, flats fit") {

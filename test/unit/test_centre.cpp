@@ -117,6 +117,10 @@ TEST_SUITE("centre") {
       CHECK(s.method == "sinogram");
       CHECK(std::fabs(s.offset_px - 2.6) < 0.1);
     }
+    // But a coarse scan missing tens of degrees is no half-turn (9 views at 15 degrees: 120).
+    const riner::Geometry coarse =
+        with_angles(riner::test::small_parallel2d(), 9, 9 * 15.0 * M_PI / 180.0, false);
+    CHECK_THROWS_AS(riner::estimate_centre(scan_with_offset(coarse, 2.6)), riner::InputError);
   }
 
   TEST_CASE("a head wider than the detector, the axis 15% off its middle: the sinogram") {

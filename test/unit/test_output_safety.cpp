@@ -1,6 +1,8 @@
 // Outputs are atomic and never replace an input.
 #include <doctest/doctest.h>
 
+#include <thread>
+
 #include "riner/error.hpp"
 #include "riner/io.hpp"
 #include "support/fixture.hpp"
@@ -20,6 +22,38 @@ TEST_SUITE("output_safety") {
     // And through a hard link.
     std::filesystem::create_hard_link(dir / "in.npy", dir / "alias.npy");
     CHECK_THROWS_AS(riner::write_array(dir / "alias.npy", a), riner::InputError);
+  }
+
+  TEST_CASE("a read inside an InputScope guards its file during the scope only") {
+    riner::test::TempDir dir;
+    const riner::Array a({2, 2}, 1.0f);
+    riner::write_array(dir / "scoped.npy", a);
+    riner::write_array(dir / "held.npy", a);
+    riner::read_array(dir / "held.npy");  // the process's own read: held for good
+    {
+      const riner::InputScope scope;
+      riner::read_array(dir / "scoped.npy");
+      riner::read_array(dir / "held.npy");
+      CHECK_THROWS_AS(riner::write_array(dir / "scoped.npy", a), riner::InputError);
+      {
+        const riner::InputScope inner;  // a nested call's scope
+        riner::read_array(dir / "scoped.npy");
+      }
+      CHECK_THROWS_AS(riner::write_array(dir / "scoped.npy", a), riner::InputError);
+    }
+    CHECK_NOTHROW(riner::write_array(dir / "scoped.npy", a));
+    CHECK_THROWS_AS(riner::write_array(dir / "held.npy", a), riner::InputError);
+    // Another thread's scope, ending while this one's lives, releases only its own reads.
+    {
+      const riner::InputScope mine;
+      riner::read_array(dir / "scoped.npy");
+      std::thread([&] {
+        const riner::InputScope theirs;
+        riner::read_array(dir / "scoped.npy");
+      }).join();
+      CHECK_THROWS_AS(riner::write_array(dir / "scoped.npy", a), riner::InputError);
+    }
+    CHECK_NOTHROW(riner::write_array(dir / "scoped.npy", a));
   }
 
   TEST_CASE("writes leave no temporary files and replace outputs whole") {

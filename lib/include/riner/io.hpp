@@ -104,9 +104,10 @@ std::string read_text(const std::filesystem::path& path);
 // Marks a path as an input of this process: writers refuse to replace it. Readers call this
 // themselves; call it for inputs read by other means.
 void register_input(const std::filesystem::path& path);
-// Inputs registered while it lives are forgotten when it ends: a library caller's read (a
-// Python session's read_array) guards the files only during that call, not every later write
-// of the process.
+// Inputs this thread registers while it lives are released when it ends: a library caller's
+// read (a Python session's read_array) guards the files only during that call, not every
+// later write of the process. Other threads' registrations, and one the same file had before,
+// stay.
 class InputScope {
  public:
   InputScope();
@@ -115,11 +116,13 @@ class InputScope {
   InputScope& operator=(const InputScope&) = delete;
 
  private:
-  std::vector<std::filesystem::path> before_;
+  std::vector<std::filesystem::path> registered_;
+  std::vector<std::filesystem::path>* outer_;  // an enclosing scope's, restored at the end
 };
 
 // InputError "refusing to overwrite an input file" when `path` is a registered input (the same
-// file by any name), or, for a folder, holds one: what writers check before they replace it.
+// file or folder by any name; a folder of TIFFs read as a stack is one): what writers check
+// before they replace it.
 void refuse_overwriting_input(const std::filesystem::path& path);
 
 }  // namespace riner

@@ -24,6 +24,8 @@ struct SlabFbpReport {
   // Raw projections' normalisation over the slabs: counts of each row once, the drift of the
   // slab where the air moved most.
   std::optional<FlatFieldReport> flat_field;
+  // Slices of slabs whose rows read nothing to reconstruct (all NaN): written as NaN.
+  std::size_t slices_without_readings = 0;
 };
 
 // The detector rows slices [first, first + count) of g's volume project to, with the row

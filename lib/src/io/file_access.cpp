@@ -4,9 +4,10 @@
 #include <cctype>
 #include <fstream>
 #include <iterator>
+#include <map>
 #include <mutex>
-#include <set>
 #include <system_error>
+#include <vector>
 
 #include "riner/array.hpp"
 #include "riner/error.hpp"
@@ -21,10 +22,15 @@ std::mutex& registry_mutex() {
   return mutex;
 }
 
-std::set<std::filesystem::path>& registry() {
-  static std::set<std::filesystem::path> inputs;
+// Each input with the number of registrations that hold it: a scope's own end releases only
+// its own (another thread's calls, or the process's, keep theirs).
+std::map<std::filesystem::path, std::size_t>& registry() {
+  static std::map<std::filesystem::path, std::size_t> inputs;
   return inputs;
 }
+
+// The paths registered on this thread while its innermost InputScope lives.
+thread_local std::vector<std::filesystem::path>* scope_paths = nullptr;
 
 std::filesystem::path canonical_or_absolute(const std::filesystem::path& path) {
   std::error_code error;
@@ -35,35 +41,30 @@ std::filesystem::path canonical_or_absolute(const std::filesystem::path& path) {
 }  // namespace
 
 void register_input(const std::filesystem::path& path) {
+  const std::filesystem::path input = canonical_or_absolute(path);
   std::lock_guard<std::mutex> lock(registry_mutex());
-  registry().insert(canonical_or_absolute(path));
+  ++registry()[input];
+  if (scope_paths != nullptr) scope_paths->push_back(input);
 }
 
-InputScope::InputScope() {
-  std::lock_guard<std::mutex> lock(registry_mutex());
-  before_.assign(registry().begin(), registry().end());
-}
+InputScope::InputScope() : outer_(scope_paths) { scope_paths = &registered_; }
 
 InputScope::~InputScope() {
+  scope_paths = outer_;
   std::lock_guard<std::mutex> lock(registry_mutex());
-  registry() = std::set<std::filesystem::path>(before_.begin(), before_.end());
+  for (const std::filesystem::path& input : registered_) {
+    const auto it = registry().find(input);
+    if (it != registry().end() && --it->second == 0) registry().erase(it);
+  }
 }
 
 void refuse_overwriting_input(const std::filesystem::path& path) {
   const std::filesystem::path target = canonical_or_absolute(path);
   std::error_code error;
-  const bool folder = std::filesystem::is_directory(target, error);
   std::lock_guard<std::mutex> lock(registry_mutex());
-  for (const std::filesystem::path& input : registry()) {
+  for (const auto& [input, holders] : registry()) {
     if (input == target || std::filesystem::equivalent(input, target, error)) {
       throw InputError(path.string() + ": refusing to overwrite an input file");
-    }
-    // A folder that holds an input TIFF (a folder of TIFFs read as a stack) takes no slices:
-    // they would join the stack.
-    if (folder && input.parent_path() == target &&
-        (io::lower_extension(input) == ".tif" || io::lower_extension(input) == ".tiff")) {
-      throw InputError(path.string() + ": refusing to write into a folder that holds an input (" +
-                       input.filename().string() + ")");
     }
   }
 }

@@ -330,6 +330,57 @@ Scan in_angle_order(Scan scan) {
   return sorted;
 }
 
+// A hot or dead element reading a steady value matches its own mirror image only about itself,
+// and pulls the axis onto it (a 180-degree scan with one column at 50: the axis at that
+// column): such elements are left out, as non-finite ones are. The scan itself where none is.
+Scan without_stuck(const Scan& scan) {
+  const std::vector<std::uint8_t> stuck =
+      model::stuck_elements(scan, model::reading_noise(scan).sigma);
+  if (std::find(stuck.begin(), stuck.end(), 1) == stuck.end()) return scan;
+  Scan without = scan;
+  std::vector<float>& rho = without.measurement.data;
+  for (std::size_t e = 0; e < stuck.size(); ++e) {
+    if (!stuck[e]) continue;
+    for (std::size_t i = e; i < rho.size(); i += stuck.size()) rho[i] = NAN;
+  }
+  without.non_finite = compute_stats(without.measurement).non_finite();
+  return without;
+}
+
+// Beyond this many readings a 3D scan's centre is found on the rows its methods use.
+constexpr std::size_t kMostCopiedReadings = std::size_t{1} << 25;
+
+// A 3D scan cut to the rows the centre is found on: a cone's four rows about the source's
+// plane; a parallel beam's kMostRows evenly spread (each row a slice of its own).
+Scan centre_rows(const Scan& scan) {
+  const Geometry& g = scan.geometry;
+  const std::size_t views = g.n_views(), n_u = g.n_u;
+  std::vector<std::size_t> rows;
+  Scan cut;
+  if (g.type == GeometryType::kCone3d) {
+    const double v = std::clamp(project_to_detector(g, 0, Vec3{0.0, 0.0, 0.0}).v, 0.0,
+                                static_cast<double>(g.n_v - 1));
+    const std::size_t first =
+        std::min(static_cast<std::size_t>(std::max(0.0, v - 1.0)), g.n_v > 4 ? g.n_v - 4 : 0);
+    const std::size_t count = std::min<std::size_t>(4, g.n_v);
+    for (std::size_t r = first; r < first + count; ++r) rows.push_back(r);
+    cut.geometry = detector_rows_geometry(g, first, count);
+  } else {
+    rows = evenly(g.n_v, kMostRows);
+    cut.geometry = g;
+    cut.geometry.n_v = rows.size();
+  }
+  cut.measurement = Array({views, rows.size(), n_u});
+  for (std::size_t a = 0; a < views; ++a) {
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      std::copy_n(scan.measurement.ptr() + (a * g.n_v + rows[i]) * n_u, n_u,
+                  cut.measurement.ptr() + (a * rows.size() + i) * n_u);
+    }
+  }
+  cut.non_finite = compute_stats(cut.measurement).non_finite();
+  return cut;
+}
+
 // estimate_centre before the check of the readings (the geometry's reasons come first).
 CentreEstimate estimate_from(const Scan& scan) {
   const Geometry& g = scan.geometry;
@@ -405,26 +456,16 @@ bool centre_search_covers(const Geometry& g) {
 }
 
 CentreEstimate estimate_centre(const Scan& scan) {
-  // A hot or dead element reading a steady value matches its own mirror image only about
-  // itself, and pulls the axis onto it (a 180-degree scan with one column at 50: the axis at
-  // that column): such elements are left out, as non-finite ones are.
-  const std::vector<std::uint8_t> stuck =
-      model::stuck_elements(scan, model::reading_noise(scan).sigma);
-  if (std::find(stuck.begin(), stuck.end(), 1) == stuck.end()) {
-    const CentreEstimate e = estimate_from(scan);
-    if (!holds_structure(scan.measurement)) throw_without_structure();
-    return e;
+  if (!holds_structure(scan.measurement)) {
+    (void)estimate_from(scan);  // the geometry's reasons first
+    throw_without_structure();
   }
-  Scan without = scan;
-  std::vector<float>& rho = without.measurement.data;
-  for (std::size_t e = 0; e < stuck.size(); ++e) {
-    if (!stuck[e]) continue;
-    for (std::size_t i = e; i < rho.size(); i += stuck.size()) rho[i] = NAN;
+  // A large 3D scan is read on the rows the methods use: the elements left out below would
+  // otherwise copy all of it (a whole scan that fits in memory, doubled).
+  if (scan.geometry.is_3d() && scan.measurement.size() > kMostCopiedReadings) {
+    return estimate_from(without_stuck(centre_rows(scan)));
   }
-  without.non_finite = compute_stats(without.measurement).non_finite();
-  const CentreEstimate e = estimate_from(without);
-  if (!holds_structure(scan.measurement)) throw_without_structure();
-  return e;
+  return estimate_from(without_stuck(scan));
 }
 
 }  // namespace riner

@@ -160,8 +160,8 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, double search_px) 
   // acquisition: around its offset only the few rays near the axis have conjugates, and the
   // absolute mismatch, which counts only offsets with most rays paired, would pull the axis
   // inwards (-19.6 for -35 on 100 elements); the relative one counts every offset.
-  const bool declared_half =
-      std::fabs(g.offset_u) >= kCentreSearchShare * static_cast<double>(g.n_u);
+  const double inner = kCentreSearchShare * static_cast<double>(g.n_u);
+  const bool declared_half = std::fabs(g.offset_u) >= inner && farthest_outer_offset(g.n_u) > inner;
   std::vector<double> coarse_at;
   std::vector<Cost> coarse;
   std::size_t most_rays = 0;

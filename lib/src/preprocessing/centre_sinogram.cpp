@@ -29,8 +29,10 @@ constexpr std::size_t kMostRows = 8;
 // Angles evenly spaced within this share of the step.
 constexpr double kEvenSpacing = 0.1;
 // The half-turn may end this many steps short of pi (a 179.5-degree scan of 180 views ends
-// 1.5 steps and a hair short).
+// 1.5 steps and a hair short), but no more than kMostGapRad unless within 1.5 steps (a coarse
+// scan's missing 60 degrees is no half-turn).
 constexpr double kMostGapSteps = 4.0;
+constexpr double kMostGapRad = 4.0 * M_PI / 180.0;
 
 using Row = std::vector<double>;
 
@@ -333,7 +335,8 @@ std::vector<std::size_t> half_turns(const std::vector<double>& angles, std::size
       }
       ++end;
     }
-    if (std::fabs(angles[end - 1] - angles[start]) < M_PI - kMostGapSteps * step) return starts;
+    const double gap = std::max(1.5 * step, std::min(kMostGapSteps * step, kMostGapRad));
+    if (std::fabs(angles[end - 1] - angles[start]) < M_PI - gap) return starts;
     if (starts.empty()) *views = end - start;
     if (end - start != *views) return starts;
     starts.push_back(start);

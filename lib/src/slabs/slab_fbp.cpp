@@ -156,7 +156,17 @@ SlabFbpReport fbp_by_slabs(const ScanRows& source, const FbpOptions& options, Vo
       // The rows in their place on the whole detector, the whole volume's grid: the slab's
       // slices selected from it sample exactly what the whole FBP's would.
       FlatFieldReport flat;
-      Scan scan = source.read(rows, &flat);
+      Scan scan;
+      try {
+        scan = source.read(rows, &flat);
+      } catch (const NoReadingsError&) {
+        // Rows that read nothing (a dead row's slice): NaN, said, the rest of the volume goes on.
+        std::fill(slices.data.begin(), slices.data.end(), NAN);
+        report.slices_without_readings += count;
+        out.write(first, slices);
+        if (written) written(first, slices);
+        continue;
+      }
       const std::size_t new_first = std::max(rows.first, counted_end);
       const std::size_t new_rows = rows.end() > new_first ? rows.end() - new_first : 0;
       counted_end = std::max(counted_end, rows.end());

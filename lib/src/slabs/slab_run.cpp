@@ -84,7 +84,7 @@ nlohmann::json readings_record(const Scan& scan, const Slab& slab, const FlatFie
                        {"flat_change", flat.flat_change},
                        {"air_first", number(flat.air_first)},
                        {"air_last", number(flat.air_last)},
-                       {"air_drift_sigmas", flat.air_drift_sigmas}};
+                       {"air_drift_sigmas", number(flat.air_drift_sigmas)}};
   return out;
 }
 
