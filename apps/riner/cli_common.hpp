@@ -56,5 +56,7 @@ void print_quality_doubts(Console& console, const QualityReport& q);
 // detection reading the object's structure (Vo's rule alone on neutron360: 149 of 503 elements,
 // 785 pixels of object set to air; docs/guide/destripe.md), with what to try instead.
 void note_large_stripes(Console& console, const DestripeReport& report);
+// The measurement's NaN/inf readings, counted for a reconstruction (nothing when there are none).
+void note_non_finite(const Console& console, std::size_t non_finite);
 
 }  // namespace riner::app

@@ -125,11 +125,7 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
     write_png(png, middle);
   }
   if (report.flat_field) {
-    for (const std::string& line :
-         {flat_field_line(*report.flat_field), pixels_without_beam_line(*report.flat_field),
-          air_drift_line(*report.flat_field)}) {
-      if (!line.empty()) console.line(line);
-    }
+    for (const std::string& line : flat_field_notes(*report.flat_field)) console.line(line);
   }
   if (report.slices_without_readings > 0) {
     console.line(std::to_string(report.slices_without_readings) +

@@ -179,11 +179,7 @@ int run_reconstruct(int argc, char** argv, int first) {
     throw UsageError("--format h5 writes volumes; write a 2D image as nii, npy, tif or raw");
   }
   const std::filesystem::path out = make_output_dir(args.get("out"));
-  if (scan.non_finite > 0) {
-    console.line(std::to_string(scan.non_finite) +
-                 " measurements are NaN/inf (dead elements?): they count as 0 "
-                 "and their elements' beta learns to switch them off");
-  }
+  note_non_finite(console, scan.non_finite);
 
   const std::optional<Device> device = device_from(args, config.engine);
   const double checkpoint_every = checkpoint_seconds(args);

@@ -486,16 +486,9 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   }
   if (flat) {
     flat->air_drift_sigmas = std::max(0.0, flat->air_drift_sigmas);
-    for (const std::string& line :
-         {flat_field_line(*flat), pixels_without_beam_line(*flat), air_drift_line(*flat)}) {
-      if (!line.empty()) console.line(line);
-    }
+    for (const std::string& line : flat_field_notes(*flat)) console.line(line);
   }
-  if (non_finite > 0) {
-    console.line(std::to_string(non_finite) +
-                 " measurements are NaN/inf (dead elements?): they count as 0 and their "
-                 "elements' beta learns to switch them off");
-  }
+  note_non_finite(console, non_finite);
   // Slabs with nothing to reconstruct (a dead detector row): written as NaN, said here.
   nlohmann::json without_readings = nlohmann::json::array();
   for (const Slab& s : run.slabs()) {

@@ -68,6 +68,9 @@ class ScanRows {
 
 // One line: how many frames went into each field, what became invalid.
 std::string flat_field_line(const FlatFieldReport& report);
+// What a raw scan's normalisation tells: flat_field_line, then the pixels without beam and the
+// beam's drift where they say anything.
+std::vector<std::string> flat_field_notes(const FlatFieldReport& report);
 std::string centre_line(const CentreEstimate& estimate);
 
 }  // namespace riner

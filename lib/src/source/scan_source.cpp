@@ -122,6 +122,7 @@ LoadedScan load_scan_source(ScanSource source) {
   const bool tomo_file = resolve_files(source);
   LoadedScan loaded;
   FlatFieldReport report;
+  std::string layout;  // a tomography file's, before its flat field's line
   if (tomo_file) {
     const TomoFile file = read_tomo_file(source.path);
     require_flats(file, source.path);
@@ -129,7 +130,7 @@ LoadedScan load_scan_source(ScanSource source) {
         raw_scan(Geometry::load(find_geometry(source.path, source.geometry)), file.projections,
                  file.flats, file.darks, source.row, source.path, &report, file.flat_positions);
     loaded.flat_field = report;
-    loaded.notes.push_back(file.layout + " file: " + flat_field_line(report));
+    layout = file.layout + " file: ";
   } else if (source.flat.empty()) {
     loaded.scan = load_scan(source.path, source.geometry, source.row);
     if (std::optional<std::string> note = transmission_note(loaded.scan)) {
@@ -139,13 +140,11 @@ LoadedScan load_scan_source(ScanSource source) {
     loaded.scan = load_raw_scan(source.path, source.flat, source.dark, source.geometry, &report,
                                 source.row, source.flat_after);
     loaded.flat_field = report;
-    loaded.notes.push_back(flat_field_line(report));
   }
   if (loaded.flat_field) {
-    for (std::string note :
-         {pixels_without_beam_line(*loaded.flat_field), air_drift_line(*loaded.flat_field)}) {
-      if (!note.empty()) loaded.notes.push_back(std::move(note));
-    }
+    std::vector<std::string> notes = flat_field_notes(*loaded.flat_field);
+    notes.front() = layout + notes.front();
+    loaded.notes.insert(loaded.notes.end(), notes.begin(), notes.end());
   }
   if (source.offset_px == "auto") {
     loaded.centre = estimate_centre(loaded.scan);
@@ -218,6 +217,14 @@ Scan ScanRows::read(RowRange rows, FlatFieldReport* report) const {
   scan.non_finite = file.non_finite;
   check_scan(scan, source_.path);
   return scan;
+}
+
+std::vector<std::string> flat_field_notes(const FlatFieldReport& report) {
+  std::vector<std::string> notes{flat_field_line(report)};
+  for (std::string note : {pixels_without_beam_line(report), air_drift_line(report)}) {
+    if (!note.empty()) notes.push_back(std::move(note));
+  }
+  return notes;
 }
 
 std::string flat_field_line(const FlatFieldReport& r) {
