@@ -14,6 +14,8 @@
 #include "destripe/sinogram_ops.hpp"
 #include "destripe/stripe_rules.hpp"
 #include "destripe/wavelets.hpp"
+#include "model/noise_evidence.hpp"
+#include "model/stuck_elements.hpp"
 #include "riner/error.hpp"
 
 namespace riner {
@@ -239,6 +241,44 @@ std::vector<bool> dead_stripes(Sinogram& s, std::size_t size, double snr) {
   return mask;
 }
 
+bool finds_dead(DestripeMethod method) {
+  return method == DestripeMethod::kDead || method == DestripeMethod::kAll;
+}
+
+// Algorithm 6 judges an element's fluctuation against its neighbours' through a threshold
+// fitted to the sorted ratios, which a wide spread pushes below zero: a column stuck at 0 or
+// at 3 on a simulated scan went unfound. A column steady over the views while its neighbours
+// vary is the training's stuck element (model/stuck_elements.hpp), found on the whole scan.
+// The measurement is moved in and out, not copied.
+std::vector<std::uint8_t> steady_elements(const Geometry& g, Array& measurement) {
+  Scan scan{std::move(measurement), g, 0};
+  std::vector<std::uint8_t> stuck;
+  try {
+    stuck = model::stuck_elements(scan, model::reading_noise(scan).sigma);
+  } catch (...) {
+    measurement = std::move(scan.measurement);
+    throw;
+  }
+  measurement = std::move(scan.measurement);
+  return stuck;
+}
+
+// Row r's steady columns, interpolated from their neighbours in `row` (views x columns) before
+// the method runs, as algotom's combination removes dead stripes first.
+std::vector<bool> interpolate_stuck(const std::vector<std::uint8_t>& stuck, std::size_t r,
+                                    std::size_t views, std::size_t columns,
+                                    std::vector<float>& row) {
+  std::vector<bool> mask(columns, false);
+  if (stuck.empty()) return mask;
+  for (std::size_t c = 0; c < columns; ++c) mask[c] = stuck[r * columns + c] != 0;
+  if (std::find(mask.begin(), mask.end(), true) == mask.end()) return mask;
+  Sinogram s{views, columns, std::vector<double>(row.begin(), row.end())};
+  stripes::interpolate_columns(s, stripes::interpolation_plan(mask));
+  std::transform(s.values.begin(), s.values.end(), row.begin(),
+                 [](double x) { return static_cast<float>(x); });
+  return mask;
+}
+
 // `method` on one sinogram on the CPU; the masks of dead and large stripes where it finds them.
 void destripe_on_cpu(DestripeMethod method, const StripeSettings& k, Sinogram& s,
                      std::vector<bool>& dead, std::vector<bool>& large) {
@@ -338,6 +378,8 @@ Array destripe(const Array& measurement, const Geometry& g, const DestripeOption
   Array out = measurement;
   DestripeReport local;
   local.non_finite_replaced = analytic::repair_non_finite(out, columns);
+  const std::vector<std::uint8_t> stuck =
+      finds_dead(options.method) ? steady_elements(g, out) : std::vector<std::uint8_t>{};
   local.removed = Array({rows, columns});
   local.size = settings.size;
   local.large_size = settings.large_size;
@@ -360,6 +402,7 @@ Array destripe(const Array& measurement, const Geometry& g, const DestripeOption
       std::copy(from, from + columns, row.begin() + static_cast<std::ptrdiff_t>(v * columns));
     }
     column_sums(column_before);
+    const std::vector<bool> steady = interpolate_stuck(stuck, r, views, columns, row);
     std::vector<bool> dead, large;
     if (device) {
       device->run(row, dead, large);
@@ -371,7 +414,7 @@ Array destripe(const Array& measurement, const Geometry& g, const DestripeOption
     }
     column_sums(column_after);
     for (std::size_t c = 0; c < columns; ++c) {
-      if (c < dead.size() && dead[c]) local.dead.push_back(r * columns + c);
+      if ((c < dead.size() && dead[c]) || steady[c]) local.dead.push_back(r * columns + c);
       if (c < large.size() && large[c]) local.large.push_back(r * columns + c);
       local.removed.data[r * columns + c] =
           static_cast<float>((column_before[c] - column_after[c]) / static_cast<double>(views));
