@@ -84,12 +84,30 @@ TEST_SUITE("fbp_setup") {
     CHECK(short_scan);
   }
 
-  TEST_CASE("non-finite repair: interpolated inside, constant at the ends, zero for empty rows") {
+  TEST_CASE(
+      "non-finite repair: interpolated inside, constant at the ends, a lost view from "
+      "the views beside it") {
     riner::Array m({3, 5}, std::vector<float>{1, NAN, NAN, 4, 5,               //
                                               INFINITY, 2, 3, -INFINITY, NAN,  //
                                               NAN, NAN, NAN, NAN, NAN});
     CHECK(riner::analytic::repair_non_finite(m, 5) == 10);
-    CHECK(m.data == std::vector<float>{1, 2, 3, 4, 5, 2, 2, 3, 3, 3, 0, 0, 0, 0, 0});
+    CHECK(m.data == std::vector<float>{1, 2, 3, 4, 5, 2, 2, 3, 3, 3, 2, 2, 3, 3, 3});
+    riner::Array between({3, 2}, std::vector<float>{1, 2, NAN, INFINITY, 3, 6});
+    riner::analytic::repair_non_finite(between, 2);
+    CHECK(between.data == std::vector<float>{1, 2, 2, 4, 3, 6});
+    riner::Array nothing({2, 2}, NAN);
+    riner::analytic::repair_non_finite(nothing, 2);
+    CHECK(nothing.data == std::vector<float>{0, 0, 0, 0});
+  }
+
+  TEST_CASE("non-finite repair: a dead detector row takes the rows beside it in each view") {
+    // Before: 0, which FBP reconstructs as a slice of air (a parallel stack's dead row 20:
+    // 0.0198 rms off the noise-free slice against 0.0120 interpolated, riner simulate).
+    riner::Array m({2, 4, 2}, std::vector<float>{1, 2, NAN, NAN, 3, 6, 4, 4,  //
+                                                 NAN, NAN, 5, 5, NAN, NAN, 7, 9});
+    CHECK(riner::analytic::repair_non_finite(m, 2, 4) == 6);
+    CHECK(m.data == std::vector<float>{1, 2, 2, 4, 3, 6, 4, 4,  //
+                                       5, 5, 5, 5, 6, 7, 7, 9});
   }
 
   TEST_CASE("cosine weights: 1 on the central ray, SDD / distance elsewhere") {

@@ -54,7 +54,9 @@ struct FbpReport {
 };
 
 // The image/volume on the scan geometry's grid, mu in 1/mm. Non-finite measurements are
-// replaced by linear interpolation between the nearest finite elements of the same view row.
+// replaced by linear interpolation between the nearest finite elements of the same view row;
+// a row with none (a dead detector row) from the rows beside it, a view with none from the
+// views beside it.
 Array fbp(const Scan& scan, const FbpOptions& options = {}, FbpReport* report = nullptr);
 
 }  // namespace riner

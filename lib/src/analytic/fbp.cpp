@@ -56,7 +56,7 @@ Array fbp(const Scan& scan, const FbpOptions& options, FbpReport* report) {
   Geometry g = scan.geometry;  // a half acquisition's detector widens below
   Array weighted = scan.measurement;
   FbpReport local;
-  local.non_finite_replaced = analytic::repair_non_finite(weighted, g.n_u);
+  local.non_finite_replaced = analytic::repair_non_finite(weighted, g.n_u, g.is_3d() ? g.n_v : 1);
   analytic::cosine_weight(weighted, g);
   std::vector<double> view_weights = analytic::view_weights(g, &local.short_scan);
   if (local.short_scan) {

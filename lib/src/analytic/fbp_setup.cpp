@@ -5,17 +5,52 @@
 #include <complex>
 #include <numeric>
 #include <unsupported/Eigen/FFT>
+#include <vector>
 
 #include "riner/rays.hpp"
 
 namespace riner::analytic {
 
-std::size_t repair_non_finite(Array& measurement, std::size_t n_u) {
+namespace {
+
+// Line `to` = the blend of lines `a` and `b` (weight w on b) of n values.
+void blend_line(float* to, const float* a, const float* b, float w, std::size_t n) {
+  for (std::size_t k = 0; k < n; ++k) to[k] = (1.0f - w) * a[k] + w * b[k];
+}
+
+// Fills each flagged entry of `empty` (count entries, lines of `size` values `stride` apart from
+// `base`) from the nearest unflagged ones on either side: linearly between two, a copy beside
+// one; false where none is left unflagged.
+bool fill_between(float* base, std::size_t stride, std::size_t size, std::vector<bool>& empty) {
+  const std::size_t count = empty.size();
+  long previous = -1;
+  bool any = false;
+  for (std::size_t j = 0; j <= count; ++j) {
+    if (j < count && empty[j]) continue;
+    if (j < count) any = true;
+    for (std::size_t k = static_cast<std::size_t>(previous + 1); k < j; ++k) {
+      if (previous < 0 && j == count) break;
+      const std::size_t a = previous >= 0 ? static_cast<std::size_t>(previous) : j;
+      const std::size_t b = j < count ? j : a;
+      const float w = a == b ? 0.0f : static_cast<float>(k - a) / static_cast<float>(b - a);
+      blend_line(base + k * stride, base + a * stride, base + b * stride, w, size);
+      empty[k] = false;
+    }
+    previous = static_cast<long>(j);
+  }
+  return any;
+}
+
+}  // namespace
+
+std::size_t repair_non_finite(Array& measurement, std::size_t n_u, std::size_t rows) {
   std::size_t replaced = 0;
   const std::size_t lines = measurement.size() / n_u;
+  std::vector<bool> empty(lines, false);
   for (std::size_t line = 0; line < lines; ++line) {
     float* p = measurement.ptr() + line * n_u;
     long previous = -1;  // last finite index
+    empty[line] = true;
     for (std::size_t j = 0; j <= n_u; ++j) {
       if (j < n_u && !(std::fabs(p[j]) <= kLargestReading)) continue;  // NaN fails it too
       // Fill the gap (previous, j) from its finite ends.
@@ -33,8 +68,21 @@ std::size_t repair_non_finite(Array& measurement, std::size_t n_u) {
         ++replaced;
       }
       previous = static_cast<long>(j);
+      empty[line] = empty[line] && j == n_u;
     }
   }
+  // A line with nothing finite (a dead detector row, a lost view) read as 0 is air where the
+  // object is: it takes the rows beside it in its view, then, for a view with none, the views
+  // beside it.
+  rows = std::max<std::size_t>(rows, 1);
+  const std::size_t views = lines / rows;
+  std::vector<bool> view_empty(views, false);
+  for (std::size_t v = 0; v < views; ++v) {
+    std::vector<bool> row_empty(empty.begin() + static_cast<std::ptrdiff_t>(v * rows),
+                                empty.begin() + static_cast<std::ptrdiff_t>((v + 1) * rows));
+    view_empty[v] = !fill_between(measurement.ptr() + v * rows * n_u, n_u, n_u, row_empty);
+  }
+  fill_between(measurement.ptr(), rows * n_u, rows * n_u, view_empty);
   return replaced;
 }
 

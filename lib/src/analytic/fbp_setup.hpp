@@ -14,8 +14,9 @@ namespace riner::analytic {
 
 // Replaces NaN/inf, and readings beyond kLargestReading (riner/scan.hpp), in every detector row of
 // every view by linear interpolation between the nearest valid neighbours (constant beyond the last
-// one; 0 for a row with none). Returns the number replaced.
-std::size_t repair_non_finite(Array& measurement, std::size_t n_u);
+// one). A row with none takes the nearest rows of its view that have some (of `rows` per view), a
+// view with none the nearest views; 0 only where nothing is valid. Returns the number replaced.
+std::size_t repair_non_finite(Array& measurement, std::size_t n_u, std::size_t rows = 1);
 
 // Multiplies fan/cone measurements by SDD / sqrt(SDD^2 + u^2 + v^2) (the cosine of the ray's
 // angle to the central ray); parallel beams are unchanged.

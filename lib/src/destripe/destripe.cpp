@@ -377,7 +377,7 @@ Array destripe(const Array& measurement, const Geometry& g, const DestripeOption
   }
   Array out = measurement;
   DestripeReport local;
-  local.non_finite_replaced = analytic::repair_non_finite(out, columns);
+  local.non_finite_replaced = analytic::repair_non_finite(out, columns, rows);
   const std::vector<std::uint8_t> stuck =
       finds_dead(options.method) ? steady_elements(g, out) : std::vector<std::uint8_t>{};
   local.removed = Array({rows, columns});
