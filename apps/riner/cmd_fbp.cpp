@@ -91,6 +91,7 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
   if (source.centre()) console.line(centre_line(*source.centre()));
   const Geometry& g = source.geometry();
   const SlabOptions asked = slab_size_options(args);
+  refuse_limit_below_one_slice(asked, fbp_slab_bytes(g, 1));
   const std::size_t limit = asked.limit();
   const std::size_t per =
       asked.slices_per_slab
@@ -181,8 +182,8 @@ int run_fbp(int argc, char** argv, int first) {
               "")
       .option("memory-limit", "SIZE",
               "memory a slab may take, on the host and on a GPU (8G, 512M); a stack whose "
-              "volume does not fit goes by slabs (default: three quarters of the machine's "
-              "memory, nine tenths of a GPU's)",
+              "volume does not fit goes by slabs; one below a slab of one slice is refused "
+              "(default: three quarters of the machine's memory, nine tenths of a GPU's)",
               "")
       .option("destripe", "METHOD",
               "remove stripes from every sinogram first (riner destripe's methods: normalise, "

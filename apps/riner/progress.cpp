@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <string>
 
 namespace riner::app {
 
@@ -20,10 +21,11 @@ std::string format_duration(double seconds) {
   return buf;
 }
 
-Progress::Progress(std::string label, std::size_t total, bool quiet)
+Progress::Progress(std::string label, std::size_t total, bool quiet, bool counts)
     : label_(std::move(label)),
       total_(total),
       quiet_(quiet),
+      counts_(counts),
       tty_(::isatty(STDERR_FILENO) != 0),
       start_(Clock::now()),
       last_draw_(start_) {}
@@ -55,17 +57,19 @@ void Progress::draw(std::size_t done, const std::string& status, bool final_line
   std::string eta = final_line ? "took " + format_duration(elapsed)
                     : done > 0 ? "ETA " + format_duration(elapsed * (1.0 / fraction - 1.0))
                                : "ETA ?";
+  const std::string count =
+      counts_ ? " " + std::to_string(done) + "/" + std::to_string(total_) : std::string();
   if (tty_) {
     constexpr int kWidth = 28;
     const int filled = static_cast<int>(fraction * kWidth + 0.5);
     std::string bar(static_cast<std::size_t>(filled), '#');
     bar.resize(kWidth, '.');
-    std::fprintf(stderr, "\r\033[K%s [%s] %3d%% %zu/%zu %s %s", label_.c_str(), bar.c_str(),
-                 static_cast<int>(fraction * 100.0 + 0.5), done, total_, eta.c_str(),
+    std::fprintf(stderr, "\r\033[K%s [%s] %3d%%%s %s %s", label_.c_str(), bar.c_str(),
+                 static_cast<int>(fraction * 100.0 + 0.5), count.c_str(), eta.c_str(),
                  status.c_str());
     if (final_line) std::fputc('\n', stderr);
   } else {
-    std::fprintf(stderr, "%s: %zu/%zu (%d%%) %s %s\n", label_.c_str(), done, total_,
+    std::fprintf(stderr, "%s:%s (%d%%) %s %s\n", label_.c_str(), count.c_str(),
                  static_cast<int>(fraction * 100.0 + 0.5), eta.c_str(), status.c_str());
   }
   std::fflush(stderr);

@@ -10,7 +10,8 @@ namespace riner::app {
 
 class Progress {
  public:
-  Progress(std::string label, std::size_t total, bool quiet);
+  // `counts`: draw done/total; off where the status says what was done in its own units.
+  Progress(std::string label, std::size_t total, bool quiet, bool counts = true);
   ~Progress();
 
   void update(std::size_t done, const std::string& status = "");
@@ -23,6 +24,7 @@ class Progress {
   std::string label_;
   std::size_t total_;
   bool quiet_;
+  bool counts_;
   bool tty_;
   bool finished_ = false;
   Clock::time_point start_;

@@ -43,6 +43,15 @@ SlabOptions slab_size_options(const Args& args) {
   return options;
 }
 
+void refuse_limit_below_one_slice(const SlabOptions& asked, std::size_t one_slice) {
+  if (asked.memory_limit == 0 || asked.memory_limit >= one_slice) return;
+  const auto mib = [](std::size_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20); };
+  throw UsageError("--memory-limit " + mib(asked.memory_limit) +
+                   "M is less than a slab of one slice takes (about " + mib(one_slice) +
+                   " MiB): give at least " + mib(one_slice) +
+                   "M, or leave it out (three quarters of the machine's memory)");
+}
+
 namespace {
 
 // Stopped before every slab was written (a stop after the last one changes nothing).
@@ -104,8 +113,8 @@ void add_slab_options(Args& args) {
               "")
       .option("memory-limit", "SIZE",
               "memory the slabs may take, on the host and on a GPU (8G, 512M); a volume larger "
-              "than this goes by slabs (default: three quarters of the machine's memory, nine "
-              "tenths of a GPU's)",
+              "than this goes by slabs; one below a slab of one slice is refused (default: three "
+              "quarters of the machine's memory, nine tenths of a GPU's)",
               "")
       .option("workers", "N",
               "slabs trained at once on the device, each on its own queue (default: 8 on a "
@@ -223,6 +232,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   if (source.centre() && speak) console.line(centre_line(*source.centre()));
   require_quality_grid(source.geometry());
   require_training(settings);
+  refuse_limit_below_one_slice(options, slab_bytes(source.geometry(), 1));
   const std::filesystem::path out = make_output_dir(args.get("out"));
   // Refused now, not after every slab is trained.
   refuse_overwriting_input(out / "volume");
@@ -345,7 +355,8 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   double slices_at_start = static_cast<double>(total);  // until a report says otherwise
   bool copies_pinned = false;  // as they were started (none on a resume with nothing left)
   try {
-    Progress progress("slabs", total * 100, !speak);
+    // In hundredths of a slice, for a bar that moves within a slab; the status counts slices.
+    Progress progress("slabs", total * 100, !speak, false);
     if (processes > 1) {
       // This process plans and gathers; its copies train (none if every slab is done).
       std::size_t slabs = 0;

@@ -22,6 +22,11 @@ std::string output_format(const Args& args);
 // --slab-slices and --memory-limit (0 where not given), as riner fbp takes them too.
 SlabOptions slab_size_options(const Args& args);
 
+// A --memory-limit given below what a slab of one slice takes (`one_slice` bytes) cannot be kept:
+// UsageError naming both, before anything is read or written. The default limit is not checked
+// here (the run says so and goes on).
+void refuse_limit_below_one_slice(const SlabOptions& asked, std::size_t one_slice);
+
 // A parallel-beam stack whose slices are at least this wide trains each slice alone in 2D by
 // default: on 256² slices that is 10-15 dB above slabs of 3D fields at the same or less time
 // (docs/history/RESULTS.md, "a slab as one field or each slice in 2D"); on smaller ones

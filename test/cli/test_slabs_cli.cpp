@@ -268,6 +268,22 @@ TEST_SUITE("cli") {
     CHECK(run.err.find("--processes must be 1 to 1024") != std::string::npos);
   }
 
+  TEST_CASE("a --memory-limit below one slice's slab is refused before anything is written") {
+    // Before: a note, and the run went on at 268 MiB under a limit of 1 MiB.
+    riner::test::TempDir dir;
+    const std::string scan = simulate_stack(dir);
+    for (const std::string command : {"reconstruct", "fbp"}) {
+      CAPTURE(command);
+      const std::filesystem::path out = dir / (command + "_out");
+      const Run run =
+          riner_cli(command + " " + scan + " --memory-limit 1M --out " + out.string(), dir);
+      CHECK(run.code == 2);
+      CHECK(run.err.find("--memory-limit 1M is less than a slab of one slice takes") !=
+            std::string::npos);
+      CHECK_FALSE(std::filesystem::exists(out));
+    }
+  }
+
   TEST_CASE("--slices-2d trains each slice as the 2D scan of its row, and resumes only so") {
     riner::test::TempDir dir;
     const std::string scan = simulate_stack(dir);  // one detector row per slice
