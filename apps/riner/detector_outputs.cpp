@@ -4,11 +4,13 @@
 
 #include "riner/io.hpp"
 #include "riner/plot.hpp"
+#include "riner/reconstructor.hpp"
 
 namespace riner::app {
 
-void write_detector_outputs(const std::filesystem::path& dir, const Array& alpha, const Array& beta,
+void write_detector_outputs(const std::filesystem::path& dir, Array alpha, Array beta,
                             const std::vector<std::size_t>& dead, const Array& alpha_by_view) {
+  mark_dead_elements(dead, alpha, beta);
   write_array(dir / "alpha.npy", alpha);
   write_array(dir / "beta.npy", beta);
   if (alpha_by_view.size() > 0) write_array(dir / "alpha_by_view.npy", alpha_by_view);

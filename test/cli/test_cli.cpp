@@ -308,6 +308,8 @@ TEST_SUITE("cli") {
       }
     }
     CHECK(row_five == 30);
+    const riner::Array beta = riner::read_array(dir / "c" / "beta.npy").array;
+    for (std::size_t c = 0; c < 30; ++c) CHECK(beta.data[5 * 30 + c] < 0.5f);
     MESSAGE("row 10: " << row_ten << " of 30 found stuck");
     CHECK(row_ten >= 10);  // the columns the phantom's shadow sweeps
     CHECK(stuck_elsewhere == 0);
@@ -693,6 +695,15 @@ TEST_SUITE("cli") {
       }
     }
     CHECK(unreadable == 2);
+    // beta.npy and alpha.npy say the same (before: beta ~0.7-1 and alpha 1 for an element with
+    // no finite reading, which gets no gradient).
+    const riner::Array beta = riner::read_array(dir / "r" / "beta.npy").array;
+    const riner::Array alpha = riner::read_array(dir / "r" / "alpha.npy").array;
+    for (const auto& d : reasons) {
+      const std::size_t e = d["element"];
+      CHECK(beta.data[e] < 0.5f);
+      CHECK(alpha.data[e] == 0.0f);
+    }
     // Memory: the process held at least the scan (360 views x 500 floats) on the device, and
     // the host at least that too.
     const double scan_mb = 360.0 * 500 * 4 / 1048576;

@@ -173,6 +173,9 @@ def test_reconstruct_returns_image_alpha_beta_summary(fan_scan):
     assert summary["steps"] == 300
     # The two dead elements of the simulation are reported dead.
     assert set(np.flatnonzero(sim["alpha"] == 0)) <= set(summary["dead_elements"])
+    # ... and so are beta (below 0.5) and alpha (0), as the CLI writes them.
+    assert np.all(beta[summary["dead_elements"]] < 0.5)
+    assert np.all(alpha[summary["dead_elements"]] == 0)
     assert summary["quality"]["ring_index"] < summary["quality"]["fbp_ring_index"]
     fbp = riner.compare(riner.fbp(sim["sino"], g), sim["ground_truth"])["psnr"]
     assert riner.compare(image, sim["ground_truth"])["psnr"] > fbp

@@ -130,6 +130,7 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
     py::gil_scoped_release release;
     result = reconstructor->result();
     beta = reconstructor->beta();
+    mark_dead_elements(reconstructor->dead_elements(), result.alpha, beta);
     const app::QualityCheck check =
         quality ? app::check_quality(*reconstructor, result, dev) : app::QualityCheck{};
     nlohmann::json json = app::run_summary(*reconstructor, result, check);

@@ -270,4 +270,10 @@ class CheckpointSaver {
   double saved_at_;  // training seconds at the last save (or at the start)
 };
 
+// alpha and beta as riner hands them out (alpha.npy, beta.npy, Python): an element taken for
+// dead (Reconstructor::dead_elements) has alpha 0, simulate's mark of a dead element, and beta
+// 0 where training left it at kDeadBelowBeta or above (an element with no finite reading gets
+// no gradient, so its beta stays near 1), so that beta below 0.5 means dead in every case.
+void mark_dead_elements(const std::vector<std::size_t>& dead, Array& alpha, Array& beta);
+
 }  // namespace riner

@@ -528,4 +528,11 @@ TrainingStats Reconstructor::stats() const {
 const RinerConfig& Reconstructor::config() const { return impl_->setup.config; }
 const Scan& Reconstructor::scan() const { return impl_->setup.scan; }
 
+void mark_dead_elements(const std::vector<std::size_t>& dead, Array& alpha, Array& beta) {
+  for (const std::size_t e : dead) {
+    if (e < alpha.size()) alpha.data[e] = 0.0f;
+    if (e < beta.size() && !(beta.data[e] < Reconstructor::kDeadBelowBeta)) beta.data[e] = 0.0f;
+  }
+}
+
 }  // namespace riner
