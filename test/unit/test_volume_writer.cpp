@@ -60,6 +60,26 @@ TEST_CASE("a volume written by blocks reads back whole, in every format") {
   CHECK_THROWS_AS(riner::write_array(dir / "image.h5", riner::Array({4, 3})), riner::InputError);
 }
 
+TEST_CASE("a dataset written into an HDF5 file already there is added to what it holds") {
+  // Before: the whole file was replaced (a Data Exchange scan's projections and flats lost).
+  riner::test::TempDir dir;
+  const riner::Array v = counting_volume();
+  riner::write_array(dir / "scan.h5:/exchange/data", v);
+  riner::Array twice = v;
+  for (float& x : twice.data) x *= 2.0f;
+  riner::write_array(dir / "scan.h5:/exchange/recon", twice);
+  riner::write_array(dir / "scan.h5:/exchange/more", twice);
+  // The same dataset again replaces it, the rest kept (read last: a file read is an input).
+  riner::write_array(dir / "scan.h5:/exchange/recon", v);
+  CHECK(riner::read_array((dir / "scan.h5:/exchange/data").string()).array.data == v.data);
+  CHECK(riner::read_array((dir / "scan.h5:/exchange/more").string()).array.data == twice.data);
+  CHECK(riner::read_array((dir / "scan.h5:/exchange/recon").string()).array.data == v.data);
+  // A file of that name that is no HDF5 file is not replaced.
+  riner::test::write_bytes(dir / "notes.h5", "notes");
+  CHECK_THROWS_AS(riner::write_array(dir / "notes.h5:/x", v), riner::InputError);
+  CHECK(riner::test::read_bytes(dir / "notes.h5") == "notes");
+}
+
 TEST_CASE("a volume is in place only once every slice is written, and each slice once") {
   riner::test::TempDir dir;
   const riner::Array v = counting_volume();

@@ -11,12 +11,44 @@ struct Hdf5VolumeFile::Handles {
   std::optional<Hid> file, set;
 };
 
+namespace {
+
+// Whether `path` ("a/b/c") names a link in the file; H5Lexists fails where a group on the way
+// is missing, so each step is asked in turn.
+bool link_exists(hid_t file, const std::string& path) {
+  std::size_t end = 0;
+  while (end != std::string::npos) {
+    end = path.find('/', end + 1);
+    const std::string part = path.substr(0, end);
+    if (part.empty() || part == "/") continue;
+    if (H5Lexists(file, part.c_str(), H5P_DEFAULT) <= 0) return false;
+  }
+  return true;
+}
+
+}  // namespace
+
+bool is_hdf5_file(const std::filesystem::path& path) {
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  return H5Fis_hdf5(path.c_str()) > 0;
+}
+
 Hdf5VolumeFile::Hdf5VolumeFile(const std::filesystem::path& file, const std::string& dataset,
-                               const std::vector<std::size_t>& shape, double voxel_mm)
+                               const std::vector<std::size_t>& shape, double voxel_mm,
+                               bool add_to_file)
     : handles_(std::make_unique<Handles>()), where_(file.string() + ":" + dataset + ": ") {
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
-  handles_->file.emplace(H5Fcreate(file.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
-                         H5Fclose);
+  if (add_to_file) {
+    handles_->file.emplace(H5Fopen(file.c_str(), H5F_ACC_RDWR, H5P_DEFAULT), H5Fclose);
+    if (!handles_->file->ok()) throw InputError(where_ + "cannot open the HDF5 file to add to it");
+    if (link_exists(handles_->file->get(), dataset) &&
+        H5Ldelete(handles_->file->get(), dataset.c_str(), H5P_DEFAULT) < 0) {
+      throw Error(where_ + "cannot replace the dataset already there");
+    }
+  } else {
+    handles_->file.emplace(H5Fcreate(file.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT),
+                           H5Fclose);
+  }
   if (!handles_->file->ok()) throw Error(where_ + "cannot create the HDF5 file");
   const hsize_t dims[3] = {shape[0], shape[1], shape[2]};
   const hsize_t chunk[3] = {1, shape[1], shape[2]};

@@ -12,11 +12,16 @@
 
 namespace riner::io {
 
+// Whether `path` is an HDF5 file (by its signature).
+bool is_hdf5_file(const std::filesystem::path& path);
+
 class Hdf5VolumeFile {
  public:
-  // Creates `file` (its groups too) holding `dataset` with a "voxel_size_mm" attribute.
+  // Creates `file` (its groups too) holding `dataset` with a "voxel_size_mm" attribute; with
+  // `add_to_file`, `file` is an HDF5 file already (InputError if not) and the dataset is added
+  // to what it holds, a dataset of that name replaced.
   Hdf5VolumeFile(const std::filesystem::path& file, const std::string& dataset,
-                 const std::vector<std::size_t>& shape, double voxel_mm);
+                 const std::vector<std::size_t>& shape, double voxel_mm, bool add_to_file = false);
   Hdf5VolumeFile(const Hdf5VolumeFile&) = delete;
   Hdf5VolumeFile& operator=(const Hdf5VolumeFile&) = delete;
   ~Hdf5VolumeFile();

@@ -77,11 +77,33 @@ class FlatFileSink : public VolumeWriter::Sink {
   int fd_ = -1;
 };
 
+// `temp`, a copy of `target` where that exists (InputError where it is no HDF5 file).
+const std::filesystem::path& copy_of_existing(const std::filesystem::path& target,
+                                              const std::filesystem::path& temp) {
+  if (!std::filesystem::exists(target)) return temp;
+  if (!io::is_hdf5_file(target)) {
+    throw InputError(io::prefix(target) +
+                     "is there already and is no HDF5 file: refusing to replace it");
+  }
+  std::error_code error;
+  std::filesystem::copy_file(target, temp, std::filesystem::copy_options::overwrite_existing,
+                             error);
+  if (error) {
+    throw Error(io::prefix(target) + "cannot copy it to add the dataset (" + error.message() + ")");
+  }
+  return temp;
+}
+
 class Hdf5Sink : public VolumeWriter::Sink {
  public:
+  // A file that is there already keeps what it holds: the dataset is added to a copy of it,
+  // which replaces it when complete (before: the whole file was replaced, a Data Exchange
+  // scan's projections, flats and darks with it).
   Hdf5Sink(const std::filesystem::path& path, const std::string& dataset,
            const std::vector<std::size_t>& shape, double voxel_mm)
-      : file_(path), volume_(file_.temp_path(), dataset, shape, voxel_mm) {}
+      : file_(path),
+        volume_(copy_of_existing(path, file_.temp_path()), dataset, shape, voxel_mm,
+                std::filesystem::exists(path)) {}
   void write(std::size_t first_slice, const Array& slices) override {
     volume_.write(first_slice, slices);
   }
