@@ -1,9 +1,15 @@
 #include "cli_common.hpp"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 
 #include "riner/error.hpp"
+#include "riner/io.hpp"
 #include "riner/simulate.hpp"
 
 namespace riner::app {
@@ -21,13 +27,30 @@ std::optional<Device> device_from(const Args& args, Engine engine) {
 }
 
 std::filesystem::path make_output_dir(const std::string& path) {
+  refuse_overwriting_input(path);  // a stack's folder
   std::error_code error;
   std::filesystem::create_directories(path, error);
   if (!std::filesystem::is_directory(path)) {
     throw InputError(path + ": cannot create the output folder" +
                      (error ? " (" + error.message() + ")" : std::string()));
   }
+  // A file made and removed: a folder the process may not write into fails here, not after
+  // an hour of training.
+  const std::filesystem::path probe =
+      std::filesystem::path(path) / (".riner-probe-" + std::to_string(::getpid()));
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+  if (fd < 0) {
+    throw InputError(path + ": cannot write into the output folder (" + std::strerror(errno) +
+                     ")");
+  }
+  ::close(fd);
+  ::unlink(probe.c_str());
   return path;
+}
+
+void refuse_outputs_over_inputs(const std::filesystem::path& out,
+                                const std::vector<std::string>& names) {
+  for (const std::string& name : names) refuse_overwriting_input(out / name);
 }
 
 Geometry geometry_from(const std::string& name_or_path) {

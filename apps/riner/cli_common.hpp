@@ -23,8 +23,16 @@ Engine engine_from(const Args& args);
 // The device for the OpenCL engine (nullopt for the reference engine).
 std::optional<Device> device_from(const Args& args, Engine engine);
 
-// Creates the folder (and parents) if needed; InputError if it is a file.
+// Creates the folder (and parents) if needed; InputError if it is a file, an input (a folder of
+// TIFFs read as a stack), or a folder this process cannot write into (said now, not after
+// training).
 std::filesystem::path make_output_dir(const std::string& path);
+
+// InputError "refusing to overwrite an input file" when any of `names` in `out` was read as an
+// input: checked once the inputs are read and before anything is trained or written, so a
+// refused run leaves the folder as it was (the writers check again as they write).
+void refuse_outputs_over_inputs(const std::filesystem::path& out,
+                                const std::vector<std::string>& names);
 
 // "a,b,,c" -> {"a", "b", "", "c"}: the items of an option's comma-separated list.
 std::vector<std::string> split_commas(const std::string& list);

@@ -103,6 +103,8 @@ int run_destripe(int argc, char** argv, int first) {
   const LoadedScan loaded = scan_from(args, console);
   const Scan& scan = loaded.scan;
   const std::filesystem::path out = make_output_dir(args.get("out"));
+  refuse_outputs_over_inputs(out, {"sino.npy", "geometry.json", "stripes.npy", "response.npy",
+                                   "image.nii", "image.png", "summary.json"});
   const auto start = std::chrono::steady_clock::now();
   DestripeReport report;
   const Array destriped = destripe(scan.measurement, scan.geometry, options, &report);

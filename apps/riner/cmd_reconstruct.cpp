@@ -179,6 +179,9 @@ int run_reconstruct(int argc, char** argv, int first) {
     throw UsageError("--format h5 writes volumes; write a 2D image as nii, npy, tif or raw");
   }
   const std::filesystem::path out = make_output_dir(args.get("out"));
+  refuse_outputs_over_inputs(out, {"image." + format, "image.png", "alpha.npy", "beta.npy",
+                                   "alpha_by_view.npy", "detector.png", "loss.csv", "config.json",
+                                   "summary.json", kCheckpointName});
   note_non_finite(console, scan.non_finite);
 
   const std::optional<Device> device = device_from(args, config.engine);

@@ -171,6 +171,9 @@ int run_simulate(int argc, char** argv, int first) {
     const Projector projector(g, engine, device_from(args, engine));
     sim.clean = projector.project(sim.ground_truth);
   }
+  refuse_outputs_over_inputs(out, {"sino.npy", "sino_clean.npy", "alpha.npy", "ground_truth.nii",
+                                   "geometry.json", "ground_truth.png", "sino.png",
+                                   "simulation.json"});
   sim.alpha = draw_responses(g, model);
   sim.scan.measurement = corrupt_measurement(sim.clean, sim.alpha, model);
   const ArrayStats stats = compute_stats(sim.scan.measurement);

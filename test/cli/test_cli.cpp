@@ -199,6 +199,21 @@ TEST_SUITE("cli") {
                  out + "/sino.npy has shape [360, 500] but the fan2d geometry expects [360, 400]");
     expect_error(riner_cli("fbp " + out + "/sino.npy --out " + out + "/sino.npy", dir), 2,
                  out + "/sino.npy: refusing to overwrite an input file");
+    // Every output a command writes is checked against its inputs before it trains or writes
+    // anything (before: reconstruct trained, wrote image, alpha, beta and the rest, then
+    // refused config.json; destripe wrote sino.npy, then refused geometry.json).
+    const std::string first = (dir / "first").string();
+    REQUIRE(riner_cli("reconstruct " + out + "/sino.npy --steps 20 --quiet --out " + first, dir)
+                .code == 0);
+    const std::string image_before = riner::test::read_bytes(dir / "first" / "image.nii");
+    expect_error(riner_cli("reconstruct " + out + "/sino.npy --steps 20 --config " + first +
+                               "/config.json --seed 3 --out " + first,
+                           dir),
+                 2, first + "/config.json: refusing to overwrite an input file");
+    CHECK(riner::test::read_bytes(dir / "first" / "image.nii") == image_before);
+    expect_error(riner_cli("destripe " + out + "/sino.npy --out " + out, dir), 2,
+                 out + "/sino.npy: refusing to overwrite an input file");
+    CHECK_FALSE(std::filesystem::exists(dir / "sim" / "stripes.npy"));
     expect_error(riner_cli("fbp " + out + "/sino.npy --out " + out + "/x.nii --device 99", dir), 1,
                  "--device=99: no such device");
     expect_error(riner_cli("fbp " + out + "/sino.npy --out " + out + "/x.dcm", dir), 2,

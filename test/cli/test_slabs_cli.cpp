@@ -670,6 +670,14 @@ TEST_SUITE("cli") {
     CHECK(run.code == 2);
     CHECK(run.err.find("refusing to overwrite an input file") != std::string::npos);
     CHECK_FALSE(std::filesystem::exists(riner::VolumeWriter::slice_file(dir / "tifs", 0)));
+    // One field for the whole stack into its own folder (before: image.tif written among the
+    // projections, which then no longer read as a stack).
+    run = riner_cli("reconstruct " + (dir / "tifs").string() + " --geometry " + geometry +
+                        " --field-3d --steps 20 --format tif --out " + (dir / "tifs").string(),
+                    dir);
+    CHECK(run.code == 2);
+    CHECK(run.err.find("tifs: refusing to overwrite an input file") != std::string::npos);
+    CHECK_FALSE(std::filesystem::exists(dir / "tifs" / "image.tif"));
     // reconstruct's gathered volume file: refused before any slab is trained.
     std::filesystem::create_directories(dir / "held");
     std::filesystem::copy_file(scan, dir / "held" / "volume.npy");
