@@ -39,6 +39,7 @@ std::filesystem::path make_output_dir(const std::string& path) {
   const std::filesystem::path probe =
       std::filesystem::path(path) / (".riner-probe-" + std::to_string(::getpid()));
   const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+  if (fd < 0 && errno == EEXIST) return path;  // another machine's rank of that pid: writable
   if (fd < 0) {
     throw InputError(path + ": cannot write into the output folder (" + std::strerror(errno) +
                      ")");
@@ -51,6 +52,19 @@ std::filesystem::path make_output_dir(const std::string& path) {
 void refuse_outputs_over_inputs(const std::filesystem::path& out,
                                 const std::vector<std::string>& names) {
   for (const std::string& name : names) refuse_overwriting_input(out / name);
+}
+
+void clear_previous_outputs(const std::filesystem::path& out,
+                            const std::vector<std::string>& names) {
+  for (const std::string& name : names) {
+    refuse_overwriting_input(out / name);
+    std::error_code error;
+    std::filesystem::remove(out / name, error);
+    if (error) {
+      throw Error((out / name).string() + ": cannot remove an earlier run's output (" +
+                  error.message() + ")");
+    }
+  }
 }
 
 Geometry geometry_from(const std::string& name_or_path) {

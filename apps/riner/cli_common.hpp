@@ -34,6 +34,12 @@ std::filesystem::path make_output_dir(const std::string& path);
 void refuse_outputs_over_inputs(const std::filesystem::path& out,
                                 const std::vector<std::string>& names);
 
+// Removes what an earlier run left of `names` in `out`, called before a run writes its first
+// output: a run killed part-way then leaves a set short of files, never one of two runs (a new
+// sino.npy beside an earlier run's geometry.json of the same shape was read without a word).
+void clear_previous_outputs(const std::filesystem::path& out,
+                            const std::vector<std::string>& names);
+
 // "a,b,,c" -> {"a", "b", "", "c"}: the items of an option's comma-separated list.
 std::vector<std::string> split_commas(const std::string& list);
 

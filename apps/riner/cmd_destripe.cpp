@@ -103,13 +103,16 @@ int run_destripe(int argc, char** argv, int first) {
   const LoadedScan loaded = scan_from(args, console);
   const Scan& scan = loaded.scan;
   const std::filesystem::path out = make_output_dir(args.get("out"));
-  refuse_outputs_over_inputs(out, {"sino.npy", "geometry.json", "stripes.npy", "response.npy",
-                                   "image.nii", "image.png", "summary.json"});
+  const std::vector<std::string> outputs = {"sino.npy",     "geometry.json", "stripes.npy",
+                                            "response.npy", "image.nii",     "image.png",
+                                            "summary.json"};
+  refuse_outputs_over_inputs(out, outputs);
   const auto start = std::chrono::steady_clock::now();
   DestripeReport report;
   const Array destriped = destripe(scan.measurement, scan.geometry, options, &report);
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  clear_previous_outputs(out, outputs);
   write_array(out / "sino.npy", destriped);
   write_text(out / "geometry.json", scan.geometry.to_json());
   write_array(out / "stripes.npy", report.removed);

@@ -179,9 +179,16 @@ int run_reconstruct(int argc, char** argv, int first) {
     throw UsageError("--format h5 writes volumes; write a 2D image as nii, npy, tif or raw");
   }
   const std::filesystem::path out = make_output_dir(args.get("out"));
-  refuse_outputs_over_inputs(out, {"image." + format, "image.png", "alpha.npy", "beta.npy",
-                                   "alpha_by_view.npy", "detector.png", "loss.csv", "config.json",
-                                   "summary.json", kCheckpointName});
+  // Every image format's name: an earlier run's image.nii beside this run's image.npy would
+  // pass for this run's.
+  std::vector<std::string> outputs = {"image.png",         "alpha.npy",    "beta.npy",
+                                      "alpha_by_view.npy", "detector.png", "loss.csv",
+                                      "config.json",       "summary.json"};
+  for (const char* ext : {"nii", "npy", "tif", "raw", "raw.json", "h5"}) {
+    outputs.push_back(std::string("image.") + ext);
+  }
+  refuse_outputs_over_inputs(out, outputs);
+  refuse_overwriting_input(out / kCheckpointName);
   note_non_finite(console, scan.non_finite);
 
   const std::optional<Device> device = device_from(args, config.engine);
@@ -290,6 +297,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   const Array& image = result.image;
   const Array& alpha = result.alpha;
   const std::filesystem::path image_path = out / ("image." + format);
+  clear_previous_outputs(out, outputs);
   write_array(image_path, image, {std::vector<double>(image.rank(), g.voxel_mm)});
   write_png(out / "image.png", image);
   const TrainingStats stats = reconstructor.stats();

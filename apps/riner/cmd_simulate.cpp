@@ -171,9 +171,10 @@ int run_simulate(int argc, char** argv, int first) {
     const Projector projector(g, engine, device_from(args, engine));
     sim.clean = projector.project(sim.ground_truth);
   }
-  refuse_outputs_over_inputs(out, {"sino.npy", "sino_clean.npy", "alpha.npy", "ground_truth.nii",
-                                   "geometry.json", "ground_truth.png", "sino.png",
-                                   "simulation.json"});
+  const std::vector<std::string> outputs = {
+      "sino.npy",      "sino_clean.npy",   "alpha.npy", "ground_truth.nii",
+      "geometry.json", "ground_truth.png", "sino.png",  "simulation.json"};
+  refuse_outputs_over_inputs(out, outputs);
   sim.alpha = draw_responses(g, model);
   sim.scan.measurement = corrupt_measurement(sim.clean, sim.alpha, model);
   const ArrayStats stats = compute_stats(sim.scan.measurement);
@@ -183,6 +184,7 @@ int run_simulate(int argc, char** argv, int first) {
                  std::to_string(max_line) + "); is --mu-unit right?");
   }
 
+  clear_previous_outputs(out, outputs);
   write_array(out / "sino.npy", sim.scan.measurement);
   write_array(out / "sino_clean.npy", sim.clean);
   write_array(out / "alpha.npy", sim.alpha);

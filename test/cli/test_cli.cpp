@@ -211,6 +211,14 @@ TEST_SUITE("cli") {
                            dir),
                  2, first + "/config.json: refusing to overwrite an input file");
     CHECK(riner::test::read_bytes(dir / "first" / "image.nii") == image_before);
+    // A run into a folder of an earlier one leaves none of the earlier run's outputs beside its
+    // own (here the image of another format).
+    REQUIRE(
+        riner_cli("reconstruct " + out + "/sino.npy --steps 20 --quiet --format npy --out " + first,
+                  dir)
+            .code == 0);
+    CHECK_FALSE(std::filesystem::exists(dir / "first" / "image.nii"));
+    CHECK(std::filesystem::exists(dir / "first" / "image.npy"));
     expect_error(riner_cli("destripe " + out + "/sino.npy --out " + out, dir), 2,
                  out + "/sino.npy: refusing to overwrite an input file");
     CHECK_FALSE(std::filesystem::exists(dir / "sim" / "stripes.npy"));

@@ -670,6 +670,8 @@ TEST_SUITE("cli") {
     CHECK(run.code == 2);
     CHECK(run.err.find("refusing to overwrite an input file") != std::string::npos);
     CHECK_FALSE(std::filesystem::exists(riner::VolumeWriter::slice_file(dir / "tifs", 0)));
+    // `info` of a folder read as a stack (before: "unknown file type ''").
+    CHECK(riner_cli("info --quiet " + (dir / "tifs").string(), dir).code == 0);
     // One field for the whole stack into its own folder (before: image.tif written among the
     // projections, which then no longer read as a stack).
     run = riner_cli("reconstruct " + (dir / "tifs").string() + " --geometry " + geometry +

@@ -80,6 +80,25 @@ TEST_CASE("a dataset written into an HDF5 file already there is added to what it
   CHECK(riner::test::read_bytes(dir / "notes.h5") == "notes");
 }
 
+TEST_CASE("a folder of slices left unfinished is marked, refused as a stack, and replaced") {
+  // Before: a stopped `riner fbp --out FOLDER` left some slices and no sign of the rest.
+  riner::test::TempDir dir;
+  const riner::Array v = counting_volume();
+  {
+    riner::VolumeWriter writer((dir / "slices").string(), v.shape, 0.5);
+    writer.write(0, slices_of(v, 0, 2));  // stopped here: never closed
+  }
+  CHECK(std::filesystem::exists(dir / "slices" / riner::VolumeWriter::kUnfinishedMarker));
+  CHECK_THROWS_WITH_AS(riner::read_array(dir / "slices"), doctest::Contains("an unfinished volume"),
+                       riner::InputError);
+  riner::VolumeWriter again((dir / "slices").string(), v.shape, 0.5);
+  again.write(2, slices_of(v, 2, 3));
+  again.write(0, slices_of(v, 0, 2));
+  again.close();
+  CHECK_FALSE(std::filesystem::exists(dir / "slices" / riner::VolumeWriter::kUnfinishedMarker));
+  CHECK(riner::read_array(dir / "slices").array.data == v.data);
+}
+
 TEST_CASE("a volume is in place only once every slice is written, and each slice once") {
   riner::test::TempDir dir;
   const riner::Array v = counting_volume();

@@ -25,7 +25,7 @@ namespace riner {
 class VolumeWriter {
  public:
   // InputError for a target riner cannot write, a shape that is not [slices, rows, columns], or
-  // a folder that already holds slices.
+  // a folder that already holds slices (but an unfinished volume's, kUnfinishedMarker).
   VolumeWriter(const std::string& target, const std::vector<std::size_t>& shape, double voxel_mm);
   VolumeWriter(const VolumeWriter&) = delete;
   VolumeWriter& operator=(const VolumeWriter&) = delete;
@@ -41,6 +41,10 @@ class VolumeWriter {
   const std::string& target() const { return target_; }
   // A folder target's file for slice k.
   static std::filesystem::path slice_file(const std::filesystem::path& folder, std::size_t k);
+  // In a folder target while its slices are written, removed by close(): a folder that still
+  // holds it after a stop is no volume (reading it as a stack is refused), and the next
+  // writer into it replaces its slices.
+  static constexpr const char* kUnfinishedMarker = "riner-unfinished.txt";
 
   class Sink;
 

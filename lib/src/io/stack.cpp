@@ -9,6 +9,7 @@
 #include "io/formats.hpp"
 #include "io/row_blocks.hpp"
 #include "riner/error.hpp"
+#include "riner/volume_writer.hpp"
 
 namespace riner::io {
 
@@ -68,6 +69,10 @@ std::vector<std::filesystem::path> stack_files(const std::filesystem::path& path
   const std::string pattern = folder ? "" : path.filename().string();
   if (!std::filesystem::is_directory(dir)) {
     throw InputError(prefix(path) + "no such folder '" + dir.string() + "'");
+  }
+  if (folder && std::filesystem::exists(dir / VolumeWriter::kUnfinishedMarker)) {
+    throw InputError(prefix(path) + "an unfinished volume (" + VolumeWriter::kUnfinishedMarker +
+                     ": riner was stopped before its last slice); run that command again");
   }
   std::vector<std::filesystem::path> files;
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {

@@ -146,17 +146,38 @@ class TiffSink : public VolumeWriter::Sink {
 
 class FolderSink : public VolumeWriter::Sink {
  public:
-  explicit FolderSink(std::filesystem::path folder) : folder_(std::move(folder)) {}
+  explicit FolderSink(std::filesystem::path folder) : folder_(std::move(folder)) {
+    write_text(folder_ / VolumeWriter::kUnfinishedMarker,
+               "riner is writing this folder's slices, or was stopped before the last: it is no "
+               "volume until this file is gone. Run the command again to replace them.\n");
+  }
   void write(std::size_t first_slice, const Array& slices) override {
     for (std::size_t k = 0; k < slices.shape[0]; ++k) {
       write_array(VolumeWriter::slice_file(folder_, first_slice + k), axial_slice(slices, k));
     }
   }
-  void close() override {}
+  void close() override {
+    std::error_code error;
+    std::filesystem::remove(folder_ / VolumeWriter::kUnfinishedMarker, error);
+    if (error) {
+      throw Error((folder_ / VolumeWriter::kUnfinishedMarker).string() +
+                  ": cannot remove it, the volume is complete (" + error.message() + ")");
+    }
+  }
 
  private:
   std::filesystem::path folder_;
 };
+
+// The slice files riner wrote into `folder` (slice_NNNNN.tif).
+void remove_slices(const std::filesystem::path& folder) {
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("slice_", 0) == 0 && entry.path().extension() == ".tif") {
+      std::filesystem::remove(entry.path());
+    }
+  }
+}
 
 std::unique_ptr<VolumeWriter::Sink> open_sink(const std::string& target,
                                               const std::vector<std::size_t>& shape,
@@ -174,6 +195,9 @@ std::unique_ptr<VolumeWriter::Sink> open_sink(const std::string& target,
   if (path.extension().empty() || std::filesystem::is_directory(path)) {
     refuse_overwriting_input(path);
     std::filesystem::create_directories(path);
+    if (std::filesystem::exists(path / VolumeWriter::kUnfinishedMarker)) {
+      remove_slices(path);  // an unfinished volume's, riner's own
+    }
     if (std::filesystem::exists(VolumeWriter::slice_file(path, 0))) {
       throw InputError(path.string() + " already holds slices (" +
                        VolumeWriter::slice_file(path, 0).filename().string() +
