@@ -22,14 +22,21 @@ int run_compare(int argc, char** argv, int first) {
   args.output_flags();
   if (!args.parse(argc, argv, first)) return 0;
   Console console(args);
+  // 0 is the option's "not given"; anything else must be a range SSIM's constants can square.
+  const double data_range = args.number("data-range");
+  if (data_range != 0.0 && !(data_range > 0.0 && data_range <= 1e30)) {
+    throw UsageError(
+        "--data-range must be a positive number up to 1e30 (default: the "
+        "reference's max - min)");
+  }
   const Array image = read_array(args.get("IMAGE")).array;
   const Array reference = read_array(args.get("REFERENCE")).array;
   const std::string mask_kind = args.get("mask");
   if (mask_kind != "none" && mask_kind != "circle")
     throw UsageError("--mask must be none or circle");
   const Array mask = mask_kind == "circle" ? circle_mask(reference.shape) : Array();
-  const ImageMetrics m = compare_images(image, reference, mask_kind == "circle" ? &mask : nullptr,
-                                        args.number("data-range"));
+  const ImageMetrics m =
+      compare_images(image, reference, mask_kind == "circle" ? &mask : nullptr, data_range);
   char line[256];
   std::snprintf(line, sizeof(line),
                 "PSNR %.4f dB  SSIM %.5f  MAE %.6g  RMSE %.6g  edges %.3f  (range %.6g, %zu "

@@ -222,6 +222,30 @@ TEST_SUITE("cli") {
     expect_error(riner_cli("destripe " + out + "/sino.npy --out " + out, dir), 2,
                  out + "/sino.npy: refusing to overwrite an input file");
     CHECK_FALSE(std::filesystem::exists(dir / "sim" / "stripes.npy"));
+    // Values that gave an answer with exit 0: a data range SSIM cannot square, a demo of 0
+    // steps (after the whole simulation), photons beyond the counts' 64 bits (all readings
+    // infinite), a pitch in metres (FBP of +-4.7 for 0.1).
+    expect_error(riner_cli("compare " + out + "/ground_truth.nii " + out +
+                               "/ground_truth.nii --data-range -1",
+                           dir),
+                 2, "--data-range must be a positive number up to 1e30");
+    expect_error(riner_cli("demo --steps 0 --out " + (dir / "demo0").string(), dir), 2,
+                 "training.steps is 0 and there is no warm start");
+    CHECK_FALSE(std::filesystem::exists(dir / "demo0"));
+    expect_error(riner_cli("simulate --photons 1e20 --out " + (dir / "loud").string(), dir), 2,
+                 "photons must be 0 (no noise) to 1e15");
+    riner::test::write_bytes(dir / "metres.json", R"({"type": "fan2d",
+      "detector": {"count": 500, "pitch_mm": 0.002}, "source_origin_mm": 370,
+      "origin_detector_mm": 370, "angles": {"count": 360, "range_rad": 6.283185307179586},
+      "volume": {"shape": [256, 256], "voxel_mm": 1.0}})");
+    expect_error(riner_cli("fbp " + out + "/sino.npy --geometry " + (dir / "metres.json").string() +
+                               " --out " + out + "/m.nii",
+                           dir),
+                 2,
+                 (dir / "metres.json").string() +
+                     ": the detector's rays reach 0.2495 mm from the axis, under 1/20 of the "
+                     "grid's half width (128 mm): check detector.pitch_mm and volume.voxel_mm "
+                     "(both in mm)");
     expect_error(riner_cli("fbp " + out + "/sino.npy --out " + out + "/x.nii --device 99", dir), 1,
                  "--device=99: no such device");
     expect_error(riner_cli("fbp " + out + "/sino.npy --out " + out + "/x.dcm", dir), 2,

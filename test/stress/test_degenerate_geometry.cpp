@@ -42,14 +42,22 @@ TEST_SUITE("degenerate_geometry") {
   TEST_CASE("one view, one element, one voxel row") {
     using riner::GeometryType;
     survives(riner::test::make_geometry(GeometryType::kParallel2d, 1, 16, 1, {16, 16}, 1.0, 1.0));
-    survives(riner::test::make_geometry(GeometryType::kFan2d, 8, 1, 1, {16, 16}, 1.0, 1.0));
+    // One element on the axis reaches nothing of a 16 mm grid: refused, like a unit's mistake.
+    CHECK_THROWS_WITH_AS(
+        riner::test::make_geometry(GeometryType::kFan2d, 8, 1, 1, {16, 16}, 1.0, 1.0),
+        doctest::Contains("the detector's rays reach 0 mm from the axis"), riner::InputError);
+    survives(riner::test::make_geometry(GeometryType::kFan2d, 8, 3, 1, {4, 4}, 1.0, 1.0));
     survives(riner::test::make_geometry(GeometryType::kParallel2d, 8, 16, 1, {1, 16}, 1.0, 1.0));
     survives(riner::test::make_geometry(GeometryType::kCone3d, 1, 9, 1, {1, 8, 8}, 1.0, 1.0));
   }
 
   TEST_CASE("tiny and huge pitch, an offset beyond the field of view") {
     using riner::GeometryType;
-    survives(riner::test::make_geometry(GeometryType::kFan2d, 12, 32, 1, {16, 16}, 1e-6, 1.0));
+    // A pitch of 1 nm: 32 elements cover 0.00001 mm of a 16 mm grid (a pitch in metres).
+    CHECK_THROWS_WITH_AS(
+        riner::test::make_geometry(GeometryType::kFan2d, 12, 32, 1, {16, 16}, 1e-6, 1.0),
+        doctest::Contains("check detector.pitch_mm and volume.voxel_mm"), riner::InputError);
+    survives(riner::test::make_geometry(GeometryType::kFan2d, 12, 32, 1, {16, 16}, 0.05, 1.0));
     // A pitch of 1 km: the 16 mm grid lies behind one element.
     CHECK_THROWS_WITH_AS(
         riner::test::make_geometry(GeometryType::kFan2d, 12, 32, 1, {16, 16}, 1e6, 1.0),

@@ -95,6 +95,10 @@ TEST_SUITE("fbp_setup") {
     riner::Array between({3, 2}, std::vector<float>{1, 2, NAN, INFINITY, 3, 6});
     riner::analytic::repair_non_finite(between, 2);
     CHECK(between.data == std::vector<float>{1, 2, 2, 4, 3, 6});
+    // A reading no line integral reaches (two of 1e19 made an FBP image of +-1e17).
+    riner::Array corrupt({1, 3}, std::vector<float>{1, 1e19f, 3});
+    CHECK(riner::analytic::repair_non_finite(corrupt, 3) == 1);
+    CHECK(corrupt.data == std::vector<float>{1, 2, 3});
     riner::Array nothing({2, 2}, NAN);
     riner::analytic::repair_non_finite(nothing, 2);
     CHECK(nothing.data == std::vector<float>{0, 0, 0, 0});

@@ -286,5 +286,14 @@ TEST_SUITE("image stacks") {
     riner::write_array(dir / "raw_2.tif", Array({3, 3}, 1.0f));
     const std::string m = message(dir / "raw_*.tif");
     CHECK(m.find("raw_2.tif: is [3, 3] where raw_1.tif is [2, 3]") != std::string::npos);
+    // Frames of another sample type: line integrals beside raw counts.
+    riner::write_array(dir / "mixed_1.npy", Array({2, 3}, 1.0f));
+    std::string counts;
+    for (int k = 0; k < 6; ++k) riner::test::append<std::uint16_t>(counts, 1000);
+    riner::test::write_bytes(dir / "mixed_2.npy",
+                             riner::test::make_npy("<u2", false, {2, 3}, counts));
+    CHECK(message(dir / "mixed_*.npy")
+              .find("mixed_2.npy: holds uint16 samples where mixed_1.npy "
+                    "holds float32") != std::string::npos);
   }
 }

@@ -12,9 +12,10 @@
 namespace riner {
 
 // Readings beyond this magnitude are no line integral (rho = -ln(I/I0) of a real scan stays
-// below a few tens) nor raw counts: a corrupt value, which FBP repairs like a non-finite one.
-// Below it every sum the filters form stays finite in float (a column of 10^7 views).
-constexpr float kLargestReading = 1e20f;
+// below a few tens; a scaled integer store, x1000, below 10^5) nor raw counts: a corrupt value,
+// which FBP repairs and training leaves out like a non-finite one (at 1e20, two readings of
+// 1e19 made an FBP image of +-1e17 without a word).
+constexpr float kLargestReading = 1e6f;
 
 struct Scan {
   Array measurement;  // [views, elements] in 2D, [views, rows, columns] in 3D

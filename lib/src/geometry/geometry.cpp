@@ -21,6 +21,8 @@ namespace {
 
 // Sixteen turns: beyond any scan's angles in radians, short of 180 or 360 read as radians.
 constexpr double kLargestAngleRad = 16.0 * 2.0 * M_PI;
+// The detector's reach from the axis under this share of the grid's half width: a unit error.
+constexpr double kNarrowestDetectorShare = 20.0;
 
 // Whether the line of `ray` passes through the cylinder of radius `reach` about the axis within
 // |z| <= half_height (the grid's extent; z counts from the grid's centre in detector_ray).
@@ -111,6 +113,18 @@ void Geometry::validate() const {
   const std::vector<double> d = column_ray_distances(*this);
   const auto [low, high] = std::minmax_element(d.begin(), d.end());
   const double nearest = *low > 0.0 ? *low : (*high < 0.0 ? -*high : 0.0);
+  // A detector that covers a sliver of the grid is a unit's mistake (a pitch in metres, a voxel
+  // in micrometres): FBP gave garbage, or NaN, without a word. A region of interest or a half
+  // acquisition still covers far more than this share of the grid's width.
+  const double reach = std::max(std::fabs(*low), std::fabs(*high));
+  if (reach * kNarrowestDetectorShare < 0.5 * grid_width) {
+    char line[300];
+    std::snprintf(line, sizeof(line),
+                  "the detector's rays reach %.4g mm from the axis, under 1/%.0f of the grid's "
+                  "half width (%.4g mm): check detector.pitch_mm and volume.voxel_mm (both in mm)",
+                  reach, kNarrowestDetectorShare, 0.5 * grid_width);
+    fail(line);
+  }
   if (nearest >= half_diagonal) {
     char line[240];
     std::snprintf(line, sizeof(line),

@@ -1,7 +1,9 @@
 // Raw samples described by a JSON sidecar "<file>.json":
 //   {"dtype": "float32", "shape": [views, elements], "byte_order": "little",
-//    "offset_bytes": 0, "order": "C"}
-// Only dtype and shape are required.
+//    "offset_bytes": 0, "trailing_bytes": 0, "order": "C"}
+// Only dtype and shape are required; the file holds exactly what they say (a footer after the
+// samples is named by trailing_bytes), and any other key is refused (a misspelt "endian" read
+// byte-swapped samples without a word).
 #include <nlohmann/json.hpp>
 
 #include <fstream>
@@ -29,7 +31,16 @@ struct RawLayout {
   bool little_endian = true;
   bool fortran_order = false;
   std::size_t offset = 0;
+  std::size_t trailing = 0;
 };
+
+bool known_sidecar_key(const std::string& key) {
+  for (const char* known : {"dtype", "shape", "byte_order", "order", "offset_bytes",
+                            "trailing_bytes", "comment", "description", "notes"}) {
+    if (key == known) return true;
+  }
+  return !key.empty() && key[0] == '_';
+}
 
 RawLayout read_sidecar(const std::filesystem::path& path) {
   const std::filesystem::path sidecar = sidecar_path(path);
@@ -41,6 +52,13 @@ RawLayout read_sidecar(const std::filesystem::path& path) {
   }
   auto bad = [&](const std::string& what) { return InputError(prefix(sidecar) + what); };
   if (!meta.is_object()) throw bad("must be a JSON object");
+  for (const auto& [key, value] : meta.items()) {
+    if (!known_sidecar_key(key)) {
+      throw bad("unknown key \"" + key +
+                "\" (a sidecar takes dtype, shape, byte_order, order, offset_bytes, "
+                "trailing_bytes)");
+    }
+  }
   if (!meta.contains("dtype") || !meta["dtype"].is_string()) throw bad("needs \"dtype\" (string)");
   const auto type = sample_type_from_name(meta["dtype"].get<std::string>());
   if (!type) throw bad("unsupported dtype \"" + meta["dtype"].get<std::string>() + "\"");
@@ -71,6 +89,10 @@ RawLayout read_sidecar(const std::filesystem::path& path) {
     if (!meta["offset_bytes"].is_number_unsigned()) throw bad("\"offset_bytes\" must be >= 0");
     layout.offset = meta["offset_bytes"].get<std::size_t>();
   }
+  if (meta.contains("trailing_bytes")) {
+    if (!meta["trailing_bytes"].is_number_unsigned()) throw bad("\"trailing_bytes\" must be >= 0");
+    layout.trailing = meta["trailing_bytes"].get<std::size_t>();
+  }
   return layout;
 }
 
@@ -83,6 +105,14 @@ void check_file_size(const RawLayout& layout, const std::filesystem::path& path,
                      sample_type_name(layout.type) + " from byte " +
                      std::to_string(layout.offset) + " but the file has " +
                      std::to_string(bytes) + " bytes");
+  }
+  const std::uint64_t described = layout.offset + count * item + layout.trailing;
+  if (bytes != described) {
+    throw InputError(prefix(path) + "sidecar says " + shape_string(layout.shape) + " " +
+                     sample_type_name(layout.type) + " from byte " + std::to_string(layout.offset) +
+                     " (" + std::to_string(described) + " bytes) but the file has " +
+                     std::to_string(bytes) +
+                     ": check dtype and shape (a footer after the samples: \"trailing_bytes\")");
   }
 }
 

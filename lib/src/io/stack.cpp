@@ -96,7 +96,7 @@ std::vector<std::filesystem::path> stack_files(const std::filesystem::path& path
 
 namespace {
 
-// Each file, read by `read_one`, must be 2D and shaped like the first.
+// Each file, read by `read_one`, must be 2D, shaped like the first and of its sample type.
 template <typename ReadOne>
 ArrayFile stack_of(const std::vector<std::filesystem::path>& files, ReadOne&& read_one) {
   ArrayFile stack;
@@ -115,6 +115,12 @@ ArrayFile stack_of(const std::vector<std::filesystem::path>& files, ReadOne&& re
     } else if (frame.array.shape != frame_shape) {
       throw InputError(prefix(file) + "is " + shape_string(frame.array.shape) + " where " +
                        files.front().filename().string() + " is " + shape_string(frame_shape));
+    } else if (frame.dtype != stack.dtype) {
+      // Line integrals beside raw counts (float32 and uint16 frames) merged into one scan
+      // without a word.
+      throw InputError(prefix(file) + "holds " + frame.dtype + " samples where " +
+                       files.front().filename().string() + " holds " + stack.dtype +
+                       ": a stack's frames are of one kind");
     }
     stack.non_finite += frame.non_finite;
     stack.array.data.insert(stack.array.data.end(), frame.array.data.begin(),

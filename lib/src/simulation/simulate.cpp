@@ -11,6 +11,9 @@ namespace riner {
 
 namespace {
 
+// The most incident photons a simulation draws (RingModel::validate).
+constexpr double kMostPhotons = 1e15;
+
 // Independent streams for responses and noise, both derived from the user's seed (splitmix64).
 std::uint64_t stream_seed(std::uint64_t seed, std::uint64_t stream) {
   std::uint64_t z = seed + stream * 0x9E3779B97F4A7C15ull;
@@ -87,7 +90,11 @@ void RingModel::validate() const {
   if (!(alpha_min > 0.0) || !(alpha_max >= alpha_min) || !std::isfinite(alpha_max)) {
     throw InputError("the response range must satisfy 0 < alpha_min <= alpha_max");
   }
-  if (!(photons >= 0.0) || !std::isfinite(photons)) throw InputError("photons must be >= 0");
+  // The counts are drawn as 64-bit integers: at 1e20 they overflowed and nearly every reading
+  // came out infinite. Beyond 1e15 the noise is far below float's precision anyway.
+  if (!(photons >= 0.0) || !(photons <= kMostPhotons)) {
+    throw InputError("photons must be 0 (no noise) to 1e15");
+  }
 }
 
 std::vector<std::size_t> dead_in_every_view(const Array& alpha, std::size_t elements) {

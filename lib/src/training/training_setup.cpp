@@ -88,6 +88,14 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
   config.validate();
   scan.geometry.validate();
   check_scan(scan);
+  // A reading beyond any line integral is a corrupt value: dead for training as a non-finite
+  // one is (FBP repairs both alike), not a target a field and alpha chase.
+  for (float& x : scan.measurement.data) {
+    if (std::isfinite(x) && !(std::fabs(x) <= kLargestReading)) {
+      x = NAN;
+      ++scan.non_finite;
+    }
+  }
   const Geometry& g = scan.geometry;
   elements_per_view = g.n_u * (g.is_3d() ? g.n_v : 1);
   segments = model::RaySegments(g, config.training.sample_spacing * g.voxel_mm,
