@@ -49,7 +49,7 @@ DestripeOptions destripe_options_from(const Args& args, const std::string& metho
   options.snr = positive_option(args, "snr");
   options.sigma = args.get("sigma").empty() ? 0.0 : positive_option(args, "sigma");
   options.fit_order = bounded_option(args, "fit-order", 0, 10, options.fit_order);
-  options.levels = bounded_option(args, "levels", 1, 10, 0);
+  options.levels = bounded_option(args, "levels", 0, 10, 0);  // 0: as many as fit, as unset
   options.wavelet_order = bounded_option(args, "wavelet", 1, 12, options.wavelet_order);
   options.engine = engine_from(args);
   options.device = device_from(args, options.engine);
@@ -61,8 +61,7 @@ void add_destripe_tuning(Args& args) {
               "median window across columns for small stripes (odd; default 21, in all 5: "
               "wider for wide stripes, narrower where the object's detail is finer)",
               "")
-      .option("large-size", "N",
-              "the window for large and dead stripes (default 51)", "")
+      .option("large-size", "N", "the window for large and dead stripes (default 51)", "")
       .option("snr", "X", "how far above the noise a stripe must stand to be detected", "3")
       .option("sigma", "S",
               "the Gaussian's width in frequency bins (default: the method's own): filtering's "
@@ -70,8 +69,8 @@ void add_destripe_tuning(Args& args) {
               "stronger), wavelet's high-pass along the views (1, larger is stronger)",
               "")
       .option("fit-order", "N", "fitting: the polynomial's order along the views", "2")
-      .option("levels", "N", "wavelet: decomposition levels (default: as many as fit, up to 4)",
-              "")
+      .option("levels", "N",
+              "wavelet: decomposition levels (default or 0: as many as fit, up to 4)", "")
       .option("wavelet", "N", "wavelet: Daubechies' order (db N)", "9");
 }
 

@@ -86,13 +86,16 @@ nlohmann::json quality_summary(const QualityCheck& check) {
                         {"slices_measured", check.slices},
                         {"volume_slices", check.volume_slices},
                         {"centre", nullptr}};
-  if (check.field) {
+  // Measured on a 2D image (a classical filter's too, whose console note it backs), not on a
+  // volume's slices; the field's own only where there is a field.
+  if (check.field || (check.volume_slices == 0 && q.centre.fbp_noise > 0.0)) {
     out["centre"] = {{"radius_px", q.centre.radius_px},
                      {"largest_broad_deviation_from_fbp_per_mm", q.centre.deviation},
                      {"at_px", q.centre.at_px},
                      {"fbp_profile_noise_per_mm", q.centre.fbp_noise},
                      {"fbp_noise_sigmas", q.centre.sigmas},
-                     {"field_fbp_noise_sigmas", check.field->sigmas}};
+                     {"field_fbp_noise_sigmas",
+                      check.field ? nlohmann::json(check.field->sigmas) : nlohmann::json()}};
   }
   return out;
 }

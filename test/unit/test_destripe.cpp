@@ -95,6 +95,22 @@ TEST_CASE("each method takes most of a ringed sinogram's offsets away and report
   }
 }
 
+TEST_CASE("on a narrow detector the default windows shrink to an eighth of it") {
+  // 64 columns with the literature's 51: the large-stripe median spanned the object, and `all`
+  // took a simulated scan's FBP from 18.1 to 12.5 dB (now 23.1).
+  const Ringed r = ringed_sinogram(180, 64);
+  riner::DestripeOptions options;
+  options.method = riner::DestripeMethod::kAll;
+  riner::DestripeReport report;
+  const riner::Array out = riner::destripe(r.ringed, r.g, options, &report);
+  CHECK(report.size == 5u);
+  CHECK(report.large_size == 9u);
+  CHECK(rms(out.data, r.clean.data) < rms(r.ringed.data, r.clean.data));
+  options.large_size = 51;  // given: it stands
+  riner::destripe(r.ringed, r.g, options, &report);
+  CHECK(report.large_size == 51u);
+}
+
 TEST_CASE("a sinogram without stripes comes through nearly as it was") {
   const Ringed r = ringed_sinogram();
   for (riner::DestripeMethod method :

@@ -2,7 +2,7 @@
 
     import numpy as np, riner
     geometry = riner.parallel_beam(np.linspace(0, np.pi, 181), columns=640, center=295.6)
-    image, alpha, beta, summary = riner.reconstruct(sino, geometry, steps=12000)
+    image, alpha, beta, summary, field = riner.reconstruct(sino, geometry, steps=12000)
 
 Arrays are numpy arrays: a sinogram [views, columns] (2D) or a projection stack
 [views, rows, columns] (3D), images [y, x] or volumes [z, y, x] in 1/mm. A geometry is the

@@ -67,8 +67,9 @@ struct DestripeOptions {
 };
 
 struct DestripeReport {
-  // [rows, columns] (2D: [1, columns]): each element's mean over the views of what was removed
-  // (rho); exp(-removed) is the response a classical filter read off the scan, as alpha.npy.
+  // [rows, columns] (2D: [columns], as alpha): each element's mean over the views of what was
+  // removed (rho); exp(-removed) is the response a classical filter read off the scan, as
+  // alpha.npy.
   Array removed;
   std::vector<std::size_t> dead;   // elements (row * columns + column) interpolated as dead
   std::vector<std::size_t> large;  // elements normalised as large stripes
