@@ -24,6 +24,21 @@ TEST_SUITE("output_safety") {
     CHECK_THROWS_AS(riner::write_array(dir / "alias.npy", a), riner::InputError);
   }
 
+  TEST_CASE("a write that fails names its target and the system's reason") {
+    // Before: "<dir>/<name>.tmp.<hash>: write failed", the temporary's name and no reason.
+    riner::test::TempDir dir;
+    const std::filesystem::path target = dir / (std::string(250, 'x') + ".npy");
+    try {
+      riner::write_array(target, riner::Array({2, 2}, 1.0f));
+      FAIL("a 254-character name was written");
+    } catch (const riner::Error& e) {
+      const std::string what = e.what();
+      CHECK(what.rfind(target.string() + ": write failed", 0) == 0);
+      CHECK(what.find(".tmp.") == std::string::npos);
+      CHECK(what.find("File name too long") != std::string::npos);
+    }
+  }
+
   TEST_CASE("a read inside an InputScope guards its file during the scope only") {
     riner::test::TempDir dir;
     const riner::Array a({2, 2}, 1.0f);

@@ -1,6 +1,8 @@
 // Format dispatch, atomic outputs and previews.
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <optional>
 #include <utility>
@@ -24,7 +26,28 @@ template <typename WriteFn>
 void write_atomically(const std::filesystem::path& path, WriteFn&& write) {
   io::check_output_path(path);
   util::AtomicFile file(path);
-  write(file.temp_path());
+  // A writer names the file it was given, the temporary, and often not why it failed: the
+  // message names the target and the system's reason (permission denied, disk full, a name
+  // too long) instead.
+  const auto told = [&](const std::exception& e, int code) {
+    std::string what = e.what();
+    const std::string temp = file.temp_path().string();
+    if (const std::size_t at = what.find(temp); at != std::string::npos) {
+      what.replace(at, temp.size(), path.string());
+    }
+    if (code != 0 && what.find(std::strerror(code)) == std::string::npos) {
+      what += std::string(" (") + std::strerror(code) + ")";
+    }
+    return what;
+  };
+  errno = 0;
+  try {
+    write(file.temp_path());
+  } catch (const InputError& e) {
+    throw InputError(told(e, errno));
+  } catch (const Error& e) {
+    throw Error(told(e, errno));
+  }
   file.commit();
 }
 
