@@ -179,10 +179,6 @@ int run_simulate(int argc, char** argv, int first) {
   sim.scan.measurement = corrupt_measurement(sim.clean, sim.alpha, model);
   const ArrayStats stats = compute_stats(sim.scan.measurement);
   const double max_line = compute_stats(sim.clean).max;
-  if (model.photons > 0 && max_line > std::log(model.photons / 10.0)) {
-    console.line("warning: the longest ray leaves fewer than 10 photons (line integral " +
-                 std::to_string(max_line) + "); is --mu-unit right?");
-  }
 
   clear_previous_outputs(out, outputs);
   write_array(out / "sino.npy", sim.scan.measurement);

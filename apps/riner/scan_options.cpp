@@ -5,6 +5,7 @@
 
 #include "riner/error.hpp"
 #include "riner/io.hpp"
+#include "summary_json.hpp"
 
 namespace riner::app {
 
@@ -81,33 +82,9 @@ LoadedScan scan_from(const Args& args, const Console& console) {
 
 std::optional<CentreEstimate> check_centre(const LoadedScan& loaded, const Console& console) {
   if (loaded.centre) return std::nullopt;
-  const Geometry& g = loaded.scan.geometry;
-  if (!centre_search_covers(g)) {
-    console.line("note: the rotation axis lies outside the detector's central half and the "
-                 "views cover less than a full turn: the centre finders search the central half "
-                 "only, so the geometry's offset is not checked");
-    return std::nullopt;
-  }
-  std::optional<CentreEstimate> e;
-  try {
-    e = estimate_centre(loaded.scan);
-  } catch (const InputError&) {
-    return std::nullopt;  // no half-turn, no view pair: nothing to check against
-  }
-  const double given = loaded.scan.geometry.offset_u;
-  if (std::fabs(e->offset_px - given) > kCentreDoubtPx) {
-    char line[300];
-    std::snprintf(line, sizeof(line),
-                  "note: the scan's own %s the rotation axis at offset %.2f px, the "
-                  "geometry at %.2f: a wrong axis doubles edges and leaves arcs (pass "
-                  "--offset-px auto, or check the geometry)",
-                  e->method.rfind("conjugate rays", 0) == 0 ? "conjugate rays put"
-                  : e->method.rfind("view pairs", 0) == 0 ? "view pairs put"
-                                                          : "sinogram puts",
-                  e->offset_px,
-                  given);
-    console.line(line);
-  }
+  std::string note;
+  std::optional<CentreEstimate> e = check_geometry_centre(loaded.scan, note);
+  if (!note.empty()) console.line(note);
   return e;
 }
 

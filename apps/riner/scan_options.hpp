@@ -25,13 +25,8 @@ std::optional<Geometry> stack_geometry(const Args& args);
 // Console lines say what was done.
 LoadedScan scan_from(const Args& args, const Console& console);
 
-// Further from the scan's own estimate of its axis (`riner center`) than this, the geometry's
-// offset is doubted aloud: half a pixel blurs little, a few pixels double edges.
-constexpr double kCentreDoubtPx = 1.0;
-
-// A scan whose offset was given (not auto): the scan's own estimate, and a console note when
-// the two differ by more than kCentreDoubtPx. nullopt for auto offsets, and scans without a
-// half-turn or a view pair (a fan or cone beam: a full turn).
+// A scan whose offset was given (not auto): check_geometry_centre (summary_json.hpp), its note
+// on the console. nullopt for auto offsets.
 std::optional<CentreEstimate> check_centre(const LoadedScan& loaded, const Console& console);
 
 }  // namespace riner::app

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "riner/error.hpp"
 #include "riner/execution_plan.hpp"
@@ -315,6 +316,37 @@ nlohmann::json device_json(const DeviceInfo& d) {
           {"native_vector_width_int", d.native_vector_width_int},
           {"fp32_global_atomic_add", d.fp32_global_atomic_add},
           {"training_plan", nlohmann::json::parse(choose_execution_plan(d).to_json())}};
+}
+
+std::optional<CentreEstimate> check_geometry_centre(const Scan& scan, std::string& note) {
+  note.clear();
+  const Geometry& g = scan.geometry;
+  if (!centre_search_covers(g)) {
+    note =
+        "note: the rotation axis lies outside the detector's central half and the views cover "
+        "less than a full turn: the centre finders search the central half only, so the "
+        "geometry's offset is not checked";
+    return std::nullopt;
+  }
+  std::optional<CentreEstimate> e;
+  try {
+    e = estimate_centre(scan);
+  } catch (const InputError&) {
+    return std::nullopt;  // no half-turn, no view pair: nothing to check against
+  }
+  if (std::fabs(e->offset_px - g.offset_u) > kCentreDoubtPx) {
+    char line[300];
+    std::snprintf(line, sizeof(line),
+                  "note: the scan's own %s the rotation axis at offset %.2f px, the geometry at "
+                  "%.2f: a wrong axis doubles edges and leaves arcs (pass --offset-px auto, or "
+                  "check the geometry)",
+                  e->method.rfind("conjugate rays", 0) == 0 ? "conjugate rays put"
+                  : e->method.rfind("view pairs", 0) == 0   ? "view pairs put"
+                                                            : "sinogram puts",
+                  e->offset_px, g.offset_u);
+    note = line;
+  }
+  return e;
 }
 
 }  // namespace riner::app

@@ -431,3 +431,17 @@ def test_a_file_read_in_the_session_can_be_written_back(tmp_path):
     b = riner.read_array(tmp_path / "p.npy")
     riner.write_array(tmp_path / "p.npy", b + 1)
     assert np.array_equal(riner.read_array(tmp_path / "p.npy"), a + 1)
+
+
+def test_the_librarys_warnings_and_the_centre_check_reach_python():
+    # Before: simulate's starved-photons warning was the CLI's alone, and reconstruct neither
+    # warned of a geometry whose axis the scan contradicts nor kept the check in its summary.
+    g = riner.parallel_beam(np.linspace(0, np.pi, 91), columns=96, center=47.5 + 6.0)
+    with pytest.warns(UserWarning, match="fewer than 10 photons"):
+        riner.simulate(None, g, mu_scale=30.0)
+    sim = riner.simulate(None, g, seed=1)
+    wrong = json.loads(json.dumps(g))
+    wrong["detector"]["offset_px"] = 0.0
+    with pytest.warns(UserWarning, match="puts the rotation axis at offset"):
+        r = riner.reconstruct(sim["sino"], wrong, steps=20, quality=False)
+    assert r.summary["centre_check"]["offset_px"] == pytest.approx(g["detector"]["offset_px"], abs=0.5)

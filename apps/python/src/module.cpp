@@ -5,11 +5,14 @@
 // Python's keywords (python_wording.hpp).
 #include <pybind11/stl.h>
 
+#include <cstdio>
+
 #include "bindings.hpp"
 #include "python_wording.hpp"
 #include "riner/error.hpp"
 #include "riner/geometry.hpp"
 #include "riner/io.hpp"
+#include "riner/log.hpp"
 #include "riner/riner_config.hpp"
 #include "riner/simulate.hpp"
 #include "summary_json.hpp"
@@ -62,6 +65,18 @@ void bind_environment(py::module_& m) {
 PYBIND11_MODULE(_riner, m) {
   namespace py = pybind11;
   m.doc() = "riner's C++ library; use the riner package, not this module";
+  // The library's warnings as Python warnings where the calling thread holds the GIL (a
+  // UserWarning a script can filter or catch); from inside a call that released it, on stderr
+  // as before.
+  riner::set_warning_handler([](std::string_view message) {
+    if (PyGILState_Check() == 1) {
+      const std::string text = riner::python::python_wording(std::string(message));
+      if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) == 0) return;
+      PyErr_Clear();  // warnings as errors: no exception can leave from here
+    }
+    std::fprintf(stderr, "riner: warning: %.*s\n", static_cast<int>(message.size()),
+                 message.data());
+  });
   static py::exception<riner::Error> error(m, "Error", PyExc_RuntimeError);
   static py::exception<riner::InputError> input_error(
       m, "InputError", py::make_tuple(error, py::handle(PyExc_ValueError)));

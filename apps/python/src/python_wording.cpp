@@ -10,8 +10,10 @@ namespace {
 
 // Phrases first (an offset in pixels becomes the axis's column), then single options; an
 // option matches only whole (--flat is not the start of --flat-after).
-constexpr std::array<std::pair<std::string_view, std::string_view>, 9> kWording{{
+constexpr std::array<std::pair<std::string_view, std::string_view>, 11> kWording{{
     {"pass the offset with --offset-px", "pass the axis's column with center="},
+    {"pass --offset-px auto", "pass center=\"auto\""},
+    {"--mu-unit cm", "mu_unit=\"cm\""},
     {"see `riner devices`", "see riner.devices()"},
     {"--offset-px", "center="},
     {"--flat-after", "flat_after="},

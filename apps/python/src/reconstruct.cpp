@@ -88,6 +88,18 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
   Scan scan = scan_from(measurement, geometry_json);
   const RinerConfig config = config_from(config_json, settings, engine);
   app::require_training(config);
+  // The CLI's check of the geometry's axis against the scan's own, said as a Python warning
+  // and kept in the summary (it was missing from both).
+  std::optional<CentreEstimate> centre_check;
+  std::string centre_note;
+  {
+    py::gil_scoped_release release;
+    centre_check = app::check_geometry_centre(scan, centre_note);
+  }
+  if (!centre_note.empty()) {
+    const std::string text = python_wording(centre_note.substr(centre_note.find(": ") + 2));
+    if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) < 0) throw py::error_already_set();
+  }
 
   std::unique_ptr<Reconstructor> reconstructor;
   std::optional<Device> dev;
@@ -135,6 +147,7 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
         quality ? app::check_quality(*reconstructor, result, dev) : app::QualityCheck{};
     nlohmann::json json = app::run_summary(*reconstructor, result, check);
     if (!quality) json["quality"] = nullptr;
+    json["centre_check"] = centre_check ? app::centre_json(*centre_check) : nlohmann::json(nullptr);
     summary = python_wording(json.dump());
   }
   const TrainingStats done = reconstructor->stats();

@@ -115,9 +115,10 @@ py::dict simulate_scan(const py::object& image, const std::string& geometry_json
       const Projector forward(g, e, device_for(e, device));
       sim.clean = forward.project(sim.ground_truth);
     }
-    sim.alpha = draw_responses(g, model);
-    sim.scan.measurement = corrupt_measurement(sim.clean, sim.alpha, model);
   }
+  // With the GIL: its warning (photons starved: is mu_unit right?) is a Python warning.
+  sim.alpha = draw_responses(g, model);
+  sim.scan.measurement = corrupt_measurement(sim.clean, sim.alpha, model);
   py::dict out;
   out["sino"] = to_numpy(std::move(sim.scan.measurement));
   out["clean"] = to_numpy(std::move(sim.clean));

@@ -5,6 +5,7 @@
 #include <numeric>
 
 #include "riner/error.hpp"
+#include "riner/log.hpp"
 #include "simulation/random.hpp"
 
 namespace riner {
@@ -199,6 +200,15 @@ Array corrupt_measurement(const Array& clean, const Array& alpha, const RingMode
   model.validate();
   if (alpha.size() == 0 || clean.size() % alpha.size() != 0) {
     throw InputError("the response map does not match the measurement's detector");
+  }
+  // The mistake this catches is an image in 1/cm read as 1/mm (DeepLesion without mu_unit):
+  // said by the library, so the CLI and Python both say it.
+  if (model.photons > 0.0) {
+    const double longest = compute_stats(clean).max;
+    if (longest > std::log(model.photons / 10.0)) {
+      warn("the longest ray leaves fewer than 10 photons (line integral " +
+           std::to_string(longest) + "): is the image's unit right (mu in 1/mm; --mu-unit cm)?");
+    }
   }
   sim::Random rng(stream_seed(model.seed, 2));
   Array out(clean.shape);
