@@ -54,11 +54,23 @@ int run_settings(int argc, char** argv, int first) {
             "Lists every setting of `riner reconstruct` (--config FILE, --set NAME=VALUE): its "
             "default, the values it takes and what it does. With --paper, the paper preset's "
             "values as defaults.");
-  args.flag("markdown", "print the settings reference as Markdown (docs/settings.md)");
+  args.flag("markdown", "print the settings reference as Markdown (docs/settings.md)")
+      .flag("paper", "the paper preset's values as defaults (reconstruct --paper)");
   args.output_flags();
   if (!args.parse(argc, argv, first)) return 0;
   Console console(args);
-  const std::vector<RinerConfig::SettingInfo> settings = RinerConfig::settings();
+  std::vector<RinerConfig::SettingInfo> settings = RinerConfig::settings();
+  if (args.is_set("paper")) {
+    // Each setting's value in the paper preset, by its dotted name ("training.steps").
+    const nlohmann::json paper = nlohmann::json::parse(RinerConfig::paper().to_json());
+    for (RinerConfig::SettingInfo& s : settings) {
+      const nlohmann::json::json_pointer at("/" + s.name.substr(0, s.name.find('.')) + "/" +
+                                            s.name.substr(s.name.find('.') + 1));
+      if (s.name.find('.') != std::string::npos && paper.contains(at)) {
+        s.default_value = paper.at(at).dump();
+      }
+    }
+  }
   nlohmann::json list = nlohmann::json::array();
   for (const auto& s : settings) {
     list.push_back({{"name", s.name},

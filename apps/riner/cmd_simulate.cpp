@@ -143,6 +143,10 @@ int run_simulate(int argc, char** argv, int first) {
   args.output_flags();
   if (!args.parse(argc, argv, first)) return 0;
   Console console(args);
+  // Checked for a built-in phantom too, where it is not used (xyz passed without a word).
+  if (args.get("mu-unit") != "mm" && args.get("mu-unit") != "cm") {
+    throw UsageError("--mu-unit must be mm or cm");
+  }
   const Geometry g = geometry_from(args.get("geometry"));
   const RingModel model = model_from(args);
   const Engine engine = engine_from(args);

@@ -1,5 +1,7 @@
 #include "scan_options.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 
@@ -59,6 +61,10 @@ ScanSource source_from(const Args& args) {
   if (!source.flat_after.empty() && source.flat.empty()) {
     throw UsageError("--flat-after needs --flat (the flats before the scan)");
   }
+  std::string lowered = source.offset_px;
+  std::transform(lowered.begin(), lowered.end(), lowered.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (lowered == "auto") source.offset_px = "auto";  // AUTO, Auto
   if (source.offset_px != "auto" && !source.offset_px.empty()) args.number("offset-px");
   return source;
 }

@@ -234,6 +234,15 @@ TEST_SUITE("cli") {
     CHECK_FALSE(std::filesystem::exists(dir / "demo0"));
     expect_error(riner_cli("simulate --photons 1e20 --out " + (dir / "loud").string(), dir), 2,
                  "photons must be 0 (no noise) to 1e15");
+    expect_error(riner_cli("simulate --dead 500 --out " + (dir / "dead").string(), dir), 2,
+                 "every detector element would be dead: the scan would measure nothing");
+    expect_error(riner_cli("simulate --mu-unit xyz --out " + (dir / "unit").string(), dir), 2,
+                 "--mu-unit must be mm or cm");
+    expect_error(riner_cli("fbp " + out + "/sino.npy --out " + out + "/image.png", dir), 2,
+                 out + "/image.png: a PNG is an 8-bit preview");
+    const Run paper = riner_cli("settings --paper", dir);
+    CHECK(paper.code == 0);
+    CHECK(paper.out.find("training.steps = 4000") != std::string::npos);
     riner::test::write_bytes(dir / "metres.json", R"({"type": "fan2d",
       "detector": {"count": 500, "pitch_mm": 0.002}, "source_origin_mm": 370,
       "origin_detector_mm": 370, "angles": {"count": 360, "range_rad": 6.283185307179586},

@@ -256,7 +256,11 @@ TEST_CASE("a cone-beam slab's field of view: the heights of its grid that every 
 TEST_CASE("sizes and memory parse") {
   CHECK(riner::parse_memory_size("8G") == (std::size_t{8} << 30));
   CHECK(riner::parse_memory_size("512M") == (std::size_t{512} << 20));
-  CHECK(riner::parse_memory_size("1000") == 1000);
+  CHECK(riner::parse_memory_size("8g") == (std::size_t{8} << 30));
+  CHECK(riner::parse_memory_size("2000000") == 2000000);
+  // Under a mebibyte, or beyond any machine: a unit's slip (1000 bytes, 1e99G were taken).
+  CHECK_THROWS_AS(riner::parse_memory_size("1000"), riner::InputError);
+  CHECK_THROWS_AS(riner::parse_memory_size("1e99G"), riner::InputError);
   CHECK_THROWS_AS(riner::parse_memory_size("lots"), riner::InputError);
   CHECK_THROWS_AS(riner::parse_memory_size("-1G"), riner::InputError);
   CHECK_THROWS_AS(riner::parse_memory_size("2X"), riner::InputError);

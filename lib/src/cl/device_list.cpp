@@ -158,7 +158,13 @@ DeviceEntry select_device(std::string_view selector) {
   for (const DeviceEntry& entry : entries) {
     if (lower(entry.info.full_name()).find(needle) != std::string::npos) return entry;
   }
-  throw Error(origin + "=" + chosen + ": no device name contains it (see `riner devices`)");
+  // A kind, as `riner devices` shows it ("(CPU)"): the first device of it.
+  for (const DeviceEntry& entry : entries) {
+    if (lower(entry.info.type) == needle) return entry;
+  }
+  throw Error(origin + "=" + chosen +
+              ": no device name contains it, nor is it a device kind (cpu, gpu; see `riner "
+              "devices`)");
 }
 
 }  // namespace riner::cl

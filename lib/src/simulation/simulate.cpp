@@ -149,6 +149,9 @@ Array draw_responses(const Geometry& g, const RingModel& model) {
     throw InputError("more dead rows, columns or elements than the detector has");
   }
   sim::Random rng(stream_seed(model.seed, 1));
+  if (model.dead_rows == rows || model.dead_columns == g.n_u || model.dead_elements == n) {
+    throw InputError("every detector element would be dead: the scan would measure nothing");
+  }
   std::vector<char> dead(n, 0);
   for (std::size_t r : choose(iota(rows), model.dead_rows, rng)) {
     for (std::size_t u = 0; u < g.n_u; ++u) dead[r * g.n_u + u] = 1;

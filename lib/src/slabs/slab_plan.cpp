@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <utility>
@@ -339,16 +340,28 @@ std::size_t parse_memory_size(const std::string& text) {
                      "')");
   }
   double scale = 1.0;
-  const std::string unit(end);
-  if (unit == "K" || unit == "k" || unit == "KB" || unit == "KiB") scale = 1024.0;
-  else if (unit == "M" || unit == "MB" || unit == "MiB") scale = 1024.0 * 1024.0;
-  else if (unit == "G" || unit == "GB" || unit == "GiB") scale = 1024.0 * 1024.0 * 1024.0;
-  else if (unit == "T" || unit == "TB" || unit == "TiB") scale = 1024.0 * 1024.0 * 1024.0 * 1024.0;
+  std::string unit(end);
+  // 8g and 512m as well as 8G and 512M (sizes are binary either way).
+  std::transform(unit.begin(), unit.end(), unit.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::toupper(c)); });
+  if (unit == "K" || unit == "KB" || unit == "KIB")
+    scale = 1024.0;
+  else if (unit == "M" || unit == "MB" || unit == "MIB")
+    scale = 1024.0 * 1024.0;
+  else if (unit == "G" || unit == "GB" || unit == "GIB")
+    scale = 1024.0 * 1024.0 * 1024.0;
+  else if (unit == "T" || unit == "TB" || unit == "TIB")
+    scale = 1024.0 * 1024.0 * 1024.0 * 1024.0;
   else if (!unit.empty()) {
     throw InputError("a memory size is a number with an optional K, M, G or T (got '" + text +
                      "')");
   }
-  return static_cast<std::size_t>(value * scale);
+  // Less than a mebibyte holds no slab, and beyond an exbibyte is no machine's: a unit's slip.
+  const double bytes = value * scale;
+  if (bytes < 1024.0 * 1024.0 || bytes > 1152921504606846976.0) {
+    throw InputError("a memory size is 1M to 1024P (got '" + text + "')");
+  }
+  return static_cast<std::size_t>(bytes);
 }
 
 }  // namespace riner
