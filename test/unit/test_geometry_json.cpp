@@ -174,6 +174,20 @@ TEST_SUITE("geometry_json") {
         "and volume.voxel_mm)");
   }
 
+  TEST_CASE("a key given twice in one object is refused; the same key in sibling objects is not") {
+    // Before: the last one won without a word (a geometry's "detector", a config's "steps").
+    const std::string twice = R"({"type": "parallel2d", "detector": {"count": 8, "pitch_mm": 1},
+      "detector": {"count": 4, "pitch_mm": 1}, "angles": {"count": 3, "range_rad": 3.14},
+      "volume": {"shape": [8, 8], "voxel_mm": 1}})";
+    CHECK_THROWS_WITH_AS(riner::Geometry::from_json(twice, "g.json"),
+                         "g.json: the key \"detector\" appears twice in one object (which one "
+                         "is meant?)",
+                         riner::InputError);
+    const std::string siblings = R"({"type": "parallel2d", "detector": {"count": 8, "pitch_mm": 1},
+      "angles": {"count": 3, "range_rad": 3.14}, "volume": {"shape": [8, 8], "voxel_mm": 1}})";
+    CHECK(riner::Geometry::from_json(siblings, "g.json").n_u == 8);
+  }
+
   TEST_CASE("measurement shape mismatch names both shapes and the view count") {
     const riner::Geometry g = riner::Geometry::from_json(kFan);
     CHECK_NOTHROW(g.check_measurement_shape({360, 500}));

@@ -14,6 +14,7 @@
 #include "riner/error.hpp"
 #include "riner/io.hpp"
 #include "riner/tomo_file.hpp"
+#include "util/user_json.hpp"
 
 namespace riner {
 
@@ -173,12 +174,7 @@ Scan load_scan(const std::filesystem::path& measurement, const std::filesystem::
 
 std::optional<ScanFiles> read_scan_files(const std::filesystem::path& scan_json) {
   const std::string where = scan_json.string();
-  nlohmann::json root;
-  try {
-    root = nlohmann::json::parse(read_text(scan_json));
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(where + ": invalid JSON: " + e.what());
-  }
+  const nlohmann::json root = util::parse_user_json(read_text(scan_json), where);
   if (!root.is_object() || !root.contains("files")) return std::nullopt;
   const nlohmann::json& files = root["files"];
   if (!files.is_object()) throw InputError(where + ": files must be an object");

@@ -7,6 +7,7 @@
 #include "riner/error.hpp"
 #include "riner/geometry.hpp"
 #include "riner/io.hpp"
+#include "util/user_json.hpp"
 
 namespace riner {
 
@@ -130,12 +131,7 @@ std::vector<double> uniform_angles(const UniformAngles& spec) {
 
 Geometry Geometry::from_json(std::string_view json_text, std::string_view source) {
   const Parser p(source);
-  json root;
-  try {
-    root = json::parse(json_text);
-  } catch (const json::exception& e) {
-    throw InputError(std::string(source) + ": invalid JSON: " + e.what());
-  }
+  const json root = util::parse_user_json(json_text, std::string(source));
   if (!root.is_object()) p.fail("top level", "must be a JSON object");
 
   // "files": a scan JSON is its geometry with the files it names (riner/scan.hpp).

@@ -14,6 +14,7 @@
 #include "io/row_blocks.hpp"
 #include "io/sample_type.hpp"
 #include "riner/error.hpp"
+#include "util/user_json.hpp"
 
 namespace riner::io {
 
@@ -44,12 +45,7 @@ bool known_sidecar_key(const std::string& key) {
 
 RawLayout read_sidecar(const std::filesystem::path& path) {
   const std::filesystem::path sidecar = sidecar_path(path);
-  nlohmann::json meta;
-  try {
-    meta = nlohmann::json::parse(read_file_bytes(sidecar));
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(prefix(sidecar) + "invalid JSON: " + e.what());
-  }
+  const nlohmann::json meta = util::parse_user_json(read_file_bytes(sidecar), sidecar.string());
   auto bad = [&](const std::string& what) { return InputError(prefix(sidecar) + what); };
   if (!meta.is_object()) throw bad("must be a JSON object");
   for (const auto& [key, value] : meta.items()) {

@@ -5,6 +5,7 @@
 
 #include "riner/error.hpp"
 #include "settings/config_settings.hpp"
+#include "util/user_json.hpp"
 
 namespace riner {
 
@@ -104,12 +105,7 @@ void RinerConfig::validate() const {
 }
 
 void RinerConfig::update_from_json(std::string_view text, std::string_view source) {
-  json root;
-  try {
-    root = json::parse(text);
-  } catch (const json::exception& e) {
-    throw InputError(std::string(source) + ": invalid JSON: " + e.what());
-  }
+  const json root = util::parse_user_json(text, std::string(source));
   try {
     require(root.is_object(), "the settings must be a JSON object");
     const std::vector<std::string> sections = config_sections();
