@@ -286,6 +286,9 @@ def test_bad_measurements_raise(fan_scan, sino, error, message):
     ({"device": "no such device anywhere"}, "no such device"),
     ({"steps": 0}, "training.steps is 0 and there is no warm start"),
     ({"learning_rate": float("nan")}, r'training.learning_rate must be a number \(got "NaN"\)'),
+    # Each an InputError with one line (were FileNotFoundError, and "config: config:").
+    ({"config": "/nonexistent/settings.json"}, "cannot read the settings file"),
+    ({"config": {"training": {"steps": "x"}}}, "^config: training.steps must be an integer"),
 ])
 def test_bad_settings_raise(fan_scan, kwargs, message):
     sim, g = fan_scan
@@ -445,3 +448,13 @@ def test_the_librarys_warnings_and_the_centre_check_reach_python():
     with pytest.warns(UserWarning, match="puts the rotation axis at offset"):
         r = riner.reconstruct(sim["sino"], wrong, steps=20, quality=False)
     assert r.summary["centre_check"]["offset_px"] == pytest.approx(g["detector"]["offset_px"], abs=0.5)
+
+
+def test_bad_arguments_raise_input_error_with_one_line(fan_scan):
+    sim, g = fan_scan
+    # A negative count reached the binding as a TypeError printing the whole array.
+    with pytest.raises(riner.InputError, match=r"^size must be a whole number >= 0 \(got -3\)$"):
+        riner.destripe(sim["sino"], g, size=-3)
+    with pytest.raises(riner.InputError, match="center must be the axis's column"):
+        riner.fbp(sim["sino"], riner.parallel_beam(np.linspace(0, np.pi, 10), columns=8),
+                  center="abc")

@@ -59,49 +59,46 @@ TEST_SUITE("riner_config") {
         CHECK(std::string(e.what()) == message);
       }
     };
-    expect(R"({"training": {"stepz": 3}})", "c.json: config: unknown setting training.stepz");
-    expect(R"({"network": {"width": 24}})",
-           "c.json: config: network.width must be a multiple of 16");
-    expect(R"({"training": {"steps": "many"}})",
-           "c.json: config: training.steps must be an integer");
+    expect(R"({"training": {"stepz": 3}})", "c.json: unknown setting training.stepz");
+    expect(R"({"network": {"width": 24}})", "c.json: network.width must be a multiple of 16");
+    expect(R"({"training": {"steps": "many"}})", "c.json: training.steps must be an integer");
     expect(R"({"training": {"steps": 3.5}})",
-           "c.json: config: training.steps must be an integer (got 3.5)");
+           "c.json: training.steps must be an integer (got 3.5)");
     expect(R"({"training": {"seed": 1180591620717411303424}})",
-           "c.json: config: training.seed must be an integer (got 1.1805916207174113e+21, beyond "
+           "c.json: training.seed must be an integer (got 1.1805916207174113e+21, beyond "
            "64 bits)");
     // 1e19 written as a float fits 64 bits (the seed's range is 0..2^64 - 1): only a float.
     expect(R"({"training": {"seed": 1e19}})",
-           "c.json: config: training.seed must be an integer (got 1e+19)");
+           "c.json: training.seed must be an integer (got 1e+19)");
     expect(R"({"training": {"learning_rate": -1}})",
-           "c.json: config: training.learning_rate must be in (0, 10) (Adam's learning rate)");
+           "c.json: training.learning_rate must be in (0, 10) (Adam's learning rate)");
     expect(R"({"training": {"sampler": "random"}})",
-           "c.json: config: training.sampler must be one of uniform, views-x-elements, mixed, even");
+           "c.json: training.sampler must be one of uniform, views-x-elements, mixed, even");
     expect(R"({"training": {"ring_lambda": 1}})",
-           "c.json: config: training.ring_lambda needs the views-x-elements or mixed sampler "
+           "c.json: training.ring_lambda needs the views-x-elements or mixed sampler "
            "with elements_per_step >= 3");
     expect(R"({"encoding": {"finest_resolution": 8}})",
-           "c.json: config: encoding.finest_resolution must be 0 (the grid's size) or >= "
+           "c.json: encoding.finest_resolution must be 0 (the grid's size) or >= "
            "base_resolution");
-    expect(R"({"engine": "gpu"})", "c.json: config: engine must be one of opencl, reference");
-    expect("[1, 2]", "c.json: config: the settings must be a JSON object");
+    expect(R"({"engine": "gpu"})", "c.json: engine must be one of opencl, reference");
+    expect("[1, 2]", "c.json: the settings must be a JSON object");
     expect(R"({"rings": {"gradient_flat_fraction": 0}})",
-           "c.json: config: rings.gradient_flat_fraction must be in (0, 1] (gradient correction: "
+           "c.json: rings.gradient_flat_fraction must be in (0, 1] (gradient correction: "
            "fraction of each circle's flattest points in the median)");
     expect(R"({"rings": {"air_reference": 1}})",
-           "c.json: config: rings.air_reference must be true or false");
-    expect(R"({"plan": {"kind": 1}})",
-           "c.json: config: plan.kind must be a string: one of auto, cpu, gpu");
-    expect(R"({"plan": {"lanes": 4}})", "c.json: config: unknown setting plan.lanes");
-    expect(R"({"plan": 4})", "c.json: config: plan must be an object");
+           "c.json: rings.air_reference must be true or false");
+    expect(R"({"plan": {"kind": 1}})", "c.json: plan.kind must be a string: one of auto, cpu, gpu");
+    expect(R"({"plan": {"lanes": 4}})", "c.json: unknown setting plan.lanes");
+    expect(R"({"plan": 4})", "c.json: plan must be an object");
     expect(R"({"training": {"rays_per_step": -3}})",
-           "c.json: config: training.rays_per_step must be in 0..1048576 (uniform, even and "
+           "c.json: training.rays_per_step must be in 0..1048576 (uniform, even and "
            "mixed samplers' rays per step; 0: the execution plan's)");
     // A value beyond an int's range is refused, not wrapped.
     expect(R"({"training": {"steps": 5000000000}})",
-           "c.json: config: training.steps must be in -1..10000000 (training steps; -1: the scan's, "
+           "c.json: training.steps must be in -1..10000000 (training steps; -1: the scan's, "
            "24000 in 2D and 12000 in 3D or more (min_draws_per_ray, min_samples_per_voxel))");
     expect(R"({"training": {"seed": -1}})",
-           "c.json: config: training.seed must be in 0..1.84467e+19 (seed of the initial "
+           "c.json: training.seed must be in 0..1.84467e+19 (seed of the initial "
            "weights and the sampler)");
   }
 

@@ -14,6 +14,7 @@ during training raises KeyboardInterrupt once training has stopped.
 """
 
 import json
+import numbers
 import os
 from typing import NamedTuple
 
@@ -67,10 +68,25 @@ def _image_grid(columns, pitch, magnification, rows, image_shape, voxel_size):
     return {"shape": [int(n) for n in image_shape], "voxel_mm": float(voxel_size)}
 
 
+def _count(name, value):
+    """A whole number >= 0 for `name`, or InputError (a negative one reached the C++ binding as a
+    TypeError that printed the whole array)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < 0:
+        if isinstance(value, float) and value.is_integer() and value >= 0:
+            return int(value)
+        raise InputError(f"{name} must be a whole number >= 0 (got {value!r})")
+    return int(value)
+
+
 def _offset(columns, center):
     # center: the 0-based, fractional column the rotation axis projects to (tomopy's and
     # algotom's "center"); riner's offset_px is its distance from the detector's middle.
-    return 0.0 if center is None else (columns - 1) / 2.0 - float(center)
+    if center is None:
+        return 0.0
+    try:
+        return (columns - 1) / 2.0 - float(center)
+    except (TypeError, ValueError):
+        raise InputError(f'center must be the axis\'s column (a number) or "auto" (got {center!r})') from None
 
 
 def _detector(columns, rows, pitch, center):
@@ -191,8 +207,10 @@ def destripe(sino, geometry, flat=None, dark=None, center=None, method="all", si
     engine "opencl" runs every step as a kernel on device (None: the first GPU, else the first
     device), "reference" on the CPU twins. flat_after: as flat_field's."""
     sino, geometry_json, _ = _scan(sino, geometry, flat, dark, center, flat_after)
-    return _riner.destripe(sino, geometry_json, method, size, large_size, snr, sigma,
-                           fit_order, levels, wavelet, engine, _device(device))
+    return _riner.destripe(sino, geometry_json, method, _count("size", size),
+                           _count("large_size", large_size), snr, sigma,
+                           _count("fit_order", fit_order), _count("levels", levels),
+                           _count("wavelet", wavelet), engine, _device(device))
 
 
 def simulate(image=None, geometry="fan2d-paper", seed=0, photons=1e7, nonideal_fraction=0.75,
@@ -213,10 +231,11 @@ def simulate(image=None, geometry="fan2d-paper", seed=0, photons=1e7, nonideal_f
         if mu_unit == "cm":
             image = image * 0.1
     geometry_json = _geometry_json(geometry)
-    out = _riner.simulate(image, geometry_json, mu_scale, seed, photons, nonideal_fraction,
-                          alpha_min, alpha_max, dead, dead_rows, dead_columns, projector,
-                          engine, _device(device), response_pattern, int(partial),
-                          int(partial_dead))
+    out = _riner.simulate(image, geometry_json, mu_scale, _count("seed", seed), photons,
+                          nonideal_fraction, alpha_min, alpha_max, _count("dead", dead),
+                          _count("dead_rows", dead_rows), _count("dead_columns", dead_columns),
+                          projector, engine, _device(device), response_pattern,
+                          _count("partial", partial), _count("partial_dead", partial_dead))
     out["geometry"] = json.loads(geometry_json)
     return out
 
@@ -285,8 +304,12 @@ def reconstruct(sino, geometry, flat=None, dark=None, center=None, config=None, 
     elif isinstance(config, dict):
         config_json = json.dumps(config)
     else:
-        with open(config, encoding="utf-8") as f:
-            config_json = f.read()
+        try:
+            with open(config, encoding="utf-8") as f:
+                config_json = f.read()
+        except OSError as e:
+            raise InputError(f"{os.fspath(config)}: cannot read the settings file "
+                             f"({e.strerror})") from None
     pairs = _settings_list(dict(settings or {}, **short_settings))
     image, alpha, beta, summary, field, alpha_by_view = _riner.reconstruct(
         sino, geometry_json, config_json, pairs, engine, _device(device), progress,

@@ -131,7 +131,10 @@ void RinerConfig::update_from_json(std::string_view text, std::string_view sourc
   } catch (const json::exception& e) {
     throw InputError(std::string(source) + ": " + e.what());
   } catch (const InputError& e) {
-    throw InputError(std::string(source) + ": " + e.what());
+    // The source names the settings already: "config: config: ..." said it twice.
+    std::string what = e.what();
+    if (what.rfind("config: ", 0) == 0) what.erase(0, 8);
+    throw InputError(std::string(source) + ": " + what);
   }
 }
 
