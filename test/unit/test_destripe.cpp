@@ -111,6 +111,31 @@ TEST_CASE("on a narrow detector the default windows shrink to an eighth of it") 
   CHECK(report.large_size == 51u);
 }
 
+TEST_CASE("the large-stripe step leaves a stripe-free object's curve as it was") {
+  // A body's central peak (a dense part near the axis): the median of 51 columns cut it, every
+  // column there was moved by that bias and 30 of them replaced as "large stripes" (a
+  // stripe-free DeepLesion scan's FBP: 38.6 -> 27.5 dB; now 34.7).
+  Ringed r = ringed_sinogram();
+  const std::size_t columns = r.g.n_u, views = r.g.n_views();
+  for (std::size_t v = 0; v < views; ++v) {
+    const double t = M_PI * static_cast<double>(v) / static_cast<double>(views);
+    for (std::size_t c = 0; c < columns; ++c) {
+      const double x = static_cast<double>(c) - 127.5 - 3.0 * std::cos(t);
+      r.clean.data[v * columns + c] += static_cast<float>(0.6 * std::exp(-0.5 * x * x / 144.0));
+    }
+  }
+  for (riner::DestripeMethod method :
+       {riner::DestripeMethod::kLarge, riner::DestripeMethod::kAll}) {
+    CAPTURE(riner::destripe_method_name(method));
+    riner::DestripeOptions options;
+    options.method = method;
+    riner::DestripeReport report;
+    const riner::Array out = riner::destripe(r.clean, r.g, options, &report);
+    CHECK(report.large.empty());
+    CHECK(rms(out.data, r.clean.data) < 3.0 * kNoise);
+  }
+}
+
 TEST_CASE("a sinogram without stripes comes through nearly as it was") {
   const Ringed r = ringed_sinogram();
   for (riner::DestripeMethod method :

@@ -212,9 +212,9 @@ std::vector<bool> large_stripes(Sinogram& s, std::size_t size, double snr, doubl
     quarters.emplace_back(a.size());
     for (std::size_t c = 0; c < a.size(); ++c) quarters.back()[c] = a[c] - b[c];
   }
-  const stripes::LargeStripes found =
-      stripes::large_stripe_offsets(column_means(sorted.sorted, drop, s.views - drop),
-                                    column_means(smooth, drop, s.views - drop), snr, quarters);
+  const stripes::LargeStripes found = stripes::large_stripe_offsets(
+      column_means(sorted.sorted, drop, s.views - drop), column_means(smooth, drop, s.views - drop),
+      snr, quarters, size);
   subtract_column_offsets(s, found.offset);
   // A column less its offset ranks its views as before: the first sort's order serves.
   const Sinogram corrected = stripes::unsort_columns(smooth, sorted.view);

@@ -180,7 +180,8 @@ std::vector<bool> DeviceDestripe::large_stripes() {
     quarters.emplace_back(a.size());
     for (std::size_t c = 0; c < a.size(); ++c) quarters.back()[c] = a[c] - b[c];
   }
-  const LargeStripes found = large_stripe_offsets(level, smooth_level, settings_.snr, quarters);
+  const LargeStripes found =
+      large_stripe_offsets(level, smooth_level, settings_.snr, quarters, settings_.large_size);
   write_columns(column_a_, found.offset);
   steps_.subtract_column_offsets(columns_, column_a_, values_);
   if (std::find(found.mask.begin(), found.mask.end(), true) == found.mask.end()) return found.mask;

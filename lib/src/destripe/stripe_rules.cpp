@@ -86,9 +86,46 @@ std::vector<double> normalise_offsets(const std::vector<double>& mean, std::size
   return offset;
 }
 
+// A detector's large stripe is a band whose offset steps up and down at its ends; where the
+// median's bias on a curve (a body's central peak) stands out, the offset rises and falls
+// smoothly: 30 columns of a stripe-free DeepLesion scan were replaced by their neighbours'
+// smoothed values. A band is kept where the offset steps by half its mean or more between
+// neighbouring columns within two of each end.
+static void keep_stepped_bands(std::vector<bool>& mask, const std::vector<double>& offset) {
+  const long n = static_cast<long>(mask.size());
+  long c = 0;
+  while (c < n) {
+    if (!mask[static_cast<std::size_t>(c)]) {
+      ++c;
+      continue;
+    }
+    long end = c;
+    while (end < n && mask[static_cast<std::size_t>(end)]) ++end;
+    double mean = 0.0;
+    for (long i = c; i < end; ++i) mean += offset[static_cast<std::size_t>(i)];
+    mean /= static_cast<double>(end - c);
+    // The largest step between neighbouring columns near each end of the band.
+    const auto step_near = [&](long at) {
+      double most = 0.0;
+      for (long i = std::max(1L, at - 2); i <= std::min(n - 1, at + 2); ++i) {
+        most = std::max(most, std::fabs(offset[static_cast<std::size_t>(i)] -
+                                        offset[static_cast<std::size_t>(i - 1)]));
+      }
+      return most;
+    };
+    const bool stepped =
+        step_near(c) >= 0.5 * std::fabs(mean) && step_near(end) >= 0.5 * std::fabs(mean);
+    if (!stepped) {
+      for (long i = c; i < end; ++i) mask[static_cast<std::size_t>(i)] = false;
+    }
+    c = end;
+  }
+}
+
 LargeStripes large_stripe_offsets(const std::vector<double>& level,
                                   const std::vector<double>& smooth_level, double snr,
-                                  const std::vector<std::vector<double>>& quarters) {
+                                  const std::vector<std::vector<double>>& quarters,
+                                  std::size_t size) {
   LargeStripes out;
   out.offset.resize(level.size());
   std::vector<bool> whole_column(level.size(), true);
@@ -99,6 +136,13 @@ LargeStripes large_stripe_offsets(const std::vector<double>& level,
     }
   }
   out.mask = detect_stripes(out.offset, snr, &whole_column);
+  keep_stepped_bands(out.mask, out.offset);
+  // What moves every column is only the offsets' part that changes from column to column: the
+  // median's bias on the object's own curve (a body's central peak, 0.17 over 50 columns) is
+  // broad, and took a stripe-free scan's FBP from 38.6 to 31.3 dB; a detector's offsets differ
+  // element by element.
+  const std::vector<double> broad = median_filter(out.offset, (size / 2) | 1);
+  for (std::size_t c = 0; c < level.size(); ++c) out.offset[c] -= broad[c];
   return out;
 }
 

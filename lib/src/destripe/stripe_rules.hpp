@@ -74,9 +74,12 @@ struct LargeStripes {
 // its offset; an object's edge shifts some ranks only (a dense rod's top quarter, its air
 // none), and such a column is no stripe: only columns whose every quarter carries at least
 // half the offset, with its sign, may stand out.
+// Bands that do not step at both ends are no stripes; the offsets returned are what changes
+// from column to column (less their median over half of `size`).
 LargeStripes large_stripe_offsets(const std::vector<double>& level,
                                   const std::vector<double>& smooth_level, double snr,
-                                  const std::vector<std::vector<double>>& quarters);
+                                  const std::vector<std::vector<double>>& quarters,
+                                  std::size_t size);
 // The ranks [first, last) of quarter q (0..3) of the trimmed ranks [drop, views - drop).
 std::pair<std::size_t, std::size_t> rank_quarter(std::size_t views, std::size_t drop, int q);
 // The share of each sorted column's extremes large-stripe removal leaves out, as views per end.
