@@ -95,6 +95,19 @@ TEST_CASE("each method takes most of a ringed sinogram's offsets away and report
   }
 }
 
+TEST_CASE("a column with no finite reading is filled and named dead") {
+  // Before: counted in non_finite_replaced only, though the training names it dead.
+  Ringed r = ringed_sinogram();
+  for (std::size_t v = 0; v < r.g.n_views(); ++v) r.ringed.data[v * r.g.n_u + 77] = NAN;
+  riner::DestripeOptions options;
+  options.method = riner::DestripeMethod::kSorting;
+  riner::DestripeReport report;
+  const riner::Array out = riner::destripe(r.ringed, r.g, options, &report);
+  CHECK(report.dead == std::vector<std::size_t>{77});
+  CHECK(report.non_finite_replaced == r.g.n_views());
+  for (float x : out.data) REQUIRE(std::isfinite(x));
+}
+
 TEST_CASE("on a narrow detector the default windows shrink to an eighth of it") {
   // 64 columns with the literature's 51: the large-stripe median spanned the object, and `all`
   // took a simulated scan's FBP from 18.1 to 12.5 dB (now 23.1).

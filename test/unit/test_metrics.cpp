@@ -95,6 +95,26 @@ TEST_SUITE("metrics") {
                     riner::InputError);
   }
 
+  TEST_CASE("a volume of fewer slices than SSIM's window: its slices' SSIM, averaged") {
+    // Before: "SSIM needs every side to be at least 7 pixels", and no PSNR or MAE either.
+    riner::Array a({3, 16, 16}), b({3, 16, 16});
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      a.data[i] = static_cast<float>(std::sin(0.37 * static_cast<double>(i)));
+      b.data[i] = a.data[i] + static_cast<float>(0.1 * std::cos(1.3 * static_cast<double>(i)));
+    }
+    const riner::ImageMetrics whole = riner::compare_images(a, b, nullptr, 2.0);
+    double sum = 0.0;
+    for (std::size_t k = 0; k < 3; ++k) {
+      const auto slice = [&](const riner::Array& v) {
+        return riner::Array(
+            {16, 16}, std::vector<float>(v.data.begin() + k * 256, v.data.begin() + (k + 1) * 256));
+      };
+      sum += riner::compare_images(slice(a), slice(b), nullptr, 2.0).ssim;
+    }
+    CHECK(whole.ssim == doctest::Approx(sum / 3.0));
+    CHECK(std::isfinite(whole.psnr));
+  }
+
   TEST_CASE("ring index: high for concentric rings, low for a smooth object") {
     riner::Array smooth({64, 64});
     riner::Array ringed({64, 64});

@@ -381,6 +381,15 @@ Array destripe(const Array& measurement, const Geometry& g, const DestripeOption
   }
   Array out = measurement;
   DestripeReport local;
+  // An element with no finite reading is dead as surely as a stuck one (the training says
+  // "no finite reading"); the repair below fills it, and the report names it.
+  std::vector<bool> unread(rows * columns, true);
+  for (std::size_t v = 0; v < views; ++v) {
+    const float* line = measurement.data.data() + v * rows * columns;
+    for (std::size_t e = 0; e < rows * columns; ++e) {
+      if (std::fabs(line[e]) <= kLargestReading) unread[e] = false;
+    }
+  }
   local.non_finite_replaced = analytic::repair_non_finite(out, columns, rows);
   const std::vector<std::uint8_t> stuck =
       finds_dead(options.method) ? steady_elements(g, out) : std::vector<std::uint8_t>{};
@@ -419,7 +428,9 @@ Array destripe(const Array& measurement, const Geometry& g, const DestripeOption
     }
     column_sums(column_after);
     for (std::size_t c = 0; c < columns; ++c) {
-      if ((c < dead.size() && dead[c]) || steady[c]) local.dead.push_back(r * columns + c);
+      if ((c < dead.size() && dead[c]) || steady[c] || unread[r * columns + c]) {
+        local.dead.push_back(r * columns + c);
+      }
       if (c < large.size() && large[c]) local.large.push_back(r * columns + c);
       local.removed.data[r * columns + c] =
           static_cast<float>((column_before[c] - column_after[c]) / static_cast<double>(views));

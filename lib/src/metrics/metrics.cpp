@@ -126,6 +126,31 @@ double ssim_mean(const Array& image, const Array& reference, const Array* mask, 
   return count > 0 ? sum / static_cast<double>(count) : 0.0;
 }
 
+// A volume thinner than SSIM's window along its slices (a few slices of a stack): its axial
+// slices' 2D SSIM, averaged, where the whole comparison failed before.
+bool thin_volume(const std::vector<std::size_t>& shape) {
+  return shape.size() == 3 && shape[0] < static_cast<std::size_t>(kWindow) &&
+         shape[1] >= static_cast<std::size_t>(kWindow) &&
+         shape[2] >= static_cast<std::size_t>(kWindow);
+}
+
+double slice_ssim_mean(const Array& image, const Array& reference, const Array* mask,
+                       double range) {
+  const std::size_t plane = image.shape[1] * image.shape[2];
+  double sum = 0.0;
+  for (std::size_t k = 0; k < image.shape[0]; ++k) {
+    const auto slice = [&](const Array& a) {
+      return Array(
+          {a.shape[1], a.shape[2]},
+          std::vector<float>(a.data.begin() + static_cast<std::ptrdiff_t>(k * plane),
+                             a.data.begin() + static_cast<std::ptrdiff_t>((k + 1) * plane)));
+    };
+    const Array m = mask != nullptr ? slice(*mask) : Array();
+    sum += ssim_mean(slice(image), slice(reference), mask != nullptr ? &m : nullptr, range);
+  }
+  return sum / static_cast<double>(image.shape[0]);
+}
+
 }  // namespace
 
 Array circle_mask(const std::vector<std::size_t>& shape, double fraction) {
@@ -210,7 +235,8 @@ ImageMetrics compare_images(const Array& image, const Array& reference, const Ar
   m.rmse = std::sqrt(mse);
   m.psnr = mse > 0.0 ? 10.0 * std::log10(m.data_range * m.data_range / mse)
                      : std::numeric_limits<double>::infinity();
-  m.ssim = ssim_mean(image, reference, mask, m.data_range);
+  m.ssim = thin_volume(image.shape) ? slice_ssim_mean(image, reference, mask, m.data_range)
+                                    : ssim_mean(image, reference, mask, m.data_range);
   m.edge_ratio = edge_ratio(image, reference, mask);
   return m;
 }
