@@ -41,8 +41,11 @@ RinerConfig config_from(const Args& args) {
   // Flags override the file.
   if (auto v = args.maybe("steps"); v && !v->empty())
     config.training.steps = static_cast<int>(args.integer("steps"));
-  if (auto v = args.maybe("seed"); v && !v->empty())
-    config.training.seed = static_cast<std::uint64_t>(args.integer("seed"));
+  if (auto v = args.maybe("seed"); v && !v->empty()) {
+    const long seed = args.integer("seed");
+    if (seed < 0) throw UsageError("--seed must be 0 or more");  // -1 wrapped to 2^64 - 1
+    config.training.seed = static_cast<std::uint64_t>(seed);
+  }
   if (auto v = args.maybe("rays-per-step"); v && !v->empty()) {
     config.training.rays_per_step = static_cast<int>(args.integer("rays-per-step"));
   }
@@ -161,6 +164,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   // set-up and evaluation take longer than the training.
   const auto started = std::chrono::steady_clock::now();
   Console console(args);
+  (void)report_every(args);  // a bad value said now, not after the set-up
   if (wants_slabs(args)) return reconstruct_by_slabs(args, console, config_from(args), started);
   // Only a slabbed run shares out its work; anything else would run N times into one folder.
   if (SlabRanks::launched_size() > 1) {
@@ -172,6 +176,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   const std::optional<CentreEstimate> centre_check = check_centre(loaded, console);
   Scan& scan = loaded.scan;
   require_quality_grid(scan.geometry);
+  require_memory(scan.geometry);
   const RinerConfig config = config_from(args);
   require_training(config);
   const std::string format = output_format(args);
@@ -282,7 +287,7 @@ int run_reconstruct(int argc, char** argv, int first) {
           saver.after_report(p, stopping);
           return !stopping;
         },
-        static_cast<int>(args.integer("report-every")));
+        report_every(args));
     progress.finish();
   }
   release_stop_signals();

@@ -43,6 +43,12 @@ SlabOptions slab_size_options(const Args& args) {
   return options;
 }
 
+int report_every(const Args& args) {
+  const long n = args.integer("report-every");
+  if (n < 1 || n > 100000000) throw UsageError("--report-every must be 1 or more steps");
+  return static_cast<int>(n);
+}
+
 void refuse_limit_below_one_slice(const SlabOptions& asked, std::size_t one_slice) {
   if (asked.memory_limit == 0 || asked.memory_limit >= one_slice) return;
   const auto mib = [](std::size_t bytes) { return std::to_string((bytes + (1u << 20) - 1) >> 20); };
@@ -386,23 +392,23 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       // A stopped run leaves its last line as drawn.
       if (!stopped_early(*rank_stop, run)) progress.finish();
     } else {
-    run.run(
-        [&](const SlabProgress& p) {
-          slices_at_start = p.slices_at_start;
-          const double this_run = p.slices_done - p.slices_at_start;
-          char status[160];
-          std::snprintf(status, sizeof(status), "%zu/%zu slabs, %zu/%zu slices, %.1f slices/min",
-                        p.slabs_done, p.slabs, static_cast<std::size_t>(p.slices_done), p.slices,
-                        p.seconds > 0 ? 60.0 * this_run / p.seconds : 0.0);
-          progress.update(static_cast<std::size_t>(100.0 * p.slices_done), status);
-        },
-        [&](const Reconstructor& r, const ReconstructionResult& result,
-            const std::optional<Device>& own) {
-          return run_summary(r, result, check_quality(r, result, own));
-        },
-        static_cast<int>(args.integer("report-every")),
-        ranks.size() > 1 || !joined.empty() ? claim_by_file(out, token) : SlabRun::Claim{});
-    if (!stopped_early(*rank_stop, run)) progress.finish();
+      run.run(
+          [&](const SlabProgress& p) {
+            slices_at_start = p.slices_at_start;
+            const double this_run = p.slices_done - p.slices_at_start;
+            char status[160];
+            std::snprintf(status, sizeof(status), "%zu/%zu slabs, %zu/%zu slices, %.1f slices/min",
+                          p.slabs_done, p.slabs, static_cast<std::size_t>(p.slices_done), p.slices,
+                          p.seconds > 0 ? 60.0 * this_run / p.seconds : 0.0);
+            progress.update(static_cast<std::size_t>(100.0 * p.slices_done), status);
+          },
+          [&](const Reconstructor& r, const ReconstructionResult& result,
+              const std::optional<Device>& own) {
+            return run_summary(r, result, check_quality(r, result, own));
+          },
+          report_every(args),
+          ranks.size() > 1 || !joined.empty() ? claim_by_file(out, token) : SlabRun::Claim{});
+      if (!stopped_early(*rank_stop, run)) progress.finish();
     }
   } catch (const std::exception& e) {
     if (ranks.size() == 1) throw;

@@ -22,6 +22,9 @@ std::string output_format(const Args& args);
 // --slab-slices and --memory-limit (0 where not given), as riner fbp takes them too.
 SlabOptions slab_size_options(const Args& args);
 
+// --report-every, checked: 1 or more steps (-1 and 0 were taken).
+int report_every(const Args& args);
+
 // A --memory-limit given below what a slab of one slice takes (`one_slice` bytes) cannot be kept:
 // UsageError naming both, before anything is read or written. The default limit is not checked
 // here (the run says so and goes on).

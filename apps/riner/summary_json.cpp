@@ -1,5 +1,7 @@
 #include "summary_json.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -110,6 +112,31 @@ void require_quality_grid(const Geometry& g) {
                      " pixels: the quality report against FBP needs at least " +
                      std::to_string(kQualitySmallestSide) + " x " +
                      std::to_string(kQualitySmallestSide) + " (volume.shape)");
+  }
+}
+
+void require_memory(const Geometry& g) {
+  // Far below what a run takes per voxel and per reading (the image, the field, the ring
+  // corrections, the quality check's FBP; the readings, their rays and weights): a bound that
+  // refuses only what cannot fit at all.
+  constexpr double kBytesPerVoxel = 32.0;
+  constexpr double kBytesPerReading = 16.0;
+  const double voxels = static_cast<double>(shape_size(g.volume_shape));
+  const double readings = static_cast<double>(g.n_views()) * static_cast<double>(g.n_u) *
+                          static_cast<double>(g.is_3d() ? g.n_v : 1);
+  const double needed = kBytesPerVoxel * voxels + kBytesPerReading * readings;
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGE_SIZE);
+  if (pages <= 0 || page <= 0) return;
+  const double memory = static_cast<double>(pages) * static_cast<double>(page);
+  if (needed > memory) {
+    char line[300];
+    std::snprintf(line, sizeof(line),
+                  "the grid %s and %.3g readings need at least %.1f GiB, more than the "
+                  "machine's %.1f GiB: a smaller grid (volume.shape, volume.voxel_mm), or a "
+                  "stack by slabs",
+                  shape_string(g.volume_shape).c_str(), readings, needed / 1073741824.0,
+                  memory / 1073741824.0);
+    throw InputError(line);
   }
 }
 

@@ -34,6 +34,9 @@ QualityCheck check_quality(const Reconstructor& r, const ReconstructionResult& r
 // InputError when the grid's slices are too small for check_quality (kQualitySmallestSide):
 // called before training, so that a run does not end in that error after it.
 void require_quality_grid(const Geometry& g);
+// InputError when a whole run's grid and readings could not fit the machine's memory (a grid
+// of 30000 x 30000 trained for about 110 s before "out of memory"): said before any work.
+void require_memory(const Geometry& g);
 // InputError for 0 training steps without a warm start: the image would be the untrained
 // field's noise (the library allows it, to look at the initial state).
 void require_training(const RinerConfig& c);

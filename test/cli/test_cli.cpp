@@ -1,5 +1,6 @@
 // The riner executable end to end: exit codes, one-line errors, outputs that read back.
 #include <doctest/doctest.h>
+#include <unistd.h>
 
 #include <sys/wait.h>
 
@@ -243,6 +244,31 @@ TEST_SUITE("cli") {
     const Run paper = riner_cli("settings --paper", dir);
     CHECK(paper.code == 0);
     CHECK(paper.out.find("training.steps = 4000") != std::string::npos);
+    // A grid no machine here holds: refused before any work (it trained about 110 s before
+    // "out of memory"). 30000^2 voxels need at least 26.8 GiB; where a machine has that much,
+    // the run is not tried.
+    const double memory =
+        static_cast<double>(sysconf(_SC_PHYS_PAGES)) * static_cast<double>(sysconf(_SC_PAGE_SIZE));
+    if (memory < 26.0 * 1073741824.0) {
+      riner::test::write_bytes(dir / "huge.json", R"({"type": "parallel2d",
+        "detector": {"count": 2000, "pitch_mm": 20.0}, "angles": {"count": 10,
+        "range_rad": 3.14159}, "volume": {"shape": [30000, 30000], "voxel_mm": 1.0}})");
+      riner::write_array(dir / "huge_sino.npy", riner::Array({10, 2000}, 0.5f));
+      const Run huge =
+          riner_cli("reconstruct " + (dir / "huge_sino.npy").string() + " --geometry " +
+                        (dir / "huge.json").string() + " --out " + (dir / "huge").string(),
+                    dir);
+      CHECK(huge.code == 2);
+      CHECK(huge.err.find("need at least 26.8 GiB, more than the machine's") != std::string::npos);
+    }
+    expect_error(
+        riner_cli("reconstruct " + out + "/sino.npy --seed -1 --out " + (dir / "seed").string(),
+                  dir),
+        2, "--seed must be 0 or more");
+    expect_error(riner_cli("reconstruct " + out + "/sino.npy --report-every 0 --out " +
+                               (dir / "seed").string(),
+                           dir),
+                 2, "--report-every must be 1 or more steps");
     riner::test::write_bytes(dir / "metres.json", R"({"type": "fan2d",
       "detector": {"count": 500, "pitch_mm": 0.002}, "source_origin_mm": 370,
       "origin_detector_mm": 370, "angles": {"count": 360, "range_rad": 6.283185307179586},

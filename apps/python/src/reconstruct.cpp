@@ -106,6 +106,7 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
   {
     py::gil_scoped_release release;
     if (quality) app::require_quality_grid(scan.geometry);
+    app::require_memory(scan.geometry);
     dev = device_for(config.engine, device);
     reconstructor = std::make_unique<Reconstructor>(std::move(scan), config, dev);
     if (!checkpoint.empty()) {
