@@ -40,6 +40,9 @@ void refuse_outputs_over_inputs(const std::filesystem::path& out,
 void clear_previous_outputs(const std::filesystem::path& out,
                             const std::vector<std::string>& names);
 
+// `text` in lower case ("AUTO" -> "auto", ".PNG" -> ".png").
+std::string lowercase(std::string text);
+
 // "a,b,,c" -> {"a", "b", "", "c"}: the items of an option's comma-separated list.
 std::vector<std::string> split_commas(const std::string& list);
 

@@ -1,6 +1,4 @@
 // riner fbp: filtered backprojection (FBP, or FDK for cone beam) of a scan.
-#include <algorithm>
-#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -197,10 +195,7 @@ int run_fbp(int argc, char** argv, int first) {
   if (!args.parse(argc, argv, first)) return 0;
   Console console(args);
   // A PNG is an 8-bit preview, not the image: it was written as "the result" with exit 0.
-  std::string out_ext = std::filesystem::path(args.get("out")).extension().string();
-  std::transform(out_ext.begin(), out_ext.end(), out_ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (out_ext == ".png") {
+  if (lowercase(std::filesystem::path(args.get("out")).extension().string()) == ".png") {
     throw UsageError(args.get("out") +
                      ": a PNG is an 8-bit preview; write the image as .nii, .npy, .tif, .raw or "
                      ".h5 and add --png for a preview beside it");

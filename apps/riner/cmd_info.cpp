@@ -1,13 +1,12 @@
 // riner info FILE: what an array file holds (shape, type, value range, non-finite count), or a
 // summary of a geometry file.
-#include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
 #include "cli_args.hpp"
+#include "cli_common.hpp"
 #include "commands.hpp"
 #include "riner/error.hpp"
 #include "riner/geometry.hpp"
@@ -73,10 +72,8 @@ int run_info(int argc, char** argv, int first) {
   const bool quiet = args.is_set("quiet");
 
   // A folder or a pattern of TIFFs has no extension of its own: read_array takes it as a stack.
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (ext == ".json" && !std::filesystem::is_directory(path)) {
+  if (lowercase(std::filesystem::path(path).extension().string()) == ".json" &&
+      !std::filesystem::is_directory(path)) {
     const Geometry g = Geometry::load(path);
     if (json) {
       nlohmann::json out = {

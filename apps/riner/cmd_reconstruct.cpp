@@ -164,7 +164,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   // set-up and evaluation take longer than the training.
   const auto started = std::chrono::steady_clock::now();
   Console console(args);
-  (void)report_every(args);  // a bad value said now, not after the set-up
+  const int every = report_every(args);  // a bad value said now, not after the set-up
   if (wants_slabs(args)) return reconstruct_by_slabs(args, console, config_from(args), started);
   // Only a slabbed run shares out its work; anything else would run N times into one folder.
   if (SlabRanks::launched_size() > 1) {
@@ -287,7 +287,7 @@ int run_reconstruct(int argc, char** argv, int first) {
           saver.after_report(p, stopping);
           return !stopping;
         },
-        report_every(args));
+        every);
     progress.finish();
   }
   release_stop_signals();

@@ -1,7 +1,5 @@
 #include "scan_options.hpp"
 
-#include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 
@@ -61,10 +59,7 @@ ScanSource source_from(const Args& args) {
   if (!source.flat_after.empty() && source.flat.empty()) {
     throw UsageError("--flat-after needs --flat (the flats before the scan)");
   }
-  std::string lowered = source.offset_px;
-  std::transform(lowered.begin(), lowered.end(), lowered.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (lowered == "auto") source.offset_px = "auto";  // AUTO, Auto
+  if (lowercase(source.offset_px) == "auto") source.offset_px = "auto";  // AUTO, Auto
   if (source.offset_px != "auto" && !source.offset_px.empty()) args.number("offset-px");
   return source;
 }
@@ -90,7 +85,7 @@ std::optional<CentreEstimate> check_centre(const LoadedScan& loaded, const Conso
   if (loaded.centre) return std::nullopt;
   std::string note;
   std::optional<CentreEstimate> e = check_geometry_centre(loaded.scan, note);
-  if (!note.empty()) console.line(note);
+  if (!note.empty()) console.line("note: " + note);
   return e;
 }
 

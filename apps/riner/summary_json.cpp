@@ -350,7 +350,7 @@ std::optional<CentreEstimate> check_geometry_centre(const Scan& scan, std::strin
   const Geometry& g = scan.geometry;
   if (!centre_search_covers(g)) {
     note =
-        "note: the rotation axis lies outside the detector's central half and the views cover "
+        "the rotation axis lies outside the detector's central half and the views cover "
         "less than a full turn: the centre finders search the central half only, so the "
         "geometry's offset is not checked";
     return std::nullopt;
@@ -364,7 +364,7 @@ std::optional<CentreEstimate> check_geometry_centre(const Scan& scan, std::strin
   if (std::fabs(e->offset_px - g.offset_u) > kCentreDoubtPx) {
     char line[300];
     std::snprintf(line, sizeof(line),
-                  "note: the scan's own %s the rotation axis at offset %.2f px, the geometry at "
+                  "the scan's own %s the rotation axis at offset %.2f px, the geometry at "
                   "%.2f: a wrong axis doubles edges and leaves arcs (pass --offset-px auto, or "
                   "check the geometry)",
                   e->method.rfind("conjugate rays", 0) == 0 ? "conjugate rays put"

@@ -60,10 +60,10 @@ nlohmann::json centre_json(const CentreEstimate& estimate);
 constexpr double kCentreDoubtPx = 1.0;
 
 // The scan's own estimate of its axis, to check the geometry's offset against, and in `note`
-// what to say: that the two differ by more than kCentreDoubtPx, or that the search cannot
-// check this geometry (empty when there is nothing to say). nullopt for scans without a
-// half-turn or a view pair (a fan or cone beam: a full turn). The CLI prints the note, the
-// Python module warns with it.
+// what to say (without a "note: " of its own): that the two differ by more than kCentreDoubtPx, or
+// that the search cannot check this geometry (empty when there is nothing to say). nullopt for
+// scans without a half-turn or a view pair (a fan or cone beam: a full turn). The CLI prints the
+// note, the Python module warns with it.
 std::optional<CentreEstimate> check_geometry_centre(const Scan& scan, std::string& note);
 
 }  // namespace riner::app

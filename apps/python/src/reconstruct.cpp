@@ -97,7 +97,7 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
     centre_check = app::check_geometry_centre(scan, centre_note);
   }
   if (!centre_note.empty()) {
-    const std::string text = python_wording(centre_note.substr(centre_note.find(": ") + 2));
+    const std::string text = python_wording(centre_note);
     if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) < 0) throw py::error_already_set();
   }
 

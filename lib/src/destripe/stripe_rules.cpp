@@ -86,12 +86,14 @@ std::vector<double> normalise_offsets(const std::vector<double>& mean, std::size
   return offset;
 }
 
+namespace {
+
 // A detector's large stripe is a band whose offset steps up and down at its ends; where the
 // median's bias on a curve (a body's central peak) stands out, the offset rises and falls
 // smoothly: 30 columns of a stripe-free DeepLesion scan were replaced by their neighbours'
 // smoothed values. A band is kept where the offset steps by half its mean or more between
 // neighbouring columns within two of each end.
-static void keep_stepped_bands(std::vector<bool>& mask, const std::vector<double>& offset) {
+void keep_stepped_bands(std::vector<bool>& mask, const std::vector<double>& offset) {
   const long n = static_cast<long>(mask.size());
   long c = 0;
   while (c < n) {
@@ -121,6 +123,8 @@ static void keep_stepped_bands(std::vector<bool>& mask, const std::vector<double
     c = end;
   }
 }
+
+}  // namespace
 
 LargeStripes large_stripe_offsets(const std::vector<double>& level,
                                   const std::vector<double>& smooth_level, double snr,

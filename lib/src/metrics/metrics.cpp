@@ -136,17 +136,11 @@ bool thin_volume(const std::vector<std::size_t>& shape) {
 
 double slice_ssim_mean(const Array& image, const Array& reference, const Array* mask,
                        double range) {
-  const std::size_t plane = image.shape[1] * image.shape[2];
   double sum = 0.0;
   for (std::size_t k = 0; k < image.shape[0]; ++k) {
-    const auto slice = [&](const Array& a) {
-      return Array(
-          {a.shape[1], a.shape[2]},
-          std::vector<float>(a.data.begin() + static_cast<std::ptrdiff_t>(k * plane),
-                             a.data.begin() + static_cast<std::ptrdiff_t>((k + 1) * plane)));
-    };
-    const Array m = mask != nullptr ? slice(*mask) : Array();
-    sum += ssim_mean(slice(image), slice(reference), mask != nullptr ? &m : nullptr, range);
+    const Array m = mask != nullptr ? axial_slice(*mask, k) : Array();
+    sum += ssim_mean(axial_slice(image, k), axial_slice(reference, k),
+                     mask != nullptr ? &m : nullptr, range);
   }
   return sum / static_cast<double>(image.shape[0]);
 }
