@@ -7,6 +7,9 @@
 //   median_across_columns(views, columns, size, sorted, filtered)
 //     one work-item per (rank k, column c): the median of the `size` (odd, <= kMostWindow)
 //     columns around c at rank k, mirrored at the ends (d c b a | a b c d | d c b a).
+//   smooth_along_ranks(views, columns, window, sorted, filtered, out)
+//     one work-item per column: out = sorted plus the correction (filtered - sorted) averaged
+//     over the `window` (odd) ranks around each rank, the window cut at the column's ends.
 //   unsort_columns(views, columns, filtered, order, out)
 //     out[order[k][c]][c] = filtered[k][c].
 // A CPU's shapes of the first two (the same results to the bit; a barrier per bitonic stage and
@@ -92,6 +95,39 @@ __kernel void median_across_columns(const uint views, const uint columns, const 
     }
   }
   filtered[gid] = window[want];
+}
+
+// A compensated sum (Kahan's): a window slides over thousands of ranks, each adding one
+// correction and taking one away, and a float sum's rounding would accumulate along them.
+inline void add_compensated(float* sum, float* lost, const float x) {
+  const float y = x - *lost;
+  const float t = *sum + y;
+  *lost = (t - *sum) - y;
+  *sum = t;
+}
+
+__kernel void smooth_along_ranks(const uint views, const uint columns, const uint window,
+                                 __global const float* sorted, __global const float* filtered,
+                                 __global float* out) {
+  const uint c = get_global_id(0);
+  if (c >= columns) return;
+  const int n = views, reach = window / 2;
+  float sum = 0.0f, lost = 0.0f;
+  for (int k = 0; k <= min(reach, n - 1); ++k) {
+    add_compensated(&sum, &lost, filtered[k * columns + c] - sorted[k * columns + c]);
+  }
+  for (int k = 0; k < n; ++k) {
+    const int first = max(k - reach, 0), last = min(k + reach, n - 1);
+    out[k * columns + c] = sorted[k * columns + c] + (sum - lost) / (float)(last - first + 1);
+    const int entering = k + reach + 1, leaving = k - reach;
+    if (entering < n) {
+      add_compensated(&sum, &lost,
+                      filtered[entering * columns + c] - sorted[entering * columns + c]);
+    }
+    if (leaving >= 0) {
+      add_compensated(&sum, &lost, sorted[leaving * columns + c] - filtered[leaving * columns + c]);
+    }
+  }
 }
 
 __kernel void unsort_columns(const uint views, const uint columns, __global const float* filtered,

@@ -46,6 +46,7 @@ DestripeOptions destripe_options_from(const Args& args, const std::string& metho
   options.method = parse_destripe_method(method);
   options.size = window_option(args, "size");
   options.large_size = window_option(args, "large-size");
+  options.rank_window = window_option(args, "rank-window");
   options.snr = positive_option(args, "snr");
   options.sigma = args.get("sigma").empty() ? 0.0 : positive_option(args, "sigma");
   options.fit_order = bounded_option(args, "fit-order", 0, 10, options.fit_order);
@@ -62,6 +63,10 @@ void add_destripe_tuning(Args& args) {
               "wider for wide stripes, narrower where the object's detail is finer)",
               "")
       .option("large-size", "N", "the window for large and dead stripes (default 51)", "")
+      .option("rank-window", "N",
+              "the sorting step's mean of its correction over N neighbouring ranks of each "
+              "sorted column (odd; default: a sixth of the views; 1: Vo's as published)",
+              "")
       .option("snr", "X", "how far above the noise a stripe must stand to be detected", "3")
       .option("sigma", "S",
               "the Gaussian's width in frequency bins (default: the method's own): filtering's "
@@ -131,6 +136,7 @@ int run_destripe(int argc, char** argv, int first) {
                             {"method", destripe_method_name(options.method)},
                             {"size", report.size},
                             {"large_size", report.large_size},
+                            {"rank_window", report.rank_window},
                             {"snr", options.snr},
                             {"sigma", report.sigma},
                             {"wavelet_levels", report.levels},

@@ -4,10 +4,11 @@
 // against the ground truth and the seconds of each filter.
 //
 //   riner_bench --case=destripe [--first=0] [--last=9] [--wavelet=9] [--levels=0]
-//               [--window=21] [--large_window=51] [--json=FILE]
+//               [--window=21] [--large_window=51] [--stripe_free=1] [--json=FILE]
 // (--wavelet and --levels: the wavelet method's Daubechies order and levels; --window and
 // --large_window: the median windows, 0 for the literature's 21 and 51; --size is the
-// harness's own.)
+// harness's own; --stripe_free: the same scans with a perfect detector, where a filter can only
+// take away.)
 //
 // And on a real scan, where there is no ground truth: each method's FBP against the scan's own
 // FBP through the quality report (ring index, specks, edge strength, lost object), with a PNG
@@ -70,7 +71,12 @@ std::vector<Result> destripe_case(const Options& o) {
   std::vector<Result> results;
   int scenes = 0;
   for (int index = first; index <= last; ++index, ++scenes) {
-    const riner::bench::RingScene scene = riner::bench::paper_scene(o, index, projector);
+    riner::RingModel model;
+    if (o.get_int("stripe_free", 0) != 0) {
+      model.nonideal_fraction = 0.0;
+      model.dead_elements = 0;
+    }
+    const riner::bench::RingScene scene = riner::bench::paper_scene(o, index, projector, model);
     const riner::Scan& scan = scene.sim.scan;
     nlohmann::json row{{"scene", scene.name}};
     std::string line = scene.name;

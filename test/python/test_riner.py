@@ -123,6 +123,16 @@ def test_destripe_matches_the_cli(cli, tmp_path, fan_scan):
     assert np.array_equal(out["sino"], riner.read_array(tmp_path / "clean" / "sino.npy"))
     assert np.array_equal(out["stripes"], riner.read_array(tmp_path / "clean" / "stripes.npy"))
     assert out["size"] == 13  # the literature's 21, at most an eighth of 96 columns
+    views = sim["sino"].shape[0]
+    assert out["rank_window"] == (views // 6) | 1
+    subprocess.run([cli, "destripe", str(tmp_path / "sino.npy"), "--method", "sorting",
+                    "--rank-window", "1", "--out", str(tmp_path / "published"), "--quiet"],
+                   check=True)
+    published = riner.destripe(sim["sino"], g, method="sorting", rank_window=1)
+    assert published["rank_window"] == 1
+    assert np.array_equal(published["sino"],
+                          riner.read_array(tmp_path / "published" / "sino.npy"))
+    assert not np.array_equal(published["sino"], out["sino"])
     wavelet = riner.destripe(sim["sino"], g, method="wavelet", levels=3, wavelet=5)
     assert wavelet["sino"].shape == sim["sino"].shape and wavelet["wavelet_levels"] == 3
     assert wavelet["sigma"] == 1.0  # the method's own width

@@ -149,6 +149,41 @@ TEST_CASE("the large-stripe step leaves a stripe-free object's curve as it was")
   }
 }
 
+TEST_CASE("the sorting step keeps an object's narrow detail that its median cuts") {
+  // A small dense disc off the axis: a peak 7 columns wide on a sinusoid, which the median of 21
+  // columns flattens at the ranks where its readings sort. The correction that leaves comes and
+  // goes from rank to rank, a detector's offset does not: averaged over the ranks, the first is
+  // spread thin and the second stays.
+  Ringed r = ringed_sinogram();
+  const std::size_t columns = r.g.n_u, views = r.g.n_views();
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> offset(-0.05f, 0.05f);
+  std::vector<float> offsets(columns);
+  for (float& o : offsets) o = offset(rng);
+  for (std::size_t v = 0; v < views; ++v) {
+    const double t = M_PI * static_cast<double>(v) / static_cast<double>(views);
+    for (std::size_t c = 0; c < columns; ++c) {
+      const double x = static_cast<double>(c) - 127.5 - 60.0 * std::cos(t);
+      const float peak = static_cast<float>(0.3 * std::exp(-0.5 * x * x / 4.0));
+      r.clean.data[v * columns + c] += peak;
+      r.ringed.data[v * columns + c] = r.clean.data[v * columns + c] + offsets[c];
+    }
+  }
+  riner::DestripeOptions options;
+  options.method = riner::DestripeMethod::kSorting;
+  riner::DestripeReport report;
+  // Measured: without stripes 0.0070 -> 0.0055, with them 0.0128 -> 0.0119 (most of what is
+  // left there is the offsets the median of 21 misreads, as in Vo's).
+  for (const auto& [scan, gain] : {std::pair{&r.clean, 0.85}, std::pair{&r.ringed, 0.97}}) {
+    options.rank_window = 1;  // Vo's as published
+    const double published = rms(riner::destripe(*scan, r.g, options).data, r.clean.data);
+    options.rank_window = 0;
+    const double averaged = rms(riner::destripe(*scan, r.g, options, &report).data, r.clean.data);
+    CHECK(report.rank_window == 31u);  // a sixth of 180 views
+    CHECK(averaged < gain * published);
+  }
+}
+
 TEST_CASE("a sinogram without stripes comes through nearly as it was") {
   const Ringed r = ringed_sinogram();
   for (riner::DestripeMethod method :

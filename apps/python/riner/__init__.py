@@ -195,20 +195,24 @@ def fbp(sino, geometry, flat=None, dark=None, center=None, filter="ram-lak", dev
 
 def destripe(sino, geometry, flat=None, dark=None, center=None, method="all", size=0,
              large_size=0, snr=3.0, sigma=0.0, fit_order=2, levels=0, wavelet=9, device=None,
-             engine="opencl", flat_after=None):
+             engine="opencl", flat_after=None, rank_window=0):
     """Classical stripe removal on the sinogram, as `riner destripe`: method "normalise",
     "sorting", "filtering", "fitting", "wavelet" (Münch et al.'s wavelet-Fourier filter),
     "large", "dead" or "all" (Vo et al.'s combination); size and large_size 0 for the
-    literature's 21 (5 in "all", after its large-stripe step) and 51, sigma 0 for the method's
+    literature's 21 (5 in "all", after its large-stripe step) and 51; rank_window the sorting
+    step's mean of its correction over that many ranks (0: a sixth of the views, 1: Vo's as
+    published); sigma 0 for the method's
     own width, levels 0 for as many as fit (up to 4), wavelet the Daubechies order. Returns a
     dict: sino (the destriped measurement), stripes (each element's mean removed, rho;
     exp(-stripes) reads as alpha), dead_elements,
-    large_stripe_elements, size, large_size, sigma, wavelet_levels, non_finite_replaced.
+    large_stripe_elements, size, large_size, rank_window, sigma, wavelet_levels,
+    non_finite_replaced.
     engine "opencl" runs every step as a kernel on device (None: the first GPU, else the first
     device), "reference" on the CPU twins. flat_after: as flat_field's."""
     sino, geometry_json, _ = _scan(sino, geometry, flat, dark, center, flat_after)
     return _riner.destripe(sino, geometry_json, method, _count("size", size),
-                           _count("large_size", large_size), snr, sigma,
+                           _count("large_size", large_size), _count("rank_window", rank_window),
+                           snr, sigma,
                            _count("fit_order", fit_order), _count("levels", levels),
                            _count("wavelet", wavelet), engine, _device(device))
 

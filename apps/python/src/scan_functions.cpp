@@ -46,14 +46,15 @@ py::array fbp_of(const py::handle& measurement, const std::string& geometry_json
 // Classical stripe removal (riner/destripe.hpp): the destriped measurement and a report.
 py::dict destripe_of(const py::handle& measurement, const std::string& geometry_json,
                      const std::string& method, std::size_t size, std::size_t large_size,
-                     double snr, double sigma, int fit_order, int levels, int wavelet_order,
-                     const std::string& engine, const std::string& device) {
+                     std::size_t rank_window, double snr, double sigma, int fit_order, int levels,
+                     int wavelet_order, const std::string& engine, const std::string& device) {
   const Scan scan = scan_from(measurement, geometry_json);
   DestripeOptions options;
   options.engine = parse_engine(engine);
   options.method = parse_destripe_method(method);
   options.size = size;
   options.large_size = large_size;
+  options.rank_window = rank_window;
   options.snr = snr;
   options.sigma = sigma;
   options.fit_order = fit_order;
@@ -73,6 +74,7 @@ py::dict destripe_of(const py::handle& measurement, const std::string& geometry_
   result["large_stripe_elements"] = report.large;
   result["size"] = report.size;
   result["large_size"] = report.large_size;
+  result["rank_window"] = report.rank_window;
   result["sigma"] = report.sigma;
   result["wavelet_levels"] = report.levels;
   result["non_finite_replaced"] = report.non_finite_replaced;

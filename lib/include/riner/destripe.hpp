@@ -49,6 +49,12 @@ struct DestripeOptions {
   std::size_t size = 0;
   // The window for large and dead stripes; 0: the literature's 51.
   std::size_t large_size = 0;
+  // The sorting step's (sorting, filtering, all) mean of its correction over this many
+  // neighbouring ranks of each sorted column (odd); 0: a sixth of the views; 1: none, Vo's
+  // algorithm as published. A detector's offset moves neighbouring ranks alike, the median's
+  // bias on the object's detail does not: on the ten DeepLesion slices at the paper's protocol
+  // sorting 27.66 -> 29.48 dB, and 32.42 -> 34.26 on the same scans without stripes.
+  std::size_t rank_window = 0;
   double snr = 3.0;    // how far above the noise a stripe must stand out to be detected
   // The Gaussian's width in frequency bins; 0: the literature's for the method. filtering: the
   // low-pass along the views (3); fitting: the low-pass across columns (10; smaller is
@@ -75,6 +81,7 @@ struct DestripeReport {
   std::vector<std::size_t> large;  // elements normalised as large stripes
   std::size_t size = 0;            // the windows used
   std::size_t large_size = 0;
+  std::size_t rank_window = 0;     // sorting, filtering, all: the window along the ranks used
   double sigma = 0.0;              // fitting, filtering, wavelet: the width used
   int levels = 0;                  // wavelet: the levels used
   // NaN/inf readings, and absurd ones (beyond 1e20), interpolated from their neighbours first.

@@ -84,9 +84,11 @@ void normalise(Sinogram& s, std::size_t size) {
 
 // Algorithm 3: a stripe is an offset of one column, which sorting turns into an offset of one
 // column of a smooth image; a median across columns removes it there.
-void sorting(Sinogram& s, std::size_t size) {
+void sorting(Sinogram& s, std::size_t size, std::size_t rank_window) {
   const stripes::SortedColumns sorted = stripes::sort_columns(s);
-  s = stripes::unsort_columns(stripes::median_across_columns(sorted.sorted, size), sorted.view);
+  const Sinogram filtered = stripes::median_across_columns(sorted.sorted, size);
+  s = stripes::unsort_columns(stripes::smooth_along_ranks(sorted.sorted, filtered, rank_window),
+                              sorted.view);
 }
 
 // Each line `stride` apart in `values` of n values multiplied in Fourier space by
@@ -110,7 +112,7 @@ void filter_lines(std::vector<double>& values, std::size_t first, std::size_t li
 
 // Algorithm 2: only each column's slow variation along the views (a Gaussian low-pass, the
 // columns mirrored at both ends) goes through the sorting; the fast part is kept as measured.
-void filtering(Sinogram& s, std::size_t size, double sigma) {
+void filtering(Sinogram& s, std::size_t size, std::size_t rank_window, double sigma) {
   const std::size_t pad = stripes::filtering_pad(s.views);
   const stripes::PaddedLine line = stripes::filtering_line(s.views);
   const std::size_t n = line.length;
@@ -131,7 +133,7 @@ void filtering(Sinogram& s, std::size_t size, double sigma) {
     for (std::size_t c = 0; c < s.columns; ++c) smooth.at(v, c) = padded.at(v + pad, c);
   }
   Sinogram corrected = smooth;
-  sorting(corrected, size);
+  sorting(corrected, size, rank_window);
   for (std::size_t i = 0; i < s.values.size(); ++i) {
     s.values[i] += corrected.values[i] - smooth.values[i];
   }
@@ -249,6 +251,11 @@ bool finds_dead(DestripeMethod method) {
   return method == DestripeMethod::kDead || method == DestripeMethod::kAll;
 }
 
+bool sorts_readings(DestripeMethod method) {
+  return method == DestripeMethod::kSorting || method == DestripeMethod::kFiltering ||
+         method == DestripeMethod::kAll;
+}
+
 // Algorithm 6 judges an element's fluctuation against its neighbours' through a threshold
 // fitted to the sorted ratios, which a wide spread pushes below zero: a column stuck at 0 or
 // at 3 on a simulated scan went unfound. A column steady over the views while its neighbours
@@ -288,8 +295,12 @@ void destripe_on_cpu(DestripeMethod method, const StripeSettings& k, Sinogram& s
                      std::vector<bool>& dead, std::vector<bool>& large) {
   switch (method) {
     case DestripeMethod::kNormalise: normalise(s, k.size); break;
-    case DestripeMethod::kSorting: sorting(s, k.size); break;
-    case DestripeMethod::kFiltering: filtering(s, k.size, k.sigma); break;
+    case DestripeMethod::kSorting:
+      sorting(s, k.size, k.rank_window);
+      break;
+    case DestripeMethod::kFiltering:
+      filtering(s, k.size, k.rank_window, k.sigma);
+      break;
     case DestripeMethod::kFitting: fitting(s, k.fit_order, k.sigma); break;
     case DestripeMethod::kWavelet: wavelet_fft(s, k.levels, k.wavelet_order, k.sigma); break;
     case DestripeMethod::kLarge: large = large_stripes(s, k.large_size, k.snr, k.drop_ratio); break;
@@ -297,7 +308,7 @@ void destripe_on_cpu(DestripeMethod method, const StripeSettings& k, Sinogram& s
     case DestripeMethod::kAll:
       dead = dead_stripes(s, k.large_size, k.snr);
       large = large_stripes(s, k.large_size, k.snr, k.drop_ratio);
-      sorting(s, k.size);
+      sorting(s, k.size, k.rank_window);
       break;
   }
 }
@@ -367,6 +378,8 @@ Array destripe(const Array& measurement, const Geometry& g, const DestripeOption
                         : 0;
   settings.wavelet_order = options.wavelet_order;
   settings.drop_ratio = options.drop_ratio;
+  settings.rank_window = options.rank_window ? std::min(options.rank_window | 1, views | 1)
+                                             : stripes::rank_window(views);
   // Every per-reading step on the device where it holds a column for the sorting step; the
   // device outlives the steps that hold its context.
   std::optional<Device> opened;
@@ -397,6 +410,7 @@ Array destripe(const Array& measurement, const Geometry& g, const DestripeOption
   local.removed = g.is_3d() ? Array({rows, columns}) : Array({columns});
   local.size = settings.size;
   local.large_size = settings.large_size;
+  local.rank_window = sorts_readings(options.method) ? settings.rank_window : 0;
   local.sigma = settings.sigma;
   local.levels = settings.levels;
   // Each row's sinogram as floats, the readings' own type: the device takes them as they are,

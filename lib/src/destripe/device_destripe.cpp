@@ -88,7 +88,9 @@ void DeviceDestripe::run(std::vector<float>& values, std::vector<bool>& dead,
   values_.write(std::span<const float>(values));
   switch (method_) {
     case DestripeMethod::kNormalise: normalise(); break;
-    case DestripeMethod::kSorting: sorting_->apply(values_, values_, settings_.size); break;
+    case DestripeMethod::kSorting:
+      sorting_->apply(values_, values_, settings_.size, settings_.rank_window);
+      break;
     case DestripeMethod::kFiltering: filtering(); break;
     case DestripeMethod::kFitting: fitting(); break;
     case DestripeMethod::kWavelet: wavelet(); break;
@@ -97,7 +99,7 @@ void DeviceDestripe::run(std::vector<float>& values, std::vector<bool>& dead,
     case DestripeMethod::kAll:
       dead = dead_stripes();
       large = large_stripes();
-      sorting_->apply(values_, values_, settings_.size);
+      sorting_->apply(values_, values_, settings_.size, settings_.rank_window);
       break;
   }
   values_.read(std::span<float>(values));
@@ -127,7 +129,7 @@ void DeviceDestripe::filtering() {
   steps_.reflect_pad_views(views_, columns_, pad_, wide_views_, values_, padded_);
   filter_->run(padded_, padded2_, ops::LineLayout{columns_, 0, 1, columns_});
   steps_.copy_block(views_, columns_, padded2_, pad_ * columns_, columns_, work_, 0, columns_);
-  sorting_->apply(work_, work2_, settings_.size);
+  sorting_->apply(work_, work2_, settings_.size, settings_.rank_window);
   steps_.add_difference(views_, columns_, work2_, 0, columns_, work_, 0, columns_, values_);
 }
 

@@ -73,6 +73,26 @@ Sinogram median_across_columns(const Sinogram& s, std::size_t size) {
   return out;
 }
 
+Sinogram smooth_along_ranks(const Sinogram& sorted, const Sinogram& filtered, std::size_t window) {
+  Sinogram out = sorted;
+  const long n = static_cast<long>(sorted.views), reach = static_cast<long>(window / 2);
+  const auto correction = [&](long k, std::size_t c) {
+    const auto at = static_cast<std::size_t>(k);
+    return filtered.at(at, c) - sorted.at(at, c);
+  };
+  for (std::size_t c = 0; c < sorted.columns; ++c) {
+    double sum = 0.0;
+    for (long k = 0; k <= std::min(reach, n - 1); ++k) sum += correction(k, c);
+    for (long k = 0; k < n; ++k) {
+      const long first = std::max(k - reach, 0L), last = std::min(k + reach, n - 1);
+      out.at(static_cast<std::size_t>(k), c) += sum / static_cast<double>(last - first + 1);
+      if (k + reach + 1 < n) sum += correction(k + reach + 1, c);
+      if (k - reach >= 0) sum -= correction(k - reach, c);
+    }
+  }
+  return out;
+}
+
 std::vector<bool> detect_stripes(const std::vector<double>& values, double snr,
                                  const std::vector<bool>* allowed) {
   const std::size_t n = values.size();

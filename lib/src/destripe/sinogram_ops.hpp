@@ -32,6 +32,10 @@ Sinogram unsort_columns(const Sinogram& sorted, const std::vector<std::size_t>& 
 Sinogram median_across_columns(const Sinogram& s, std::size_t size);
 std::vector<double> median_filter(const std::vector<double>& values, std::size_t size);
 
+// `sorted` plus its correction (filtered - sorted) averaged, column by column, over the `window`
+// (odd) ranks around each rank, the window cut at the column's first and last ranks.
+Sinogram smooth_along_ranks(const Sinogram& sorted, const Sinogram& filtered, std::size_t window);
+
 // Vo's algorithm 4: the elements of `values` (about 1 or 0 where there is no stripe) that stand
 // out of the noise of their sorted profile by `snr`, then grown by one on each side.
 // Where `allowed` is given, only its elements may stand out (before the growth).

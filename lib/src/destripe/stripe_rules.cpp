@@ -27,6 +27,8 @@ std::size_t fft_friendly(std::size_t n) {
   }
 }
 
+std::size_t rank_window(std::size_t views) { return (views / 6) | 1; }
+
 namespace {
 
 PaddedLine padded_line(std::size_t nominal, std::size_t length) {

@@ -21,7 +21,14 @@ struct StripeSettings {
   int levels = 1;         // wavelet levels
   int wavelet_order = 9;  // Daubechies'
   double drop_ratio = 0.1;
+  std::size_t rank_window = 1;  // the sorting step's mean of its correction along the ranks (odd)
 };
+
+// The sorting step's window along the ranks: a sixth of the views (odd). A detector's offset
+// moves a column's sorted readings alike at neighbouring ranks, while the median's bias on the
+// object's own detail (a peak narrower than the window across columns) comes and goes from one
+// rank to the next: the mean keeps the first and averages the second away.
+std::size_t rank_window(std::size_t views);
 
 // Algorithm 6's moving mean along the views.
 constexpr std::size_t kFluctuationWindow = 11;

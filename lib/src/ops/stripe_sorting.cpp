@@ -51,6 +51,7 @@ StripeSortingOp::StripeSortingOp(cl::Context& context, std::size_t views, std::s
       program_(context.program(stripe_program_sources())),
       sort_(*program_, "sort_columns"),
       median_(*program_, "median_across_columns"),
+      smooth_(*program_, "smooth_along_ranks"),
       unsort_(*program_, "unsort_columns"),
       sort_merge_(*program_, "sort_columns_merge"),
       median_sliding_(*program_, "median_across_columns_sliding"),
@@ -68,10 +69,22 @@ void StripeSortingOp::use_shape(Shape shape) {
   shape_ = shape;
 }
 
-void StripeSortingOp::apply(const cl::Buffer<float>& in, cl::Buffer<float>& out, std::size_t size) {
+void StripeSortingOp::apply(const cl::Buffer<float>& in, cl::Buffer<float>& out, std::size_t size,
+                            std::size_t rank_window) {
   sort(in);
   median(size);
-  unsort(out);
+  if (rank_window <= 1) {
+    unsort(out);
+    return;
+  }
+  if (rank_window % 2 == 0) throw Error("stripe sorting: an even window along the ranks");
+  if (smoothed_.size() != sorted_.size()) smoothed_ = cl::Buffer<float>(context_, sorted_.size());
+  smooth_.set_args(views_, columns_, static_cast<cl_uint>(rank_window), sorted_, filtered_,
+                   smoothed_);
+  context_.launch(smooth_, std::size_t{columns_});
+  if (out.size() != sorted_.size()) throw Error("stripe sorting: size mismatch");
+  unsort_.set_args(views_, columns_, smoothed_, order_, out);
+  context_.launch(unsort_, sorted_.size());
 }
 
 void StripeSortingOp::sort(const cl::Buffer<float>& in) {

@@ -19,8 +19,10 @@ class StripeSortingOp {
   static bool supported(const cl::Context& context, std::size_t views, std::size_t size);
 
   // out [views][columns]: in with every column's sorted readings replaced by their median
-  // across `size` neighbouring columns at the same rank (in and out may be one buffer).
-  void apply(const cl::Buffer<float>& in, cl::Buffer<float>& out, std::size_t size);
+  // across `size` neighbouring columns at the same rank, that correction averaged over the
+  // `rank_window` ranks around each (1: as it is; in and out may be one buffer).
+  void apply(const cl::Buffer<float>& in, cl::Buffer<float>& out, std::size_t size,
+             std::size_t rank_window);
 
   // The three steps apart, for large-stripe removal: sort() ranks in's columns (sorted(),
   // and the views they came from); median() fills filtered() from sorted(); unsort() puts
@@ -43,9 +45,10 @@ class StripeSortingOp {
   cl::Context& context_;
   cl_uint views_, columns_, padded_;
   std::shared_ptr<const cl::Program> program_;
-  cl::Kernel sort_, median_, unsort_, sort_merge_, median_sliding_;
+  cl::Kernel sort_, median_, smooth_, unsort_, sort_merge_, median_sliding_;
   Shape shape_;
   cl::Buffer<float> sorted_, filtered_;
+  cl::Buffer<float> smoothed_;  // apply()'s correction averaged along the ranks
   cl::Buffer<cl_uint> order_;
   cl::Buffer<float> keys_;  // the merge sort's scratch (kSerial only), with filtered_
   cl::Buffer<cl_uint> views_a_, views_b_;
