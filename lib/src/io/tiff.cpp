@@ -73,7 +73,7 @@ SampleType page_type(TIFF* tif, const std::filesystem::path& path) {
 }
 
 // Reads rows [y0, y1) of one page, cols samples each, into out (host-order bytes, as libtiff
-// delivers them). Scanlines before y0 are decoded only where a compressed strip needs them.
+// delivers them): the tiles or strips that hold them, decoded whole.
 void read_page(TIFF* tif, std::size_t y0, std::size_t y1, std::size_t cols, std::size_t item,
                unsigned char* out, const std::filesystem::path& path) {
   if (TIFFIsTiled(tif)) {
@@ -99,9 +99,26 @@ void read_page(TIFF* tif, std::size_t y0, std::size_t y1, std::size_t cols, std:
   if (static_cast<std::size_t>(TIFFScanlineSize(tif)) != cols * item) {
     fail(path, "scanline size does not match width x sample size");
   }
-  for (std::size_t y = y0; y < y1; ++y) {
-    if (TIFFReadScanline(tif, out + (y - y0) * cols * item, static_cast<uint32_t>(y), 0) < 0) {
-      fail(path, "truncated or corrupt image data at row " + std::to_string(y));
+  // Whole strips: LZW and Deflate cannot start a strip's decoding at a row inside it (libtiff:
+  // "Compression algorithm does not support random access"), and most writers put a whole
+  // image in one strip.
+  uint32_t rows_per_strip = 0;
+  if (!TIFFGetFieldDefaulted(tif, TIFFTAG_ROWSPERSTRIP, &rows_per_strip) || rows_per_strip == 0) {
+    fail(path, "TIFF without rows per strip");
+  }
+  const std::size_t per_strip = std::min<std::size_t>(rows_per_strip, y1);
+  std::vector<unsigned char> strip(per_strip * cols * item);
+  for (std::size_t first = y0 - y0 % per_strip; first < y1; first += per_strip) {
+    const auto index = TIFFComputeStrip(tif, static_cast<uint32_t>(first), 0);
+    const tmsize_t got = TIFFReadEncodedStrip(tif, index, strip.data(),
+                                              static_cast<tmsize_t>(strip.size()));
+    const std::size_t rows_here = std::min(per_strip, y1 - first);
+    if (got < 0 || static_cast<std::size_t>(got) < rows_here * cols * item) {
+      fail(path, "truncated or corrupt image data at row " + std::to_string(std::max(first, y0)));
+    }
+    for (std::size_t y = std::max(first, y0); y < first + rows_here; ++y) {
+      std::memcpy(out + (y - y0) * cols * item, strip.data() + (y - first) * cols * item,
+                  cols * item);
     }
   }
 }
