@@ -101,6 +101,8 @@ bool Args::has(const std::string& name) const {
   return spec != nullptr && spec->default_value.has_value();
 }
 
+bool Args::given(const std::string& name) const { return values_.count(name) > 0; }
+
 std::optional<std::string> Args::maybe(const std::string& name) const {
   if (auto it = values_.find(name); it != values_.end()) return it->second;
   if (const Spec* spec = find_option(name); spec != nullptr) return spec->default_value;

@@ -35,6 +35,7 @@ class Args {
   bool parse(int argc, char** argv, int first);
 
   bool has(const std::string& name) const;
+  bool given(const std::string& name) const;       // on the command line, not by a default
   std::string get(const std::string& name) const;  // UsageError if absent without default
   std::optional<std::string> maybe(const std::string& name) const;
   double number(const std::string& name) const;

@@ -5,6 +5,7 @@
 
 #include "riner/error.hpp"
 #include "riner/io.hpp"
+#include "riner/tomo_file.hpp"
 #include "summary_json.hpp"
 
 namespace riner::app {
@@ -53,10 +54,18 @@ ScanSource source_from(const Args& args) {
         "a scan JSON names its own data and geometry: drop --flat, --dark and "
         "--geometry");
   }
-  if (!scan_json && !source.dark.empty() && source.flat.empty()) {
+  for (const char* name : {"geometry", "flat", "dark", "flat-after"}) {
+    // An unset shell variable ("--dark $DARK") read as no dark field at all.
+    if (args.given(name) && args.get(name).empty()) {
+      throw UsageError(std::string("--") + name + " needs a file (got an empty name)");
+    }
+  }
+  // A tomography file holds its own flats and darks: one given beside it replaces the file's.
+  const bool tomo_file = is_hdf5_path(source.path) && !split_hdf5_dataset(source.path);
+  if (!scan_json && !tomo_file && !source.dark.empty() && source.flat.empty()) {
     throw UsageError("--dark needs --flat (and SCAN holding raw projections)");
   }
-  if (!source.flat_after.empty() && source.flat.empty()) {
+  if (!tomo_file && !source.flat_after.empty() && source.flat.empty()) {
     throw UsageError("--flat-after needs --flat (the flats before the scan)");
   }
   if (lowercase(source.offset_px) == "auto") source.offset_px = "auto";  // AUTO, Auto

@@ -564,6 +564,11 @@ TEST_SUITE("cli") {
         riner_cli("fbp " + raw + "/projections --dark " + raw + "/dark.npy --out " + raw + "/x.nii",
                   dir),
         2, "--dark needs --flat");
+    // An unset shell variable: no dark field at all, without a word.
+    expect_error(riner_cli("fbp " + raw + "/projections --flat " + raw + "/flat_0.tif --dark '' " +
+                               "--out " + raw + "/x.nii",
+                           dir),
+                 2, "--dark needs a file (got an empty name)");
     expect_error(riner_cli("fbp " + raw + "/projections --flat " + raw + "/dark.npy --dark " + raw +
                                "/flat_0.tif --out " + raw + "/x.nii",
                            dir),

@@ -424,7 +424,7 @@ def test_load_scan_interpolates_flats_before_and_after_a_drifting_beam(tmp_path)
         g, files={"projections": "raw.npy", "flat": "before.npy", "flat_after": "after.npy"})))
     sino_json, _, _ = riner.load_scan(tmp_path / "scan.json")
     assert np.array_equal(sino_json, sino, equal_nan=True)
-    with pytest.raises(riner.InputError, match="flat_after needs flat"):
+    with pytest.raises(riner.InputError, match="flats after the scan need the flats before"):
         riner.load_scan(tmp_path / "raw.npy", flat_after=tmp_path / "after.npy")
     # And from arrays: flat_field, fbp and reconstruct take the second series as flat_after.
     rho, report = riner.flat_field(raw, before, flat_after=after)

@@ -9,6 +9,7 @@
 #include "riner/fbp.hpp"
 #include "riner/flat_field.hpp"
 #include "riner/io.hpp"
+#include "riner/scan_source.hpp"
 #include "riner/tomo_file.hpp"
 #include "support/fixture.hpp"
 #include "support/geometries.hpp"
@@ -126,6 +127,107 @@ TEST_SUITE("tomo_file") {
     CHECK(riner::read_array(dir / "tooth.h5").array.data == t.projections.data);
   }
 
+  TEST_CASE("a field beside a tomography file replaces its own; a tomography file as a field") {
+    // --flat beside a Data Exchange file dropped the file's darks (rho off by up to 0.3), and a
+    // Data Exchange file given as --flat or --dark gave its projections as the field.
+    riner::test::TempDir dir;
+    const auto projections = frames(0, 6, 0), flats = frames(1, 3, 0), darks = frames(2, 2, 0),
+               other_flats = frames(1, 2, 40), other_darks = frames(2, 5, 0);
+    {
+      riner::test::Hdf5Writer w(dir / "scan.h5");
+      w.write("/exchange/data", {6, kRows, kCols}, projections, H5T_STD_U16LE);
+      w.write("/exchange/data_white", {3, kRows, kCols}, flats, H5T_STD_U16LE);
+      w.write("/exchange/data_dark", {2, kRows, kCols}, darks, H5T_STD_U16LE);
+    }
+    riner::write_array(dir / "projections.npy", as_array(projections, 6));
+    riner::write_array(dir / "flats.npy", as_array(flats, 3));
+    riner::write_array(dir / "darks.npy", as_array(darks, 2));
+    riner::write_array(dir / "other_flats.npy", as_array(other_flats, 2));
+    riner::write_array(dir / "other_darks.npy", as_array(other_darks, 5));
+    const riner::Geometry g = riner::test::make_geometry(riner::GeometryType::kParallel3d, 6, kCols,
+                                                         kRows, {kRows, 24, 24}, 1.0, 1.0, M_PI);
+    riner::write_text(dir / "geometry.json", g.to_json());
+    const auto measured = [&](const std::string& scan, const std::string& flat,
+                              const std::string& dark, const std::string& after = "") {
+      riner::ScanSource source{(dir / scan).string(),
+                               "",
+                               flat.empty() ? "" : (dir / flat).string(),
+                               dark.empty() ? "" : (dir / dark).string(),
+                               std::nullopt,
+                               "",
+                               after.empty() ? "" : (dir / after).string()};
+      return riner::load_scan_source(source).scan.measurement.data;
+    };
+    const auto expected = [&](const std::vector<std::uint16_t>& f, std::size_t n_flats,
+                              const std::vector<std::uint16_t>& d, std::size_t n_darks) {
+      return riner::raw_scan(g, as_array(projections, 6), as_array(f, n_flats),
+                             as_array(d, n_darks), std::nullopt, "arrays")
+          .measurement.data;
+    };
+    CHECK(measured("scan.h5", "", "") == expected(flats, 3, darks, 2));
+    // A flat given beside the file: the file's darks stay.
+    CHECK(measured("scan.h5", "other_flats.npy", "") == expected(other_flats, 2, darks, 2));
+    // A dark given beside it replaces the file's, its flats stay.
+    CHECK(measured("scan.h5", "", "other_darks.npy") == expected(flats, 3, other_darks, 5));
+    // The file as the flat or the dark field of projections in another file: its own fields.
+    CHECK(measured("projections.npy", "scan.h5", "scan.h5") == expected(flats, 3, darks, 2));
+    CHECK(measured("projections.npy", "scan.h5", "darks.npy") == expected(flats, 3, darks, 2));
+    // Flats after the scan beside the file add a second series to its own.
+    const riner::FlatStack both =
+        riner::flats_before_after(as_array(flats, 3), as_array(other_flats, 2), {6, kRows, kCols});
+    CHECK(measured("scan.h5", "", "", "other_flats.npy") ==
+          riner::raw_scan(g, as_array(projections, 6), both.frames, as_array(darks, 2),
+                          std::nullopt, "arrays", nullptr, both.positions)
+              .measurement.data);
+    // The slab reader reads the same rows the same way.
+    riner::ScanRows rows({(dir / "scan.h5").string(), "", (dir / "other_flats.npy").string(), "",
+                          std::nullopt, "", ""});
+    const riner::Scan two = rows.read({1, 2});
+    const std::vector<float> whole = expected(other_flats, 2, darks, 2);
+    CHECK(two.measurement(3, 1, 5) == whole[(3 * kRows + 2) * kCols + 5]);
+    // A tomography file without that field, as the field: said so.
+    {
+      riner::test::Hdf5Writer w(dir / "no_dark.h5");
+      w.write("/exchange/data", {6, kRows, kCols}, projections, H5T_STD_U16LE);
+      w.write("/exchange/data_white", {3, kRows, kCols}, flats, H5T_STD_U16LE);
+    }
+    CHECK_THROWS_WITH_AS(measured("projections.npy", "flats.npy", "no_dark.h5"),
+                         doctest::Contains("holds no dark field"), riner::InputError);
+  }
+
+  TEST_CASE("NXtomo entries where ESRF and Diamond put them; other frames left out") {
+    // ESRF's nxtomomill writes /entry0000 and marks alignment frames by image_key_control -1
+    // (image_key 0: they were read as projections); Diamond writes /entry1/tomo_entry. Neither
+    // was found ("holds neither ...").
+    riner::test::TempDir dir;
+    const auto darks = frames(2, 2, 0), flats = frames(1, 2, 1), projections = frames(0, 5, 0),
+               extra = frames(0, 2, 9);
+    {
+      riner::test::Hdf5Writer w(dir / "esrf.nxs");
+      w.write("/entry0000/instrument/detector/data", {11, kRows, kCols},
+              join({darks, flats, projections, extra}), H5T_STD_U16LE);
+      w.write("/entry0000/instrument/detector/image_key", {11},
+              std::vector<int>{2, 2, 1, 1, 0, 0, 0, 0, 0, 0, 3}, H5T_STD_I32LE);
+      w.write("/entry0000/instrument/detector/image_key_control", {11},
+              std::vector<int>{2, 2, 1, 1, 0, 0, 0, 0, 0, -1, 3}, H5T_STD_I32LE);
+    }
+    const riner::TomoFile esrf = riner::read_tomo_file(dir / "esrf.nxs");
+    CHECK(esrf.projections.shape == std::vector<std::size_t>{5, kRows, kCols});
+    CHECK(esrf.projections.data == as_array(projections, 5).data);
+    CHECK(esrf.frames_left_out == 2);
+    CHECK(riner::read_array_shape(dir / "esrf.nxs") == std::vector<std::size_t>{5, kRows, kCols});
+    {
+      riner::test::Hdf5Writer w(dir / "dls.nxs");
+      w.write("/entry1/tomo_entry/data/data", {9, kRows, kCols}, join({darks, flats, projections}),
+              H5T_STD_U16LE);
+      w.write("/entry1/tomo_entry/instrument/detector/image_key", {9},
+              std::vector<int>{2, 2, 1, 1, 0, 0, 0, 0, 0}, H5T_STD_I32LE);
+    }
+    const riner::TomoFile dls = riner::read_tomo_file(dir / "dls.nxs");
+    CHECK(dls.flats.data == as_array(flats, 2).data);
+    CHECK(dls.frames_left_out == 0);
+  }
+
   TEST_CASE("bad files: not HDF5, no known layout, a missing key, counts that disagree") {
     riner::test::TempDir dir;
     riner::test::write_bytes(dir / "text.h5", "not an hdf5 file");
@@ -155,5 +257,41 @@ TEST_SUITE("tomo_file") {
     }
     CHECK(error_of(dir / "flat.h5").find("/exchange/data: is [4, 30]; expected [frames") !=
           std::string::npos);
+    // Compressed by a filter this library lacks (bitshuffle on Eiger detectors): registered here
+    // to write the file, gone when it is read. It read as "truncated or corrupt".
+    {
+      constexpr H5Z_filter_t kBitshuffle = 32008;
+      const H5Z_class2_t identity{H5Z_CLASS_T_VERS,
+                                  kBitshuffle,
+                                  1,
+                                  1,
+                                  "bitshuffle",
+                                  nullptr,
+                                  nullptr,
+                                  [](unsigned, std::size_t, const unsigned[], std::size_t bytes,
+                                     std::size_t*, void**) { return bytes; }};
+      REQUIRE(H5Zregister(&identity) >= 0);
+      const hid_t file =
+          H5Fcreate((dir / "plugin.h5").c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+      const hsize_t shape[3] = {2, kRows, kCols};
+      const hid_t space = H5Screate_simple(3, shape, nullptr);
+      const hid_t plist = H5Pcreate(H5P_DATASET_CREATE);
+      H5Pset_chunk(plist, 3, shape);
+      H5Pset_filter(plist, kBitshuffle, H5Z_FLAG_MANDATORY, 0, nullptr);
+      const hid_t group = H5Gcreate2(file, "/exchange", H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+      const hid_t set =
+          H5Dcreate2(file, "/exchange/data", H5T_STD_U16LE, space, H5P_DEFAULT, plist, H5P_DEFAULT);
+      const std::vector<std::uint16_t> values = frames(0, 2, 0);
+      REQUIRE(H5Dwrite(set, H5T_NATIVE_USHORT, H5S_ALL, H5S_ALL, H5P_DEFAULT, values.data()) >= 0);
+      H5Dclose(set);
+      H5Gclose(group);
+      H5Pclose(plist);
+      H5Sclose(space);
+      H5Fclose(file);
+      REQUIRE(H5Zunregister(kBitshuffle) >= 0);
+    }
+    CHECK(error_of(dir / "plugin.h5")
+              .find("/exchange/data: is compressed with HDF5 filter 32008 "
+                    "(bitshuffle), which this HDF5 library lacks") != std::string::npos);
   }
 }

@@ -330,22 +330,24 @@ def load_scan(path, geometry=None, flat=None, dark=None, row=None, center=None,
     a TIFF folder or pattern, "file.h5:/dataset"), raw projections with flat (and dark) files,
     a Data Exchange / NXtomo file with its own flats and darks, or a scan JSON naming its
     files. geometry: a JSON path (default: geometry.json beside the scan); row: one detector
-    row of a stack (a 2D slice); center "auto" estimates the offset; flat_after: flats taken
-    after the scan (each view's flat interpolated between the two). Returns (sino, geometry
-    dict, notes dict with flat_field and centre)."""
-    if center not in (None, "auto"):
-        raise InputError(f"center must be None or 'auto' here (got {center!r}); "
-                         "set the geometry's detector.offset_px instead")
-    if dark is not None and flat is None and not os.fspath(path).endswith(".json"):
-        raise InputError("dark needs flat")
-    if flat_after is not None and flat is None:
-        raise InputError("flat_after needs flat")
+    row of a stack (a 2D slice); center: the axis's column, or "auto" to estimate it;
+    flat_after: flats taken after the scan (each view's flat interpolated between the two).
+    Beside a Data Exchange / NXtomo file, flat and dark replace the file's own and flat_after
+    adds to them. Returns (sino, geometry dict, notes dict with flat_field and centre)."""
     sino, geometry_json, notes = _riner.load_scan(
         os.fspath(path), "" if geometry is None else os.fspath(geometry),
         "" if flat is None else os.fspath(flat), "" if dark is None else os.fspath(dark),
-        row, "" if center is None else center,
+        row, "auto" if center == "auto" else "",
         "" if flat_after is None else os.fspath(flat_after))
-    return sino, json.loads(geometry_json), json.loads(notes)
+    g = json.loads(geometry_json)
+    if center not in (None, "auto"):
+        columns = g["detector"]["count"]
+        offset = _offset(columns[0] if isinstance(columns, list) else columns, center)
+        if isinstance(g["detector"]["offset_px"], list):
+            g["detector"]["offset_px"][0] = offset
+        else:
+            g["detector"]["offset_px"] = offset
+    return sino, g, json.loads(notes)
 
 
 def read_array(path):

@@ -26,6 +26,9 @@ struct TomoFile {
   // before it, less a half); empty when the file does not say (Data Exchange): one series.
   std::vector<double> flat_positions;
   std::vector<double> angles_deg;  // per projection, as the file states them (may be empty)
+  // NXtomo frames neither projection, flat nor dark (image_key 3: invalid; an alignment frame,
+  // image_key_control -1): not read.
+  std::size_t frames_left_out = 0;
 };
 
 // Whether the path names an HDF5 file by its extension (.h5, .hdf5, .hdf, .nxs, .nx).

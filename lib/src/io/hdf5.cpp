@@ -71,6 +71,26 @@ OpenDataset open_dataset(const Hid& file, const std::filesystem::path& path,
   return d;
 }
 
+// The first of a dataset's filters that the library cannot apply ("HDF5 filter 32008
+// (bitshuffle)"), or "" when it has them all: a file compressed by a detector's plugin
+// (bitshuffle/LZ4 on Eiger detectors) otherwise read as a corrupt file.
+std::string missing_filter(const Hid& set) {
+  const Hid plist(H5Dget_create_plist(set.get()), H5Pclose);
+  if (!plist.ok()) return "";
+  const int filters = H5Pget_nfilters(plist.get());
+  for (int i = 0; i < filters; ++i) {
+    unsigned flags = 0, config = 0;
+    std::size_t values = 0;
+    char name[80] = "";
+    const H5Z_filter_t id = H5Pget_filter2(plist.get(), static_cast<unsigned>(i), &flags, &values,
+                                           nullptr, sizeof(name), name, &config);
+    if (id >= 0 && H5Zfilter_avail(id) <= 0) {
+      return "HDF5 filter " + std::to_string(id) + (name[0] ? " (" + std::string(name) + ")" : "");
+    }
+  }
+  return "";
+}
+
 // A dataset's shape and values as float64 or float32; with `rows`, only those of the second
 // axis of a [frames, rows, cols] dataset (a hyperslab: the file is read for those alone).
 template <typename T>
@@ -97,6 +117,11 @@ std::vector<T> read_values(const Hid& file, const std::filesystem::path& path,
   if (!values.empty() &&
       H5Dread(d.set->get(), memory_type, memory_space ? memory_space->get() : H5S_ALL, file_space,
               H5P_DEFAULT, values.data()) < 0) {
+    if (const std::string filter = missing_filter(*d.set); !filter.empty()) {
+      throw InputError(where(path, dataset) + "is compressed with " + filter +
+                       ", which this HDF5 library lacks: install its plugin (Debian: "
+                       "hdf5-filter-plugin) and set HDF5_PLUGIN_PATH to its folder");
+    }
     throw InputError(where(path, dataset) + "read failed (truncated or corrupt file?)");
   }
   return values;
@@ -168,6 +193,10 @@ TomoFile read_nxtomo(const Hid& file, const std::filesystem::path& path, const s
   t.projections = frames_with_key(all, keys, 0);
   t.flats = frames_with_key(all, keys, 1);
   t.darks = frames_with_key(all, keys, 2);
+  t.frames_left_out =
+      static_cast<std::size_t>(std::count_if(keys.begin(), keys.end(), [](double k) {
+        return static_cast<int>(k) < 0 || static_cast<int>(k) > 2;
+      }));
   double projections_before = 0.0;
   for (double key : keys) {
     if (static_cast<int>(key) == 0) projections_before += 1.0;
@@ -206,22 +235,54 @@ struct TomoLayout {
   std::string angles;
 };
 
-TomoLayout find_layout(const Hid& file, const std::filesystem::path& path) {
-  if (exists(file, "/exchange/data")) return {true, "/exchange/data", "", ""};
-  for (const char* entry_name : {"/entry", "/entry1"}) {
-    const std::string entry = entry_name;
-    for (const std::string& data : {entry + "/data/data", entry + "/instrument/detector/data"}) {
-      if (!exists(file, data)) continue;
-      for (const std::string& keys :
-           {entry + "/instrument/detector/image_key", entry + "/data/image_key"}) {
-        if (exists(file, keys)) return {false, data, keys, entry + "/sample/rotation_angle"};
-      }
-      throw InputError(where(path, data) + "has no image_key beside it (NXtomo)");
+// The names of the links directly under `group` (none when it is not a group).
+std::vector<std::string> links_under(const Hid& file, const std::string& group) {
+  H5G_info_t info;
+  if (H5Gget_info_by_name(file.get(), group.c_str(), &info, H5P_DEFAULT) < 0) return {};
+  std::vector<std::string> names;
+  for (hsize_t i = 0; i < info.nlinks && i < 64; ++i) {
+    char name[256] = "";
+    if (H5Lget_name_by_idx(file.get(), group.c_str(), H5_INDEX_NAME, H5_ITER_INC, i, name,
+                           sizeof(name), H5P_DEFAULT) > 0) {
+      names.emplace_back(name);
     }
   }
+  return names;
+}
+
+// An NXtomo entry's frames and keys, where `entry` holds them: /entry (the standard), ESRF's
+// /entry0000, Diamond's /entry1/tomo_entry. image_key_control, where there is one, also marks
+// alignment frames (-1), which image_key counts as projections.
+std::optional<TomoLayout> nxtomo_at(const Hid& file, const std::filesystem::path& path,
+                                    const std::string& entry) {
+  for (const std::string& data : {entry + "/data/data", entry + "/instrument/detector/data"}) {
+    if (!exists(file, data)) continue;
+    for (const std::string& keys :
+         {entry + "/instrument/detector/image_key_control", entry + "/data/image_key_control",
+          entry + "/instrument/detector/image_key", entry + "/data/image_key"}) {
+      if (exists(file, keys))
+        return TomoLayout{false, data, keys, entry + "/sample/rotation_angle"};
+    }
+    throw InputError(where(path, data) + "has no image_key beside it (NXtomo)");
+  }
+  return std::nullopt;
+}
+
+TomoLayout find_layout(const Hid& file, const std::filesystem::path& path) {
+  if (exists(file, "/exchange/data")) return {true, "/exchange/data", "", ""};
+  std::vector<std::string> entries = {"/entry", "/entry1"};
+  for (const std::string& top : links_under(file, "/")) {
+    entries.push_back("/" + top);
+    for (const std::string& inner : links_under(file, "/" + top)) {
+      entries.push_back("/" + top + "/" + inner);
+    }
+  }
+  for (const std::string& entry : entries) {
+    if (std::optional<TomoLayout> layout = nxtomo_at(file, path, entry)) return *layout;
+  }
   throw InputError(io::prefix(path) +
-                   "holds neither /exchange/data (Data Exchange) nor /entry/data/data (NXtomo); "
-                   "name a dataset as FILE:/path");
+                   "holds neither /exchange/data (Data Exchange) nor an NXtomo entry's "
+                   "data/data with its image_key; name a dataset as FILE:/path");
 }
 
 }  // namespace

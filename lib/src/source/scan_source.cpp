@@ -59,25 +59,76 @@ Array frames_rows(const std::filesystem::path& path, RowRange rows) {
 }
 
 // Resolves a scan JSON into its files and checks the flat and dark fit SCAN; true when SCAN is
-// a tomography file that holds its own flats and darks.
+// a tomography file, which holds its own flats and darks (a flat, dark or flats-after field
+// given beside it replaces or adds to the file's own).
 bool resolve_files(ScanSource& source) {
   if (std::filesystem::path(source.path).extension() == ".json") resolve_scan_json(source);
-  if (!source.dark.empty() && source.flat.empty() && !is_tomo_file(source.path)) {
+  const bool tomo_file = is_tomo_file(source.path);
+  if (!source.dark.empty() && source.flat.empty() && !tomo_file) {
     throw InputError("a dark field needs a flat field (and SCAN holding raw projections)");
   }
-  if (!source.flat_after.empty() && source.flat.empty()) {
-    throw InputError("flats after the scan need the flats before it (--flat)");
+  if (!source.flat_after.empty() && source.flat.empty() && !tomo_file) {
+    throw InputError("flats after the scan need the flats before them");
   }
-  const bool tomo_file = source.flat.empty() && is_tomo_file(source.path);
-  if (tomo_file && !source.dark.empty())
-    throw InputError("a tomography file brings its own dark field");
   return tomo_file;
 }
 
-void require_flats(const TomoFile& file, const std::string& path) {
-  if (file.flats.shape.empty()) {
-    throw InputError(path + ": the file holds no flat field (" + file.layout +
+enum class Field { kFlat, kDark };
+
+// A flat or dark field's frames from `path` (only rows `rows` of each, when set). A tomography
+// file gives its own flats or darks: read as an array it gave its projections, which passed as
+// a flat field of 90 frames.
+Array field_frames(const std::string& path, Field field, std::optional<RowRange> rows) {
+  if (is_tomo_file(path)) {
+    TomoFile file = read_tomo_file(path, rows);
+    Array& frames = field == Field::kFlat ? file.flats : file.darks;
+    if (frames.shape.empty()) {
+      throw InputError(path + ": the file holds no " + (field == Field::kFlat ? "flat" : "dark") +
+                       " field (" + file.layout + ")");
+    }
+    return std::move(frames);
+  }
+  return rows ? frames_rows(path, *rows) : read_array(path).array;
+}
+
+// A tomography file's projections with its own flats and darks, each replaced by a field given
+// beside it, and flats after the scan added to them.
+Scan tomo_scan(const ScanSource& source, Geometry g, std::optional<RowRange> rows,
+               std::optional<std::size_t> row, FlatFieldReport* report, std::string* layout) {
+  TomoFile file = read_tomo_file(source.path, rows);
+  const std::string left_out =
+      file.frames_left_out == 0
+          ? ""
+          : std::to_string(file.frames_left_out) +
+                " frame(s) neither projection, flat nor dark (image_key 3 or an alignment "
+                "frame) left out";
+  if (layout) *layout = file.layout + (left_out.empty() ? "" : " (" + left_out + ")");
+  Array flats =
+      source.flat.empty() ? std::move(file.flats) : field_frames(source.flat, Field::kFlat, rows);
+  std::vector<double> positions = source.flat.empty() ? file.flat_positions : std::vector<double>{};
+  if (flats.shape.empty()) {
+    throw InputError(source.path + ": the file holds no flat field (" + file.layout +
                      "); pass one with --flat");
+  }
+  const Array darks =
+      source.dark.empty() ? std::move(file.darks) : field_frames(source.dark, Field::kDark, rows);
+  if (!source.flat_after.empty()) {
+    const std::size_t series_before = positions.size();
+    FlatStack both = flats_before_after(flats, field_frames(source.flat_after, Field::kFlat, rows),
+                                        file.projections.shape);
+    // The file's own series keep their places among the views; those after the scan follow.
+    if (series_before > 0) {
+      std::copy(positions.begin(), positions.end(), both.positions.begin());
+    }
+    flats = std::move(both.frames);
+    positions = std::move(both.positions);
+  }
+  try {
+    return raw_scan(std::move(g), file.projections, flats, darks, row, source.path, report,
+                    positions);
+  } catch (const InputError& e) {
+    if (left_out.empty()) throw;
+    throw InputError(std::string(e.what()) + " (" + left_out + ")");
   }
 }
 
@@ -124,21 +175,27 @@ LoadedScan load_scan_source(ScanSource source) {
   FlatFieldReport report;
   std::string layout;  // a tomography file's, before its flat field's line
   if (tomo_file) {
-    const TomoFile file = read_tomo_file(source.path);
-    require_flats(file, source.path);
-    loaded.scan =
-        raw_scan(Geometry::load(find_geometry(source.path, source.geometry)), file.projections,
-                 file.flats, file.darks, source.row, source.path, &report, file.flat_positions);
+    loaded.scan = tomo_scan(source, Geometry::load(find_geometry(source.path, source.geometry)),
+                            std::nullopt, source.row, &report, &layout);
     loaded.flat_field = report;
-    layout = file.layout + " file: ";
+    layout += " file: ";
   } else if (source.flat.empty()) {
     loaded.scan = load_scan(source.path, source.geometry, source.row);
     if (std::optional<std::string> note = transmission_note(loaded.scan)) {
       loaded.notes.push_back(std::move(*note));
     }
   } else {
-    loaded.scan = load_raw_scan(source.path, source.flat, source.dark, source.geometry, &report,
-                                source.row, source.flat_after);
+    Geometry g = Geometry::load(find_geometry(source.path, source.geometry));
+    const ArrayFile raw = read_array(source.path);
+    const Array after = source.flat_after.empty()
+                            ? Array()
+                            : field_frames(source.flat_after, Field::kFlat, std::nullopt);
+    const FlatStack flats = flats_before_after(
+        field_frames(source.flat, Field::kFlat, std::nullopt), after, raw.array.shape);
+    const Array darks =
+        source.dark.empty() ? Array() : field_frames(source.dark, Field::kDark, std::nullopt);
+    loaded.scan = raw_scan(std::move(g), raw.array, flats.frames, darks, source.row, source.path,
+                           &report, flats.positions);
     loaded.flat_field = report;
   }
   if (loaded.flat_field) {
@@ -194,19 +251,15 @@ ScanRows::ScanRows(ScanSource source) : source_(std::move(source)) {
 
 Scan ScanRows::read(RowRange rows, FlatFieldReport* report) const {
   const Geometry g = detector_rows_geometry(geometry_, rows.first, rows.count);
-  if (tomo_file_) {
-    const TomoFile file = read_tomo_file(source_.path, rows);
-    require_flats(file, source_.path);
-    return raw_scan(g, file.projections, file.flats, file.darks, std::nullopt, source_.path,
-                    report, file.flat_positions);
-  }
+  if (tomo_file_) return tomo_scan(source_, g, rows, std::nullopt, report, nullptr);
   if (!source_.flat.empty()) {
     const Array projections = read_array_rows(source_.path, rows).array;
     const FlatStack flats = flats_before_after(
-        frames_rows(source_.flat, rows),
-        source_.flat_after.empty() ? Array() : frames_rows(source_.flat_after, rows),
+        field_frames(source_.flat, Field::kFlat, rows),
+        source_.flat_after.empty() ? Array() : field_frames(source_.flat_after, Field::kFlat, rows),
         projections.shape);
-    const Array darks = source_.dark.empty() ? Array() : frames_rows(source_.dark, rows);
+    const Array darks =
+        source_.dark.empty() ? Array() : field_frames(source_.dark, Field::kDark, rows);
     return raw_scan(g, projections, flats.frames, darks, std::nullopt, source_.path, report,
                     flats.positions);
   }
