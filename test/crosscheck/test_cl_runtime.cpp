@@ -144,4 +144,23 @@ TEST_SUITE("cl_runtime") {
     ops.axpy(0.5f, dx, dy);
     CHECK(dy.read() == std::vector<float>(5, 2.0f));
   }
+
+  TEST_CASE("interop: an out-of-order queue, or one of another context, is refused") {
+    // An out-of-order queue trained into garbage without an error (an image summing to 1e36).
+    riner::cl::Context& own = ctx();
+    cl_int status = CL_SUCCESS;
+    cl_command_queue unordered = clCreateCommandQueue(
+        own.get(), own.device(), CL_QUEUE_OUT_OF_ORDER_EXEC_MODE_ENABLE, &status);
+    if (status == CL_SUCCESS) {
+      CHECK_THROWS_WITH_AS(riner::Device::from_handles(own.get(), unordered),
+                           doctest::Contains("riner needs an in-order queue"), riner::Error);
+      clReleaseCommandQueue(unordered);
+    }
+    const cl_device_id device = own.device();
+    cl_context other = clCreateContext(nullptr, 1, &device, nullptr, nullptr, &status);
+    REQUIRE(status == CL_SUCCESS);
+    CHECK_THROWS_WITH_AS(riner::Device::from_handles(other, own.queue()),
+                         doctest::Contains("belongs to another OpenCL context"), riner::Error);
+    clReleaseContext(other);
+  }
 }

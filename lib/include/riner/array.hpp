@@ -4,6 +4,7 @@
 
 #include <cstddef>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace riner {
@@ -34,6 +35,10 @@ struct Array {
 
 // Number of elements a shape holds; throws InputError if the product overflows.
 std::size_t shape_size(const std::vector<std::size_t>& shape);
+
+// InputError naming `what` unless `a` holds exactly the values its shape says: its fields are
+// public, and a shape that says more than the data holds sent the steps reading past its end.
+void check_array(const Array& a, std::string_view what);
 
 // Slice z of a volume [z, y, x] as a 2D image [y, x] (a copy).
 Array axial_slice(const Array& volume, std::size_t z);

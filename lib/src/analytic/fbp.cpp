@@ -52,7 +52,8 @@ SliceSelection SliceSelection::spread(std::size_t nz, std::size_t most) {
 
 Array fbp(const Scan& scan, const FbpOptions& options, FbpReport* report) {
   scan.geometry.validate();
-  scan.geometry.check_measurement_shape(scan.measurement.shape);
+  // All NaN gave an image of zeros, raw intensities an image of thousands, without a word.
+  check_scan(scan, "fbp");
   Geometry g = scan.geometry;  // a half acquisition's detector widens below
   Array weighted = scan.measurement;
   FbpReport local;

@@ -47,6 +47,18 @@ Context::Context(cl_context context, cl_command_queue queue, bool profiling)
         "profiling was requested but the given queue was created without "
         "CL_QUEUE_PROFILING_ENABLE");
   }
+  // Every step relies on the queue's order (a kernel reads what the one before it wrote): an
+  // out-of-order queue trained into garbage (an image summing to 1e36) without an error.
+  if (props & CL_QUEUE_OUT_OF_ORDER_EXEC_MODE_ENABLE) {
+    throw Error(
+        "the given queue was created with CL_QUEUE_OUT_OF_ORDER_EXEC_MODE_ENABLE; riner needs an "
+        "in-order queue");
+  }
+  cl_context owner = nullptr;
+  RINER_CL_CALL(clGetCommandQueueInfo, queue, CL_QUEUE_CONTEXT, sizeof(owner), &owner, nullptr);
+  if (owner != context) {
+    throw Error("the given queue belongs to another OpenCL context than the one given with it");
+  }
   init_common();
 }
 

@@ -67,8 +67,16 @@ ArrayStats compute_stats(const Array& array) {
   return stats;
 }
 
+void check_array(const Array& a, std::string_view what) {
+  if (a.data.size() != shape_size(a.shape)) {
+    throw InputError(std::string(what) + ": its shape " + shape_string(a.shape) + " holds " +
+                     std::to_string(shape_size(a.shape)) + " values, its data " +
+                     std::to_string(a.data.size()));
+  }
+}
+
 Array first_axis_range(const Array& a, std::size_t first, std::size_t count) {
-  if (a.rank() < 1 || first + count > a.shape[0]) {
+  if (a.rank() < 1 || first > a.shape[0] || count > a.shape[0] - first) {
     throw InputError("no entries " + std::to_string(first) + ".." + std::to_string(first + count) +
                      " in an array of shape " + shape_string(a.shape));
   }

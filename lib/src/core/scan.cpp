@@ -75,8 +75,13 @@ ReadingsLook look_at_readings(const Array& measurement) {
 }  // namespace
 
 void check_scan(const Scan& scan, std::string_view what) {
+  check_array(scan.measurement, what);
   scan.geometry.check_measurement_shape(scan.measurement.shape, what);
-  if (scan.measurement.size() > 0 && scan.non_finite >= scan.measurement.size()) {
+  // Counted here, not taken from scan.non_finite: a caller's count may be anything.
+  const auto non_finite = static_cast<std::size_t>(
+      std::count_if(scan.measurement.data.begin(), scan.measurement.data.end(),
+                    [](float x) { return !std::isfinite(x); }));
+  if (scan.measurement.size() > 0 && non_finite >= scan.measurement.size()) {
     throw NoReadingsError(std::string(what) + ": all " + std::to_string(scan.measurement.size()) +
                           " values are NaN or infinite; there is nothing to reconstruct");
   }

@@ -344,6 +344,7 @@ const char* destripe_method_name(DestripeMethod method) {
 Array destripe(const Array& measurement, const Geometry& g, const DestripeOptions& options,
                DestripeReport* report) {
   g.validate();
+  check_array(measurement, "destripe");
   g.check_measurement_shape(measurement.shape);
   const std::size_t views = g.n_views(), columns = g.n_u, rows = g.is_3d() ? g.n_v : 1;
   if (views < 8 || columns < 8) {

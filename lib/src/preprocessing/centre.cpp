@@ -456,6 +456,7 @@ bool centre_search_covers(const Geometry& g) {
 }
 
 CentreEstimate estimate_centre(const Scan& scan) {
+  check_array(scan.measurement, "the centre's scan");
   if (!holds_structure(scan.measurement)) {
     (void)estimate_from(scan);  // the geometry's reasons first
     throw_without_structure();
