@@ -106,6 +106,29 @@ TEST_SUITE("flat_field") {
     CHECK(riner::pixels_without_beam_line(report).empty());
   }
 
+  TEST_CASE("a flat field of another exposure, or readings already -ln(I/I0), are named") {
+    // 20 views x 64 pixels: an object on the middle 40, air at the ends; counts about 4000.
+    Array raw({20, 64}), flat({64});
+    for (std::size_t p = 0; p < 64; ++p) {
+      flat.data[p] = 4000.0f;
+      const double object = p >= 12 && p < 52 ? 1.5 : 0.0;
+      for (std::size_t v = 0; v < 20; ++v) {
+        raw.data[v * 64 + p] = static_cast<float>(4000.0 * std::exp(-object) + (v + p) % 3);
+      }
+    }
+    FlatFieldReport report;
+    riner::flat_field_normalise(raw, flat, Array{}, &report);
+    CHECK(riner::air_level_line(report).empty());
+    // A flat of ones (the air read -7.06 without a word).
+    riner::flat_field_normalise(raw, Array({64}, 1.0f), Array{}, &report);
+    CHECK(riner::air_level_line(report).find("note: the air reads -8.29") == 0);
+    // Line integrals given as raw projections with the flat.
+    Array rho = raw;
+    for (float& x : rho.data) x = -std::log(x / 4000.0f) + 0.001f;
+    riner::flat_field_normalise(rho, flat, Array{}, &report);
+    CHECK(riner::air_level_line(report).find("note: even the least-attenuated elements read") == 0);
+  }
+
   TEST_CASE("a frame of the wrong shape, or nothing valid, is an InputError saying which") {
     const Array raw({2, 2, 3}, 50.0f);
     auto message = [&](const Array& flat, const Array& dark) -> std::string {

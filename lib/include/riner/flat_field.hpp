@@ -45,6 +45,15 @@ bool air_drifts(const FlatFieldReport& report);
 // One line naming the drift and what to do about it (empty when air_drifts is false).
 std::string air_drift_line(const FlatFieldReport& report);
 
+// Where the air (flat_field_drift's least-attenuated elements) reads after the flat field: below
+// -kAirBelowZero the projections saw more light than the flat (a flat of another exposure,
+// gain or scale: -7 for a flat of ones under counts of thousands); above kAirAbove even the
+// least-attenuated elements pass under 5% of the beam (readings that were -ln(I/I0) already,
+// or a flat of another detector region). One line saying so, or empty.
+constexpr double kAirBelowZero = 0.1;
+constexpr double kAirAbove = 3.0;
+std::string air_level_line(const FlatFieldReport& report);
+
 // A real detector has a few dead pixels; past this share of pixels without beam the flat field
 // is more likely of another detector region, binning or exposure than the projections'.
 constexpr double kMostPixelsWithoutBeam = 0.05;

@@ -110,6 +110,29 @@ std::string air_drift_line(const FlatFieldReport& r) {
   return line;
 }
 
+std::string air_level_line(const FlatFieldReport& r) {
+  if (!std::isfinite(r.air_first) || !std::isfinite(r.air_last)) return "";
+  const double level = std::min(r.air_first, r.air_last);
+  char line[400];
+  if (level < -kAirBelowZero) {
+    std::snprintf(line, sizeof(line),
+                  "note: the air reads %.3f after the flat field, where it reads 0: the "
+                  "projections saw %.0f%% more light than the flat field; check that the flat "
+                  "and dark fields are of this scan's exposure, gain and scale",
+                  level, 100.0 * std::expm1(-level));
+    return line;
+  }
+  if (level > kAirAbove) {
+    std::snprintf(line, sizeof(line),
+                  "note: even the least-attenuated elements read %.2f after the flat field "
+                  "(under %.1f%% of the beam): were the readings -ln(I/I0) already, or is the "
+                  "flat field of another detector region or exposure?",
+                  level, 100.0 * std::exp(-level));
+    return line;
+  }
+  return "";
+}
+
 std::string pixels_without_beam_line(const FlatFieldReport& r) {
   const double share =
       r.pixels > 0 ? static_cast<double>(r.pixels_without_beam) / static_cast<double>(r.pixels)

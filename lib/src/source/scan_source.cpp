@@ -274,7 +274,8 @@ Scan ScanRows::read(RowRange rows, FlatFieldReport* report) const {
 
 std::vector<std::string> flat_field_notes(const FlatFieldReport& report) {
   std::vector<std::string> notes{flat_field_line(report)};
-  for (std::string note : {pixels_without_beam_line(report), air_drift_line(report)}) {
+  for (std::string note :
+       {pixels_without_beam_line(report), air_level_line(report), air_drift_line(report)}) {
     if (!note.empty()) notes.push_back(std::move(note));
   }
   return notes;
