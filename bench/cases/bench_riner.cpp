@@ -84,7 +84,8 @@ std::vector<Result> riner_deeplesion(const Options& o) {
       riner::write_png(png_dir + "/deeplesion_slice" + std::to_string(slice) + ".png", panel,
                        riner::Window{0.0f, 0.035f});
     }
-    nlohmann::json fields = riner::bench::detector_accuracy(result.alpha, r.beta(), scene.sim, r.dead_elements());
+    nlohmann::json fields = riner::bench::detector_accuracy(result.alpha, r.trained_beta(),
+                                                            scene.sim, r.dead_elements());
     fields.update({{"scene", scene.name},
                    {"slice", slice},
                    {"psnr", m.psnr},
@@ -181,7 +182,7 @@ nlohmann::json real_scan_run(const riner::Scan& scan, const riner::Array& fbp_im
   const bool corrected = (rings && rings->applied) || (gradient && gradient->applied) ||
                          (response && response->applied) || (again && again->applied) ||
                          (after_detail && after_detail->applied);
-  const riner::Array beta = r.beta();
+  const riner::Array beta = r.trained_beta();
   int off = 0;
   for (float b : beta.data) off += b < 0.5f;
   if (!png.empty()) {

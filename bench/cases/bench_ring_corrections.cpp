@@ -74,7 +74,7 @@ std::vector<Result> ring_corrections(const Options& o) {
     r.run();
     const riner::Array field = r.field_image();
     const riner::Array alpha = r.trained_alpha();
-    const riner::Array beta = r.beta();
+    const riner::Array beta = r.trained_beta();
     const std::vector<std::size_t> dead = r.dead_elements();
     const riner::RingCorrection air =
         riner::correct_rings_from_air(field, alpha, g, config.rings.air);

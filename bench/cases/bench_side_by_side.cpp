@@ -44,7 +44,7 @@ std::vector<Checkpoint> train(riner::Reconstructor& r, const riner::bench::RingS
     const riner::ImageMetrics m = riner::compare_images(result.image, scene.sim.ground_truth);
     const riner::ImageMetrics f = riner::compare_images(result.field_image, scene.sim.ground_truth);
     curve.push_back({r.steps_done(), r.stats().seconds, m.psnr, m.ssim, f.psnr, f.ssim,
-                     riner::bench::detector_accuracy(result.alpha, r.beta(), scene.sim)});
+                     riner::bench::detector_accuracy(result.alpha, r.trained_beta(), scene.sim)});
   }
   return curve;
 }

@@ -125,7 +125,7 @@ std::vector<Result> size_scaling(const Options& o) {
           static_cast<double>(st.steps) * rays_per_step / static_cast<double>(g.n_views() * g.n_u);
       // beta below 0.5 on a live element takes its rays out of training: at size it was the
       // first sign of a loose fit (docs/history/RESULTS.md, issue 29).
-      const riner::Array beta = r.beta();
+      const riner::Array beta = r.trained_beta();
       int live_off = 0, dead_found = 0, dead = 0;
       for (std::size_t e = 0; e < beta.size(); ++e) {
         const bool is_dead = sim.alpha.data[e] == 0.0f;

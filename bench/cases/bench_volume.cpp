@@ -101,7 +101,8 @@ std::vector<Result> volume_case(const Options& o) {
   const riner::TrainingStats st = r.stats();
   const std::string png = o.get("png", "");
   if (!png.empty()) write_panel(png, {&sim.ground_truth, &fdk, &result.image});
-  nlohmann::json fields = riner::bench::detector_accuracy(result.alpha, r.beta(), sim, r.dead_elements());
+  nlohmann::json fields =
+      riner::bench::detector_accuracy(result.alpha, r.trained_beta(), sim, r.dead_elements());
   fields.update({{"volume", path},
                  {"spacing_mm", spacing.empty() ? "on the grid" : spacing},
                  {"psnr", m.psnr},

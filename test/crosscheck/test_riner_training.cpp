@@ -77,11 +77,11 @@ TEST_SUITE("riner_training") {
     riner::RinerConfig c = riner::test::tiny_config();
     c.training.beta_warmup_steps = 1000;
     auto [device, reference] = both_engines(t.scan, c);
-    const riner::Array before = device.beta();
+    const riner::Array before = device.trained_beta();
     device.step(40);
     reference.step(40);
-    const riner::Array a = device.beta();
-    const riner::Array b = reference.beta();
+    const riner::Array a = device.trained_beta();
+    const riner::Array b = reference.trained_beta();
     int dead = 0;
     for (std::size_t e = 0; e < a.size(); ++e) {
       CAPTURE(e);
@@ -293,7 +293,7 @@ TEST_SUITE("riner_training") {
     REQUIRE(by_view.shape == std::vector<std::size_t>{240, elements});
     // An element whose response holds over the scan reads, in every view, the response the
     // corrections left it (alpha_by_view is formed after the last of them).
-    const riner::Array alpha = on.alpha();
+    const riner::Array alpha = on.result().alpha;
     std::vector<bool> changes(elements, false);
     for (const riner::ChangingElement& e : changing) changes[e.element] = true;
     for (std::size_t e = 0; e < elements; ++e) {
@@ -437,7 +437,7 @@ TEST_SUITE("riner_training") {
     CHECK(r.steps_done() == 0);
     // trained_alpha(): alpha() also carries the ring corrections of the initial field's noise.
     for (float a : r.trained_alpha().data) CHECK(a == 1.0f);
-    for (float b : r.beta().data) CHECK(b == doctest::Approx(1.0 / (1.0 + std::exp(-1.0))));
+    for (float b : r.trained_beta().data) CHECK(b == doctest::Approx(1.0 / (1.0 + std::exp(-1.0))));
     CHECK(r.history().empty());
   }
 

@@ -47,7 +47,7 @@ TEST_SUITE("extreme_training") {
       riner::Reconstructor r(t.scan, c, riner::test::device());
       r.run();
       CHECK(all_finite(r.image()));
-      const riner::Array beta = r.beta();
+      const riner::Array beta = r.trained_beta();
       CHECK(all_finite(beta));
       double mean = 0.0;
       for (float b : beta.data) mean += b / static_cast<double>(beta.size());

@@ -132,11 +132,17 @@ TEST_SUITE("hostile_inputs") {
     riner::Reconstructor r = train(t.scan, 1200);
     // Element 25 crosses the middle of the object: it must be switched off. Element 0's rays
     // miss the object, so training keeps it on; no finite reading makes it dead all the same.
-    CHECK(r.beta().data[25] < 0.5f);
-    CHECK(r.beta().data[0] > 0.5f);
+    CHECK(r.trained_beta().data[25] < 0.5f);
+    CHECK(r.trained_beta().data[0] > 0.5f);
     const std::vector<std::size_t> dead = r.dead_elements();
     CHECK(std::count(dead.begin(), dead.end(), 0) == 1);
     CHECK(std::count(dead.begin(), dead.end(), 25) == 1);
+    // As riner hands them out (alpha.npy, beta.npy, the library's alpha() and beta()): both
+    // dead, beta < 0.5 and alpha 0 (the library's beta() read 1.0 for element 0).
+    CHECK(r.beta().data[0] < 0.5f);
+    CHECK(r.alpha().data[0] == 0.0f);
+    CHECK(r.alpha().data[25] == 0.0f);
+    CHECK(r.beta().data[1] == r.trained_beta().data[1]);
   }
 
   TEST_CASE("an all-zero scan gives a near-zero image; FBP gives exactly zero") {

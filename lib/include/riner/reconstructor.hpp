@@ -216,11 +216,15 @@ class Reconstructor {
   // the image and alpha together and keep the data fit.
   Array image() const;
   // An element whose response changes part-way: the geometric mean of its live segments'
-  // (beta >= kDeadBelowBeta) by their views; alpha_by_view() has each view's.
+  // (beta >= kDeadBelowBeta) by their views; alpha_by_view() has each view's. alpha() and beta()
+  // are as riner hands them out (alpha.npy, beta.npy): a dead element (dead_elements()) has
+  // alpha 0 and beta 0 (mark_dead_elements), so that beta < kDeadBelowBeta marks every dead
+  // element; trained_alpha() and trained_beta() are training's own values.
   Array alpha() const;
-  // sigmoid(beta0) per element (its largest segment's where it changes); < kDeadBelowBeta marks
-  // an element as dead.
   Array beta() const;
+  // sigmoid(beta0) per element (its largest segment's where it changes). An element with no
+  // finite reading gets no gradient: its beta stays near 1.
+  Array trained_beta() const;
   // ReconstructionResult::alpha_by_view, and the elements it is about.
   Array alpha_by_view() const;
   std::vector<ChangingElement> changing_elements() const;

@@ -399,7 +399,8 @@ void SlabRun::write_slab(const Slab& slab, const Reconstructor& r, const Summari
   const ReconstructionResult result = r.result();
   Array image = result.image;
   Array alpha = result.alpha;
-  Array beta = r.beta();
+  Array beta = r.trained_beta();
+  mark_dead_elements(r.dead_elements(), alpha, beta);  // as SlabRun::alpha() and beta() give them
   if (slices_2d_) {
     image.shape.insert(image.shape.begin(), 1);
     alpha = on_rows(alpha, slab.rows.count);

@@ -400,8 +400,10 @@ Array Reconstructor::image() const { return result().image; }
 Array Reconstructor::alpha() const {
   const RinerConfig& c = impl_->setup.config;
   // Without the corrections, alpha needs no evaluation of the field.
-  if (!corrects_rings(c, impl_->setup.scan.geometry)) return trained_alpha();
-  return result().alpha;
+  Array alpha = corrects_rings(c, impl_->setup.scan.geometry) ? result().alpha : trained_alpha();
+  Array beta = trained_beta();
+  mark_dead_elements(dead_elements(), alpha, beta);
+  return alpha;
 }
 
 Array Reconstructor::trained_alpha() const {
@@ -409,6 +411,13 @@ Array Reconstructor::trained_alpha() const {
 }
 
 Array Reconstructor::beta() const {
+  Array alpha = trained_alpha();
+  Array beta = trained_beta();
+  mark_dead_elements(dead_elements(), alpha, beta);
+  return beta;
+}
+
+Array Reconstructor::trained_beta() const {
   const model::ParameterLayout& l = impl_->setup.layout;
   const std::vector<float> p = impl_->trainer->parameters();
   const Geometry& g = impl_->setup.scan.geometry;
@@ -422,7 +431,7 @@ Array Reconstructor::beta() const {
 }
 
 std::vector<DeadElement> Reconstructor::dead_element_report() const {
-  const Array b = beta();
+  const Array b = trained_beta();
   // Per element (the slots of a changing element summed).
   std::vector<std::uint32_t> invalid(b.size(), 0);
   for (std::size_t slot = 0; slot < impl_->setup.invalid_readings.size(); ++slot) {
