@@ -1,13 +1,16 @@
 // OpenCL devices: discovery, capabilities and selection.
 #pragma once
 
-#include <CL/cl.h>
-
 #include <cstdint>
 #include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
+
+// OpenCL's handle types (cl_context and cl_command_queue point to these), named without
+// <CL/cl.h>, whose CL_TARGET_OPENCL_VERSION would then be riner's rather than the caller's.
+struct _cl_context;
+struct _cl_command_queue;
 
 namespace riner {
 
@@ -62,8 +65,9 @@ class Device {
   // Throws Error when nothing matches or no device exists.
   static Device open(std::string_view selector = "", bool profiling = false);
 
-  // Wraps a context and queue the caller already has (interop); riner retains them.
-  static Device from_handles(cl_context context, cl_command_queue queue, bool profiling = false);
+  // Wraps a context and queue the caller already has (interop); riner retains them. Error when
+  // the queue is out of order (every step relies on the order) or of another context.
+  static Device from_handles(_cl_context* context, _cl_command_queue* queue, bool profiling = false);
 
   const DeviceInfo& info() const;
   bool profiling() const;
