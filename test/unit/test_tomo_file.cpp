@@ -124,7 +124,28 @@ TEST_SUITE("tomo_file") {
     const riner::ArrayFile white =
         riner::read_array((dir / "tooth.h5").string() + ":/exchange/data_white");
     CHECK(white.array.data == t.flats.data);
-    CHECK(riner::read_array(dir / "tooth.h5").array.data == t.projections.data);
+    const riner::ArrayFile whole = riner::read_array(dir / "tooth.h5");
+    CHECK(whole.array.data == t.projections.data);
+    CHECK(whole.dtype == "uint16");  // as stored (read as float32; info said "float32")
+    CHECK(white.dtype == "uint16");
+  }
+
+  TEST_CASE("riner's own HDF5 volume reads back by the file's name alone") {
+    // fbp --out vol.h5 writes /volume; info, compare and read_array of vol.h5 said "holds
+    // neither /exchange/data ...".
+    riner::test::TempDir dir;
+    riner::Array volume({3, 5, 4});
+    for (std::size_t i = 0; i < volume.size(); ++i) volume.data[i] = 0.25f * static_cast<float>(i);
+    {
+      riner::test::Hdf5Writer w(dir / "vol.h5");
+      w.write("/volume", {3, 5, 4}, volume.data, H5T_IEEE_F32LE);
+    }
+    const riner::ArrayFile f = riner::read_array(dir / "vol.h5");
+    CHECK(f.array.shape == volume.shape);
+    CHECK(f.array.data == volume.data);
+    CHECK(f.dtype == "float32");
+    CHECK(riner::read_array_shape(dir / "vol.h5") == volume.shape);
+    CHECK(riner::read_array_rows(dir / "vol.h5", {1, 2}).array(2, 1, 3) == volume(2, 2, 3));
   }
 
   TEST_CASE("a field beside a tomography file replaces its own; a tomography file as a field") {

@@ -26,6 +26,7 @@ struct TomoFile {
   // before it, less a half); empty when the file does not say (Data Exchange): one series.
   std::vector<double> flat_positions;
   std::vector<double> angles_deg;  // per projection, as the file states them (may be empty)
+  std::string dtype;               // the frames' type in the file ("uint16"; read as float32)
   // NXtomo frames neither projection, flat nor dark (image_key 3: invalid; an alignment frame,
   // image_key_control -1): not read.
   std::size_t frames_left_out = 0;
@@ -49,6 +50,12 @@ Array read_hdf5_dataset(const std::filesystem::path& file, const std::string& da
                         std::optional<RowRange> rows = std::nullopt);
 std::vector<std::size_t> hdf5_dataset_shape(const std::filesystem::path& file,
                                             const std::string& dataset);
+
+// "/volume" where the file holds riner's own volume (riner fbp or reconstruct --out FILE.h5)
+// and no tomography layout, else "": a file read by its name alone.
+std::string hdf5_volume_dataset(const std::filesystem::path& file);
+// A dataset's type in the file, as numpy names it ("uint16", "float64").
+std::string hdf5_dataset_dtype(const std::filesystem::path& file, const std::string& dataset);
 
 // "file.h5:/group/dataset" -> {"file.h5", "/group/dataset"}; nullopt for any other path.
 std::optional<std::pair<std::filesystem::path, std::string>> split_hdf5_dataset(

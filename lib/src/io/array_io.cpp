@@ -51,11 +51,11 @@ void write_atomically(const std::filesystem::path& path, WriteFn&& write) {
   file.commit();
 }
 
-ArrayFile array_file(Array array, FileFormat format) {
+ArrayFile array_file(Array array, FileFormat format, std::string dtype = "float32") {
   ArrayFile f;
   f.array = std::move(array);
   f.format = format;
-  f.dtype = "float32";
+  f.dtype = std::move(dtype);
   f.non_finite = compute_stats(f.array).non_finite();
   return f;
 }
@@ -102,7 +102,8 @@ const char* format_name(FileFormat format) {
 
 ArrayFile read_array(const std::filesystem::path& path) {
   if (const auto named = split_hdf5_dataset(path)) {
-    return array_file(read_hdf5_dataset(named->first, named->second), FileFormat::kHdf5);
+    return array_file(read_hdf5_dataset(named->first, named->second), FileFormat::kHdf5,
+                      hdf5_dataset_dtype(named->first, named->second));
   }
   if (io::is_stack_path(path)) return io::read_stack(path, &read_array);
   switch (format_from_path(path)) {
@@ -119,7 +120,14 @@ ArrayFile read_array(const std::filesystem::path& path) {
     case FileFormat::kJson:
       throw InputError(io::prefix(path) + "is JSON, not an array file");
     case FileFormat::kHdf5:
-      return array_file(read_tomo_file(path).projections, FileFormat::kHdf5);
+      if (const std::string volume = hdf5_volume_dataset(path); !volume.empty()) {
+        return array_file(read_hdf5_dataset(path, volume), FileFormat::kHdf5,
+                          hdf5_dataset_dtype(path, volume));
+      }
+      {
+        TomoFile tomo = read_tomo_file(path);
+        return array_file(std::move(tomo.projections), FileFormat::kHdf5, tomo.dtype);
+      }
   }
   throw InputError(io::prefix(path) + "unknown file type");
 }
@@ -148,6 +156,9 @@ ArrayFile read_array_rows(const std::filesystem::path& path, RowRange rows) {
       return pages;
     }
     case FileFormat::kHdf5:
+      if (const std::string volume = hdf5_volume_dataset(path); !volume.empty()) {
+        return array_file(read_hdf5_dataset(path, volume, rows), FileFormat::kHdf5);
+      }
       return array_file(read_tomo_file(path, rows).projections, FileFormat::kHdf5);
     default:
       break;
@@ -169,6 +180,9 @@ std::vector<std::size_t> read_array_shape(const std::filesystem::path& path) {
     case FileFormat::kTiff:
       return io::tiff_shape(path);
     case FileFormat::kHdf5:
+      if (const std::string volume = hdf5_volume_dataset(path); !volume.empty()) {
+        return hdf5_dataset_shape(path, volume);
+      }
       return tomo_file_shape(path);
     case FileFormat::kNifti:
       return io::nifti_shape(path);

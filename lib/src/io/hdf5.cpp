@@ -71,6 +71,17 @@ OpenDataset open_dataset(const Hid& file, const std::filesystem::path& path,
   return d;
 }
 
+// The type a dataset holds on disk, as numpy names it ("uint16", "float32"); riner reads every
+// one as float32.
+std::string stored_type(const Hid& file, const std::string& dataset) {
+  const Hid set(H5Dopen2(file.get(), dataset.c_str(), H5P_DEFAULT), H5Dclose);
+  if (!set.ok()) return "unknown";
+  const Hid type(H5Dget_type(set.get()), H5Tclose);
+  const std::string bits = std::to_string(8 * H5Tget_size(type.get()));
+  if (H5Tget_class(type.get()) == H5T_FLOAT) return "float" + bits;
+  return (H5Tget_sign(type.get()) == H5T_SGN_NONE ? "uint" : "int") + bits;
+}
+
 // The first of a dataset's filters that the library cannot apply ("HDF5 filter 32008
 // (bitshuffle)"), or "" when it has them all: a file compressed by a detector's plugin
 // (bitshuffle/LZ4 on Eiger detectors) otherwise read as a corrupt file.
@@ -161,6 +172,7 @@ TomoFile read_data_exchange(const Hid& file, const std::filesystem::path& path,
                             std::optional<RowRange> rows) {
   TomoFile t;
   t.layout = "data exchange";
+  t.dtype = stored_type(file, "/exchange/data");
   t.projections =
       require_rank3(read_float_array(file, path, "/exchange/data", rows), path, "/exchange/data");
   if (exists(file, "/exchange/data_white")) {
@@ -190,6 +202,7 @@ TomoFile read_nxtomo(const Hid& file, const std::filesystem::path& path, const s
   }
   TomoFile t;
   t.layout = "nxtomo";
+  t.dtype = stored_type(file, data);
   t.projections = frames_with_key(all, keys, 0);
   t.flats = frames_with_key(all, keys, 1);
   t.darks = frames_with_key(all, keys, 2);
@@ -321,6 +334,17 @@ std::optional<std::pair<std::filesystem::path, std::string>> split_hdf5_dataset(
     if (is_hdf5_path(file)) return std::make_pair(file, text.substr(colon + 1));
   }
   return std::nullopt;
+}
+
+std::string hdf5_dataset_dtype(const std::filesystem::path& path, const std::string& dataset) {
+  const Hid file = open_file(path);
+  (void)open_dataset(file, path, dataset);  // its errors first
+  return stored_type(file, dataset);
+}
+
+std::string hdf5_volume_dataset(const std::filesystem::path& path) {
+  const Hid file = open_file(path);
+  return exists(file, "/volume") && !exists(file, "/exchange/data") ? "/volume" : "";
 }
 
 Array read_hdf5_dataset(const std::filesystem::path& path, const std::string& dataset,
