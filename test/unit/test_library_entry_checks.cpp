@@ -9,11 +9,15 @@
 #include <limits>
 
 #include "riner/centre.hpp"
+#include "riner/concurrent_trainings.hpp"
 #include "riner/destripe.hpp"
 #include "riner/error.hpp"
 #include "riner/fbp.hpp"
+#include "riner/io.hpp"
 #include "riner/reconstructor.hpp"
 #include "riner/scan.hpp"
+#include "riner/slab_run.hpp"
+#include "support/fixture.hpp"
 #include "support/geometries.hpp"
 
 namespace {
@@ -92,6 +96,41 @@ TEST_SUITE("library_entry_checks") {
     CHECK(error_of([&] { riner::fbp(scan, options); }).find("look like raw intensities") !=
           std::string::npos);
     CHECK_NOTHROW(riner::fbp(smooth_scan(), options));
+  }
+
+  TEST_CASE("slab options a library caller sets are checked, as the CLI checks its own") {
+    // A memory limit of 1 byte planned slabs of 261 MiB without a word; workers -3, processes
+    // 0 and checkpoints every -5 s were taken; an output that is a file threw
+    // std::filesystem::filesystem_error, not riner's.
+    riner::test::TempDir dir;
+    const riner::Geometry g = riner::test::small_parallel3d();
+    riner::Array stack({g.n_views(), g.n_v, g.n_u}, 0.2f);
+    riner::write_array(dir / "stack.npy", stack);
+    riner::write_text(dir / "geometry.json", g.to_json());
+    riner::RinerConfig config;
+    config.engine = riner::Engine::kReference;
+    const auto error_with = [&](const std::function<void(riner::SlabOptions&)>& set,
+                                const std::filesystem::path& out) {
+      riner::SlabOptions options;
+      set(options);
+      return error_of([&] {
+        riner::SlabRun run(riner::ScanRows({(dir / "stack.npy").string()}), config, out, options);
+      });
+    };
+    const std::filesystem::path out = dir / "run";
+    CHECK(error_with([](riner::SlabOptions& o) { o.memory_limit = 1; }, out)
+              .find("a memory limit of 1 bytes holds no slab") != std::string::npos);
+    CHECK(
+        error_with([](riner::SlabOptions& o) { o.workers = -3; }, out).find("workers must be 0") !=
+        std::string::npos);
+    CHECK(error_with([](riner::SlabOptions& o) { o.processes = 0; }, out)
+              .find("processes 1 or more") != std::string::npos);
+    CHECK(error_with([](riner::SlabOptions& o) { o.checkpoint_seconds = -5.0; }, out)
+              .find("checkpoint seconds 0") != std::string::npos);
+    riner::write_text(dir / "taken", "a file");
+    CHECK(error_with([](riner::SlabOptions&) {}, dir / "taken")
+              .find("is a file; a slabbed run writes into a folder") != std::string::npos);
+    CHECK_THROWS_AS(riner::run_concurrently(2, 1, std::nullopt, {}), riner::Error);
   }
 
   TEST_CASE("a range along the first axis past its end is refused, not wrapped") {

@@ -7,6 +7,8 @@
 #include <thread>
 #include <vector>
 
+#include "riner/error.hpp"
+
 namespace riner {
 
 namespace {
@@ -43,6 +45,7 @@ int usable_trainings(const DeviceInfo& device, int wanted, std::string* why) {
 
 void run_concurrently(std::size_t jobs, int workers, const std::optional<Device>& device,
                       const TrainingJob& job) {
+  if (!job) throw Error("run_concurrently: no job given");
   if (device) workers = usable_trainings(device->info(), workers);
   const int n =
       static_cast<int>(std::min<std::size_t>(std::max(1, workers), std::max<std::size_t>(jobs, 1)));

@@ -143,6 +143,20 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
       out_(std::move(out)),
       device_(std::move(device)) {
   config_.validate();
+  // The CLI's options are checked where they are read; a library caller's here.
+  if (options.memory_limit != 0 && options.memory_limit < (std::size_t{1} << 20)) {
+    throw InputError("slab options: a memory limit of " + std::to_string(options.memory_limit) +
+                     " bytes holds no slab (1 MiB at least; 0: the machine's)");
+  }
+  if (options.workers < 0 || options.processes < 1 || !(options.checkpoint_seconds >= 0.0) ||
+      !std::isfinite(options.checkpoint_seconds)) {
+    throw InputError(
+        "slab options: workers must be 0 (the device's) or more, processes 1 or "
+        "more, checkpoint seconds 0 (none) or more");
+  }
+  if (std::filesystem::exists(out_) && !std::filesystem::is_directory(out_)) {
+    throw InputError(out_.string() + ": is a file; a slabbed run writes into a folder");
+  }
   const Geometry& g = source_.geometry();
   memory_limit_ = options.limit();
   const int wanted_workers = options.workers > 0 ? options.workers
