@@ -235,6 +235,9 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   const bool leader = ranks.is_leader() && joined.empty();
   const bool speak = leader && !console.quiet();
   ScanRows source(source_from(args));
+  if (speak) {
+    for (const std::string& note : source.notes()) console.line(note);
+  }
   if (source.centre() && speak) console.line(centre_line(*source.centre()));
   require_quality_grid(source.geometry());
   require_training(settings);

@@ -130,6 +130,24 @@ TEST_SUITE("tomo_file") {
     CHECK(white.dtype == "uint16");
   }
 
+  TEST_CASE("a tomography file's own angles against the geometry's: a note where they differ") {
+    // A 360-degree NXtomo scan under a 180-degree geometry reconstructed garbage without a word.
+    const riner::Geometry half = riner::test::make_geometry(riner::GeometryType::kParallel2d, 360,
+                                                            64, 1, {48, 48}, 1.0, 1.0, M_PI);
+    std::vector<double> full(360), same(360), radians(360);
+    for (std::size_t v = 0; v < 360; ++v) {
+      full[v] = static_cast<double>(v);
+      same[v] = 0.5 * static_cast<double>(v);
+      radians[v] = same[v] * M_PI / 180.0;
+    }
+    CHECK(riner::file_angles_note("scan.nxs", full, half) ==
+          "note: scan.nxs states angles spanning 359.0 degrees over its 360 views, the geometry "
+          "179.5: riner takes the geometry's; check them");
+    CHECK(riner::file_angles_note("scan.nxs", same, half).empty());
+    CHECK(riner::file_angles_note("scan.nxs", radians, half).empty());
+    CHECK(riner::file_angles_note("scan.nxs", {}, half).empty());
+  }
+
   TEST_CASE("riner's own HDF5 volume reads back by the file's name alone") {
     // fbp --out vol.h5 writes /volume; info, compare and read_array of vol.h5 said "holds
     // neither /exchange/data ...".

@@ -57,6 +57,9 @@ class ScanRows {
   // Rows `rows` as a scan: measurement [views, count, columns], geometry with the detector cut to
   // those rows (detector_rows_geometry). InputError naming the data for bad readings.
   Scan read(RowRange rows, FlatFieldReport* report = nullptr) const;
+  // What reading the files found worth saying before any slab (a tomography file's own angles
+  // against the geometry's).
+  const std::vector<std::string>& notes() const { return notes_; }
 
  private:
   ScanSource source_;
@@ -64,7 +67,14 @@ class ScanRows {
   Geometry geometry_;
   std::vector<std::size_t> shape_;
   std::optional<CentreEstimate> centre_;
+  std::vector<std::string> notes_;
 };
+
+// A note where a tomography file's own angles (degrees, or radians) span other than the
+// geometry's by more than 2 degrees and a view's step (a 360-degree scan under a 180-degree
+// geometry reconstructs garbage); empty when they agree or the file states none.
+std::string file_angles_note(const std::string& path, const std::vector<double>& angles_deg,
+                             const Geometry& g);
 
 // One line: how many frames went into each field, what became invalid.
 std::string flat_field_line(const FlatFieldReport& report);

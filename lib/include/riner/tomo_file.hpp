@@ -42,6 +42,9 @@ bool is_hdf5_path(const std::filesystem::path& path);
 // slab of a large scan reads its own bytes).
 TomoFile read_tomo_file(const std::filesystem::path& path,
                         std::optional<RowRange> rows = std::nullopt);
+// The projections' angles as the file states them (degrees; empty where it states none),
+// without reading the frames.
+std::vector<double> tomo_file_angles(const std::filesystem::path& path);
 // The projections' shape [views, rows, columns], from the file's metadata.
 std::vector<std::size_t> tomo_file_shape(const std::filesystem::path& path);
 

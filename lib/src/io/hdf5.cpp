@@ -307,6 +307,24 @@ TomoFile read_tomo_file(const std::filesystem::path& path, std::optional<RowRang
   return read_nxtomo(file, path, layout.data, layout.keys, layout.angles, rows);
 }
 
+std::vector<double> tomo_file_angles(const std::filesystem::path& path) {
+  const Hid file = open_file(path);
+  const TomoLayout layout = find_layout(file, path);
+  std::vector<std::size_t> shape;
+  if (layout.data_exchange) {
+    if (!exists(file, "/exchange/theta")) return {};
+    return read_values<double>(file, path, "/exchange/theta", shape);
+  }
+  if (layout.angles.empty() || !exists(file, layout.angles)) return {};
+  const std::vector<double> keys = read_values<double>(file, path, layout.keys, shape);
+  const std::vector<double> angles = read_values<double>(file, path, layout.angles, shape);
+  std::vector<double> out;
+  for (std::size_t f = 0; f < keys.size() && f < angles.size(); ++f) {
+    if (static_cast<int>(keys[f]) == 0) out.push_back(angles[f]);
+  }
+  return out;
+}
+
 std::vector<std::size_t> tomo_file_shape(const std::filesystem::path& path) {
   const Hid file = open_file(path);
   const TomoLayout layout = find_layout(file, path);

@@ -1,5 +1,7 @@
 #include "riner/scan_source.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 
@@ -169,6 +171,27 @@ double parse_offset(const std::string& text) {
 
 }  // namespace
 
+std::string file_angles_note(const std::string& path, const std::vector<double>& angles_deg,
+                             const Geometry& g) {
+  if (angles_deg.size() < 2 || angles_deg.size() != g.n_views() || g.angles.size() < 2) return "";
+  const auto [low, high] = std::minmax_element(angles_deg.begin(), angles_deg.end());
+  const auto [first, last] = std::minmax_element(g.angles.begin(), g.angles.end());
+  const double file_span = *high - *low;
+  const double span = (*last - *first) * 180.0 / M_PI;
+  const double step = span / static_cast<double>(g.n_views() - 1);
+  const double tolerance = std::max(2.0, 0.02 * span) + step;  // an endpoint counted or not
+  if (std::fabs(file_span - span) <= tolerance ||
+      std::fabs(file_span * 180.0 / M_PI - span) <= tolerance) {  // the file's in radians
+    return "";
+  }
+  char line[400];
+  std::snprintf(line, sizeof(line),
+                "note: %s states angles spanning %.1f degrees over its %zu views, the geometry "
+                "%.1f: riner takes the geometry's; check them",
+                path.c_str(), file_span, angles_deg.size(), span);
+  return line;
+}
+
 LoadedScan load_scan_source(ScanSource source) {
   const bool tomo_file = resolve_files(source);
   LoadedScan loaded;
@@ -179,6 +202,11 @@ LoadedScan load_scan_source(ScanSource source) {
                             std::nullopt, source.row, &report, &layout);
     loaded.flat_field = report;
     layout += " file: ";
+    if (std::string note =
+            file_angles_note(source.path, tomo_file_angles(source.path), loaded.scan.geometry);
+        !note.empty()) {
+      loaded.notes.push_back(std::move(note));
+    }
   } else if (source.flat.empty()) {
     loaded.scan = load_scan(source.path, source.geometry, source.row);
     if (std::optional<std::string> note = transmission_note(loaded.scan)) {
@@ -233,6 +261,13 @@ ScanRows::ScanRows(ScanSource source) : source_(std::move(source)) {
                      "; slabs of detector rows need a 3D geometry");
   }
   geometry_.check_measurement_shape(shape_, source_.path);
+  if (tomo_file_) {
+    if (std::string note =
+            file_angles_note(source_.path, tomo_file_angles(source_.path), geometry_);
+        !note.empty()) {
+      notes_.push_back(std::move(note));
+    }
+  }
   // Slabs read the fields' rows late: their frames checked now, not after slabs are written.
   for (const auto& [name, what] :
        {std::pair{&source_.flat, "the flat field"}, std::pair{&source_.dark, "the dark field"},
