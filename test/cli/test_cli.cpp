@@ -577,7 +577,13 @@ TEST_SUITE("cli") {
     expect_error(
         riner_cli("fbp " + raw + "/projections --flat " + raw + "/wide.tif --out " + raw + "/x.nii",
                   dir),
-        2, raw + "/projections: the flat field is [20, 31]; it must be one frame");
+        2, raw + "/wide.tif: the flat field of shape [20, 31] is neither one frame of a view's");
+    // The flats after the scan named no file at all.
+    expect_error(
+        riner_cli("fbp " + raw + "/projections --flat " + raw + "/flat_0.tif --flat-after " + raw +
+                      "/wide.tif --out " + raw + "/x.nii",
+                  dir),
+        2, raw + "/wide.tif: the flat field after the scan of shape [20, 31] is neither");
     expect_error(riner_cli("fbp '" + raw + "/nothing_*.tif' --flat " + raw + "/wide.tif --out " +
                                raw + "/x.nii",
                            dir),

@@ -702,8 +702,8 @@ TEST_SUITE("cli") {
                           " --slab-slices 4 --out " + (dir / "flat").string(),
                       dir);
       CHECK(run.code == 2);
-      CHECK(run.err.find("the flat field is [2, " + std::to_string(rows) +
-                         ", 30]; it must be one frame of a view's shape [20, 30]") !=
+      CHECK(run.err.find("flats.npy: the flat field of shape [2, " + std::to_string(rows) +
+                         ", 30] is neither one frame of a view's shape [20, 30]") !=
             std::string::npos);
       CHECK_FALSE(std::filesystem::exists(dir / "flat" / "slabs"));
     }

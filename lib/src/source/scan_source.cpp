@@ -77,10 +77,28 @@ bool resolve_files(ScanSource& source) {
 
 enum class Field { kFlat, kDark };
 
+// A field's frames must be one frame of a view's shape or a stack of them: said naming the
+// field's file (it named the scan, or nothing for the flats after it).
+Array checked_field(Array frames, const std::vector<std::size_t>& projections,
+                    const std::string& path, const char* what) {
+  const std::vector<std::size_t> view(projections.begin() + 1, projections.end());
+  const bool one = frames.shape == view;
+  const bool stack = frames.rank() == view.size() + 1 && frames.shape[0] > 0 &&
+                     std::equal(view.begin(), view.end(), frames.shape.begin() + 1);
+  if (!one && !stack) {
+    throw InputError(path + ": " + what + " of shape " + shape_string(frames.shape) +
+                     " is neither one frame of a view's shape " + shape_string(view) +
+                     " nor a stack of them");
+  }
+  return frames;
+}
+
 // A flat or dark field's frames from `path` (only rows `rows` of each, when set). A tomography
 // file gives its own flats or darks: read as an array it gave its projections, which passed as
 // a flat field of 90 frames.
-Array field_frames(const std::string& path, Field field, std::optional<RowRange> rows) {
+// Checked against the projections' shape: named by its own file.
+Array field_frames(const std::string& path, Field field, std::optional<RowRange> rows,
+                   const std::vector<std::size_t>& projections, const char* what) {
   if (is_tomo_file(path)) {
     TomoFile file = read_tomo_file(path, rows);
     Array& frames = field == Field::kFlat ? file.flats : file.darks;
@@ -88,9 +106,10 @@ Array field_frames(const std::string& path, Field field, std::optional<RowRange>
       throw InputError(path + ": the file holds no " + (field == Field::kFlat ? "flat" : "dark") +
                        " field (" + file.layout + ")");
     }
-    return std::move(frames);
+    return checked_field(std::move(frames), projections, path, what);
   }
-  return rows ? frames_rows(path, *rows) : read_array(path).array;
+  return checked_field(rows ? frames_rows(path, *rows) : read_array(path).array, projections, path,
+                       what);
 }
 
 // A tomography file's projections with its own flats and darks, each replaced by a field given
@@ -105,19 +124,24 @@ Scan tomo_scan(const ScanSource& source, Geometry g, std::optional<RowRange> row
                 " frame(s) neither projection, flat nor dark (image_key 3 or an alignment "
                 "frame) left out";
   if (layout) *layout = file.layout + (left_out.empty() ? "" : " (" + left_out + ")");
-  Array flats =
-      source.flat.empty() ? std::move(file.flats) : field_frames(source.flat, Field::kFlat, rows);
+  Array flats = source.flat.empty() ? std::move(file.flats)
+                                    : field_frames(source.flat, Field::kFlat, rows,
+                                                   file.projections.shape, "the flat field");
   std::vector<double> positions = source.flat.empty() ? file.flat_positions : std::vector<double>{};
   if (flats.shape.empty()) {
     throw InputError(source.path + ": the file holds no flat field (" + file.layout +
                      "); pass one with --flat");
   }
-  const Array darks =
-      source.dark.empty() ? std::move(file.darks) : field_frames(source.dark, Field::kDark, rows);
+  const Array darks = source.dark.empty() ? std::move(file.darks)
+                                          : field_frames(source.dark, Field::kDark, rows,
+                                                         file.projections.shape, "the dark field");
   if (!source.flat_after.empty()) {
     const std::size_t series_before = positions.size();
-    FlatStack both = flats_before_after(flats, field_frames(source.flat_after, Field::kFlat, rows),
-                                        file.projections.shape);
+    FlatStack both =
+        flats_before_after(flats,
+                           field_frames(source.flat_after, Field::kFlat, rows,
+                                        file.projections.shape, "the flat field after the scan"),
+                           file.projections.shape);
     // The file's own series keep their places among the views; those after the scan follow.
     if (series_before > 0) {
       std::copy(positions.begin(), positions.end(), both.positions.begin());
@@ -140,9 +164,9 @@ void check_frames_shape(const std::string& path, const char* what,
   std::vector<std::size_t> shape = read_array_shape(path);
   if (shape.size() == 2) shape.insert(shape.begin(), 1);
   if (shape.size() != 3 || shape[0] == 0 || shape[1] != frame[0] || shape[2] != frame[1]) {
-    throw InputError(path + ": " + what + " is " + shape_string(read_array_shape(path)) +
-                     "; it must be one frame of a view's shape " + shape_string(frame) +
-                     " or a stack of them");
+    throw InputError(path + ": " + what + " of shape " + shape_string(read_array_shape(path)) +
+                     " is neither one frame of a view's shape " + shape_string(frame) +
+                     " nor a stack of them");
   }
 }
 
@@ -217,11 +241,14 @@ LoadedScan load_scan_source(ScanSource source) {
     const ArrayFile raw = read_array(source.path);
     const Array after = source.flat_after.empty()
                             ? Array()
-                            : field_frames(source.flat_after, Field::kFlat, std::nullopt);
+                            : field_frames(source.flat_after, Field::kFlat, std::nullopt,
+                                           raw.array.shape, "the flat field after the scan");
     const FlatStack flats = flats_before_after(
-        field_frames(source.flat, Field::kFlat, std::nullopt), after, raw.array.shape);
-    const Array darks =
-        source.dark.empty() ? Array() : field_frames(source.dark, Field::kDark, std::nullopt);
+        field_frames(source.flat, Field::kFlat, std::nullopt, raw.array.shape, "the flat field"),
+        after, raw.array.shape);
+    const Array darks = source.dark.empty() ? Array()
+                                            : field_frames(source.dark, Field::kDark, std::nullopt,
+                                                           raw.array.shape, "the dark field");
     loaded.scan = raw_scan(std::move(g), raw.array, flats.frames, darks, source.row, source.path,
                            &report, flats.positions);
     loaded.flat_field = report;
@@ -271,7 +298,7 @@ ScanRows::ScanRows(ScanSource source) : source_(std::move(source)) {
   // Slabs read the fields' rows late: their frames checked now, not after slabs are written.
   for (const auto& [name, what] :
        {std::pair{&source_.flat, "the flat field"}, std::pair{&source_.dark, "the dark field"},
-        std::pair{&source_.flat_after, "the flats after the scan"}}) {
+        std::pair{&source_.flat_after, "the flat field after the scan"}}) {
     if (!name->empty()) check_frames_shape(*name, what, {shape_[1], shape_[2]});
   }
   if (source_.offset_px == "auto") {
@@ -290,11 +317,15 @@ Scan ScanRows::read(RowRange rows, FlatFieldReport* report) const {
   if (!source_.flat.empty()) {
     const Array projections = read_array_rows(source_.path, rows).array;
     const FlatStack flats = flats_before_after(
-        field_frames(source_.flat, Field::kFlat, rows),
-        source_.flat_after.empty() ? Array() : field_frames(source_.flat_after, Field::kFlat, rows),
+        field_frames(source_.flat, Field::kFlat, rows, projections.shape, "the flat field"),
+        source_.flat_after.empty()
+            ? Array()
+            : field_frames(source_.flat_after, Field::kFlat, rows, projections.shape,
+                           "the flat field after the scan"),
         projections.shape);
-    const Array darks =
-        source_.dark.empty() ? Array() : field_frames(source_.dark, Field::kDark, rows);
+    const Array darks = source_.dark.empty() ? Array()
+                                             : field_frames(source_.dark, Field::kDark, rows,
+                                                            projections.shape, "the dark field");
     return raw_scan(g, projections, flats.frames, darks, std::nullopt, source_.path, report,
                     flats.positions);
   }
