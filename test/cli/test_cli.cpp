@@ -742,7 +742,29 @@ TEST_SUITE("cli") {
                      " is a stack [181, 2, 640] and the parallel2d geometry is 2D: "
                      "pick a detector row with --row");
     expect_error(riner_cli("fbp " + tooth.string() + " --row 2 --out " + out + "/x.nii", dir), 2,
-                 tooth.string() + ": no detector row 2 in frames of shape [181, 2, 640]");
+                 tooth.string() + ": no detector row 2: the stack [181, 2, 640] has rows 0..1");
+    // A row under a 3D geometry, and a row of a single sinogram: said what --row is for (they
+    // read "has shape [181, 640] but the geometry expects ..." and "no detector row 1 in frames
+    // of shape [459, 503]").
+    riner::write_text(dir / "g3.json",
+                      R"({"type": "parallel3d", "detector": {"count": [640, 2], "pitch_mm": [1.0, 1.0]},
+                          "angles": {"count": 181, "start_rad": 0, "range_rad": 3.141592653589793},
+                          "volume": {"shape": [2, 64, 64], "voxel_mm": 10.0}})");
+    expect_error(riner_cli("fbp " + tooth.string() + " --geometry " + (dir / "g3.json").string() +
+                               " --row 1 --out " + out + "/x.nii",
+                           dir),
+                 2,
+                 "a detector row (--row) is reconstructed as one slice under a 2D geometry; "
+                 "the geometry is parallel3d");
+    riner::write_array(dir / "sino.npy", riner::Array({181, 640}, 0.1f));
+    riner::write_text(dir / "geometry.json",
+                      riner::Geometry::load(tooth.parent_path() / "geometry.json").to_json());
+    expect_error(
+        riner_cli("fbp " + (dir / "sino.npy").string() + " --row 1 --out " + out + "/x.nii", dir),
+        2,
+        (dir / "sino.npy").string() +
+            ": a detector row is picked from a projection stack [views, rows, columns]; this is "
+            "[181, 640]");
   }
 
   TEST_CASE("settings: one table for the list, docs/settings.md, --set and config.json") {

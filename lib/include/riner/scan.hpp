@@ -59,6 +59,8 @@ std::optional<ScanFiles> read_scan_files(const std::filesystem::path& scan_json)
 // NaN or infinite, when nearly all are (or beyond kLargestReading), or when nearly all exceed
 // what any line integral reaches (raw intensities: give the flat field).
 void check_scan(const Scan& scan, std::string_view what = "measurement");
+// InputError unless `g` is a 2D geometry, the one a single detector row is a slice of.
+void require_slice_geometry(const Geometry& g);
 
 // A note when the readings look like transmissions I/I0 rather than -ln(I/I0): all within
 // about 0..1 (a detector's gains let air read up to 1.25), the detector's outer columns near 1

@@ -99,9 +99,16 @@ Array axial_slice(const Array& volume, std::size_t z) {
 }
 
 Array detector_row(const Array& stack, std::size_t row) {
-  if (stack.rank() != 3 || row >= stack.shape[1]) {
-    throw InputError("no detector row " + std::to_string(row) + " in frames of shape " +
-                     shape_string(stack.shape));
+  if (stack.rank() != 3) {
+    throw InputError(
+        "a detector row is picked from a projection stack [views, rows, columns]; "
+        "this is " +
+        shape_string(stack.shape) + ", one sinogram or image");
+  }
+  if (row >= stack.shape[1]) {
+    throw InputError("no detector row " + std::to_string(row) + ": the stack " +
+                     shape_string(stack.shape) + " has rows 0.." +
+                     std::to_string(stack.shape[1] - 1));
   }
   const std::size_t frames = stack.shape[0], rows = stack.shape[1], columns = stack.shape[2];
   Array out({frames, columns});

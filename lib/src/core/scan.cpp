@@ -161,13 +161,28 @@ std::filesystem::path find_geometry(const std::filesystem::path& measurement,
                    ": no geometry given and no geometry.json beside it (use --geometry)");
 }
 
+void require_slice_geometry(const Geometry& g) {
+  if (g.is_3d()) {
+    throw InputError(
+        "a detector row (--row) is reconstructed as one slice under a 2D geometry; "
+        "the geometry is " +
+        std::string(geometry_type_name(g.type)) +
+        ": give a 2D one, or leave out the row to reconstruct the whole stack");
+  }
+}
+
 Scan load_scan(const std::filesystem::path& measurement, const std::filesystem::path& geometry,
                std::optional<std::size_t> row) {
   Scan scan;
   scan.geometry = Geometry::load(find_geometry(measurement, geometry));
+  if (row) require_slice_geometry(scan.geometry);
   ArrayFile file = read_array(measurement);
   if (row) {
-    scan.measurement = detector_row(file.array, *row);
+    try {
+      scan.measurement = detector_row(file.array, *row);
+    } catch (const InputError& e) {
+      throw InputError(measurement.string() + ": " + e.what());
+    }
     scan.non_finite = compute_stats(scan.measurement).non_finite();
   } else {
     scan.measurement = std::move(file.array);

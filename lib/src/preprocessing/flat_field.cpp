@@ -317,6 +317,7 @@ Scan raw_scan(Geometry geometry, const Array& projections, const Array& flats, c
               const std::vector<double>& flat_positions) {
   Scan scan;
   scan.geometry = std::move(geometry);
+  if (row) require_slice_geometry(scan.geometry);
   FlatFieldReport r;
   try {
     if (row) {
