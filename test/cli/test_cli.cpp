@@ -515,6 +515,14 @@ TEST_SUITE("cli") {
     CHECK(summary["flat_field"]["dark_frames"] == 2);
     CHECK(summary["flat_field"]["invalid_readings"] == 1);
     CHECK(summary["non_finite_replaced"] == 1);
+    // From inside the folder, as "." or as a pattern there: the geometry beside the folder
+    // ("no geometry.json beside it": "." and "proj_*.tif" had no parent to look in).
+    for (const char* scan_name : {".", "'proj_*.tif'"}) {
+      CAPTURE(scan_name);
+      const std::string command = "cd " + raw + "/projections && " + RINER_CLI_PATH + " fbp " +
+                                  scan_name + " --flat ../flat_0.tif --out ../inside.nii --quiet";
+      CHECK(std::system(command.c_str()) == 0);
+    }
     REQUIRE(riner_cli("fbp " + sim + "/sino_clean.npy --out " + raw + "/fbp_rho.nii --quiet", dir)
                 .code == 0);
     const Run compare =

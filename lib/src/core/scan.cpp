@@ -146,8 +146,9 @@ std::filesystem::path find_geometry(const std::filesystem::path& measurement,
   if (!geometry.empty()) return geometry;
   std::vector<std::filesystem::path> folders;
   if (io::is_stack_path(measurement)) {
-    std::filesystem::path folder = measurement;
-    if (folder.filename().empty()) folder = folder.parent_path();               // "tiffs/"
+    // Absolute first: "." and a pattern in the working folder have no parent to look beside.
+    std::filesystem::path folder = std::filesystem::absolute(measurement).lexically_normal();
+    if (folder.filename().empty()) folder = folder.parent_path();               // "tiffs/", "."
     if (!std::filesystem::is_directory(folder)) folder = folder.parent_path();  // a pattern
     folders = {folder, folder.parent_path()};
   } else {
