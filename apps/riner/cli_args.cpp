@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 
 namespace riner::app {
 
@@ -85,8 +86,17 @@ bool Args::parse(int argc, char** argv, int first) {
       }
       continue;
     }
-    if (next_positional >= positionals_.size())
-      throw UsageError("unexpected argument '" + arg + "'");
+    if (next_positional >= positionals_.size()) {
+      // The shell expanded an unquoted pattern into its files: the second is "unexpected".
+      const bool expanded =
+          !positionals_.empty() && std::filesystem::exists(arg) &&
+          std::filesystem::path(arg).extension() ==
+              std::filesystem::path(values_[positionals_.back().name]).extension();
+      throw UsageError("unexpected argument '" + arg + "'" +
+                       (expanded ? " (the shell expanded a pattern into its files: quote it, "
+                                   "'proj_*.tif')"
+                                 : ""));
+    }
     values_[positionals_[next_positional++].name] = arg;
   }
   for (std::size_t p = next_positional; p < positionals_.size(); ++p) {

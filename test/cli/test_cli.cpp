@@ -523,6 +523,20 @@ TEST_SUITE("cli") {
                                   scan_name + " --flat ../flat_0.tif --out ../inside.nii --quiet";
       CHECK(std::system(command.c_str()) == 0);
     }
+    // A folder copied from a Mac holds "._proj_0.tif" beside each image ("not a readable TIFF").
+    riner::test::write_bytes(dir / "raw" / "projections" / "._proj_0.tif", "Mac OS X metadata");
+    CHECK(riner_cli("fbp " + raw + "/projections --flat " + raw + "/flat_0.tif --out " + raw +
+                        "/mac.nii --quiet",
+                    dir)
+              .code == 0);
+    // An unquoted pattern: the shell hands riner its files.
+    expect_error(riner_cli("fbp " + raw + "/projections/proj_*.tif --flat " + raw +
+                               "/flat_0.tif --out " + raw + "/glob.nii",
+                           dir),
+                 2,
+                 "unexpected argument '" + raw +
+                     "/projections/proj_1.tif' (the shell expanded a "
+                     "pattern into its files: quote it, 'proj_*.tif')");
     REQUIRE(riner_cli("fbp " + sim + "/sino_clean.npy --out " + raw + "/fbp_rho.nii --quiet", dir)
                 .code == 0);
     const Run compare =

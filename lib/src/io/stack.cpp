@@ -78,6 +78,8 @@ std::vector<std::filesystem::path> stack_files(const std::filesystem::path& path
   for (const auto& entry : std::filesystem::directory_iterator(dir)) {
     if (!entry.is_regular_file()) continue;
     const std::string name = entry.path().filename().string();
+    // macOS's AppleDouble files ("._proj_0.tif") beside each image copied from a Mac.
+    if (name.rfind("._", 0) == 0) continue;
     const bool wanted = folder ? is_image_file(entry.path())
                                : fnmatch(pattern.c_str(), name.c_str(), FNM_PERIOD) == 0;
     if (wanted) files.push_back(entry.path());
