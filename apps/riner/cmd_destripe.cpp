@@ -133,6 +133,7 @@ int run_destripe(int argc, char** argv, int first) {
   console.line(line);
   note_large_stripes(console, report);
   nlohmann::json summary = {{"out", out.string()},
+                            {"inputs", inputs_json(args)},
                             {"method", destripe_method_name(options.method)},
                             {"size", report.size},
                             {"large_size", report.large_size},

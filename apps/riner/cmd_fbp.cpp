@@ -156,6 +156,7 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
        {"short_scan", report.fbp.short_scan},
        {"parker_weighted", report.fbp.parker_weighted},
        {"half_acquisition_overlap_mm", report.fbp.half_acquisition_overlap_mm},
+       {"inputs", inputs_json(args)},
        {"flat_field",
         report.flat_field ? flat_field_json(*report.flat_field) : nlohmann::json(nullptr)},
        {"slices_without_readings", report.slices_without_readings},
@@ -259,6 +260,7 @@ int run_fbp(int argc, char** argv, int first) {
        {"half_acquisition_overlap_mm", report.half_acquisition_overlap_mm},
        {"destripe",
         stripes ? nlohmann::json(destripe_method_name(stripes->method)) : nlohmann::json(nullptr)},
+       {"inputs", inputs_json(args)},
        {"flat_field",
         loaded.flat_field ? flat_field_json(*loaded.flat_field) : nlohmann::json(nullptr)},
        {"centre", loaded.centre ? centre_json(*loaded.centre) : nlohmann::json(nullptr)}});

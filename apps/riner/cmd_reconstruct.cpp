@@ -314,6 +314,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   write_history(out / "loss.csv", reconstructor.history());
   write_text(out / "config.json", reconstructor.config().to_json());  // as resolved for the device
 
+  summary["inputs"] = inputs_json(args);
   summary["flat_field"] =
       loaded.flat_field ? flat_field_json(*loaded.flat_field) : nlohmann::json(nullptr);
   summary["centre"] = loaded.centre ? centre_json(*loaded.centre) : nlohmann::json(nullptr);

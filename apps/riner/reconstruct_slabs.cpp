@@ -573,6 +573,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       {"changing_elements", changing},
       {"slabs_without_readings", without_readings},
       {"non_finite_measurements", non_finite},
+      {"inputs", inputs_json(args)},
       {"flat_field", flat ? flat_field_json(*flat) : nlohmann::json(nullptr)},
       {"centre",
        run.source().centre() ? centre_json(*run.source().centre()) : nlohmann::json(nullptr)},

@@ -73,6 +73,20 @@ ScanSource source_from(const Args& args) {
   return source;
 }
 
+nlohmann::json inputs_json(const Args& args) {
+  const ScanSource s = source_from(args);
+  const auto named = [](const std::string& name) {
+    return name.empty() ? nlohmann::json(nullptr) : nlohmann::json(name);
+  };
+  return {{"scan", s.path},
+          {"geometry", named(s.geometry)},
+          {"flat", named(s.flat)},
+          {"dark", named(s.dark)},
+          {"flat_after", named(s.flat_after)},
+          {"row", s.row ? nlohmann::json(*s.row) : nlohmann::json(nullptr)},
+          {"offset_px", named(s.offset_px)}};
+}
+
 std::optional<Geometry> stack_geometry(const Args& args) {
   if (auto row = args.maybe("row"); row && !row->empty()) return std::nullopt;
   ScanSource source = source_from(args);

@@ -14,6 +14,9 @@ void add_scan_options(Args& args);
 
 // The scan as the options name it (UsageError for a combination that cannot work).
 ScanSource source_from(const Args& args);
+// What the command read, for summary.json: the scan, geometry, flat, dark and flats after it as
+// given (null where not), the row and the centre offset asked for.
+nlohmann::json inputs_json(const Args& args);
 
 // The geometry of the projection stack the options name, from the files' headers alone (no
 // data, no centre estimate): what deciding on slabs needs. nullopt for one detector row

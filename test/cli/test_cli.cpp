@@ -512,6 +512,9 @@ TEST_SUITE("cli") {
     REQUIRE(fbp.code == 0);
     const auto summary = nlohmann::json::parse(fbp.out);
     CHECK(summary["flat_field"]["flat_frames"] == 3);
+    CHECK(summary["inputs"]["flat"] == raw + "/flat_*.tif");  // what was read, as given
+    CHECK(summary["inputs"]["dark"] == raw + "/dark.npy");
+    CHECK(summary["inputs"]["row"].is_null());
     CHECK(summary["flat_field"]["dark_frames"] == 2);
     CHECK(summary["flat_field"]["invalid_readings"] == 1);
     CHECK(summary["non_finite_replaced"] == 1);
