@@ -492,6 +492,8 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       flat->air_drift_sigmas = -1.0;
     }
     flat->invalid_readings += f["invalid_readings"].get<std::size_t>();
+    flat->saturated_readings +=
+        f.value("saturated_readings", std::size_t{0});  // older records: none
     flat->pixels_without_beam += f["pixels_without_beam"].get<std::size_t>();
     flat->pixels += f["pixels"].get<std::size_t>();
     // null where the air read nothing finite at the scan's start or end (NaN in JSON).

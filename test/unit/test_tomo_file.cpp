@@ -148,6 +148,29 @@ TEST_SUITE("tomo_file") {
     CHECK(riner::file_angles_note("scan.nxs", {}, half).empty());
   }
 
+  TEST_CASE("a saturated reading (65535 in uint16) is invalid, not a bright one") {
+    // It read as rho = -2.8 in every view (more light than the flat's 4000 counts).
+    riner::test::TempDir dir;
+    std::vector<std::uint16_t> projections = frames(0, 6, 0);
+    projections[2 * kFrame + 7] = 65535;
+    {
+      riner::test::Hdf5Writer w(dir / "scan.h5");
+      w.write("/exchange/data", {6, kRows, kCols}, projections, H5T_STD_U16LE);
+      w.write("/exchange/data_white", {3, kRows, kCols}, frames(1, 3, 0), H5T_STD_U16LE);
+    }
+    const riner::Geometry g = riner::test::make_geometry(riner::GeometryType::kParallel3d, 6, kCols,
+                                                         kRows, {kRows, 24, 24}, 1.0, 1.0, M_PI);
+    riner::write_text(dir / "geometry.json", g.to_json());
+    const riner::LoadedScan loaded = riner::load_scan_source({(dir / "scan.h5").string()});
+    REQUIRE(loaded.flat_field);
+    CHECK(loaded.flat_field->saturated_readings == 1);
+    CHECK(std::isnan(loaded.scan.measurement.data[2 * kFrame + 7]));
+    CHECK(riner::saturation_line(*loaded.flat_field).find("note: 1 readings at their type's") == 0);
+    riner::Array floats({2}, std::vector<float>{65535.0f, 1.0f});
+    CHECK(riner::mark_saturated(floats, "float32") == 0);  // no largest count to know
+    CHECK(riner::mark_saturated(floats, "uint16") == 1);
+  }
+
   TEST_CASE("riner's own HDF5 volume reads back by the file's name alone") {
     // fbp --out vol.h5 writes /volume; info, compare and read_array of vol.h5 said "holds
     // neither /exchange/data ...".

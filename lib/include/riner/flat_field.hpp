@@ -24,6 +24,9 @@ struct FlatFieldReport {
   // Detector pixels with F - D <= 0 or no finite flat or dark frame: all their readings are NaN.
   std::size_t pixels_without_beam = 0;
   std::size_t pixels = 0;  // of one view
+  // Of the invalid readings, those at their integer type's largest count (65535 in uint16, 255
+  // in uint8): a saturated detector's, whose -ln under-reads the attenuation.
+  std::size_t saturated_readings = 0;
   // Flat series taken at different times (before and after the scan, say) and the beam's
   // change from the first to the last, the median over pixels of (F - D) last / first - 1.
   std::size_t flat_series = 1;
@@ -53,6 +56,11 @@ std::string air_drift_line(const FlatFieldReport& report);
 constexpr double kAirBelowZero = 0.1;
 constexpr double kAirAbove = 3.0;
 std::string air_level_line(const FlatFieldReport& report);
+// One line on the saturated readings, or empty.
+std::string saturation_line(const FlatFieldReport& report);
+// Readings of `dtype` (the file's) at its largest count set to NaN, and counted: uint16 and
+// uint8 only (a 12-bit camera's 4095 in uint16 is not known from the file).
+std::size_t mark_saturated(Array& projections, const std::string& dtype);
 
 // A real detector has a few dead pixels; past this share of pixels without beam the flat field
 // is more likely of another detector region, binning or exposure than the projections'.

@@ -133,6 +133,26 @@ std::string air_level_line(const FlatFieldReport& r) {
   return "";
 }
 
+std::string saturation_line(const FlatFieldReport& r) {
+  if (r.saturated_readings == 0) return "";
+  return "note: " + std::to_string(r.saturated_readings) +
+         " readings at their type's largest count (a saturated detector: more light than it "
+         "counts) taken as invalid";
+}
+
+std::size_t mark_saturated(Array& projections, const std::string& dtype) {
+  const float most = dtype == "uint16" ? 65535.0f : dtype == "uint8" ? 255.0f : 0.0f;
+  if (most == 0.0f) return 0;
+  std::size_t count = 0;
+  for (float& x : projections.data) {
+    if (x == most) {
+      x = std::numeric_limits<float>::quiet_NaN();
+      ++count;
+    }
+  }
+  return count;
+}
+
 std::string pixels_without_beam_line(const FlatFieldReport& r) {
   const double share =
       r.pixels > 0 ? static_cast<double>(r.pixels_without_beam) / static_cast<double>(r.pixels)

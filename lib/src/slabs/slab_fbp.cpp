@@ -117,11 +117,13 @@ void merge_flat_report(SlabFbpReport& report, const FlatFieldReport& slab, std::
   if (!report.flat_field) {
     report.flat_field = slab;
     report.flat_field->invalid_readings = 0;
+    report.flat_field->saturated_readings = 0;
     report.flat_field->pixels_without_beam = 0;
     report.flat_field->pixels = 0;
   }
   FlatFieldReport& all = *report.flat_field;
   all.invalid_readings += non_finite;
+  all.saturated_readings += scaled(slab.saturated_readings);
   all.pixels_without_beam += scaled(slab.pixels_without_beam);
   all.pixels += scaled(slab.pixels);
   if (std::isfinite(slab.air_first) && std::isfinite(slab.air_last) &&

@@ -78,6 +78,7 @@ nlohmann::json readings_record(const Scan& scan, const Slab& slab, const FlatFie
   out["flat_field"] = {{"flat_frames", flat.flat_frames},
                        {"dark_frames", flat.dark_frames},
                        {"invalid_readings", scaled(flat.invalid_readings)},
+                       {"saturated_readings", scaled(flat.saturated_readings)},
                        {"pixels_without_beam", scaled(flat.pixels_without_beam)},
                        {"pixels", scaled(flat.pixels)},
                        {"flat_series", flat.flat_series},

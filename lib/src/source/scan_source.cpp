@@ -149,9 +149,12 @@ Scan tomo_scan(const ScanSource& source, Geometry g, std::optional<RowRange> row
     flats = std::move(both.frames);
     positions = std::move(both.positions);
   }
+  const std::size_t saturated = mark_saturated(file.projections, file.dtype);
   try {
-    return raw_scan(std::move(g), file.projections, flats, darks, row, source.path, report,
-                    positions);
+    Scan scan =
+        raw_scan(std::move(g), file.projections, flats, darks, row, source.path, report, positions);
+    if (report) report->saturated_readings = saturated;
+    return scan;
   } catch (const InputError& e) {
     if (left_out.empty()) throw;
     throw InputError(std::string(e.what()) + " (" + left_out + ")");
@@ -238,7 +241,8 @@ LoadedScan load_scan_source(ScanSource source) {
     }
   } else {
     Geometry g = Geometry::load(find_geometry(source.path, source.geometry));
-    const ArrayFile raw = read_array(source.path);
+    ArrayFile raw = read_array(source.path);
+    const std::size_t saturated = mark_saturated(raw.array, raw.dtype);
     const Array after = source.flat_after.empty()
                             ? Array()
                             : field_frames(source.flat_after, Field::kFlat, std::nullopt,
@@ -251,6 +255,7 @@ LoadedScan load_scan_source(ScanSource source) {
                                                            raw.array.shape, "the dark field");
     loaded.scan = raw_scan(std::move(g), raw.array, flats.frames, darks, source.row, source.path,
                            &report, flats.positions);
+    report.saturated_readings = saturated;
     loaded.flat_field = report;
   }
   if (loaded.flat_field) {
@@ -315,7 +320,9 @@ Scan ScanRows::read(RowRange rows, FlatFieldReport* report) const {
   const Geometry g = detector_rows_geometry(geometry_, rows.first, rows.count);
   if (tomo_file_) return tomo_scan(source_, g, rows, std::nullopt, report, nullptr);
   if (!source_.flat.empty()) {
-    const Array projections = read_array_rows(source_.path, rows).array;
+    ArrayFile file = read_array_rows(source_.path, rows);
+    const std::size_t saturated = mark_saturated(file.array, file.dtype);
+    const Array& projections = file.array;
     const FlatStack flats = flats_before_after(
         field_frames(source_.flat, Field::kFlat, rows, projections.shape, "the flat field"),
         source_.flat_after.empty()
@@ -326,8 +333,10 @@ Scan ScanRows::read(RowRange rows, FlatFieldReport* report) const {
     const Array darks = source_.dark.empty() ? Array()
                                              : field_frames(source_.dark, Field::kDark, rows,
                                                             projections.shape, "the dark field");
-    return raw_scan(g, projections, flats.frames, darks, std::nullopt, source_.path, report,
-                    flats.positions);
+    Scan scan = raw_scan(g, projections, flats.frames, darks, std::nullopt, source_.path, report,
+                         flats.positions);
+    if (report) report->saturated_readings = saturated;
+    return scan;
   }
   ArrayFile file = read_array_rows(source_.path, rows);
   Scan scan;
@@ -340,8 +349,8 @@ Scan ScanRows::read(RowRange rows, FlatFieldReport* report) const {
 
 std::vector<std::string> flat_field_notes(const FlatFieldReport& report) {
   std::vector<std::string> notes{flat_field_line(report)};
-  for (std::string note :
-       {pixels_without_beam_line(report), air_level_line(report), air_drift_line(report)}) {
+  for (std::string note : {saturation_line(report), pixels_without_beam_line(report),
+                           air_level_line(report), air_drift_line(report)}) {
     if (!note.empty()) notes.push_back(std::move(note));
   }
   return notes;
