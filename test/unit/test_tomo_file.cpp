@@ -148,6 +148,27 @@ TEST_SUITE("tomo_file") {
     CHECK(riner::file_angles_note("scan.nxs", {}, half).empty());
   }
 
+  TEST_CASE("Data Exchange: one flat frame stored 2D, an empty dark dataset") {
+    // Refused ("expected [frames, rows, columns]", "must be one frame ... or a stack"), though
+    // --flat takes one 2D frame and a missing data_dark is none.
+    riner::test::TempDir dir;
+    const std::vector<std::uint16_t> flat = frames(1, 1, 0);
+    {
+      riner::test::Hdf5Writer w(dir / "scan.h5");
+      w.write("/exchange/data", {6, kRows, kCols}, frames(0, 6, 0), H5T_STD_U16LE);
+      w.write("/exchange/data_white", {kRows, kCols}, flat, H5T_STD_U16LE);
+      w.write("/exchange/data_dark", {0, kRows, kCols}, std::vector<std::uint16_t>{},
+              H5T_STD_U16LE);
+    }
+    const riner::TomoFile t = riner::read_tomo_file(dir / "scan.h5");
+    CHECK(t.flats.shape == std::vector<std::size_t>{1, kRows, kCols});
+    CHECK(t.flats.data == as_array(flat, 1).data);
+    CHECK(t.darks.shape.empty());
+    const riner::TomoFile two = riner::read_tomo_file(dir / "scan.h5", riner::RowRange{1, 2});
+    CHECK(two.flats.shape == std::vector<std::size_t>{1, 2, kCols});
+    CHECK(two.flats(0, 1, 5) == t.flats(0, 2, 5));
+  }
+
   TEST_CASE("a saturated reading (65535 in uint16) is invalid, not a bright one") {
     // It read as rho = -2.8 in every view (more light than the flat's 4000 counts).
     riner::test::TempDir dir;

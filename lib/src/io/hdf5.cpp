@@ -168,6 +168,21 @@ Array frames_with_key(const Array& all, const std::vector<double>& keys, int key
   return out;
 }
 
+// A Data Exchange flat or dark field: [frames, rows, columns], or one frame [rows, columns] as
+// some writers store a single one; none where the dataset is missing or holds no frame.
+Array field_frames(const Hid& file, const std::filesystem::path& path, const std::string& dataset,
+                   std::optional<RowRange> rows) {
+  if (!exists(file, dataset)) return {};
+  const OpenDataset d = open_dataset(file, path, dataset);
+  if (d.dims.size() == 3 && d.dims[0] == 0) return {};
+  if (d.dims.size() == 2) {
+    Array frame = read_float_array(file, path, dataset);
+    frame.shape.insert(frame.shape.begin(), 1);
+    return rows ? detector_rows(frame, *rows) : frame;
+  }
+  return require_rank3(read_float_array(file, path, dataset, rows), path, dataset);
+}
+
 TomoFile read_data_exchange(const Hid& file, const std::filesystem::path& path,
                             std::optional<RowRange> rows) {
   TomoFile t;
@@ -175,14 +190,8 @@ TomoFile read_data_exchange(const Hid& file, const std::filesystem::path& path,
   t.dtype = stored_type(file, "/exchange/data");
   t.projections =
       require_rank3(read_float_array(file, path, "/exchange/data", rows), path, "/exchange/data");
-  if (exists(file, "/exchange/data_white")) {
-    t.flats = require_rank3(read_float_array(file, path, "/exchange/data_white", rows), path,
-                            "/exchange/data_white");
-  }
-  if (exists(file, "/exchange/data_dark")) {
-    t.darks = require_rank3(read_float_array(file, path, "/exchange/data_dark", rows), path,
-                            "/exchange/data_dark");
-  }
+  t.flats = field_frames(file, path, "/exchange/data_white", rows);
+  t.darks = field_frames(file, path, "/exchange/data_dark", rows);
   if (exists(file, "/exchange/theta")) {
     std::vector<std::size_t> shape;
     t.angles_deg = read_values<double>(file, path, "/exchange/theta", shape);
