@@ -381,6 +381,9 @@ def test_load_scan_reads_a_tomography_file_and_finds_its_centre(shared):
                        equal_nan=True)
     assert notes["centre"]["offset_px"] == pytest.approx(23.9, abs=1.0)  # geometry.json: 23.9
     assert g["detector"]["offset_px"] == notes["centre"]["offset_px"]
+    # The axis's column, as reconstruct takes it (it was refused: "None or 'auto' here").
+    _, g, _ = riner.load_scan(shared / "tooth" / "tooth.h5", row=0, center=296.0)
+    assert g["detector"]["offset_px"] == pytest.approx((640 - 1) / 2 - 296.0)
 
 
 def test_load_scan_reads_a_scan_json_naming_raw_files(tmp_path):

@@ -89,6 +89,20 @@ def _offset(columns, center):
         raise InputError(f'center must be the axis\'s column (a number) or "auto" (got {center!r})') from None
 
 
+def _axis_offset(g, center):
+    # The offset of a geometry dict's detector for the axis at column `center`.
+    columns = g["detector"]["count"]
+    return _offset(columns[0] if isinstance(columns, list) else columns, center)
+
+
+def _set_offset(g, offset):
+    # A 3D detector's offset is [u, v]: the axis moves u only.
+    if isinstance(g["detector"]["offset_px"], list):
+        g["detector"]["offset_px"][0] = offset
+    else:
+        g["detector"]["offset_px"] = offset
+
+
 def _detector(columns, rows, pitch, center):
     offset = _offset(columns, center)
     if rows is None:
@@ -166,12 +180,8 @@ def _scan(sino, geometry_spec, flat, dark, center_spec, flat_after=None):
             notes["centre"] = json.loads(_riner.center(sino, geometry_json))
             offset = notes["centre"]["offset_px"]
         else:
-            columns = g["detector"]["count"]
-            offset = _offset(columns[0] if isinstance(columns, list) else columns, center_spec)
-        if isinstance(g["detector"]["offset_px"], list):
-            g["detector"]["offset_px"][0] = offset
-        else:
-            g["detector"]["offset_px"] = offset
+            offset = _axis_offset(g, center_spec)
+        _set_offset(g, offset)
         geometry_json = _riner.geometry_json(json.dumps(g), "geometry")
     return sino, geometry_json, notes
 
@@ -341,12 +351,7 @@ def load_scan(path, geometry=None, flat=None, dark=None, row=None, center=None,
         "" if flat_after is None else os.fspath(flat_after))
     g = json.loads(geometry_json)
     if center not in (None, "auto"):
-        columns = g["detector"]["count"]
-        offset = _offset(columns[0] if isinstance(columns, list) else columns, center)
-        if isinstance(g["detector"]["offset_px"], list):
-            g["detector"]["offset_px"][0] = offset
-        else:
-            g["detector"]["offset_px"] = offset
+        _set_offset(g, _axis_offset(g, center))
     return sino, g, json.loads(notes)
 
 
