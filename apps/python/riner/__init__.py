@@ -370,7 +370,8 @@ def write_array(path, array, voxel_size=None):
 
 
 def compare(image, reference, mask=None):
-    """PSNR, SSIM (scikit-image's definition), MAE, RMSE of image against reference, and
+    """PSNR (keys psnr and psnr_db, the CLI's), SSIM (scikit-image's definition), MAE, RMSE of
+    image against reference, and
     edge_ratio (the image's gradient over the reference's strongest edges against the
     reference's: 1 as sharp, below 1 blurred); mask="circle" restricts them to the inscribed
     circle."""

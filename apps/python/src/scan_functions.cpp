@@ -226,6 +226,7 @@ void bind_scan_functions(py::module_& m) {
     const ImageMetrics metrics = compare_images(a, b, circle ? &mask : nullptr);
     py::dict out;
     out["psnr"] = metrics.psnr;
+    out["psnr_db"] = metrics.psnr;  // the CLI's `compare --json` key
     out["ssim"] = metrics.ssim;
     out["mae"] = metrics.mae;
     out["rmse"] = metrics.rmse;
