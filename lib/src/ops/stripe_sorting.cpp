@@ -82,9 +82,7 @@ void StripeSortingOp::apply(const cl::Buffer<float>& in, cl::Buffer<float>& out,
   smooth_.set_args(views_, columns_, static_cast<cl_uint>(rank_window), sorted_, filtered_,
                    smoothed_);
   context_.launch(smooth_, std::size_t{columns_});
-  if (out.size() != sorted_.size()) throw Error("stripe sorting: size mismatch");
-  unsort_.set_args(views_, columns_, smoothed_, order_, out);
-  context_.launch(unsort_, sorted_.size());
+  unsort_from(smoothed_, out);
 }
 
 void StripeSortingOp::sort(const cl::Buffer<float>& in) {
@@ -119,9 +117,11 @@ void StripeSortingOp::median(std::size_t size) {
   context_.launch(median_, sorted_.size());
 }
 
-void StripeSortingOp::unsort(cl::Buffer<float>& out) {
+void StripeSortingOp::unsort(cl::Buffer<float>& out) { unsort_from(filtered_, out); }
+
+void StripeSortingOp::unsort_from(const cl::Buffer<float>& ranked, cl::Buffer<float>& out) {
   if (out.size() != sorted_.size()) throw Error("stripe sorting: size mismatch");
-  unsort_.set_args(views_, columns_, filtered_, order_, out);
+  unsort_.set_args(views_, columns_, ranked, order_, out);
   context_.launch(unsort_, sorted_.size());
 }
 

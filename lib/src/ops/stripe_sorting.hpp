@@ -42,6 +42,9 @@ class StripeSortingOp {
   Shape shape() const { return shape_; }
 
  private:
+  // Values at each rank of the last sort() put back in the views they came from.
+  void unsort_from(const cl::Buffer<float>& ranked, cl::Buffer<float>& out);
+
   cl::Context& context_;
   cl_uint views_, columns_, padded_;
   std::shared_ptr<const cl::Program> program_;

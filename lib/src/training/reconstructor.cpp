@@ -401,8 +401,8 @@ Array Reconstructor::alpha() const {
   const RinerConfig& c = impl_->setup.config;
   // Without the corrections, alpha needs no evaluation of the field.
   Array alpha = corrects_rings(c, impl_->setup.scan.geometry) ? result().alpha : trained_alpha();
-  Array beta = trained_beta();
-  mark_dead_elements(dead_elements(), alpha, beta);
+  Array no_beta;  // mark_dead_elements leaves an empty one alone
+  mark_dead_elements(dead_elements(), alpha, no_beta);
   return alpha;
 }
 
@@ -411,9 +411,9 @@ Array Reconstructor::trained_alpha() const {
 }
 
 Array Reconstructor::beta() const {
-  Array alpha = trained_alpha();
+  Array no_alpha;  // mark_dead_elements leaves an empty one alone
   Array beta = trained_beta();
-  mark_dead_elements(dead_elements(), alpha, beta);
+  mark_dead_elements(dead_elements(), no_alpha, beta);
   return beta;
 }
 
