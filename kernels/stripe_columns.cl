@@ -5,16 +5,21 @@
 //   column_means(views, columns, from, to, in, means)
 //     one work-item per column: its mean over the views [from, to).
 //   subtract_column_offsets(n, columns, offsets, values): values[v][c] -= offsets[c].
-//   column_fluctuation(views, columns, reach, in, fluctuation)
-//     one work-item per column: the sum over the views of |reading - its moving mean over
-//     2 reach + 1 views|, the column mirrored at its ends (d c b a | a b c d | d c b a).
+//   view_deviations(views, columns, reach, in, deviation)
+//     deviation[v][c] = |in[v][c] - its moving mean along the views over 2 reach + 1 views|,
+//     the column mirrored at its ends (d c b a | a b c d | d c b a).
+//   column_fluctuation(views, columns, near, far, span, deviation, total, own)
+//     one work-item per column c: total[c] = the sum over the views of deviation[v][c];
+//     own[c] = the sum of what deviation[v][c] has beyond the largest deviation of the columns
+//     c +- near..far within span views of v (span <= FLUCTUATION_SPAN_MAX).
 //   interpolate_columns(n, columns, left, right, weight, values)
 //     where weight[c] >= 0: values[v][c] = (1 - weight) values[v][left] + weight
 //     values[v][right]; left and right are columns the step leaves alone (weight < 0).
 //   replace_masked_columns(n, columns, mask, source, values): values = source where mask[c].
 //   add_difference(views, columns, plus, plus_first, plus_stride, minus, minus_first,
 //                  minus_stride, values)
-//     values[v][c] += plus[plus_first + v plus_stride + c] - minus[minus_first + v minus_stride + c].
+//     values[v][c] += plus[plus_first + v plus_stride + c] - minus[minus_first + v minus_stride +
+//     c].
 //   polynomial_coefficients(views, columns, terms, basis, in, coefficients)
 //     one work-item per (term j, column c): sum_v basis[v][j] in[v][c] (basis orthonormal).
 //   polynomial_values(views, columns, terms, basis, coefficients, trend)
@@ -27,6 +32,8 @@
 //     first, then from the last view back to the first (out continuous when wrapped).
 //   copy_block(rows, columns, src, src_first, src_stride, dst, dst_first, dst_stride).
 // Needs common.cl (mirrored). No -D constants.
+
+#define FLUCTUATION_SPAN_MAX 8
 
 __kernel void column_means(const uint views, const uint columns, const uint from, const uint to,
                            __global const float* in, __global float* means) {
@@ -43,17 +50,54 @@ __kernel void subtract_column_offsets(const uint n, const uint columns,
   if (i < n) values[i] -= offsets[i % columns];
 }
 
-__kernel void column_fluctuation(const uint views, const uint columns, const int reach,
-                                 __global const float* in, __global float* fluctuation) {
-  const uint c = get_global_id(0);
-  if (c >= columns) return;
-  float sum = 0.0f;
-  for (int v = 0; v < (int)views; ++v) {
-    float mean = 0.0f;
-    for (int d = -reach; d <= reach; ++d) mean += in[mirrored(v + d, views) * columns + c];
-    sum += fabs(in[v * columns + c] - mean / (float)(2 * reach + 1));
+__kernel void view_deviations(const uint views, const uint columns, const int reach,
+                              __global const float* in, __global float* deviation) {
+  const uint i = get_global_id(0);
+  if (i >= views * columns) return;
+  const int v = (int)(i / columns);
+  const uint c = i % columns;
+  float mean = 0.0f;
+  for (int d = -reach; d <= reach; ++d) mean += in[mirrored(v + d, views) * columns + c];
+  deviation[i] = fabs(in[i] - mean / (float)(2 * reach + 1));
+}
+
+// The largest deviation of the columns c +- near..far in view v (0 where none is in the row).
+float neighbours_deviation(const uint columns, const int near, const int far, const int c,
+                           __global const float* row) {
+  float most = 0.0f;
+  for (int k = near; k <= far; ++k) {
+    if (c - k >= 0) most = fmax(most, row[c - k]);
+    if (c + k < (int)columns) most = fmax(most, row[c + k]);
   }
-  fluctuation[c] = sum;
+  return most;
+}
+
+__kernel void column_fluctuation(const uint views, const uint columns, const int near,
+                                 const int far, const int span, __global const float* deviation,
+                                 __global float* total, __global float* own) {
+  const int c = (int)get_global_id(0);
+  if (c >= (int)columns) return;
+  // The neighbours' largest deviation in the views v - span .. v + span, kept in a ring.
+  float ring[2 * FLUCTUATION_SPAN_MAX + 1];
+  const int width = 2 * span + 1, n = (int)views;
+  for (int u = 0; u < min(span, n); ++u) {
+    ring[u % width] = neighbours_deviation(columns, near, far, c, deviation + u * columns);
+  }
+  float sum = 0.0f, beyond = 0.0f;
+  for (int v = 0; v < n; ++v) {
+    const int ahead = v + span;
+    if (ahead < n) {
+      ring[ahead % width] =
+          neighbours_deviation(columns, near, far, c, deviation + ahead * columns);
+    }
+    float most = 0.0f;
+    for (int u = max(0, v - span); u <= min(n - 1, ahead); ++u) most = fmax(most, ring[u % width]);
+    const float d = deviation[v * columns + c];
+    sum += d;
+    beyond += fmax(0.0f, d - most);
+  }
+  total[c] = sum;
+  own[c] = beyond;
 }
 
 __kernel void interpolate_columns(const uint n, const uint columns, __global const uint* left,

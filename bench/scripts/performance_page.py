@@ -21,8 +21,8 @@ SOURCES = {
     "deeplesion_cpu": "issue29_gradient_after_detail.jsonl",
     "deeplesion_gpu": "issue30_throughput.jsonl",
     "deeplesion_gpu_h100": "issue12_gpu.jsonl",
-    "classical": "destripe_rank_mean.jsonl",
-    "classical_real": "destripe_rank_mean_real.jsonl",
+    "classical": "destripe_own_fluctuation.jsonl",
+    "classical_real": "destripe_own_fluctuation_real.jsonl",
     "warm_start": "issue31_short_schedules.jsonl",
     # newest first: a scene and size measured in a later file hides the earlier rows
     "sizes_cpu": ("issue29_broad_even_hold_sizes.jsonl",

@@ -112,4 +112,21 @@ TEST_SUITE("stuck elements") {
       CHECK(stuck[r * 40 + 39] == 0);
     }
   }
+
+  TEST_CASE("air between two failing elements is no band of stuck columns") {
+    // Row 0 lies outside the ball's shadow: air in every view. Elements 10 and 18 of it change
+    // their reading half-way through the scan (a response that drifts, an element dying); the
+    // 7 air columns between them vary no more than air does, with a varying column either
+    // side, and were taken for a dead module.
+    riner::Scan scan = ball_scan();
+    for (std::size_t v = 45; v < 90; ++v) {
+      scan.measurement(v, 0, 10) += 0.5f;
+      scan.measurement(v, 0, 18) -= 0.3f;
+    }
+    const std::vector<std::uint8_t> stuck = riner::model::stuck_elements(scan, 0.002);
+    for (std::size_t u = 0; u < 40; ++u) {
+      CAPTURE(u);
+      CHECK(stuck[u] == 0);
+    }
+  }
 }

@@ -228,21 +228,49 @@ std::vector<bool> large_stripes(Sinogram& s, std::size_t size, double snr, doubl
   return found.mask;
 }
 
-// Algorithm 6: an element that does not follow the scan (dead: too little fluctuation along
-// the views; fluctuating: too much) against its neighbours is interpolated from them.
-std::vector<bool> dead_stripes(Sinogram& s, std::size_t size, double snr) {
+// The twin of stripe_columns.cl's view_deviations and column_fluctuation.
+stripes::ColumnFluctuation column_fluctuation(const Sinogram& s) {
   const long half = static_cast<long>(stripes::kFluctuationWindow / 2);
-  std::vector<double> fluctuation(s.columns, 0.0);
-  for (std::size_t c = 0; c < s.columns; ++c) {
-    for (std::size_t v = 0; v < s.views; ++v) {
+  std::vector<double> deviation(s.views * s.columns);
+  for (std::size_t v = 0; v < s.views; ++v) {
+    for (std::size_t c = 0; c < s.columns; ++c) {
       double mean = 0.0;
       for (long d = -half; d <= half; ++d) {
         mean += s.at(stripes::reflect(static_cast<long>(v) + d, s.views), c);
       }
-      fluctuation[c] += std::fabs(s.at(v, c) - mean / static_cast<double>(2 * half + 1));
+      deviation[v * s.columns + c] =
+          std::fabs(s.at(v, c) - mean / static_cast<double>(2 * half + 1));
     }
   }
-  const std::vector<bool> mask = stripes::dead_columns(fluctuation, size, snr);
+  const long near = static_cast<long>(stripes::kNeighbourNear);
+  const long far = static_cast<long>(stripes::kNeighbourFar);
+  const long span = static_cast<long>(stripes::kNeighbourSpan);
+  const long views = static_cast<long>(s.views), columns = static_cast<long>(s.columns);
+  stripes::ColumnFluctuation out{std::vector<double>(s.columns, 0.0),
+                                 std::vector<double>(s.columns, 0.0)};
+  for (long c = 0; c < columns; ++c) {
+    for (long v = 0; v < views; ++v) {
+      double most = 0.0;
+      for (long u = std::max(0L, v - span); u <= std::min(views - 1, v + span); ++u) {
+        for (long k = near; k <= far; ++k) {
+          for (const long n : {c - k, c + k}) {
+            if (n >= 0 && n < columns)
+              most = std::max(most, deviation[static_cast<std::size_t>(u * columns + n)]);
+          }
+        }
+      }
+      const double d = deviation[static_cast<std::size_t>(v * columns + c)];
+      out.total[static_cast<std::size_t>(c)] += d;
+      out.own[static_cast<std::size_t>(c)] += std::max(0.0, d - most);
+    }
+  }
+  return out;
+}
+
+// Algorithm 6: an element that does not follow the scan (dead: too little fluctuation along
+// the views; fluctuating: too much, of its own) against its neighbours is interpolated from them.
+std::vector<bool> dead_stripes(Sinogram& s, std::size_t size, double snr) {
+  const std::vector<bool> mask = stripes::dead_columns(column_fluctuation(s), size, snr);
   stripes::interpolate_columns(s, stripes::interpolation_plan(mask));
   return mask;
 }

@@ -197,9 +197,15 @@ std::vector<bool> DeviceDestripe::large_stripes() {
   return found.mask;
 }
 
+static_assert(kNeighbourSpan <= ops::kFluctuationSpanMax, "column_fluctuation's ring is too short");
+
 std::vector<bool> DeviceDestripe::dead_stripes() {
-  steps_.column_fluctuation(views_, columns_, kFluctuationWindow / 2, values_, column_a_);
-  const std::vector<bool> mask = dead_columns(read_columns(column_a_), settings_.large_size, settings_.snr);
+  steps_.view_deviations(views_, columns_, kFluctuationWindow / 2, values_, work_);
+  steps_.column_fluctuation(views_, columns_, kNeighbourNear, kNeighbourFar, kNeighbourSpan, work_,
+                            column_a_, column_b_);
+  const std::vector<bool> mask =
+      dead_columns(ColumnFluctuation{read_columns(column_a_), read_columns(column_b_)},
+                   settings_.large_size, settings_.snr);
   if (std::find(mask.begin(), mask.end(), true) == mask.end()) return mask;
   const ColumnInterpolation plan = interpolation_plan(mask);
   const std::vector<cl_uint> left(plan.left.begin(), plan.left.end());

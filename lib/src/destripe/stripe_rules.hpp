@@ -32,6 +32,15 @@ std::size_t rank_window(std::size_t views);
 
 // Algorithm 6's moving mean along the views.
 constexpr std::size_t kFluctuationWindow = 11;
+// Which of a column's fluctuation is its own: what its deviation from that mean has beyond the
+// largest deviation of the columns kNeighbourNear..kNeighbourFar to either side (past a fault
+// three elements wide) within kNeighbourSpan views (an edge reaches them a few views later).
+constexpr std::size_t kNeighbourNear = 3, kNeighbourFar = 5, kNeighbourSpan = 6;
+
+// Per column: the summed deviation along the views (algorithm 6's fluctuation) and its own part.
+struct ColumnFluctuation {
+  std::vector<double> total, own;
+};
 
 // The smallest length >= n whose only prime factors are 2, 3 and 5: a Fourier filter's line
 // of that length takes n log n (a prime one, 797 say, n^2: 1.8 s instead of 20 ms for fitting
@@ -93,8 +102,8 @@ std::pair<std::size_t, std::size_t> rank_quarter(std::size_t views, std::size_t 
 std::size_t large_stripe_drop(std::size_t views, double drop_ratio);
 
 // Algorithm 6's decision: the columns whose fluctuation along the views stands out of their
-// neighbours' (dead: too little; fluctuating: too much); none when more than a share of the row
-// does (that is the object's structure, not the detector's).
-std::vector<bool> dead_columns(const std::vector<double>& fluctuation, std::size_t size, double snr);
+// neighbours' (dead: too little; fluctuating: too much, and much of it the column's own); none
+// when more than a share of the row does (that is the object's structure, not the detector's).
+std::vector<bool> dead_columns(const ColumnFluctuation& fluctuation, std::size_t size, double snr);
 
 }  // namespace riner::stripes

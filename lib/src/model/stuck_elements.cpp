@@ -13,6 +13,10 @@ constexpr double kJudgedNoiseSigmas = 10.0;
 constexpr long kFarthestNeighbour = 2;
 // A band of steady columns (a dead detector module) up to this share of the detector's width.
 constexpr double kWidestBandShare = 0.25;
+// The varying columns on each side of such a band: matter makes a run of them; one or two
+// failing elements in the air do not (two elements changing part-way, 8 and 32 of a simulated
+// fan scan, made the 23 air columns between them a "dead module").
+constexpr long kSideRun = 4;
 
 }  // namespace
 
@@ -68,7 +72,8 @@ std::vector<std::uint8_t> stuck_elements(const Scan& scan, double noise_sigma) {
   // columns either side of the band. Real matter cannot make one: a column reads lines at one
   // distance from the axis in every direction, so an off-centre part that makes the columns
   // beyond the band vary crosses the band's lines too; columns steady over the views lie beyond
-  // every such part, out to the detector's end, where a band has no second side.
+  // every such part, out to the detector's end, where a band has no second side. Each side is
+  // a run of varying columns, as matter makes.
   const long widest =
       std::max(3L, static_cast<long>(kWidestBandShare * static_cast<double>(columns)));
   const auto varies = [&](long r, long c) {
@@ -84,7 +89,13 @@ std::vector<std::uint8_t> stuck_elements(const Scan& scan, double noise_sigma) {
       }
       long end = c;  // the band [c, end)
       while (end < columns && !varies(r, end)) ++end;
-      if (c > 0 && end < columns && end - c <= widest) {
+      const auto run_varies = [&](long first) {
+        for (long k = first; k < first + kSideRun; ++k) {
+          if (k < 0 || k >= columns || !varies(r, k)) return false;
+        }
+        return true;
+      };
+      if (end - c <= widest && run_varies(c - kSideRun) && run_varies(end)) {
         const double bound = std::fmin(at(r, c - 1), at(r, end));
         bool steady = true;
         for (long k = c; k < end && steady; ++k) {

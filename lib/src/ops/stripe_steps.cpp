@@ -31,6 +31,7 @@ StripeStepsOp::StripeStepsOp(cl::Context& context)
       program_(context.program(stripe_program_sources())),
       column_means_(*program_, "column_means"),
       subtract_offsets_(*program_, "subtract_column_offsets"),
+      deviations_(*program_, "view_deviations"),
       fluctuation_(*program_, "column_fluctuation"),
       interpolate_(*program_, "interpolate_columns"),
       replace_masked_(*program_, "replace_masked_columns"),
@@ -61,11 +62,26 @@ void StripeStepsOp::subtract_column_offsets(std::size_t columns, const cl::Buffe
   context_.launch(subtract_offsets_, n);
 }
 
-void StripeStepsOp::column_fluctuation(std::size_t views, std::size_t columns, std::size_t half,
-                                       const cl::Buffer<float>& in, cl::Buffer<float>& fluctuation) {
-  need(in, views * columns, "column_fluctuation");
-  need(fluctuation, columns, "column_fluctuation");
-  fluctuation_.set_args(u32(views), u32(columns), static_cast<cl_int>(half), in, fluctuation);
+void StripeStepsOp::view_deviations(std::size_t views, std::size_t columns, std::size_t half,
+                                    const cl::Buffer<float>& in, cl::Buffer<float>& deviation) {
+  need(in, views * columns, "view_deviations");
+  need(deviation, views * columns, "view_deviations");
+  deviations_.set_args(u32(views), u32(columns), static_cast<cl_int>(half), in, deviation);
+  context_.launch(deviations_, views * columns);
+}
+
+void StripeStepsOp::column_fluctuation(std::size_t views, std::size_t columns, std::size_t near,
+                                       std::size_t far, std::size_t span,
+                                       const cl::Buffer<float>& deviation, cl::Buffer<float>& total,
+                                       cl::Buffer<float>& own) {
+  need(deviation, views * columns, "column_fluctuation");
+  need(total, columns, "column_fluctuation");
+  need(own, columns, "column_fluctuation");
+  if (span > kFluctuationSpanMax || near > far) {
+    throw Error("stripe step column_fluctuation: span or neighbours out of range");
+  }
+  fluctuation_.set_args(u32(views), u32(columns), static_cast<cl_int>(near),
+                        static_cast<cl_int>(far), static_cast<cl_int>(span), deviation, total, own);
   context_.launch(fluctuation_, columns);
 }
 

@@ -18,6 +18,9 @@ namespace riner::ops {
 // process builds it once (on PoCL every program built costs about 30 ms even from PoCL's cache).
 const std::vector<std::string>& stripe_program_sources();
 
+// stripe_columns.cl's FLUCTUATION_SPAN_MAX: column_fluctuation's ring of views.
+constexpr std::size_t kFluctuationSpanMax = 8;
+
 class StripeStepsOp {
  public:
   explicit StripeStepsOp(cl::Context& context);
@@ -30,9 +33,14 @@ class StripeStepsOp {
   // values[v][c] -= offsets[c].
   void subtract_column_offsets(std::size_t columns, const cl::Buffer<float>& offsets,
                                cl::Buffer<float>& values);
-  // Each column's summed distance from its moving mean over 2 half + 1 views.
-  void column_fluctuation(std::size_t views, std::size_t columns, std::size_t half,
-                          const cl::Buffer<float>& in, cl::Buffer<float>& fluctuation);
+  // deviation[v][c]: the reading's distance from its moving mean over 2 half + 1 views.
+  void view_deviations(std::size_t views, std::size_t columns, std::size_t half,
+                       const cl::Buffer<float>& in, cl::Buffer<float>& deviation);
+  // total[c]: column c's summed deviation; own[c]: the part of it beyond the largest deviation
+  // of the columns c +- near..far within span (<= kFluctuationSpanMax) views.
+  void column_fluctuation(std::size_t views, std::size_t columns, std::size_t near, std::size_t far,
+                          std::size_t span, const cl::Buffer<float>& deviation,
+                          cl::Buffer<float>& total, cl::Buffer<float>& own);
   // Where weight[c] >= 0, column c from its neighbours left[c] and right[c].
   void interpolate_columns(std::size_t columns, const cl::Buffer<cl_uint>& left,
                            const cl::Buffer<cl_uint>& right, const cl::Buffer<float>& weight,
@@ -73,9 +81,9 @@ class StripeStepsOp {
  private:
   cl::Context& context_;
   std::shared_ptr<const cl::Program> program_;
-  cl::Kernel column_means_, subtract_offsets_, fluctuation_, interpolate_, replace_masked_,
-      add_difference_, coefficients_, values_, reflect_pad_, periodic_, copy_block_, analyse_,
-      synthesise_;
+  cl::Kernel column_means_, subtract_offsets_, deviations_, fluctuation_, interpolate_,
+      replace_masked_, add_difference_, coefficients_, values_, reflect_pad_, periodic_,
+      copy_block_, analyse_, synthesise_;
 };
 
 }  // namespace riner::ops
