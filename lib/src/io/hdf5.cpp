@@ -170,8 +170,8 @@ Array frames_with_key(const Array& all, const std::vector<double>& keys, int key
 
 // A Data Exchange flat or dark field: [frames, rows, columns], or one frame [rows, columns] as
 // some writers store a single one; none where the dataset is missing or holds no frame.
-Array field_frames(const Hid& file, const std::filesystem::path& path, const std::string& dataset,
-                   std::optional<RowRange> rows) {
+Array exchange_field(const Hid& file, const std::filesystem::path& path, const std::string& dataset,
+                     std::optional<RowRange> rows) {
   if (!exists(file, dataset)) return {};
   const OpenDataset d = open_dataset(file, path, dataset);
   if (d.dims.size() == 3 && d.dims[0] == 0) return {};
@@ -183,30 +183,63 @@ Array field_frames(const Hid& file, const std::filesystem::path& path, const std
   return require_rank3(read_float_array(file, path, dataset, rows), path, dataset);
 }
 
+// Where a tomography file keeps its frames: the layout and the datasets.
+struct TomoLayout {
+  bool data_exchange = false;
+  std::string data;
+  std::string keys;
+  std::string angles;
+};
+
+// The angles the file states for its projections, as stored (none where it states none): Data
+// Exchange's theta, or NXtomo's rotation angle at the frames keyed 0 (`keys`, one per frame).
+std::vector<double> projection_angles(const Hid& file, const std::filesystem::path& path,
+                                      const TomoLayout& layout, const std::vector<double>& keys) {
+  std::vector<std::size_t> shape;
+  if (layout.data_exchange) {
+    if (!exists(file, "/exchange/theta")) return {};
+    return read_values<double>(file, path, "/exchange/theta", shape);
+  }
+  if (layout.angles.empty() || !exists(file, layout.angles)) return {};
+  const std::vector<double> angles = read_values<double>(file, path, layout.angles, shape);
+  if (angles.size() != keys.size()) {
+    throw InputError(where(path, layout.angles) + std::to_string(angles.size()) + " angles for " +
+                     std::to_string(keys.size()) + " frames");
+  }
+  std::vector<double> out;
+  for (std::size_t f = 0; f < keys.size(); ++f) {
+    if (static_cast<int>(keys[f]) == 0) out.push_back(angles[f]);
+  }
+  return out;
+}
+
+// NXtomo's image keys, one per frame of its data.
+std::vector<double> image_keys(const Hid& file, const std::filesystem::path& path,
+                               const TomoLayout& layout) {
+  std::vector<std::size_t> shape;
+  return read_values<double>(file, path, layout.keys, shape);
+}
+
 TomoFile read_data_exchange(const Hid& file, const std::filesystem::path& path,
-                            std::optional<RowRange> rows) {
+                            const TomoLayout& layout, std::optional<RowRange> rows) {
   TomoFile t;
   t.layout = "data exchange";
   t.dtype = stored_type(file, "/exchange/data");
   t.projections =
       require_rank3(read_float_array(file, path, "/exchange/data", rows), path, "/exchange/data");
-  t.flats = field_frames(file, path, "/exchange/data_white", rows);
-  t.darks = field_frames(file, path, "/exchange/data_dark", rows);
-  if (exists(file, "/exchange/theta")) {
-    std::vector<std::size_t> shape;
-    t.angles_deg = read_values<double>(file, path, "/exchange/theta", shape);
-  }
+  t.flats = exchange_field(file, path, "/exchange/data_white", rows);
+  t.darks = exchange_field(file, path, "/exchange/data_dark", rows);
+  t.angles_deg = projection_angles(file, path, layout, {});
   return t;
 }
 
-TomoFile read_nxtomo(const Hid& file, const std::filesystem::path& path, const std::string& data,
-                     const std::string& keys_path, const std::string& angles_path,
+TomoFile read_nxtomo(const Hid& file, const std::filesystem::path& path, const TomoLayout& layout,
                      std::optional<RowRange> rows) {
+  const std::string& data = layout.data;
   const Array all = require_rank3(read_float_array(file, path, data, rows), path, data);
-  std::vector<std::size_t> shape;
-  const std::vector<double> keys = read_values<double>(file, path, keys_path, shape);
+  const std::vector<double> keys = image_keys(file, path, layout);
   if (keys.size() != all.shape[0]) {
-    throw InputError(where(path, keys_path) + std::to_string(keys.size()) + " image keys for " +
+    throw InputError(where(path, layout.keys) + std::to_string(keys.size()) + " image keys for " +
                      std::to_string(all.shape[0]) + " frames in " + data);
   }
   TomoFile t;
@@ -225,18 +258,9 @@ TomoFile read_nxtomo(const Hid& file, const std::filesystem::path& path, const s
     if (static_cast<int>(key) == 1) t.flat_positions.push_back(projections_before - 0.5);
   }
   if (t.projections.shape.empty()) {
-    throw InputError(where(path, keys_path) + "no frame has image_key 0 (a projection)");
+    throw InputError(where(path, layout.keys) + "no frame has image_key 0 (a projection)");
   }
-  if (!angles_path.empty() && exists(file, angles_path)) {
-    const std::vector<double> angles = read_values<double>(file, path, angles_path, shape);
-    if (angles.size() != keys.size()) {
-      throw InputError(where(path, angles_path) + std::to_string(angles.size()) + " angles for " +
-                       std::to_string(keys.size()) + " frames");
-    }
-    for (std::size_t f = 0; f < keys.size(); ++f) {
-      if (static_cast<int>(keys[f]) == 0) t.angles_deg.push_back(angles[f]);
-    }
-  }
+  t.angles_deg = projection_angles(file, path, layout, keys);
   return t;
 }
 
@@ -248,14 +272,6 @@ bool is_hdf5_path(const std::filesystem::path& path) {
 }
 
 namespace {
-
-// Where a tomography file keeps its frames: the layout and the datasets.
-struct TomoLayout {
-  bool data_exchange = false;
-  std::string data;
-  std::string keys;
-  std::string angles;
-};
 
 // The names of the links directly under `group` (none when it is not a group).
 std::vector<std::string> links_under(const Hid& file, const std::string& group) {
@@ -312,26 +328,16 @@ TomoLayout find_layout(const Hid& file, const std::filesystem::path& path) {
 TomoFile read_tomo_file(const std::filesystem::path& path, std::optional<RowRange> rows) {
   const Hid file = open_file(path);
   const TomoLayout layout = find_layout(file, path);
-  if (layout.data_exchange) return read_data_exchange(file, path, rows);
-  return read_nxtomo(file, path, layout.data, layout.keys, layout.angles, rows);
+  if (layout.data_exchange) return read_data_exchange(file, path, layout, rows);
+  return read_nxtomo(file, path, layout, rows);
 }
 
 std::vector<double> tomo_file_angles(const std::filesystem::path& path) {
   const Hid file = open_file(path);
   const TomoLayout layout = find_layout(file, path);
-  std::vector<std::size_t> shape;
-  if (layout.data_exchange) {
-    if (!exists(file, "/exchange/theta")) return {};
-    return read_values<double>(file, path, "/exchange/theta", shape);
-  }
-  if (layout.angles.empty() || !exists(file, layout.angles)) return {};
-  const std::vector<double> keys = read_values<double>(file, path, layout.keys, shape);
-  const std::vector<double> angles = read_values<double>(file, path, layout.angles, shape);
-  std::vector<double> out;
-  for (std::size_t f = 0; f < keys.size() && f < angles.size(); ++f) {
-    if (static_cast<int>(keys[f]) == 0) out.push_back(angles[f]);
-  }
-  return out;
+  return projection_angles(
+      file, path, layout,
+      layout.data_exchange ? std::vector<double>{} : image_keys(file, path, layout));
 }
 
 std::vector<std::size_t> tomo_file_shape(const std::filesystem::path& path) {
@@ -344,8 +350,7 @@ std::vector<std::size_t> tomo_file_shape(const std::filesystem::path& path) {
                      "; expected [frames, rows, columns]");
   }
   if (!layout.data_exchange) {
-    std::vector<std::size_t> key_shape;
-    const std::vector<double> keys = read_values<double>(file, path, layout.keys, key_shape);
+    const std::vector<double> keys = image_keys(file, path, layout);
     shape[0] = static_cast<std::size_t>(
         std::count_if(keys.begin(), keys.end(), [](double k) { return static_cast<int>(k) == 0; }));
   }

@@ -77,19 +77,23 @@ bool resolve_files(ScanSource& source) {
 
 enum class Field { kFlat, kDark };
 
-// A field's frames must be one frame of a view's shape or a stack of them: said naming the
-// field's file (it named the scan, or nothing for the flats after it).
-Array checked_field(Array frames, const std::vector<std::size_t>& projections,
-                    const std::string& path, const char* what) {
-  const std::vector<std::size_t> view(projections.begin() + 1, projections.end());
-  const bool one = frames.shape == view;
-  const bool stack = frames.rank() == view.size() + 1 && frames.shape[0] > 0 &&
-                     std::equal(view.begin(), view.end(), frames.shape.begin() + 1);
+// A field's frames (of `shape`) must be one frame of a view's shape or a stack of them: said
+// naming the field's file (it named the scan, or nothing for the flats after it).
+void check_field_shape(const std::vector<std::size_t>& shape, const std::vector<std::size_t>& view,
+                       const std::string& path, const char* what) {
+  const bool one = shape == view;
+  const bool stack = shape.size() == view.size() + 1 && shape[0] > 0 &&
+                     std::equal(view.begin(), view.end(), shape.begin() + 1);
   if (!one && !stack) {
-    throw InputError(path + ": " + what + " of shape " + shape_string(frames.shape) +
+    throw InputError(path + ": " + what + " of shape " + shape_string(shape) +
                      " is neither one frame of a view's shape " + shape_string(view) +
                      " nor a stack of them");
   }
+}
+
+Array checked_field(Array frames, const std::vector<std::size_t>& projections,
+                    const std::string& path, const char* what) {
+  check_field_shape(frames.shape, {projections.begin() + 1, projections.end()}, path, what);
   return frames;
 }
 
@@ -112,36 +116,31 @@ Array field_frames(const std::string& path, Field field, std::optional<RowRange>
                        what);
 }
 
-// A tomography file's projections with its own flats and darks, each replaced by a field given
-// beside it, and flats after the scan added to them.
-Scan tomo_scan(const ScanSource& source, Geometry g, std::optional<RowRange> rows,
-               std::optional<std::size_t> row, FlatFieldReport* report, std::string* layout) {
-  TomoFile file = read_tomo_file(source.path, rows);
-  const std::string left_out =
-      file.frames_left_out == 0
-          ? ""
-          : std::to_string(file.frames_left_out) +
-                " frame(s) neither projection, flat nor dark (image_key 3 or an alignment "
-                "frame) left out";
-  if (layout) *layout = file.layout + (left_out.empty() ? "" : " (" + left_out + ")");
-  Array flats = source.flat.empty() ? std::move(file.flats)
-                                    : field_frames(source.flat, Field::kFlat, rows,
-                                                   file.projections.shape, "the flat field");
-  std::vector<double> positions = source.flat.empty() ? file.flat_positions : std::vector<double>{};
+// Raw projections (`frames.projections`, as stored: `frames.dtype`) with their flat and dark
+// fields: each given beside the scan, or else the tomography file's own (none in `frames` for
+// other files); flats after the scan added to them. Rows `rows` of each field, when set.
+Scan raw_frames_scan(const ScanSource& source, Geometry g, TomoFile frames,
+                     std::optional<RowRange> rows, std::optional<std::size_t> row,
+                     FlatFieldReport* report) {
+  const std::vector<std::size_t>& shape = frames.projections.shape;
+  Array flats = source.flat.empty()
+                    ? std::move(frames.flats)
+                    : field_frames(source.flat, Field::kFlat, rows, shape, "the flat field");
+  std::vector<double> positions =
+      source.flat.empty() ? frames.flat_positions : std::vector<double>{};
   if (flats.shape.empty()) {
-    throw InputError(source.path + ": the file holds no flat field (" + file.layout +
+    throw InputError(source.path + ": the file holds no flat field (" + frames.layout +
                      "); pass one with --flat");
   }
-  const Array darks = source.dark.empty() ? std::move(file.darks)
-                                          : field_frames(source.dark, Field::kDark, rows,
-                                                         file.projections.shape, "the dark field");
+  const Array darks = source.dark.empty()
+                          ? std::move(frames.darks)
+                          : field_frames(source.dark, Field::kDark, rows, shape, "the dark field");
   if (!source.flat_after.empty()) {
     const std::size_t series_before = positions.size();
-    FlatStack both =
-        flats_before_after(flats,
-                           field_frames(source.flat_after, Field::kFlat, rows,
-                                        file.projections.shape, "the flat field after the scan"),
-                           file.projections.shape);
+    FlatStack both = flats_before_after(
+        flats,
+        field_frames(source.flat_after, Field::kFlat, rows, shape, "the flat field after the scan"),
+        shape);
     // The file's own series keep their places among the views; those after the scan follow.
     if (series_before > 0) {
       std::copy(positions.begin(), positions.end(), both.positions.begin());
@@ -149,28 +148,49 @@ Scan tomo_scan(const ScanSource& source, Geometry g, std::optional<RowRange> row
     flats = std::move(both.frames);
     positions = std::move(both.positions);
   }
-  const std::size_t saturated = mark_saturated(file.projections, file.dtype);
+  const std::size_t saturated = mark_saturated(frames.projections, frames.dtype);
+  Scan scan =
+      raw_scan(std::move(g), frames.projections, flats, darks, row, source.path, report, positions);
+  if (report) report->saturated_readings = saturated;
+  return scan;
+}
+
+// Raw projections in an array file (rows `rows`, when set), as raw_frames_scan takes them.
+TomoFile raw_array_frames(const std::string& path, std::optional<RowRange> rows) {
+  ArrayFile file = rows ? read_array_rows(path, *rows) : read_array(path);
+  TomoFile frames;
+  frames.projections = std::move(file.array);
+  frames.dtype = file.dtype;
+  return frames;
+}
+
+// A tomography file's projections with its own flats and darks, each replaced by a field given
+// beside it, and flats after the scan added to them; its layout and the angles it states.
+struct TomoScan {
+  Scan scan;
+  std::string layout;
+  std::vector<double> angles_deg;
+};
+
+TomoScan tomo_scan(const ScanSource& source, Geometry g, std::optional<RowRange> rows,
+                   std::optional<std::size_t> row, FlatFieldReport* report) {
+  TomoFile file = read_tomo_file(source.path, rows);
+  const std::string left_out =
+      file.frames_left_out == 0
+          ? ""
+          : std::to_string(file.frames_left_out) +
+                " frame(s) neither projection, flat nor dark (image_key 3 or an alignment "
+                "frame) left out";
+  TomoScan out;
+  out.layout = file.layout + (left_out.empty() ? "" : " (" + left_out + ")");
+  out.angles_deg = file.angles_deg;
   try {
-    Scan scan =
-        raw_scan(std::move(g), file.projections, flats, darks, row, source.path, report, positions);
-    if (report) report->saturated_readings = saturated;
-    return scan;
+    out.scan = raw_frames_scan(source, std::move(g), std::move(file), rows, row, report);
   } catch (const InputError& e) {
     if (left_out.empty()) throw;
     throw InputError(std::string(e.what()) + " (" + left_out + ")");
   }
-}
-
-// A flat or dark field's file holds one frame of `frame` or a stack of them.
-void check_frames_shape(const std::string& path, const char* what,
-                        const std::vector<std::size_t>& frame) {
-  std::vector<std::size_t> shape = read_array_shape(path);
-  if (shape.size() == 2) shape.insert(shape.begin(), 1);
-  if (shape.size() != 3 || shape[0] == 0 || shape[1] != frame[0] || shape[2] != frame[1]) {
-    throw InputError(path + ": " + what + " of shape " + shape_string(read_array_shape(path)) +
-                     " is neither one frame of a view's shape " + shape_string(frame) +
-                     " nor a stack of them");
-  }
+  return out;
 }
 
 // Marks the files `name` reads as inputs (a stack's files and its folder; an HDF5 dataset's
@@ -225,12 +245,12 @@ LoadedScan load_scan_source(ScanSource source) {
   FlatFieldReport report;
   std::string layout;  // a tomography file's, before its flat field's line
   if (tomo_file) {
-    loaded.scan = tomo_scan(source, Geometry::load(find_geometry(source.path, source.geometry)),
-                            std::nullopt, source.row, &report, &layout);
+    TomoScan read = tomo_scan(source, Geometry::load(find_geometry(source.path, source.geometry)),
+                              std::nullopt, source.row, &report);
+    loaded.scan = std::move(read.scan);
     loaded.flat_field = report;
-    layout += " file: ";
-    if (std::string note =
-            file_angles_note(source.path, tomo_file_angles(source.path), loaded.scan.geometry);
+    layout = read.layout + " file: ";
+    if (std::string note = file_angles_note(source.path, read.angles_deg, loaded.scan.geometry);
         !note.empty()) {
       loaded.notes.push_back(std::move(note));
     }
@@ -240,22 +260,9 @@ LoadedScan load_scan_source(ScanSource source) {
       loaded.notes.push_back(std::move(*note));
     }
   } else {
-    Geometry g = Geometry::load(find_geometry(source.path, source.geometry));
-    ArrayFile raw = read_array(source.path);
-    const std::size_t saturated = mark_saturated(raw.array, raw.dtype);
-    const Array after = source.flat_after.empty()
-                            ? Array()
-                            : field_frames(source.flat_after, Field::kFlat, std::nullopt,
-                                           raw.array.shape, "the flat field after the scan");
-    const FlatStack flats = flats_before_after(
-        field_frames(source.flat, Field::kFlat, std::nullopt, raw.array.shape, "the flat field"),
-        after, raw.array.shape);
-    const Array darks = source.dark.empty() ? Array()
-                                            : field_frames(source.dark, Field::kDark, std::nullopt,
-                                                           raw.array.shape, "the dark field");
-    loaded.scan = raw_scan(std::move(g), raw.array, flats.frames, darks, source.row, source.path,
-                           &report, flats.positions);
-    report.saturated_readings = saturated;
+    loaded.scan = raw_frames_scan(
+        source, Geometry::load(find_geometry(source.path, source.geometry)),
+        raw_array_frames(source.path, std::nullopt), std::nullopt, source.row, &report);
     loaded.flat_field = report;
   }
   if (loaded.flat_field) {
@@ -304,7 +311,8 @@ ScanRows::ScanRows(ScanSource source) : source_(std::move(source)) {
   for (const auto& [name, what] :
        {std::pair{&source_.flat, "the flat field"}, std::pair{&source_.dark, "the dark field"},
         std::pair{&source_.flat_after, "the flat field after the scan"}}) {
-    if (!name->empty()) check_frames_shape(*name, what, {shape_[1], shape_[2]});
+    if (!name->empty())
+      check_field_shape(read_array_shape(*name), {shape_[1], shape_[2]}, *name, what);
   }
   if (source_.offset_px == "auto") {
     const std::size_t count = std::min(kCentreRows, rows());
@@ -318,25 +326,10 @@ ScanRows::ScanRows(ScanSource source) : source_(std::move(source)) {
 
 Scan ScanRows::read(RowRange rows, FlatFieldReport* report) const {
   const Geometry g = detector_rows_geometry(geometry_, rows.first, rows.count);
-  if (tomo_file_) return tomo_scan(source_, g, rows, std::nullopt, report, nullptr);
+  if (tomo_file_) return tomo_scan(source_, g, rows, std::nullopt, report).scan;
   if (!source_.flat.empty()) {
-    ArrayFile file = read_array_rows(source_.path, rows);
-    const std::size_t saturated = mark_saturated(file.array, file.dtype);
-    const Array& projections = file.array;
-    const FlatStack flats = flats_before_after(
-        field_frames(source_.flat, Field::kFlat, rows, projections.shape, "the flat field"),
-        source_.flat_after.empty()
-            ? Array()
-            : field_frames(source_.flat_after, Field::kFlat, rows, projections.shape,
-                           "the flat field after the scan"),
-        projections.shape);
-    const Array darks = source_.dark.empty() ? Array()
-                                             : field_frames(source_.dark, Field::kDark, rows,
-                                                            projections.shape, "the dark field");
-    Scan scan = raw_scan(g, projections, flats.frames, darks, std::nullopt, source_.path, report,
-                         flats.positions);
-    if (report) report->saturated_readings = saturated;
-    return scan;
+    return raw_frames_scan(source_, g, raw_array_frames(source_.path, rows), rows, std::nullopt,
+                           report);
   }
   ArrayFile file = read_array_rows(source_.path, rows);
   Scan scan;
