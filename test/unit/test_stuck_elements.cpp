@@ -113,20 +113,23 @@ TEST_SUITE("stuck elements") {
     }
   }
 
-  TEST_CASE("air between two failing elements is no band of stuck columns") {
-    // Row 0 lies outside the ball's shadow: air in every view. Elements 10 and 18 of it change
-    // their reading half-way through the scan (a response that drifts, an element dying); the
-    // 7 air columns between them vary no more than air does, with a varying column either
-    // side, and were taken for a dead module.
+  TEST_CASE("air beside or between failing elements is never stuck") {
+    // Rows 0 and 23 lie outside the ball's shadow: air in every view. Elements of them change
+    // their reading half-way through the scan (a response that drifts, an element dying). The
+    // 7 air columns between elements 10 and 18 of row 0, with a varying column either side,
+    // were taken for a dead module; element 22 of row 23 between elements 20 and 24, and the
+    // elements of rows 1 and 22 between a failing element and the ball's shadow, for stuck.
     riner::Scan scan = ball_scan();
     for (std::size_t v = 45; v < 90; ++v) {
       scan.measurement(v, 0, 10) += 0.5f;
       scan.measurement(v, 0, 18) -= 0.3f;
+      scan.measurement(v, 23, 20) += 0.4f;
+      scan.measurement(v, 23, 24) -= 0.4f;
     }
     const std::vector<std::uint8_t> stuck = riner::model::stuck_elements(scan, 0.002);
-    for (std::size_t u = 0; u < 40; ++u) {
-      CAPTURE(u);
-      CHECK(stuck[u] == 0);
+    for (std::size_t e = 0; e < stuck.size(); ++e) {
+      CAPTURE(e);
+      CHECK(stuck[e] == 0);
     }
   }
 }

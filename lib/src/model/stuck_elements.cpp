@@ -13,10 +13,12 @@ constexpr double kJudgedNoiseSigmas = 10.0;
 constexpr long kFarthestNeighbour = 2;
 // A band of steady columns (a dead detector module) up to this share of the detector's width.
 constexpr double kWidestBandShare = 0.25;
-// The varying columns on each side of such a band: matter makes a run of them; one or two
-// failing elements in the air do not (two elements changing part-way, 8 and 32 of a simulated
-// fan scan, made the 23 air columns between them a "dead module").
+// The elements that vary beside a steady one or a band: matter makes a run of them (at least
+// kSideVarying of the kSideRun elements outward from it); a failing element in the air does
+// not. Elements 8 and 32 of a simulated fan scan, changing part-way, made the 23 air columns
+// between them a "dead module"; elements 494 and 498 made air element 496 stuck.
 constexpr long kSideRun = 4;
+constexpr long kSideVarying = 3;
 
 }  // namespace
 
@@ -51,18 +53,32 @@ std::vector<std::uint8_t> stuck_elements(const Scan& scan, double noise_sigma) {
       return std::numeric_limits<double>::quiet_NaN();
     return variance[static_cast<std::size_t>(r * columns + c)];
   };
+  const auto varies = [&](long r, long c) {
+    const double v = at(r, c);
+    return std::isfinite(v) && v > judged;
+  };
+  // Matter from (r, c) outward along (dr, dc).
+  const auto matter_from = [&](long r, long c, long dr, long dc) {
+    long varying = 0;
+    for (long k = 0; k < kSideRun; ++k) varying += varies(r + k * dr, c + k * dc) ? 1 : 0;
+    return varying >= kSideVarying;
+  };
   for (long r = 0; r < rows; ++r) {
     for (long c = 0; c < columns; ++c) {
       const double own = at(r, c);
       if (!std::isfinite(own)) continue;
       bool found = false;
       for (long d = 1; d <= kFarthestNeighbour && !found; ++d) {
-        const double pairs[2][2] = {{at(r, c - d), at(r, c + d)}, {at(r - d, c), at(r + d, c)}};
-        for (const auto& pair : pairs) {
-          const double weaker = std::fmin(pair[0], pair[1]);
-          // fmin ignores one NaN; both neighbours must be there.
-          if (!std::isfinite(pair[0]) || !std::isfinite(pair[1])) continue;
-          if (weaker > judged && own < kSteadyFraction * weaker) found = true;
+        for (const auto [dr, dc] : {std::pair{0L, 1L}, std::pair{1L, 0L}}) {
+          const double before = at(r - d * dr, c - d * dc), after = at(r + d * dr, c + d * dc);
+          // Both neighbours must be there.
+          if (!std::isfinite(before) || !std::isfinite(after)) continue;
+          if (std::fmin(before, after) > judged &&
+              own < kSteadyFraction * std::fmin(before, after) &&
+              matter_from(r - d * dr, c - d * dc, -dr, -dc) &&
+              matter_from(r + d * dr, c + d * dc, dr, dc)) {
+            found = true;
+          }
         }
       }
       stuck[static_cast<std::size_t>(r * columns + c)] = found;
@@ -73,13 +89,9 @@ std::vector<std::uint8_t> stuck_elements(const Scan& scan, double noise_sigma) {
   // distance from the axis in every direction, so an off-centre part that makes the columns
   // beyond the band vary crosses the band's lines too; columns steady over the views lie beyond
   // every such part, out to the detector's end, where a band has no second side. Each side is
-  // a run of varying columns, as matter makes.
+  // matter's run of varying columns.
   const long widest =
       std::max(3L, static_cast<long>(kWidestBandShare * static_cast<double>(columns)));
-  const auto varies = [&](long r, long c) {
-    const double v = at(r, c);
-    return std::isfinite(v) && v > judged;
-  };
   for (long r = 0; r < rows; ++r) {
     long c = 0;
     while (c < columns) {
@@ -89,13 +101,7 @@ std::vector<std::uint8_t> stuck_elements(const Scan& scan, double noise_sigma) {
       }
       long end = c;  // the band [c, end)
       while (end < columns && !varies(r, end)) ++end;
-      const auto run_varies = [&](long first) {
-        for (long k = first; k < first + kSideRun; ++k) {
-          if (k < 0 || k >= columns || !varies(r, k)) return false;
-        }
-        return true;
-      };
-      if (end - c <= widest && run_varies(c - kSideRun) && run_varies(end)) {
+      if (end - c <= widest && matter_from(r, c - 1, 0, -1) && matter_from(r, end, 0, 1)) {
         const double bound = std::fmin(at(r, c - 1), at(r, end));
         bool steady = true;
         for (long k = c; k < end && steady; ++k) {
