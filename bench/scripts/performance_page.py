@@ -22,7 +22,7 @@ SOURCES = {
     "deeplesion_gpu": "issue30_throughput.jsonl",
     "deeplesion_gpu_h100": "issue12_gpu.jsonl",
     "classical": "destripe_own_fluctuation.jsonl",
-    "classical_real": "destripe_own_fluctuation_real.jsonl",
+    "classical_real": "lost_object_regions_real.jsonl",
     "warm_start": "issue31_short_schedules.jsonl",
     # newest first: a scene and size measured in a later file hides the earlier rows
     "sizes_cpu": ("issue29_broad_even_hold_sizes.jsonl",

@@ -83,6 +83,24 @@ TEST_SUITE("quality: lost object") {
     CHECK(riner::lost_object(square_sample(n, 1e-3, 0.0, 9, 0), fbp).pixels == 0);
   }
 
+  TEST_CASE("small faint blobs are FBP's streaks, not object; a small bright feature is") {
+    const std::size_t n = 200;
+    // A nearly noiseless FBP: blurred, its noise is about 1.4e-5. In the air beside the sample,
+    // blobs of 3 x 3 pixels at 3.5e-4 (about 6 sigmas after the measure's blur), as streaks
+    // off a dense edge leave them, and one of 3 x 3 at 2e-3 (a grain the image dropped).
+    riner::Array fbp = square_sample(n, 2e-3, 1e-4, 5, 0);
+    const auto blob = [&](std::size_t row, std::size_t column, float value) {
+      for (std::size_t i = row; i < row + 3; ++i)
+        for (std::size_t k = column; k < column + 3; ++k) fbp(i, k) += value;
+    };
+    for (std::size_t b = 0; b < 6; ++b) blob(30 + 25 * b, 25, 3.5e-4f);
+    const riner::Array image = square_sample(n, 2e-3, 0.0, 6, 0);
+    const riner::LostObject streaks = riner::lost_object(image, fbp);
+    CHECK(streaks.pixels == 0);
+    blob(100, 170, 2e-2f);
+    CHECK(riner::lost_object(image, fbp).pixels > 10);
+  }
+
   TEST_CASE("the FBP's bright rim at the field's edge is not object") {
     const std::size_t n = 200;
     riner::Array fbp = square_sample(n, 2e-3, 1e-3, 5, 0);
