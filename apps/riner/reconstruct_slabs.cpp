@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <memory>
 #include <thread>
 
@@ -171,8 +172,14 @@ bool wants_slabs(const Args& args) {
   // Left to the scan: by slabs when a volume does not fit whole, or when a parallel beam's
   // slices are large enough to train each alone.
   const std::optional<Geometry> g = stack_geometry(args);
-  // --resume on a slice goes on from its training's checkpoint (cmd_reconstruct.cpp).
-  if (args.is_set("resume")) return g && g->is_3d();
+  // --resume goes on with what the folder holds: a slabbed run (its manifest), or a volume or
+  // slice trained whole (its training's checkpoint, cmd_reconstruct.cpp); a 3D volume killed
+  // part-way was started again by slabs, from step 0.
+  if (args.is_set("resume") && g && g->is_3d()) {
+    const std::filesystem::path out = args.get("out");
+    if (std::filesystem::exists(out / "manifest.json")) return true;
+    if (std::filesystem::exists(out / "training.checkpoint")) return false;
+  }
   return g && g->is_3d() &&
          (slices_2d_by_default(*g) || slab_bytes(*g, g->volume_shape[0]) > default_memory_limit());
 }

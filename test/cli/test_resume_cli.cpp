@@ -77,6 +77,39 @@ TEST_SUITE("cli") {
           riner::test::read_bytes(whole / "image.nii"));
   }
 
+  TEST_CASE("a volume trained whole, killed mid-way, resumes from its checkpoint, not by slabs") {
+    // --resume on a 3D scan went to the slabs' scheduler whatever the folder held: a volume
+    // trained whole started again from step 0 as one slab (no image.nii), and its checkpoint
+    // stayed, refusing every plain run after.
+    riner::test::TempDir dir;
+    const std::string sim = riner::test::simulate_small_parallel3d(dir);
+    const std::string common = "reconstruct " + sim + "/sino.npy --geometry " + sim +
+                               "/geometry.json --steps 3000 --quiet";
+    const std::filesystem::path whole = dir / "whole", killed = dir / "killed";
+    REQUIRE(riner_cli(common + " --out " + whole.string(), dir).code == 0);
+    const std::filesystem::path checkpoint = killed / "training.checkpoint";
+    run_until({"reconstruct", sim + "/sino.npy", "--geometry", sim + "/geometry.json", "--steps",
+               "3000", "--quiet", "--checkpoint-minutes", "0.003", "--out", killed.string()},
+              [&] { return std::filesystem::exists(checkpoint); });
+    REQUIRE(std::filesystem::exists(checkpoint));
+    REQUIRE(!std::filesystem::exists(killed / "image.nii"));
+    const Run finished = riner_cli(common + " --resume --out " + killed.string(), dir);
+    REQUIRE(finished.code == 0);
+    const nlohmann::json summary =
+        nlohmann::json::parse(riner::test::read_bytes(killed / "summary.json"));
+    CAPTURE(summary["resumed_at_step"]);
+    CHECK(summary["resumed_at_step"] > 0);
+    CHECK(!std::filesystem::exists(killed / "manifest.json"));
+    CHECK(!std::filesystem::exists(checkpoint));
+    CHECK(riner::test::read_bytes(killed / "image.nii") ==
+          riner::test::read_bytes(whole / "image.nii"));
+    // --resume on a fresh folder trains the volume as a plain run would.
+    const Run fresh = riner_cli(common + " --resume --out " + (dir / "fresh").string(), dir);
+    REQUIRE(fresh.code == 0);
+    CHECK(riner::test::read_bytes(dir / "fresh" / "image.nii") ==
+          riner::test::read_bytes(whole / "image.nii"));
+  }
+
   TEST_CASE("a slabbed run killed mid-slab goes on from the slab's checkpoint") {
     riner::test::TempDir dir;
     const std::string sim = riner::test::simulate_small_parallel3d(dir);
