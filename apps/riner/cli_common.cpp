@@ -159,6 +159,17 @@ void note_large_stripes(Console& console, const DestripeReport& report) {
   console.line(line);
 }
 
+void note_filled_rows(const Console& console, const std::vector<std::size_t>& rows) {
+  if (rows.empty()) return;
+  std::string list;
+  for (std::size_t i = 0; i < rows.size() && i < 8; ++i)
+    list += (i ? ", " : "") + std::to_string(rows[i]);
+  if (rows.size() > 8) list += ", ... (" + std::to_string(rows.size()) + " rows)";
+  console.line("note: detector row" + std::string(rows.size() > 1 ? "s " : " ") + list +
+               " read nothing in any view: trained on the line between the rows beside them, as "
+               "FBP fills them; the slices only they see are interpolated, not measured");
+}
+
 void note_non_finite(const Console& console, std::size_t non_finite) {
   if (non_finite == 0) return;
   console.line(std::to_string(non_finite) +

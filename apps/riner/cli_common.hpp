@@ -75,5 +75,7 @@ void print_quality_doubts(Console& console, const QualityReport& q);
 void note_large_stripes(Console& console, const DestripeReport& report);
 // The measurement's NaN/inf readings, counted for a reconstruction (nothing when there are none).
 void note_non_finite(const Console& console, std::size_t non_finite);
+// The detector rows training filled from the rows beside them (TrainingStats::filled_rows).
+void note_filled_rows(const Console& console, const std::vector<std::size_t>& rows);
 
 }  // namespace riner::app

@@ -273,6 +273,7 @@ int run_reconstruct(int argc, char** argv, int first) {
     } else if (config.training.skip_air && !setup.air_note.empty()) {
       console.line("not skipping the air: " + setup.air_note);
     }
+    note_filled_rows(console, setup.filled_rows);
   }
   {
     Progress progress("reconstruct",

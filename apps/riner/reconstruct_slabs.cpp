@@ -518,6 +518,18 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
     for (const std::string& line : flat_field_notes(*flat)) console.line(line);
   }
   note_non_finite(console, non_finite);
+  // Rows a slab's training filled from the rows beside them, by the detector's numbering.
+  std::vector<std::size_t> filled_rows;
+  for (const Slab& s : run.slabs()) {
+    const nlohmann::json& entry = run.manifest()["slabs"][s.index];
+    if (!entry.contains("summary") || !entry["summary"].is_object()) continue;
+    for (const auto& r : entry["summary"].value("filled_rows", nlohmann::json::array())) {
+      filled_rows.push_back(s.rows.first + r.get<std::size_t>());
+    }
+  }
+  std::sort(filled_rows.begin(), filled_rows.end());
+  filled_rows.erase(std::unique(filled_rows.begin(), filled_rows.end()), filled_rows.end());
+  note_filled_rows(console, filled_rows);
   // Slabs with nothing to reconstruct (a dead detector row): written as NaN, said here.
   nlohmann::json without_readings = nlohmann::json::array();
   for (const Slab& s : run.slabs()) {

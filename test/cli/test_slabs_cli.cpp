@@ -584,6 +584,70 @@ TEST_SUITE("cli") {
     CHECK(fbp["flat_field"]["invalid_readings"] == whole["flat_field"]["invalid_readings"]);
   }
 
+  TEST_CASE("a dead detector row in a volume trained as one field: filled from its neighbours") {
+    // Its slice is seen by no ray: the field read there what it never learnt (a simulated cone
+    // head's slice 0.0009 against its 0.0100, 14.4 dB among neighbours at 27-30), unsaid.
+    riner::test::TempDir dir;
+    const std::string scan = simulate_stack(dir);
+    riner::Array views = riner::read_array(scan).array;
+    const std::size_t rows = views.shape[1], columns = views.shape[2];
+    for (std::size_t v = 0; v < views.shape[0]; ++v) {
+      std::fill_n(views.data.begin() + static_cast<long>((v * rows + 7) * columns), columns, NAN);
+    }
+    std::filesystem::create_directories(dir / "dead");
+    riner::write_array(dir / "dead" / "sino.npy", views);
+    const std::filesystem::path sim = std::filesystem::path(scan).parent_path();
+    std::filesystem::copy_file(sim / "geometry.json", dir / "dead" / "geometry.json");
+    const riner::Array truth = riner::read_array(sim / "ground_truth.nii").array;
+    for (const std::string mode : {"whole", "slabs"}) {
+      CAPTURE(mode);
+      const std::filesystem::path out = dir / mode;
+      const Run run =
+          riner_cli("reconstruct " + (dir / "dead" / "sino.npy").string() + " --steps 2000 --out " +
+                        out.string() + (mode == "slabs" ? " --field-3d --slab-slices 5" : ""),
+                    dir);
+      CAPTURE(run.err);
+      REQUIRE(run.code == 0);
+      CHECK(run.out.find("note: detector row 7 read nothing in any view: trained on the line "
+                         "between the rows beside them") != std::string::npos);
+      riner::Array image;
+      if (mode == "whole") {
+        image = riner::read_array(out / "image.nii").array;
+        const nlohmann::json summary =
+            nlohmann::json::parse(riner::test::read_bytes(out / "summary.json"));
+        CHECK(summary["filled_rows"] == nlohmann::json({7}));
+      } else {
+        image = truth;
+        for (std::size_t k = 0; k < truth.shape[0]; ++k) {
+          const riner::Array slice =
+              riner::read_array(riner::VolumeWriter::slice_file(out / "volume", k)).array;
+          std::copy(slice.data.begin(), slice.data.end(),
+                    image.data.begin() + static_cast<long>(k * slice.size()));
+        }
+      }
+      const auto rms_off = [&](std::size_t k) {
+        const std::size_t n = truth.shape[1] * truth.shape[2];
+        double sum = 0.0;
+        for (std::size_t i = k * n; i < (k + 1) * n; ++i) {
+          sum += (image.data[i] - truth.data[i]) * (image.data[i] - truth.data[i]);
+        }
+        return std::sqrt(sum / static_cast<double>(n));
+      };
+      const auto mean = [&](const riner::Array& a, std::size_t k) {
+        const std::size_t n = a.shape[1] * a.shape[2];
+        double sum = 0.0;
+        for (std::size_t i = k * n; i < (k + 1) * n; ++i) sum += a.data[i];
+        return sum / static_cast<double>(n);
+      };
+      // Before: slice 7 read 0.0005 for its 0.0114, 0.0179 rms off against its neighbours' 0.0085
+      // and 0.0101; now 0.0107, 0.0097.
+      CHECK(std::fabs(mean(image, 7) - mean(truth, 7)) < 0.2 * mean(truth, 7));
+      CHECK(rms_off(7) < 1.3 * std::max(rms_off(6), rms_off(8)));
+      const riner::Array beta = riner::read_array(out / "beta.npy").array;
+      CHECK(beta.data[7 * columns] == 0.0f);  // its elements are dead all the same
+    }
+  }
+
   TEST_CASE("a dead detector row: its slice is NaN and said so, the rest of the scan goes on") {
     riner::test::TempDir dir;
     const std::string scan = simulate_stack(dir);

@@ -130,6 +130,9 @@ struct TrainingStats {
   double seconds = 0.0;             // wall time inside step()/run()
   double samples = 0.0;             // field evaluations trained on (forward + backward)
   std::size_t non_finite = 0;       // measurements that were NaN/inf (treated as 0)
+  // 3D: detector rows that read nothing in any view, trained on the line between the rows
+  // beside them in each view (as FBP fills them); their elements are dead.
+  std::vector<std::size_t> filled_rows;
   std::size_t parameters = 0;
   std::string engine;
   std::string device;                 // device name, or "CPU reference"

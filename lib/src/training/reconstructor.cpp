@@ -486,6 +486,7 @@ TrainingStats Reconstructor::stats() const {
   s.seconds = impl_->seconds;
   s.samples = impl_->samples;
   s.non_finite = impl_->setup.scan.non_finite;
+  s.filled_rows = impl_->setup.filled_rows;
   s.parameters = impl_->setup.layout.total;
   s.engine = engine_name(impl_->setup.config.engine);
   s.device = impl_->trainer->device_name();

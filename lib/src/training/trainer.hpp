@@ -52,6 +52,8 @@ struct TrainingSetup {
   double alpha_rate = 1.0;                      // alpha_lr_scale times the stripe evidence's factor
   model::NoiseEvidence noise;       // model/noise_evidence.hpp; sets level_warmup_steps -1
   model::TailAverage tail_average;  // which steps' parameters the result averages
+  // Detector rows with no finite reading, filled from the rows beside them (model/dead_rows.hpp).
+  std::vector<std::size_t> filled_rows;
   std::vector<std::uint8_t> stuck;  // per element, model/stuck_elements.hpp (readings now NaN)
   std::size_t stuck_count = 0;
   model::FactorEvidence factor_evidence;             // 3D, model/factor_evidence.hpp

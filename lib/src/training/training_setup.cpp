@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "model/dead_rows.hpp"
 #include "model/factor_evidence.hpp"
 #include "model/response_changes.hpp"
 #include "model/stripe_evidence.hpp"
@@ -96,6 +97,7 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
       ++scan.non_finite;
     }
   }
+  filled_rows = model::fill_dead_rows(scan.measurement, scan.geometry);
   const Geometry& g = scan.geometry;
   elements_per_view = g.n_u * (g.is_3d() ? g.n_v : 1);
   segments = model::RaySegments(g, config.training.sample_spacing * g.voxel_mm,
@@ -183,9 +185,15 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
   }
   seed = static_cast<std::uint32_t>(config.training.seed ^ (config.training.seed >> 32));
   invalid_readings.assign(responses.slots(), 0);
+  // A filled row's elements read nothing themselves: dead, as those with no finite reading.
+  std::vector<bool> filled(elements_per_view, false);
+  for (const std::size_t r : filled_rows) {
+    std::fill(filled.begin() + static_cast<std::ptrdiff_t>(r * g.n_u),
+              filled.begin() + static_cast<std::ptrdiff_t>((r + 1) * g.n_u), true);
+  }
   const std::vector<float>& rho = scan.measurement.data;
   for (std::size_t ray = 0; ray < rho.size(); ++ray) {
-    if (!std::isfinite(rho[ray])) {
+    if (!std::isfinite(rho[ray]) || filled[ray % elements_per_view]) {
       ++invalid_readings[responses.slot(ray % elements_per_view, ray / elements_per_view)];
     }
   }
