@@ -136,6 +136,23 @@ TEST_SUITE("cli") {
     const auto summary = nlohmann::json::parse(riner::test::read_bytes(out + "/summary.json"));
     REQUIRE(summary["changing_elements"].size() == 7);
     CHECK(summary["changing_elements"][0]["segments"].size() == 2);
+    // An element after it died read nothing: alpha and beta 0 there, as simulate's alpha (they
+    // were the untrained 1 and 1, "alive").
+    const riner::Array by_view = riner::read_array(out + "/alpha_by_view.npy").array;
+    for (const auto& e : simulated["dead_part_way"]) {
+      const std::size_t element = e.get<std::size_t>();
+      CAPTURE(element);
+      CHECK(by_view.data[239 * 128 + element] == 0.0f);
+      bool reported = false;
+      for (const auto& c : summary["changing_elements"]) {
+        if (c["element"] != element) continue;
+        reported = true;
+        CHECK(c["dies"] == true);
+        CHECK(c["segments"].back()["alpha"] == 0.0);
+        CHECK(c["segments"].back()["beta"] == 0.0);
+      }
+      CHECK(reported);
+    }
   }
 
   TEST_CASE("destripe: a ringed scan's FBP gains, the scan and its stripes are written") {

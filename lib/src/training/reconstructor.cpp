@@ -249,7 +249,14 @@ ReconstructionResult Reconstructor::result() const {
 
 namespace {
 
-// The changing elements' segments with their trained alpha and beta (parameters p).
+// Whether response slot `slot`, over `views` views, read nothing finite: an element's views
+// after it died. Training never saw them, so its alpha and beta there are where they started.
+bool slot_unread(const detail::TrainingSetup& setup, std::size_t slot, std::size_t views) {
+  return setup.invalid_readings[slot] >= views;
+}
+
+// The changing elements' segments with their trained alpha and beta (parameters p); 0 and 0
+// for a segment that read nothing (an element after it died: 1 and 1, "alive", before).
 std::vector<ChangingElement> changing_elements_of(const detail::TrainingSetup& setup,
                                                   const std::vector<float>& p) {
   const model::ResponseMap& map = setup.responses;
@@ -258,6 +265,10 @@ std::vector<ChangingElement> changing_elements_of(const detail::TrainingSetup& s
   for (const model::ResponseChange& c : setup.response_changes) {
     ChangingElement element{c.element, c.dies, {}};
     for (const model::ResponseMap::Segment& s : map.segments(c.element)) {
+      if (slot_unread(setup, s.slot, s.views)) {
+        element.segments.push_back({s.first_view, s.views, 0.0, 0.0});
+        continue;
+      }
       element.segments.push_back({s.first_view, s.views,
                                   std::max(p[l.alpha_offset + s.slot], 1e-8f),
                                   1.0 / (1.0 + std::exp(-p[l.beta_offset + s.slot]))});
@@ -277,14 +288,16 @@ Array alpha_per_element(const detail::TrainingSetup& setup, const std::vector<fl
   for (const ChangingElement& c : changing_elements_of(setup, p)) {
     double log_sum = 0.0, views = 0.0, all_log = 0.0, all_views = 0.0;
     for (const ResponseSegment& s : c.segments) {
+      if (s.alpha <= 0.0) continue;  // read nothing
       all_log += std::log(s.alpha) * static_cast<double>(s.views);
       all_views += static_cast<double>(s.views);
       if (s.beta < Reconstructor::kDeadBelowBeta) continue;
       log_sum += std::log(s.alpha) * static_cast<double>(s.views);
       views += static_cast<double>(s.views);
     }
-    out.data[c.element] =
-        static_cast<float>(views > 0 ? std::exp(log_sum / views) : std::exp(all_log / all_views));
+    out.data[c.element] = static_cast<float>(views > 0       ? std::exp(log_sum / views)
+                                             : all_views > 0 ? std::exp(all_log / all_views)
+                                                             : 1e-8);
   }
   return out;
 }
@@ -305,6 +318,15 @@ Array responses_by_view(const detail::TrainingSetup& setup, const std::vector<fl
     for (std::size_t e = 0; e < elements; ++e) {
       const float a = std::max(p[l.alpha_offset + map.slot(e, v)], 1e-8f);
       out.data[v * elements + e] = a * corrected.data[e] / trained.data[e];
+    }
+  }
+  // The views a changing element read nothing in (after it died): 0, as simulate's alpha.
+  for (const model::ResponseChange& c : setup.response_changes) {
+    for (const model::ResponseMap::Segment& s : map.segments(c.element)) {
+      if (!slot_unread(setup, s.slot, s.views)) continue;
+      for (std::size_t v = s.first_view; v < s.first_view + s.views; ++v) {
+        out.data[v * elements + c.element] = 0.0f;
+      }
     }
   }
   return out;
