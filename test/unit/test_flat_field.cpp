@@ -255,6 +255,19 @@ TEST_SUITE("flat_field") {
     }
     (void)riner::flat_field_normalise(noisy.raw, noisy.before, Array(), &report);
     CHECK_FALSE(riner::air_drifts(report));
+    // A sample wider than the field: no element reads air, the least-attenuated ones read the
+    // sample turning (0.34 then 0.61): no drift to measure, none claimed.
+    Drifting wide = drifting_scan(0.0);
+    for (std::size_t v = 0; v < 200; ++v) {
+      for (std::size_t e = 0; e < 40; ++e) {
+        const double rho =
+            0.34 + 0.27 * static_cast<double>(v) / 199.0 + 0.01 * static_cast<double>(e % 5);
+        wide.raw.data[v * 40 + e] = static_cast<float>(wide.before.data[e] * std::exp(-rho));
+      }
+    }
+    (void)riner::flat_field_normalise(wide.raw, wide.before, Array(), &report);
+    CHECK(report.air_drift_sigmas > riner::kAirDriftSigmas);  // the change is there
+    CHECK_FALSE(riner::air_drifts(report));                   // but it is no air's
     CHECK_THROWS_AS(riner::flats_before_after(steady.before, Array({2, 30}), steady.raw.shape),
                     riner::InputError);
     // A position per frame, or an error.

@@ -44,6 +44,11 @@ struct FlatFieldReport {
 // scan, which a flat field taken at one time turns into rings and bands.
 constexpr double kAirDriftSigmas = 6.0;
 constexpr double kAirDriftLeast = 0.005;
+// ... and only where those elements read air at the start or the end (within this of 0, as
+// training takes air, model/air_readings.cpp): a sample wider than the field leaves none, and
+// its least-attenuated elements read the sample turning (the shared savu stack: 0.34 then
+// 0.61, called 24% less light).
+constexpr double kAirDriftLevelMost = 0.1;
 bool air_drifts(const FlatFieldReport& report);
 // One line naming the drift and what to do about it (empty when air_drifts is false).
 std::string air_drift_line(const FlatFieldReport& report);

@@ -13,12 +13,11 @@ constexpr double kJudgedNoiseSigmas = 10.0;
 constexpr long kFarthestNeighbour = 2;
 // A band of steady columns (a dead detector module) up to this share of the detector's width.
 constexpr double kWidestBandShare = 0.25;
-// The elements that vary beside a steady one or a band: matter makes a run of them (at least
-// kSideVarying of the kSideRun elements outward from it); a failing element in the air does
-// not. Elements 8 and 32 of a simulated fan scan, changing part-way, made the 23 air columns
-// between them a "dead module"; elements 494 and 498 made air element 496 stuck.
-constexpr long kSideRun = 4;
-constexpr long kSideVarying = 3;
+// An element that varies beside a steady one or a band is matter's where an element beside it
+// varies too (outward, or across: a silhouette's rim runs along the detector); a failing element
+// in the air stands alone. Elements 8 and 32 of a simulated fan scan, changing part-way, made
+// the 23 air columns between them a "dead module"; elements 494 and 498 made air element 496
+// stuck.
 
 }  // namespace
 
@@ -57,11 +56,10 @@ std::vector<std::uint8_t> stuck_elements(const Scan& scan, double noise_sigma) {
     const double v = at(r, c);
     return std::isfinite(v) && v > judged;
   };
-  // Matter from (r, c) outward along (dr, dc).
-  const auto matter_from = [&](long r, long c, long dr, long dc) {
-    long varying = 0;
-    for (long k = 0; k < kSideRun; ++k) varying += varies(r + k * dr, c + k * dc) ? 1 : 0;
-    return varying >= kSideVarying;
+  // Matter at (r, c), seen from its steady neighbour: outward is (dr, dc).
+  const auto matter_at = [&](long r, long c, long dr, long dc) {
+    return varies(r, c) &&
+           (varies(r + dr, c + dc) || varies(r + dc, c + dr) || varies(r - dc, c - dr));
   };
   for (long r = 0; r < rows; ++r) {
     for (long c = 0; c < columns; ++c) {
@@ -75,8 +73,8 @@ std::vector<std::uint8_t> stuck_elements(const Scan& scan, double noise_sigma) {
           if (!std::isfinite(before) || !std::isfinite(after)) continue;
           if (std::fmin(before, after) > judged &&
               own < kSteadyFraction * std::fmin(before, after) &&
-              matter_from(r - d * dr, c - d * dc, -dr, -dc) &&
-              matter_from(r + d * dr, c + d * dc, dr, dc)) {
+              matter_at(r - d * dr, c - d * dc, -dr, -dc) &&
+              matter_at(r + d * dr, c + d * dc, dr, dc)) {
             found = true;
           }
         }
@@ -89,7 +87,7 @@ std::vector<std::uint8_t> stuck_elements(const Scan& scan, double noise_sigma) {
   // distance from the axis in every direction, so an off-centre part that makes the columns
   // beyond the band vary crosses the band's lines too; columns steady over the views lie beyond
   // every such part, out to the detector's end, where a band has no second side. Each side is
-  // matter's run of varying columns.
+  // matter's.
   const long widest =
       std::max(3L, static_cast<long>(kWidestBandShare * static_cast<double>(columns)));
   for (long r = 0; r < rows; ++r) {
@@ -101,7 +99,7 @@ std::vector<std::uint8_t> stuck_elements(const Scan& scan, double noise_sigma) {
       }
       long end = c;  // the band [c, end)
       while (end < columns && !varies(r, end)) ++end;
-      if (end - c <= widest && matter_from(r, c - 1, 0, -1) && matter_from(r, end, 0, 1)) {
+      if (end - c <= widest && matter_at(r, c - 1, 0, -1) && matter_at(r, end, 0, 1)) {
         const double bound = std::fmin(at(r, c - 1), at(r, end));
         bool steady = true;
         for (long k = c; k < end && steady; ++k) {

@@ -92,6 +92,7 @@ double median_of(std::vector<double> values) {
 
 bool air_drifts(const FlatFieldReport& r) {
   return std::isfinite(r.air_first) && std::isfinite(r.air_last) &&
+         std::min(std::fabs(r.air_first), std::fabs(r.air_last)) <= kAirDriftLevelMost &&
          r.air_drift_sigmas > kAirDriftSigmas &&
          std::fabs(r.air_last - r.air_first) > kAirDriftLeast;
 }
