@@ -123,8 +123,8 @@ int run_reconstruct(int argc, char** argv, int first) {
   args.option("out", "DIR", "output folder (created if missing)")
       .option("format", "EXT",
               "image format: nii, npy, tif, raw or h5 (a volume, dataset /volume); a slabbed "
-              "run writes TIFF slices (volume/) and with h5, npy or raw also gathers them into "
-              "volume.<format>",
+              "run writes TIFF slices (volume/) and with h5, npy or raw, or nii or tif given, "
+              "also gathers them into volume.<format>",
               "nii")
       .option("config", "FILE", "settings JSON ({\"training\": {\"steps\": 4000}, ...})", "")
       .list_option("set", "NAME=VALUE,...",

@@ -252,9 +252,10 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   const std::filesystem::path out = make_output_dir(args.get("out"));
   // Refused now, not after every slab is trained.
   refuse_overwriting_input(out / "volume");
-  if (format == "h5" || format == "npy" || format == "raw") {
-    refuse_overwriting_input(out / ("volume." + format));
-  }
+  // The slices gathered into one file: for h5, npy and raw, and for nii or tif when asked for
+  // (by default a slabbed run writes the slices alone; --format nii or tif wrote no volume).
+  const bool gather = format == "h5" || format == "npy" || format == "raw" || args.given("format");
+  if (gather) refuse_overwriting_input(out / ("volume." + format));
   const std::optional<Device> device = rank_device(args, settings.engine, ranks);
   // On a CPU the plan splits the gradient's sums by the device's threads, and a rank has only
   // its share of them: every rank plans for the whole machine, so the sums, and the volume,
@@ -549,7 +550,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   }
   write_detector_outputs(out, run.alpha(), run.beta(), dead);
   std::string gathered;
-  if (format == "h5" || format == "npy" || format == "raw") {
+  if (gather) {
     gathered = (out / ("volume." + format)).string();
     gather_slices(run, gathered);
   }

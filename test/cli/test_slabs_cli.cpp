@@ -106,6 +106,14 @@ TEST_SUITE("cli") {
     const riner::Array slices = riner::read_array(whole / "volume").array;
     CHECK(gathered.shape == slices.shape);
     CHECK(gathered.data == slices.data);
+    // --format nii given (the default's name) gathers too: before, it wrote no volume file.
+    const std::filesystem::path nii = dir / "nii";
+    REQUIRE(riner_cli("reconstruct " + scan +
+                          " --slab-slices 10 --steps 20 --quiet --format nii --out " + nii.string(),
+                      dir)
+                .code == 0);
+    const riner::Array nii_volume = riner::read_array(nii / "volume.nii").array;
+    CHECK(nii_volume.data == riner::read_array(nii / "volume").array.data);
 
     // The same run, killed as soon as its first slab is written.
     riner::test::run_until({"reconstruct", scan, "--slab-slices", "4", "--steps", "600", "--quiet",
