@@ -114,6 +114,12 @@ TEST_SUITE("cli") {
                 .code == 0);
     const riner::Array nii_volume = riner::read_array(nii / "volume.nii").array;
     CHECK(nii_volume.data == riner::read_array(nii / "volume").array.data);
+    // A finished run is no run to finish (it said "pass --resume to finish it").
+    const Run again = riner_cli(
+        "reconstruct " + scan + " --slab-slices 10 --steps 20 --quiet --out " + nii.string(), dir);
+    CHECK(again.code != 0);
+    CHECK(again.err.find("holds a finished slabbed run (manifest.json): choose another output "
+                         "folder") != std::string::npos);
 
     // The same run, killed as soon as its first slab is written.
     riner::test::run_until({"reconstruct", scan, "--slab-slices", "4", "--steps", "600", "--quiet",

@@ -1,12 +1,13 @@
 #include "riner/slab_run.hpp"
 
+#include <unistd.h>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <map>
 #include <mutex>
-#include <unistd.h>
 
 #include "io/data_fingerprint.hpp"
 #include "riner/error.hpp"
@@ -186,9 +187,23 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
   }
   if (held_run) {
     if (!options.resume && !join_) {
+      // A finished run's manifest records every slab done: "pass --resume to finish it" misled.
+      bool finished = false;
+      try {
+        std::ifstream in(path);
+        const nlohmann::json held = nlohmann::json::parse(in);
+        const nlohmann::json& slabs = held.at("slabs");
+        finished = slabs.is_array() && !slabs.empty() &&
+                   std::all_of(slabs.begin(), slabs.end(), [](const nlohmann::json& slab) {
+                     return slab.is_object() && slab.value("done", false);
+                   });
+      } catch (const nlohmann::json::exception&) {
+      }
       throw InputError(out_.string() +
-                       " holds a slabbed run (manifest.json): pass --resume to finish it, or "
-                       "choose another output folder");
+                       (finished ? " holds a finished slabbed run (manifest.json): choose another "
+                                   "output folder, or remove it to run again"
+                                 : " holds a slabbed run (manifest.json): pass --resume to finish "
+                                   "it, or choose another output folder"));
     }
     try {
       // Not read_text: that marks the file an input, and this run rewrites it.
