@@ -55,6 +55,21 @@ std::string simulate_stack(const riner::test::TempDir& dir) {
   return riner::test::simulate_small_parallel3d(dir) + "/sino.npy";
 }
 
+// The stack `scan` with detector row 7 reading NaN in every view, written as dir/dead/sino.npy
+// beside its geometry; returned.
+riner::Array stack_with_dead_row(const riner::test::TempDir& dir, const std::string& scan) {
+  riner::Array views = riner::read_array(scan).array;
+  const std::size_t rows = views.shape[1], columns = views.shape[2];
+  for (std::size_t v = 0; v < views.shape[0]; ++v) {
+    std::fill_n(views.data.begin() + static_cast<long>((v * rows + 7) * columns), columns, NAN);
+  }
+  std::filesystem::create_directories(dir / "dead");
+  riner::write_array(dir / "dead" / "sino.npy", views);
+  std::filesystem::copy_file(std::filesystem::path(scan).parent_path() / "geometry.json",
+                             dir / "dead" / "geometry.json");
+  return views;
+}
+
 std::size_t claims_left(const std::filesystem::path& out) {
   std::size_t claims = 0;
   for (const auto& entry : std::filesystem::directory_iterator(out / "slabs")) {
@@ -603,15 +618,9 @@ TEST_SUITE("cli") {
     // head's slice 0.0009 against its 0.0100, 14.4 dB among neighbours at 27-30), unsaid.
     riner::test::TempDir dir;
     const std::string scan = simulate_stack(dir);
-    riner::Array views = riner::read_array(scan).array;
-    const std::size_t rows = views.shape[1], columns = views.shape[2];
-    for (std::size_t v = 0; v < views.shape[0]; ++v) {
-      std::fill_n(views.data.begin() + static_cast<long>((v * rows + 7) * columns), columns, NAN);
-    }
-    std::filesystem::create_directories(dir / "dead");
-    riner::write_array(dir / "dead" / "sino.npy", views);
+    const riner::Array views = stack_with_dead_row(dir, scan);
+    const std::size_t columns = views.shape[2];
     const std::filesystem::path sim = std::filesystem::path(scan).parent_path();
-    std::filesystem::copy_file(sim / "geometry.json", dir / "dead" / "geometry.json");
     const riner::Array truth = riner::read_array(sim / "ground_truth.nii").array;
     for (const std::string mode : {"whole", "slabs"}) {
       CAPTURE(mode);
@@ -665,15 +674,8 @@ TEST_SUITE("cli") {
   TEST_CASE("a dead detector row: its slice is NaN and said so, the rest of the scan goes on") {
     riner::test::TempDir dir;
     const std::string scan = simulate_stack(dir);
-    riner::Array views = riner::read_array(scan).array;
+    riner::Array views = stack_with_dead_row(dir, scan);
     const std::size_t rows = views.shape[1], columns = views.shape[2];
-    for (std::size_t v = 0; v < views.shape[0]; ++v) {
-      std::fill_n(views.data.begin() + static_cast<long>((v * rows + 7) * columns), columns, NAN);
-    }
-    std::filesystem::create_directories(dir / "dead");
-    riner::write_array(dir / "dead" / "sino.npy", views);
-    std::filesystem::copy_file(std::filesystem::path(scan).parent_path() / "geometry.json",
-                               dir / "dead" / "geometry.json");
     // Each slice trained as its row's 2D scan: row 7 has nothing (it stopped the run before).
     const Run run = riner_cli("reconstruct " + (dir / "dead" / "sino.npy").string() +
                                   " --slices-2d --steps 100 --out " + (dir / "out").string(),

@@ -25,10 +25,7 @@ struct StripeFree {
 // Slice `index` through the paper's fan-beam simulation with every response ideal and none dead.
 StripeFree stripe_free_slice(int index, const riner::Projector& projector) {
   StripeFree out;
-  out.truth = riner::read_array(riner::test::shared_data("deeplesion/slice_" +
-                                                         std::to_string(index) + ".nii"))
-                  .array;
-  for (float& v : out.truth.data) v *= 0.1f;  // cm^-1 -> mm^-1 (METHOD.md §4)
+  out.truth = riner::test::deeplesion_slice_mm(index);
   riner::RingModel model;
   model.nonideal_fraction = 0.0;
   model.dead_elements = 0;

@@ -22,10 +22,7 @@ struct PaperSlice {
 // Slice `index` of the shared DeepLesion slices through the paper's simulation (seed: index).
 PaperSlice paper_slice(int index, const riner::Projector& projector) {
   PaperSlice out;
-  out.truth = riner::read_array(riner::test::shared_data("deeplesion/slice_" +
-                                                         std::to_string(index) + ".nii"))
-                  .array;
-  for (float& v : out.truth.data) v *= 0.1f;  // cm^-1 -> mm^-1 (METHOD.md §4)
+  out.truth = riner::test::deeplesion_slice_mm(index);
   riner::RingModel model;
   model.seed = static_cast<std::uint64_t>(index);
   out.sim = riner::simulate(out.truth, projector, model);

@@ -9,6 +9,9 @@
 #include <memory>
 #include <mutex>
 #include <random>
+#include <string>
+
+#include "riner/io.hpp"
 
 namespace riner::test {
 
@@ -69,6 +72,12 @@ TempDir::~TempDir() {
 std::filesystem::path shared_data(const std::string& relative) {
   const std::filesystem::path path = std::filesystem::path(RINER_SHARED_DIR) / "data" / relative;
   return std::filesystem::exists(path) ? path : std::filesystem::path();
+}
+
+Array deeplesion_slice_mm(int index) {
+  Array truth = read_array(shared_data("deeplesion/slice_" + std::to_string(index) + ".nii")).array;
+  for (float& v : truth.data) v *= 0.1f;  // cm^-1 -> mm^-1
+  return truth;
 }
 
 void write_bytes(const std::filesystem::path& path, const std::string& bytes) {

@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "riner/array.hpp"
 #include "riner/device.hpp"
 
 namespace riner::test {
@@ -37,6 +38,9 @@ class TempDir {
 
 // Path into ../shared/data, or empty when the shared data is not beside the checkout.
 std::filesystem::path shared_data(const std::string& relative);
+// Shared DeepLesion slice `index` (deeplesion/slice_N.nii, cm^-1) in mm^-1, as METHOD.md §4
+// simulates it; the shared data must be there.
+Array deeplesion_slice_mm(int index);
 
 void write_bytes(const std::filesystem::path& path, const std::string& bytes);
 std::string read_bytes(const std::filesystem::path& path);
