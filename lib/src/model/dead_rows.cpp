@@ -37,10 +37,15 @@ std::vector<std::size_t> fill_dead_rows(Array& measurement, const Geometry& g) {
                                              : 0.0f;
     for (std::size_t v = 0; v < views; ++v) {
       float* line = measurement.data.data() + (v * rows + r) * columns;
-      const float* low = below >= 0 ? measurement.data.data() + (v * rows + static_cast<std::size_t>(below)) * columns : nullptr;
-      const float* high = above >= 0 ? measurement.data.data() + (v * rows + static_cast<std::size_t>(above)) * columns : nullptr;
+      const float* low = below >= 0 ? measurement.data.data() +
+                                          (v * rows + static_cast<std::size_t>(below)) * columns
+                                    : nullptr;
+      const float* high = above >= 0 ? measurement.data.data() +
+                                           (v * rows + static_cast<std::size_t>(above)) * columns
+                                     : nullptr;
       for (std::size_t c = 0; c < columns; ++c) {
-        const bool has_low = low && std::isfinite(low[c]), has_high = high && std::isfinite(high[c]);
+        const bool has_low = low && std::isfinite(low[c]),
+                   has_high = high && std::isfinite(high[c]);
         if (has_low && has_high) {
           line[c] = (1.0f - w) * low[c] + w * high[c];
         } else if (has_low) {

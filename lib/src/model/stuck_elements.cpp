@@ -13,11 +13,6 @@ constexpr double kJudgedNoiseSigmas = 10.0;
 constexpr long kFarthestNeighbour = 2;
 // A band of steady columns (a dead detector module) up to this share of the detector's width.
 constexpr double kWidestBandShare = 0.25;
-// An element that varies beside a steady one or a band is matter's where an element beside it
-// varies too (outward, or across: a silhouette's rim runs along the detector); a failing element
-// in the air stands alone. Elements 8 and 32 of a simulated fan scan, changing part-way, made
-// the 23 air columns between them a "dead module"; elements 494 and 498 made air element 496
-// stuck.
 
 }  // namespace
 
@@ -56,7 +51,11 @@ std::vector<std::uint8_t> stuck_elements(const Scan& scan, double noise_sigma) {
     const double v = at(r, c);
     return std::isfinite(v) && v > judged;
   };
-  // Matter at (r, c), seen from its steady neighbour: outward is (dr, dc).
+  // Matter at (r, c), seen from its steady neighbour (outward is (dr, dc)): an element that
+  // varies beside a steady one or a band is matter's where an element beside it varies too
+  // (outward, or across: a silhouette's rim runs along the detector); a failing element in the
+  // air stands alone. Elements 8 and 32 of a simulated fan scan, changing part-way, made the 23
+  // air columns between them a "dead module"; elements 494 and 498 made air element 496 stuck.
   const auto matter_at = [&](long r, long c, long dr, long dc) {
     return varies(r, c) &&
            (varies(r + dr, c + dc) || varies(r + dc, c + dr) || varies(r - dc, c - dr));
@@ -68,13 +67,11 @@ std::vector<std::uint8_t> stuck_elements(const Scan& scan, double noise_sigma) {
       bool found = false;
       for (long d = 1; d <= kFarthestNeighbour && !found; ++d) {
         for (const auto [dr, dc] : {std::pair{0L, 1L}, std::pair{1L, 0L}}) {
-          const double before = at(r - d * dr, c - d * dc), after = at(r + d * dr, c + d * dc);
-          // Both neighbours must be there.
-          if (!std::isfinite(before) || !std::isfinite(after)) continue;
-          if (std::fmin(before, after) > judged &&
-              own < kSteadyFraction * std::fmin(before, after) &&
-              matter_at(r - d * dr, c - d * dc, -dr, -dc) &&
-              matter_at(r + d * dr, c + d * dc, dr, dc)) {
+          // Both neighbours there and varying (matter_at), the element steady against them.
+          if (matter_at(r - d * dr, c - d * dc, -dr, -dc) &&
+              matter_at(r + d * dr, c + d * dc, dr, dc) &&
+              own < kSteadyFraction *
+                        std::fmin(at(r - d * dr, c - d * dc), at(r + d * dr, c + d * dc))) {
             found = true;
           }
         }
