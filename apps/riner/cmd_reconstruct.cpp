@@ -13,6 +13,7 @@
 #include "reconstruct_slabs.hpp"
 #include "riner/error.hpp"
 #include "riner/fbp.hpp"
+#include "riner/folder_lock.hpp"
 #include "riner/io.hpp"
 #include "riner/quality.hpp"
 #include "riner/reconstructor.hpp"
@@ -184,6 +185,7 @@ int run_reconstruct(int argc, char** argv, int first) {
     throw UsageError("--format h5 writes volumes; write a 2D image as nii, npy, tif or raw");
   }
   const std::filesystem::path out = make_output_dir(args.get("out"));
+  const FolderLock lock(out);  // before the checkpoint is looked at: a live run may write it
   // Every image format's name: an earlier run's image.nii beside this run's image.npy would
   // pass for this run's.
   std::vector<std::string> outputs = {"image.png",         "alpha.npy",    "beta.npy",

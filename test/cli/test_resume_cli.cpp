@@ -34,11 +34,21 @@ TEST_SUITE("cli") {
 
     // The same run saving every 0.3 s of training, killed once the first checkpoint is there.
     const std::filesystem::path checkpoint = killed / "training.checkpoint";
+    // While it trains, the same command again (--resume, as a requeued job would) is refused:
+    // it would overwrite the live run's checkpoint and outputs.
+    std::optional<Run> beside;
     run_until({"reconstruct", sim + "/sino.npy", "--geometry", sim + "/geometry.json", "--steps",
                "4000", "--quiet", "--checkpoint-minutes", "0.005", "--out", killed.string()},
-              [&] { return std::filesystem::exists(checkpoint); });
+              [&] {
+                if (!std::filesystem::exists(checkpoint)) return false;
+                beside = riner_cli(common + " --resume --out " + killed.string(), dir);
+                return true;
+              });
     REQUIRE(std::filesystem::exists(checkpoint));
     REQUIRE(!std::filesystem::exists(killed / "image.nii"));  // killed before the end
+    REQUIRE(beside);
+    CHECK(beside->code != 0);
+    CHECK(beside->err.find("another riner run") != std::string::npos);
 
     // Not overwritten without --resume; not taken up with other settings.
     Run refused = riner_cli(common + " --out " + killed.string(), dir);
@@ -119,12 +129,21 @@ TEST_SUITE("cli") {
     REQUIRE(riner_cli(common + " --out " + whole.string(), dir).code == 0);
 
     const std::filesystem::path checkpoint = killed / "slabs" / "slab_0000.checkpoint";
+    // A second run on the folder while the first trains would train every slab again beside it.
+    std::optional<Run> beside;
     run_until({"reconstruct", sim + "/sino.npy", "--geometry", sim + "/geometry.json",
                "--slab-slices", "10", "--steps", "1500", "--quiet", "--checkpoint-minutes", "0.003",
                "--out", killed.string()},
-              [&] { return std::filesystem::exists(checkpoint); });
+              [&] {
+                if (!std::filesystem::exists(checkpoint)) return false;
+                beside = riner_cli(common + " --resume --out " + killed.string(), dir);
+                return true;
+              });
     REQUIRE(std::filesystem::exists(checkpoint));
     REQUIRE(!std::filesystem::exists(killed / "slabs" / "slab_0000.json"));  // mid-slab
+    REQUIRE(beside);
+    CHECK(beside->code != 0);
+    CHECK(beside->err.find("another riner run") != std::string::npos);
     // What a SIGKILL mid-write would leave.
     const std::filesystem::path half_written =
         killed / "slabs" /

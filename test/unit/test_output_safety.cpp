@@ -1,9 +1,12 @@
 // Outputs are atomic and never replace an input.
 #include <doctest/doctest.h>
 
+#include <unistd.h>
+
 #include <thread>
 
 #include "riner/error.hpp"
+#include "riner/folder_lock.hpp"
 #include "riner/io.hpp"
 #include "support/fixture.hpp"
 
@@ -82,6 +85,28 @@ TEST_SUITE("output_safety") {
       ++files;
     }
     CHECK(files == 1);
+  }
+
+  TEST_CASE("one run writes into a folder at a time; its lock goes when it does") {
+    riner::test::TempDir dir;
+    std::string holder;
+    {
+      const riner::FolderLock first(dir.path());
+      REQUIRE(first.held());
+      holder = riner::test::read_bytes(riner::FolderLock::file_in(dir.path()));
+      CHECK(holder.find(":" + std::to_string(::getpid())) != std::string::npos);
+      holder.pop_back();  // its newline
+      // A second lock conflicts even within this process (an open file's lock, not a process's).
+      const std::string message = dir.path().string() + ": another riner run (" + holder +
+                                  ") is writing into this folder: wait for it to end, or choose "
+                                  "another output folder";
+      CHECK_THROWS_WITH_AS(riner::FolderLock(dir.path()), message.c_str(), riner::InputError);
+      // Reading the lock's file elsewhere in the process does not drop it.
+      (void)riner::test::read_bytes(riner::FolderLock::file_in(dir.path()));
+      CHECK_THROWS_AS(riner::FolderLock(dir.path()), riner::InputError);
+    }
+    const riner::FolderLock after(dir.path());
+    CHECK(after.held());
   }
 
   TEST_CASE("a missing output directory is a clear error") {

@@ -21,6 +21,7 @@
 
 #include "riner/concurrent_trainings.hpp"
 #include "riner/device.hpp"
+#include "riner/folder_lock.hpp"
 #include "riner/reconstructor.hpp"
 #include "riner/riner_config.hpp"
 #include "riner/scan_source.hpp"
@@ -161,6 +162,7 @@ class SlabRun {
   std::vector<Slab> slabs_;
   nlohmann::json manifest_;
   bool join_ = false;
+  FolderLock lock_;  // the leader's, for the run's life (joined processes share it)
 };
 
 // Seconds since the Unix epoch (the slab records' finished_unix).

@@ -177,6 +177,10 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
   slices_per_slab_ = sizing.slices_per_slab;
   const std::filesystem::path path = out_ / "manifest.json";
   join_ = options.join;
+  if (!join_) {
+    std::filesystem::create_directories(out_);
+    lock_ = FolderLock(out_);  // before the manifest is read: another live run may write it
+  }
   const bool held_run = std::filesystem::exists(path);
   if (join_ && !held_run) {
     throw InputError(path.string() + ": no run to join (the leader writes it first)");
