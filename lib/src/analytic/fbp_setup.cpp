@@ -8,40 +8,9 @@
 #include <vector>
 
 #include "riner/rays.hpp"
+#include "util/fill_between.hpp"
 
 namespace riner::analytic {
-
-namespace {
-
-// Line `to` = the blend of lines `a` and `b` (weight w on b) of n values.
-void blend_line(float* to, const float* a, const float* b, float w, std::size_t n) {
-  for (std::size_t k = 0; k < n; ++k) to[k] = (1.0f - w) * a[k] + w * b[k];
-}
-
-// Fills each flagged entry of `empty` (count entries, lines of `size` values `stride` apart from
-// `base`) from the nearest unflagged ones on either side: linearly between two, a copy beside
-// one; false where none is left unflagged.
-bool fill_between(float* base, std::size_t stride, std::size_t size, std::vector<bool>& empty) {
-  const std::size_t count = empty.size();
-  long previous = -1;
-  bool any = false;
-  for (std::size_t j = 0; j <= count; ++j) {
-    if (j < count && empty[j]) continue;
-    if (j < count) any = true;
-    for (std::size_t k = static_cast<std::size_t>(previous + 1); k < j; ++k) {
-      if (previous < 0 && j == count) break;
-      const std::size_t a = previous >= 0 ? static_cast<std::size_t>(previous) : j;
-      const std::size_t b = j < count ? j : a;
-      const float w = a == b ? 0.0f : static_cast<float>(k - a) / static_cast<float>(b - a);
-      blend_line(base + k * stride, base + a * stride, base + b * stride, w, size);
-      empty[k] = false;
-    }
-    previous = static_cast<long>(j);
-  }
-  return any;
-}
-
-}  // namespace
 
 std::size_t repair_non_finite(Array& measurement, std::size_t n_u, std::size_t rows) {
   std::size_t replaced = 0;
@@ -80,9 +49,9 @@ std::size_t repair_non_finite(Array& measurement, std::size_t n_u, std::size_t r
   for (std::size_t v = 0; v < views; ++v) {
     std::vector<bool> row_empty(empty.begin() + static_cast<std::ptrdiff_t>(v * rows),
                                 empty.begin() + static_cast<std::ptrdiff_t>((v + 1) * rows));
-    view_empty[v] = !fill_between(measurement.ptr() + v * rows * n_u, n_u, n_u, row_empty);
+    view_empty[v] = !util::fill_between(measurement.ptr() + v * rows * n_u, n_u, n_u, row_empty);
   }
-  fill_between(measurement.ptr(), rows * n_u, rows * n_u, view_empty);
+  util::fill_between(measurement.ptr(), rows * n_u, rows * n_u, view_empty);
   return replaced;
 }
 

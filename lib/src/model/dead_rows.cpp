@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "util/fill_between.hpp"
+
 namespace riner::model {
 
 std::vector<std::size_t> fill_dead_rows(Array& measurement, const Geometry& g) {
@@ -16,45 +18,13 @@ std::vector<std::size_t> fill_dead_rows(Array& measurement, const Geometry& g) {
     }
   }
   std::vector<std::size_t> filled;
-  std::vector<long> live;
   for (std::size_t r = 0; r < rows; ++r) {
-    if (dead[r]) {
-      filled.push_back(r);
-    } else {
-      live.push_back(static_cast<long>(r));
-    }
+    if (dead[r]) filled.push_back(r);
   }
-  if (filled.empty() || live.empty()) return {};
-  for (const std::size_t r : filled) {
-    // The nearest live rows below and above r (-1: none).
-    long below = -1, above = -1;
-    for (const long l : live) {
-      if (l < static_cast<long>(r)) below = l;
-      if (l > static_cast<long>(r) && above < 0) above = l;
-    }
-    const float w = below >= 0 && above >= 0 ? static_cast<float>(static_cast<long>(r) - below) /
-                                                   static_cast<float>(above - below)
-                                             : 0.0f;
-    for (std::size_t v = 0; v < views; ++v) {
-      float* line = measurement.data.data() + (v * rows + r) * columns;
-      const float* low = below >= 0 ? measurement.data.data() +
-                                          (v * rows + static_cast<std::size_t>(below)) * columns
-                                    : nullptr;
-      const float* high = above >= 0 ? measurement.data.data() +
-                                           (v * rows + static_cast<std::size_t>(above)) * columns
-                                     : nullptr;
-      for (std::size_t c = 0; c < columns; ++c) {
-        const bool has_low = low && std::isfinite(low[c]),
-                   has_high = high && std::isfinite(high[c]);
-        if (has_low && has_high) {
-          line[c] = (1.0f - w) * low[c] + w * high[c];
-        } else if (has_low) {
-          line[c] = low[c];
-        } else if (has_high) {
-          line[c] = high[c];
-        }
-      }
-    }
+  if (filled.empty() || filled.size() == rows) return {};
+  for (std::size_t v = 0; v < views; ++v) {
+    std::vector<bool> empty = dead;
+    util::fill_between(measurement.data.data() + v * rows * columns, columns, columns, empty);
   }
   return filled;
 }
