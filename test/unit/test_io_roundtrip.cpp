@@ -196,6 +196,50 @@ TEST_SUITE("io_roundtrip") {
     CHECK(f.voxel_size == std::vector<double>{0.5, 2.0});
   }
 
+  TEST_CASE("tiff and raw: the written voxel size reads back (Fiji's resolution, the sidecar)") {
+    // Before: a TIFF or raw image, slice or volume said nothing of its size; Fiji measured in
+    // pixels. TIFF holds the pixels per centimetre (float), so sizes come back within 1e-6.
+    riner::test::TempDir dir;
+    const Array image = random_array({4, 6}, 4), volume = random_array({3, 4, 6}, 5);
+    riner::write_array(dir / "v.tif", image, {{0.125, 0.125}});
+    riner::ArrayFile f = riner::read_array(dir / "v.tif");
+    REQUIRE(f.voxel_size.size() == 2);
+    CHECK(f.voxel_size[0] == doctest::Approx(0.125).epsilon(1e-6));
+    CHECK(f.voxel_size[1] == doctest::Approx(0.125).epsilon(1e-6));
+    CHECK(f.array.data == image.data);
+    // Written into every page of a stack, whose spacing no tag holds: not claimed on reading.
+    riner::write_array(dir / "s.tif", volume, {{0.02, 0.02, 0.02}});
+    {
+      TIFF* tif = TIFFOpen((dir / "s.tif").c_str(), "r");
+      REQUIRE(tif);
+      int pages_with_size = 0;
+      do {
+        float x = 0.0f;
+        uint16_t unit = 0;
+        pages_with_size += TIFFGetField(tif, TIFFTAG_XRESOLUTION, &x) &&
+                           TIFFGetField(tif, TIFFTAG_RESOLUTIONUNIT, &unit) &&
+                           unit == RESUNIT_CENTIMETER && std::fabs(x - 500.0f) < 1e-3f;
+      } while (TIFFReadDirectory(tif));
+      TIFFClose(tif);
+      CHECK(pages_with_size == 3);
+    }
+    CHECK(riner::read_array(dir / "s.tif").voxel_size.empty());
+    riner::write_array(dir / "n.tif", image);
+    CHECK(riner::read_array(dir / "n.tif").voxel_size.empty());
+
+    riner::write_array(dir / "v.raw", volume, {{0.5, 0.25, 0.25}});
+    f = riner::read_array(dir / "v.raw");
+    CHECK(f.voxel_size == std::vector<double>{0.5, 0.25, 0.25});
+    CHECK(f.array.data == volume.data);
+    riner::test::write_bytes(
+        dir / "v.raw.json", R"({"dtype": "float32", "shape": [3, 4, 6], "voxel_size_mm": [1, 0]})");
+    CHECK_THROWS_WITH_AS(riner::read_array(dir / "v.raw"),
+                         ((dir / "v.raw.json").string() +
+                          ": \"voxel_size_mm\" must be a positive size in mm per axis of \"shape\"")
+                             .c_str(),
+                         riner::InputError);
+  }
+
   TEST_CASE("tiff: uint16 and uint8, compressed, single and multi-page") {
     riner::test::TempDir dir;
     write_tiff_u16(dir / "one.tif", 1, 9, 13, 16);

@@ -205,7 +205,9 @@ void write_array(const std::filesystem::path& path, const Array& array,
       return write_atomically(
           path, [&](const auto& tmp) { io::write_nifti(tmp, array, options.voxel_size); });
     case FileFormat::kTiff:
-      return write_atomically(path, [&](const auto& tmp) { io::write_tiff(tmp, array); });
+      return write_atomically(path, [&](const auto& tmp) {
+        io::write_tiff(tmp, array, options.voxel_size.empty() ? 0.0 : options.voxel_size.back());
+      });
     case FileFormat::kRaw: {
       std::filesystem::path sidecar = path;
       sidecar += ".json";
@@ -216,7 +218,7 @@ void write_array(const std::filesystem::path& path, const Array& array,
                    static_cast<std::streamsize>(array.size() * sizeof(float)));
         if (!file.flush()) throw Error(io::prefix(path) + "write failed");
       });
-      return write_text(sidecar, io::raw_sidecar_json(array.shape));
+      return write_text(sidecar, io::raw_sidecar_json(array.shape, options.voxel_size));
     }
     case FileFormat::kPng:
       return write_png(path, array);

@@ -35,12 +35,14 @@ ArrayFile read_tiff(const std::filesystem::path& path);
 // Rows `rows` of every page: [count, cols] for one page, [pages, count, cols] for several.
 ArrayFile read_tiff_rows(const std::filesystem::path& path, RowRange rows);
 std::vector<std::size_t> tiff_shape(const std::filesystem::path& path);
-void write_tiff(const std::filesystem::path& path, const Array& array);
+// pixel_mm (> 0): the pixels' size, as TIFF's resolution in pixels per centimetre (what Fiji and
+// tifffile read); the pages' spacing has no standard tag and is not written.
+void write_tiff(const std::filesystem::path& path, const Array& array, double pixel_mm = 0.0);
 // A float32 TIFF written a page at a time, in order (libtiff appends directories).
 class TiffPageWriter {
  public:
   TiffPageWriter(const std::filesystem::path& path, std::size_t pages, std::size_t rows,
-                 std::size_t cols);
+                 std::size_t cols, double pixel_mm = 0.0);
   TiffPageWriter(const TiffPageWriter&) = delete;
   TiffPageWriter& operator=(const TiffPageWriter&) = delete;
   ~TiffPageWriter();
@@ -52,13 +54,16 @@ class TiffPageWriter {
   std::unique_ptr<File> file_;
   std::filesystem::path path_;
   std::size_t pages_, rows_, cols_, written_ = 0;
+  double pixel_mm_ = 0.0;
 };
 
 // The sidecar is "<path>.json".
 ArrayFile read_raw(const std::filesystem::path& path);
 std::vector<std::size_t> raw_shape(const std::filesystem::path& path);
 std::optional<ArrayFile> read_raw_rows(const std::filesystem::path& path, RowRange rows);
-std::string raw_sidecar_json(const std::vector<std::size_t>& shape);
+// voxel_size (mm per axis, in array order; empty: not stated) as "voxel_size_mm".
+std::string raw_sidecar_json(const std::vector<std::size_t>& shape,
+                             const std::vector<double>& voxel_size = {});
 
 // 8-bit PNG of prepared pixels (rows x cols x channels).
 void write_png_gray8(const std::filesystem::path& path, const std::vector<unsigned char>& pixels,

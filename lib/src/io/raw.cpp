@@ -6,6 +6,8 @@
 // byte-swapped samples without a word).
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <optional>
 
@@ -33,11 +35,12 @@ struct RawLayout {
   bool fortran_order = false;
   std::size_t offset = 0;
   std::size_t trailing = 0;
+  std::vector<double> voxel_size;  // mm per axis, when the sidecar states it
 };
 
 bool known_sidecar_key(const std::string& key) {
   for (const char* known : {"dtype", "shape", "byte_order", "order", "offset_bytes",
-                            "trailing_bytes", "comment", "description", "notes"}) {
+                            "trailing_bytes", "voxel_size_mm", "comment", "description", "notes"}) {
     if (key == known) return true;
   }
   return !key.empty() && key[0] == '_';
@@ -89,6 +92,17 @@ RawLayout read_sidecar(const std::filesystem::path& path) {
     if (!meta["trailing_bytes"].is_number_unsigned()) throw bad("\"trailing_bytes\" must be >= 0");
     layout.trailing = meta["trailing_bytes"].get<std::size_t>();
   }
+  if (meta.contains("voxel_size_mm")) {
+    const nlohmann::json& sizes = meta["voxel_size_mm"];
+    const auto positive = [](const nlohmann::json& v) {
+      return v.is_number() && v.get<double>() > 0.0 && std::isfinite(v.get<double>());
+    };
+    if (!sizes.is_array() || sizes.size() != layout.shape.size() ||
+        !std::all_of(sizes.begin(), sizes.end(), positive)) {
+      throw bad("\"voxel_size_mm\" must be a positive size in mm per axis of \"shape\"");
+    }
+    for (const auto& v : sizes) layout.voxel_size.push_back(v.get<double>());
+  }
   return layout;
 }
 
@@ -98,9 +112,8 @@ void check_file_size(const RawLayout& layout, const std::filesystem::path& path,
   const std::size_t item = sample_bytes(layout.type);
   if (layout.offset > bytes || count > (bytes - layout.offset) / item) {
     throw InputError(prefix(path) + "sidecar says " + shape_string(layout.shape) + " " +
-                     sample_type_name(layout.type) + " from byte " +
-                     std::to_string(layout.offset) + " but the file has " +
-                     std::to_string(bytes) + " bytes");
+                     sample_type_name(layout.type) + " from byte " + std::to_string(layout.offset) +
+                     " but the file has " + std::to_string(bytes) + " bytes");
   }
   const std::uint64_t described = layout.offset + count * item + layout.trailing;
   if (bytes != described) {
@@ -128,6 +141,7 @@ ArrayFile read_raw(const std::filesystem::path& path) {
   if (layout.fortran_order && layout.shape.size() > 1)
     data = fortran_to_c_order(data, layout.shape);
   file.array = Array(layout.shape, std::move(data));
+  file.voxel_size = layout.voxel_size;
   return file;
 }
 
@@ -149,12 +163,14 @@ std::optional<ArrayFile> read_raw_rows(const std::filesystem::path& path, RowRan
                          layout.little_endian, FileFormat::kRaw);
 }
 
-std::string raw_sidecar_json(const std::vector<std::size_t>& shape) {
+std::string raw_sidecar_json(const std::vector<std::size_t>& shape,
+                             const std::vector<double>& voxel_size) {
   nlohmann::json meta = {{"dtype", "float32"},
                          {"shape", shape},
                          {"byte_order", host_is_little_endian() ? "little" : "big"},
                          {"offset_bytes", 0},
                          {"order", "C"}};
+  if (voxel_size.size() == shape.size()) meta["voxel_size_mm"] = voxel_size;
   return meta.dump(1) + "\n";
 }
 

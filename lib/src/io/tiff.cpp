@@ -1,12 +1,13 @@
 // TIFF through libtiff: each page is a 2D image; several pages stack into [pages, rows, cols].
 #include <tiffio.h>
 
+#include <array>
 #include <cmath>
 #include <cstdarg>
 #include <cstdio>
 #include <cstring>
-#include <optional>
 #include <memory>
+#include <optional>
 
 #include "io/file_access.hpp"
 #include "io/formats.hpp"
@@ -89,8 +90,8 @@ void read_page(TIFF* tif, std::size_t y0, std::size_t y1, std::size_t cols, std:
           fail(path, "corrupt tile data");
         for (std::size_t y = std::max(ty, y0); y < std::min<std::size_t>(y1, ty + tile_h); ++y) {
           const std::size_t n = std::min<std::size_t>(cols - x0, tile_w);
-          std::memcpy(out + ((y - y0) * cols + x0) * item,
-                      tile.data() + (y - ty) * tile_w * item, n * item);
+          std::memcpy(out + ((y - y0) * cols + x0) * item, tile.data() + (y - ty) * tile_w * item,
+                      n * item);
         }
       }
     }
@@ -110,8 +111,8 @@ void read_page(TIFF* tif, std::size_t y0, std::size_t y1, std::size_t cols, std:
   std::vector<unsigned char> strip(per_strip * cols * item);
   for (std::size_t first = y0 - y0 % per_strip; first < y1; first += per_strip) {
     const auto index = TIFFComputeStrip(tif, static_cast<uint32_t>(first), 0);
-    const tmsize_t got = TIFFReadEncodedStrip(tif, index, strip.data(),
-                                              static_cast<tmsize_t>(strip.size()));
+    const tmsize_t got =
+        TIFFReadEncodedStrip(tif, index, strip.data(), static_cast<tmsize_t>(strip.size()));
     const std::size_t rows_here = std::min(per_strip, y1 - first);
     if (got < 0 || static_cast<std::size_t>(got) < rows_here * cols * item) {
       fail(path, "truncated or corrupt image data at row " + std::to_string(std::max(first, y0)));
@@ -121,6 +122,20 @@ void read_page(TIFF* tif, std::size_t y0, std::size_t y1, std::size_t cols, std:
                   cols * item);
     }
   }
+}
+
+// The pixel's height and width in mm, where the page states them in pixels per centimetre (as
+// riner writes them); {0, 0} otherwise. Resolutions in inches are left alone: most are a
+// scanner's or an editor's 72 dpi, not the detector's pitch.
+std::array<double, 2> pixel_size_mm(TIFF* tif) {
+  uint16_t unit = RESUNIT_NONE;
+  float x = 0.0f, y = 0.0f;
+  if (!TIFFGetField(tif, TIFFTAG_RESOLUTIONUNIT, &unit) || unit != RESUNIT_CENTIMETER ||
+      !TIFFGetField(tif, TIFFTAG_XRESOLUTION, &x) || !TIFFGetField(tif, TIFFTAG_YRESOLUTION, &y) ||
+      !(x > 0.0f) || !(y > 0.0f) || !std::isfinite(x) || !std::isfinite(y)) {
+    return {0.0, 0.0};
+  }
+  return {10.0 / y, 10.0 / x};
 }
 
 // Every page of the file, or only rows `rows` of each.
@@ -140,6 +155,7 @@ ArrayFile read_pages(const std::filesystem::path& path, std::optional<RowRange> 
   std::vector<unsigned char> raw;
   std::size_t pages = 0;
   RowRange range;
+  std::array<double, 2> pixel_mm{};
   do {
     uint32_t width = 0;
     uint32_t height = 0;
@@ -152,6 +168,7 @@ ArrayFile read_pages(const std::filesystem::path& path, std::optional<RowRange> 
       rows = height;
       cols = width;
       type = this_type;
+      pixel_mm = pixel_size_mm(tif.get());
       // Refuse sizes the file cannot possibly hold before allocating for them: uncompressed
       // data needs its bytes; compression rarely beats 1000:1.
       uint16_t compression = COMPRESSION_NONE;
@@ -178,13 +195,14 @@ ArrayFile read_pages(const std::filesystem::path& path, std::optional<RowRange> 
   if (!t_tiff_error.empty()) fail(path, "corrupt directory");
 
   file.dtype = sample_type_name(type);
-  std::vector<std::size_t> shape = pages == 1
-                                       ? std::vector<std::size_t>{range.count, cols}
-                                       : std::vector<std::size_t>{pages, range.count, cols};
+  std::vector<std::size_t> shape = pages == 1 ? std::vector<std::size_t>{range.count, cols}
+                                              : std::vector<std::size_t>{pages, range.count, cols};
   std::vector<float> data(shape_size(shape));
   file.non_finite =
       decode_samples(raw.data(), data.size(), type, host_is_little_endian(), data.data());
   file.array = Array(std::move(shape), std::move(data));
+  // One page's rows and columns; a stack's spacing is stated nowhere.
+  if (pages == 1 && pixel_mm[0] > 0.0) file.voxel_size = {pixel_mm[0], pixel_mm[1]};
   return file;
 }
 
@@ -218,8 +236,13 @@ struct TiffPageWriter::File {
 };
 
 TiffPageWriter::TiffPageWriter(const std::filesystem::path& path, std::size_t pages,
-                               std::size_t rows, std::size_t cols)
-    : file_(std::make_unique<File>()), path_(path), pages_(pages), rows_(rows), cols_(cols) {
+                               std::size_t rows, std::size_t cols, double pixel_mm)
+    : file_(std::make_unique<File>()),
+      path_(path),
+      pages_(pages),
+      rows_(rows),
+      cols_(cols),
+      pixel_mm_(pixel_mm > 0.0 && std::isfinite(pixel_mm) ? pixel_mm : 0.0) {
   install_handlers();
   t_tiff_error.clear();
   const bool big = pages * rows * cols * sizeof(float) > (std::size_t{1} << 31);
@@ -244,6 +267,12 @@ void TiffPageWriter::append(const float* page) {
   TIFFSetField(tif, TIFFTAG_PLANARCONFIG, PLANARCONFIG_CONTIG);
   TIFFSetField(tif, TIFFTAG_COMPRESSION, COMPRESSION_NONE);
   TIFFSetField(tif, TIFFTAG_ROWSPERSTRIP, TIFFDefaultStripSize(tif, 0));
+  if (pixel_mm_ > 0.0) {
+    const auto per_cm = static_cast<float>(10.0 / pixel_mm_);
+    TIFFSetField(tif, TIFFTAG_XRESOLUTION, per_cm);
+    TIFFSetField(tif, TIFFTAG_YRESOLUTION, per_cm);
+    TIFFSetField(tif, TIFFTAG_RESOLUTIONUNIT, RESUNIT_CENTIMETER);
+  }
   if (pages_ > 1) {
     TIFFSetField(tif, TIFFTAG_SUBFILETYPE, FILETYPE_PAGE);
     TIFFSetField(tif, TIFFTAG_PAGENUMBER, static_cast<uint16_t>(written_),
@@ -269,7 +298,7 @@ void TiffPageWriter::close() {
   file_->tif.reset();
 }
 
-void write_tiff(const std::filesystem::path& path, const Array& array) {
+void write_tiff(const std::filesystem::path& path, const Array& array, double pixel_mm) {
   if (array.rank() != 2 && array.rank() != 3) {
     throw InputError(prefix(path) + "TIFF output takes a 2D image or a 3D stack, not rank " +
                      std::to_string(array.rank()));
@@ -277,7 +306,7 @@ void write_tiff(const std::filesystem::path& path, const Array& array) {
   const std::size_t pages = array.rank() == 3 ? array.shape[0] : 1;
   const std::size_t rows = array.shape[array.rank() - 2];
   const std::size_t cols = array.shape[array.rank() - 1];
-  TiffPageWriter writer(path, pages, rows, cols);
+  TiffPageWriter writer(path, pages, rows, cols, pixel_mm);
   for (std::size_t p = 0; p < pages; ++p) writer.append(array.ptr() + p * rows * cols);
   writer.close();
 }

@@ -120,8 +120,9 @@ class Hdf5Sink : public VolumeWriter::Sink {
 // A multi-page TIFF: libtiff appends pages, so blocks come in order.
 class TiffSink : public VolumeWriter::Sink {
  public:
-  TiffSink(const std::filesystem::path& path, const std::vector<std::size_t>& shape)
-      : file_(path), pages_(file_.temp_path(), shape[0], shape[1], shape[2]) {}
+  TiffSink(const std::filesystem::path& path, const std::vector<std::size_t>& shape,
+           double voxel_mm)
+      : file_(path), pages_(file_.temp_path(), shape[0], shape[1], shape[2], voxel_mm) {}
   void write(std::size_t first_slice, const Array& slices) override {
     if (first_slice != next_) {
       throw std::invalid_argument(io::prefix(file_.target()) +
@@ -146,14 +147,16 @@ class TiffSink : public VolumeWriter::Sink {
 
 class FolderSink : public VolumeWriter::Sink {
  public:
-  explicit FolderSink(std::filesystem::path folder) : folder_(std::move(folder)) {
+  FolderSink(std::filesystem::path folder, double voxel_mm)
+      : folder_(std::move(folder)), voxel_mm_(voxel_mm) {
     write_text(folder_ / VolumeWriter::kUnfinishedMarker,
                "riner is writing this folder's slices, or was stopped before the last: it is no "
                "volume until this file is gone. Run the command again to replace them.\n");
   }
   void write(std::size_t first_slice, const Array& slices) override {
     for (std::size_t k = 0; k < slices.shape[0]; ++k) {
-      write_array(VolumeWriter::slice_file(folder_, first_slice + k), axial_slice(slices, k));
+      write_array(VolumeWriter::slice_file(folder_, first_slice + k), axial_slice(slices, k),
+                  {{voxel_mm_, voxel_mm_}});
     }
   }
   void close() override {
@@ -167,6 +170,7 @@ class FolderSink : public VolumeWriter::Sink {
 
  private:
   std::filesystem::path folder_;
+  double voxel_mm_;
 };
 
 // The slice files riner wrote into `folder` (slice_NNNNN.tif).
@@ -203,7 +207,7 @@ std::unique_ptr<VolumeWriter::Sink> open_sink(const std::string& target,
                        VolumeWriter::slice_file(path, 0).filename().string() +
                        "): name an empty or new folder");
     }
-    return std::make_unique<FolderSink>(path);
+    return std::make_unique<FolderSink>(path, voxel_mm);
   }
   io::check_output_path(path);
   switch (format_from_path(path)) {
@@ -216,11 +220,11 @@ std::unique_ptr<VolumeWriter::Sink> open_sink(const std::string& target,
       std::filesystem::path sidecar = path;
       sidecar += ".json";
       io::check_output_path(sidecar);
-      write_text(sidecar, io::raw_sidecar_json(shape));
+      write_text(sidecar, io::raw_sidecar_json(shape, {voxel_mm, voxel_mm, voxel_mm}));
       return std::make_unique<FlatFileSink>(path, std::string(), bytes);
     }
     case FileFormat::kTiff:
-      return std::make_unique<TiffSink>(path, shape);
+      return std::make_unique<TiffSink>(path, shape, voxel_mm);
     default:
       throw InputError(io::prefix(path) +
                        "a volume is written as .npy, .nii, .raw, .tif, .h5 or a folder of TIFFs");

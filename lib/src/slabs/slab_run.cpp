@@ -451,7 +451,8 @@ void SlabRun::write_slab(const Slab& slab, const Reconstructor& r, const Summari
     beta = first_axis_range(beta, slab.map_rows.first - slab.rows.first, slab.map_rows.count);
   }
   for (std::size_t k = 0; k < slab.slices; ++k) {
-    write_array(slice_path(slab.first_slice + k), axial_slice(image, k));
+    write_array(slice_path(slab.first_slice + k), axial_slice(image, k),
+                {{g.voxel_mm, g.voxel_mm}});
   }
   write_array(slab_file(slab, "alpha"), alpha);
   write_array(slab_file(slab, "beta"), beta);
@@ -482,7 +483,7 @@ void SlabRun::write_empty_slab(const Slab& slab, const std::string& why) const {
   const Geometry& g = source_.geometry();
   const std::size_t ny = g.volume_shape[1], nx = g.volume_shape[2];
   for (std::size_t k = 0; k < slab.slices; ++k) {
-    write_array(slice_path(slab.first_slice + k), Array({ny, nx}, NAN));
+    write_array(slice_path(slab.first_slice + k), Array({ny, nx}, NAN), {{g.voxel_mm, g.voxel_mm}});
   }
   write_array(slab_file(slab, "alpha"), Array({slab.map_rows.count, g.n_u}, NAN));
   write_array(slab_file(slab, "beta"), Array({slab.map_rows.count, g.n_u}, 0.0f));
