@@ -10,6 +10,7 @@
 #include <cstring>
 
 #include "riner/error.hpp"
+#include "riner/fbp.hpp"
 #include "riner/io.hpp"
 #include "riner/simulate.hpp"
 
@@ -168,6 +169,13 @@ void note_filled_rows(const Console& console, const std::vector<std::size_t>& ro
   console.line("note: detector row" + std::string(rows.size() > 1 ? "s " : " ") + list +
                " read nothing in any view: trained on the line between the rows beside them, as "
                "FBP fills them; the slices only they see are interpolated, not measured");
+}
+
+void note_missing_lines(const Console& console, const Geometry& g) {
+  if (!views_miss_lines(g)) return;
+  console.line(
+      "warning: the views miss part of the circle (a parallel beam's half turn, a fan's half "
+      "turn plus the fan): the field along the lines never measured rests on no reading");
 }
 
 void note_non_finite(const Console& console, std::size_t non_finite) {

@@ -77,5 +77,8 @@ void note_large_stripes(Console& console, const DestripeReport& report);
 void note_non_finite(const Console& console, std::size_t non_finite);
 // The detector rows training filled from the rows beside them (TrainingStats::filled_rows).
 void note_filled_rows(const Console& console, const std::vector<std::size_t>& rows);
+// Before training: a warning when the views leave lines never measured (views_miss_lines), as
+// riner fbp warns (before, reconstruct said nothing of a 0.5-degree arc).
+void note_missing_lines(const Console& console, const Geometry& g);
 
 }  // namespace riner::app

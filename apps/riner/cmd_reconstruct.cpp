@@ -175,6 +175,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   }
   LoadedScan loaded = scan_from(args, console);
   const std::optional<CentreEstimate> centre_check = check_centre(loaded, console);
+  note_missing_lines(console, loaded.scan.geometry);
   Scan& scan = loaded.scan;
   require_quality_grid(scan.geometry);
   require_memory(scan.geometry);

@@ -246,6 +246,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
     for (const std::string& note : source.notes()) console.line(note);
   }
   if (source.centre() && speak) console.line(centre_line(*source.centre()));
+  if (speak) note_missing_lines(console, source.geometry());
   require_quality_grid(source.geometry());
   require_training(settings);
   refuse_limit_below_one_slice(options, slab_bytes(source.geometry(), 1));

@@ -108,6 +108,38 @@ TEST_SUITE("cli") {
           riner::test::read_bytes(out + "2/sino.npy"));
   }
 
+  TEST_CASE(
+      "views that miss part of the circle are warned by reconstruct as by fbp; two turns not") {
+    // Before: reconstruct said nothing of a 0.5-degree arc, and fbp took a 720-degree scan for
+    // one missing part of the circle (its views paired up in the weights).
+    riner::test::TempDir dir;
+    const std::string sim = riner::test::simulate_small_parallel2d(dir, 2);
+    const auto with_range = [&](const std::string& name, double range) {
+      riner::test::write_bytes(dir / name, R"({"type": "parallel2d",
+          "detector": {"count": 70, "pitch_mm": 1.0},
+          "angles": {"count": 90, "range_rad": )" +
+                                               std::to_string(range) + R"(},
+          "volume": {"shape": [64, 64], "voxel_mm": 1.0}})");
+      return (dir / name).string();
+    };
+    const std::string warning = "warning: the views miss part of the circle";
+    for (const auto& [geometry, missing] :
+         {std::pair{sim + "/geometry.json", false}, std::pair{with_range("arc.json", 0.0087), true},
+          std::pair{with_range("two_turns.json", 4 * M_PI), false}}) {
+      CAPTURE(geometry);
+      const Run fbp = riner_cli(
+          "fbp " + sim + "/sino.npy --geometry " + geometry + " --out " + (dir / "f.npy").string(),
+          dir);
+      REQUIRE(fbp.code == 0);
+      CHECK((fbp.out.find(warning) != std::string::npos) == missing);
+      const Run rec = riner_cli("reconstruct " + sim + "/sino.npy --geometry " + geometry +
+                                    " --steps 20 --out " + (dir / "r").string(),
+                                dir);
+      REQUIRE(rec.code == 0);
+      CHECK((rec.out.find(warning) != std::string::npos) == missing);
+    }
+  }
+
   TEST_CASE("partial rings: simulate --partial, reconstruct writes alpha by view and the segments") {
     // test/support/partial_scan.hpp's scan, from the CLI: 5 elements change, 2 die part-way.
     riner::test::TempDir dir;

@@ -77,6 +77,19 @@ TEST_SUITE("fbp_setup") {
     w = riner::analytic::view_weights(fan, &short_scan);
     CHECK(std::accumulate(w.begin(), w.end(), 0.0) == doctest::Approx(M_PI));
     CHECK(w[1] == doctest::Approx(0.5 * 0.5 * (0.5 + (0.5 + 2 * M_PI - 5.9))));
+    // Two turns (720 degrees): each phase seen twice, every view an equal share, not a short
+    // scan (before: the views paired up, half of them weighed 0 and the scan read as short).
+    par.angles.clear();
+    for (int i = 0; i < 360; ++i) par.angles.push_back(i * 4 * M_PI / 360.0);
+    w = riner::analytic::view_weights(par, &short_scan);
+    CHECK_FALSE(short_scan);
+    for (double x : w) CHECK(x == doctest::Approx(M_PI / 360.0));
+    // A repeated angle shares its place's weight.
+    par.angles = {0.0, 0.5, 0.5, 1.0, 1.5, 2.0, 2.5};
+    w = riner::analytic::view_weights(par, &short_scan);
+    CHECK(w[1] == doctest::Approx(0.25));
+    CHECK(w[2] == doctest::Approx(0.25));
+    CHECK(std::accumulate(w.begin(), w.end(), 0.0) == doctest::Approx(M_PI));
     // A fan scan over half a turn is flagged.
     fan.angles.clear();
     for (int i = 0; i < 90; ++i) fan.angles.push_back(i * M_PI / 90.0);

@@ -59,4 +59,9 @@ struct FbpReport {
 // views beside it.
 Array fbp(const Scan& scan, const FbpOptions& options = {}, FbpReport* report = nullptr);
 
+// Whether the views leave lines never measured: part of the circle unseen (a parallel beam's
+// half turn; a fan or cone beam's half turn plus the fan) and no short scan Parker's weights
+// complete. FBP streaks there, and riner's field there rests on no reading.
+bool views_miss_lines(const Geometry& g);
+
 }  // namespace riner

@@ -50,6 +50,8 @@ SliceSelection SliceSelection::spread(std::size_t nz, std::size_t most) {
   return {(nz - 1 - (count - 1) * step) / 2, step, count};
 }
 
+bool views_miss_lines(const Geometry& g) { return analytic::views_miss_lines(g); }
+
 Array fbp(const Scan& scan, const FbpOptions& options, FbpReport* report) {
   scan.geometry.validate();
   // All NaN gave an image of zeros, raw intensities an image of thousands, without a word.

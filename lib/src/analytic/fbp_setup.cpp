@@ -168,21 +168,44 @@ std::vector<double> view_weights(const Geometry& g, bool* short_scan) {
   std::iota(order.begin(), order.end(), std::size_t{0});
   std::sort(order.begin(), order.end(),
             [&](std::size_t a, std::size_t b) { return phase[a] < phase[b]; });
-  // Each view owns half the gap to each neighbour, cyclically: the shares sum to the period.
+  // Views at one phase (a second turn, a repeated angle) form a group that shares its weight
+  // equally; each group owns half the gap to each neighbouring group, cyclically: the shares
+  // sum to the period. (Before, a 720-degree scan's views paired up: half weighed nothing and
+  // the gaps between pairs, twice the mean step, read as a short scan.)
+  const double same = 1e-9 * period;
+  std::vector<std::size_t> group_start;  // positions in `order` where a group begins
+  for (std::size_t s = 0; s < n; ++s) {
+    if (s == 0 || phase[order[s]] - phase[order[s - 1]] > same) group_start.push_back(s);
+  }
+  const std::size_t groups = group_start.size();
+  if (groups > 1 && phase[order[0]] + period - phase[order[n - 1]] <= same) {
+    // The last group wraps onto the first (phases just below the period and 0).
+    group_start.erase(group_start.begin());
+  }
+  const std::size_t m = group_start.size();
   std::vector<double> weights(n, period);
   double largest_gap = 0.0;
-  std::vector<double> gaps(n);
-  for (std::size_t s = 0; s < n && n > 1; ++s) {
-    const double next = s + 1 < n ? phase[order[s + 1]] : phase[order[0]] + period;
-    gaps[s] = next - phase[order[s]];
-    largest_gap = std::max(largest_gap, gaps[s]);
-  }
-  for (std::size_t s = 0; s < n && n > 1; ++s) {
-    weights[order[s]] = 0.5 * (gaps[s] + gaps[(s + n - 1) % n]);
+  if (m > 1) {
+    std::vector<double> gaps(m);
+    for (std::size_t k = 0; k < m; ++k) {
+      const double here = phase[order[group_start[k]]];
+      double next = phase[order[group_start[(k + 1) % m]]];
+      if (next <= here) next += period;
+      gaps[k] = next - here;
+      largest_gap = std::max(largest_gap, gaps[k]);
+    }
+    for (std::size_t k = 0; k < m; ++k) {
+      const std::size_t begin = group_start[k], end = group_start[(k + 1) % m];
+      const std::size_t size = (end + n - begin - 1) % n + 1;
+      const double share = 0.5 * (gaps[k] + gaps[(k + m - 1) % m]) / static_cast<double>(size);
+      for (std::size_t j = 0; j < size; ++j) weights[order[(begin + j) % n]] = share;
+    }
+  } else {
+    for (double& w : weights) w = period / static_cast<double>(n);
   }
   if (short_scan != nullptr) {
-    // A gap several times the mean step means part of the circle was never seen.
-    *short_scan = n == 1 || largest_gap > 3.0 * period / static_cast<double>(n);
+    // A gap several times the mean step between distinct views: part of the circle unseen.
+    *short_scan = m <= 1 || largest_gap > 3.0 * period / static_cast<double>(m);
   }
   const double scale = g.is_divergent() ? 0.5 : 1.0;
   for (double& w : weights) w *= scale;
@@ -215,24 +238,43 @@ std::vector<double> conjugate_fan_angles(const Geometry& g, double direction) {
 
 }  // namespace
 
-bool parker_weight(Array& measurement, const Geometry& g, std::vector<double>& view_weights) {
+std::optional<ParkerSpan> parker_span(const Geometry& g) {
   const std::size_t n = g.n_views();
-  if (!g.is_divergent() || n < 3) return false;
+  if (!g.is_divergent() || n < 3) return std::nullopt;
   // Evenly stepping views, in either direction.
   const double step = (g.angles[n - 1] - g.angles[0]) / static_cast<double>(n - 1);
   for (std::size_t i = 1; i < n; ++i) {
-    if (std::fabs(g.angles[i] - g.angles[i - 1] - step) > 0.1 * std::fabs(step)) return false;
+    if (std::fabs(g.angles[i] - g.angles[i - 1] - step) > 0.1 * std::fabs(step)) {
+      return std::nullopt;
+    }
   }
   const double last = std::fabs(step) * static_cast<double>(n - 1);  // the last view's beta
-  if (last + std::fabs(step) >= 2.0 * M_PI - 0.5 * std::fabs(step)) return false;  // a full turn
+  if (last + std::fabs(step) >= 2.0 * M_PI - 0.5 * std::fabs(step)) return std::nullopt;  // a turn
   // Which way the source moves as beta grows, from the first two views' sources.
   const Vec3 s0 = detector_ray(g, 0, 0.0).origin, s1 = detector_ray(g, 1, 0.0).origin;
   const double moved = std::remainder(std::atan2(s1.y, s1.x) - std::atan2(s0.y, s0.x), 2.0 * M_PI);
-  const std::vector<double> gamma = conjugate_fan_angles(g, moved >= 0.0 ? 1.0 : -1.0);
+  ParkerSpan span;
+  span.step = std::fabs(step);
+  span.gamma = conjugate_fan_angles(g, moved >= 0.0 ? 1.0 : -1.0);
   double fan = 0.0;  // the largest |gamma|
-  for (double v : gamma) fan = std::max(fan, std::fabs(v));
-  const double delta = 0.5 * (last - M_PI);  // Parker's half fan, stretched to the range
-  if (delta < fan - 1e-9) return false;      // lines the scan never measured
+  for (double v : span.gamma) fan = std::max(fan, std::fabs(v));
+  span.delta = 0.5 * (last - M_PI);                  // Parker's half fan, stretched to the range
+  if (span.delta < fan - 1e-9) return std::nullopt;  // lines the scan never measured
+  return span;
+}
+
+bool views_miss_lines(const Geometry& g) {
+  bool short_scan = false;
+  (void)view_weights(g, &short_scan);
+  return short_scan && !parker_span(g);
+}
+
+bool parker_weight(Array& measurement, const Geometry& g, std::vector<double>& view_weights) {
+  const std::optional<ParkerSpan> span = parker_span(g);
+  if (!span) return false;
+  const std::size_t n = g.n_views();
+  const double delta = span->delta, step = span->step;
+  const std::vector<double>& gamma = span->gamma;
   const std::size_t rows = g.is_3d() ? g.n_v : 1;
   const auto weight = [&](double beta, double gam) {
     if (beta < 2.0 * (delta - gam)) {
@@ -244,7 +286,7 @@ bool parker_weight(Array& measurement, const Geometry& g, std::vector<double>& v
     return beta <= M_PI + 2.0 * delta ? s * s : 0.0;
   };
   for (std::size_t i = 0; i < n; ++i) {
-    const double beta = std::fabs(step) * static_cast<double>(i);
+    const double beta = step * static_cast<double>(i);
     for (std::size_t r = 0; r < rows; ++r) {
       float* line = measurement.ptr() + (i * rows + r) * g.n_u;
       for (std::size_t j = 0; j < g.n_u; ++j) {
@@ -252,7 +294,7 @@ bool parker_weight(Array& measurement, const Geometry& g, std::vector<double>& v
       }
     }
   }
-  view_weights.assign(n, std::fabs(step));
+  view_weights.assign(n, step);
   return true;
 }
 

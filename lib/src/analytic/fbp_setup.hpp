@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <optional>
 #include <vector>
 
 #include "riner/array.hpp"
@@ -47,6 +48,19 @@ std::vector<double> filter_taps(std::size_t n_u, double tau, FbpFilter filter);
 // modulo pi for parallel beams, 2 pi for divergent ones), times 1/2 for divergent beams, so
 // that sum(weights) = pi either way. Sets *short_scan when part of the period was never seen.
 std::vector<double> view_weights(const Geometry& g, bool* short_scan);
+
+// A fan or cone beam's short scan that Parker's weights complete: evenly stepping views over
+// less than a turn but at least half a turn plus the fan. Its step, each column's fan angle
+// and Parker's half fan; nullopt for any other scan.
+struct ParkerSpan {
+  double step = 0.0;
+  std::vector<double> gamma;
+  double delta = 0.0;
+};
+std::optional<ParkerSpan> parker_span(const Geometry& g);
+// Whether the views leave lines of the field never measured (part of the period unseen, and no
+// Parker-completed short scan): FBP streaks there and riner's field is unconstrained.
+bool views_miss_lines(const Geometry& g);
 
 // Parker's weights (Parker 1982, with the overscan of a range beyond half a turn plus the fan)
 // for a fan or cone beam whose views step evenly over less than a full turn but at least half
