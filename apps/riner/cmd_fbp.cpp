@@ -141,7 +141,9 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
                std::to_string(report.slabs) + " slab(s) of up to " +
                std::to_string(report.slices_per_slab) + " slices in " + std::to_string(seconds) +
                " s, " + std::to_string(report.fbp.non_finite_replaced) +
-               " non-finite or absurd (beyond 1e6) measurements interpolated -> " + out);
+               " non-finite or absurd (spikes far beyond the other views' readings) measurements "
+               "interpolated -> " +
+               out);
   console.summary(
       {{"out", out},
        {"shape", g.volume_shape},
@@ -247,7 +249,9 @@ int run_fbp(int argc, char** argv, int first) {
   console.line("fbp (" + std::string(fbp_filter_name(options.filter)) + ", " +
                engine_name(options.engine) + "): " + shape_string(image.shape) + " in " +
                std::to_string(seconds) + " s, " + std::to_string(report.non_finite_replaced) +
-               " non-finite or absurd (beyond 1e6) measurements interpolated -> " + out.string());
+               " non-finite or absurd (spikes far beyond the other views' readings) measurements "
+               "interpolated -> " +
+               out.string());
   console.summary(
       {{"out", out.string()},
        {"shape", image.shape},

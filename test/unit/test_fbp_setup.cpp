@@ -7,6 +7,7 @@
 #include <unsupported/Eigen/FFT>
 
 #include "analytic/fbp_setup.hpp"
+#include "riner/scan.hpp"
 #include "support/geometries.hpp"
 
 namespace {
@@ -115,6 +116,36 @@ TEST_SUITE("fbp_setup") {
     riner::Array nothing({2, 2}, NAN);
     riner::analytic::repair_non_finite(nothing, 2);
     CHECK(nothing.data == std::vector<float>{0, 0, 0, 0});
+  }
+
+  TEST_CASE("spikes far beyond every view's readings are repaired; dense objects and scales kept") {
+    // Five readings of 1e5 among readings up to 3 (under the absolute 1e6) made FBP's image -52
+    // dB without a word (the audit). A reading counts as a spike beyond 100 times the median
+    // view's largest, and never under rho = 50.
+    const std::size_t views = 40, n_u = 30;
+    riner::Array m({views, n_u});
+    for (std::size_t v = 0; v < views; ++v) {
+      for (std::size_t j = 0; j < n_u; ++j) {
+        m.data[v * n_u + j] = 3.0f * std::sin(static_cast<float>(j) / n_u * 3.14159f);
+      }
+      m.data[v * n_u + 7] = 20.0f;  // a dense wire in every view
+    }
+    m.data[3 * n_u + 12] = 45.0f;  // one reading high, but under rho = 50
+    riner::Array spiked = m;
+    for (std::size_t k : {5u, 77u, 301u, 640u, 1111u}) spiked.data[k] = 1e5f;
+    CHECK(riner::largest_reading(spiked, views) == doctest::Approx(2000.0f));
+    CHECK(riner::analytic::repair_non_finite(spiked, n_u) == 5);
+    for (std::size_t k : {5u, 77u, 301u, 640u, 1111u}) CHECK(spiked.data[k] < 25.0f);
+    CHECK(spiked.data[3 * n_u + 12] == 45.0f);
+    CHECK(spiked.data[10 * n_u + 7] == 20.0f);
+    // The same scan stored x1000: nothing is a spike.
+    riner::Array scaled = m;
+    for (float& x : scaled.data) x *= 1000.0f;
+    CHECK(riner::analytic::repair_non_finite(scaled, n_u) == 0);
+    // Readings all small: the limit stays at rho = 50.
+    riner::Array faint = m;
+    for (float& x : faint.data) x *= 0.001f;
+    CHECK(riner::largest_reading(faint, views) == doctest::Approx(50.0f));
   }
 
   TEST_CASE("non-finite repair: a dead detector row takes the rows beside it in each view") {

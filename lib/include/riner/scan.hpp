@@ -16,6 +16,14 @@ namespace riner {
 // which FBP repairs and training leaves out like a non-finite one (at 1e20, two readings of
 // 1e19 made an FBP image of +-1e17 without a word).
 constexpr float kLargestReading = 1e6f;
+// A spike below kLargestReading (five readings of 1e5 among readings of 3 made FBP's image
+// -52 dB, unsaid): the largest magnitude a reading of `measurement` ([views, ...]) may have is
+// at most kSpikeFactor times the median over views of each view's largest finite magnitude (an
+// object is seen in every view; a spike in one), and never under kLeastSpikeLimit (rho = 50,
+// e^-50 of the beam, is beyond any detector), so no real object's ray passes for one.
+constexpr double kSpikeFactor = 100.0;
+constexpr double kLeastSpikeLimit = 50.0;
+float largest_reading(const Array& measurement, std::size_t views);
 
 struct Scan {
   Array measurement;  // [views, elements] in 2D, [views, rows, columns] in 3D

@@ -16,12 +16,13 @@ std::size_t repair_non_finite(Array& measurement, std::size_t n_u, std::size_t r
   std::size_t replaced = 0;
   const std::size_t lines = measurement.size() / n_u;
   std::vector<bool> empty(lines, false);
+  const float largest = largest_reading(measurement, lines / std::max<std::size_t>(rows, 1));
   for (std::size_t line = 0; line < lines; ++line) {
     float* p = measurement.ptr() + line * n_u;
     long previous = -1;  // last finite index
     empty[line] = true;
     for (std::size_t j = 0; j <= n_u; ++j) {
-      if (j < n_u && !(std::fabs(p[j]) <= kLargestReading)) continue;  // NaN fails it too
+      if (j < n_u && !(std::fabs(p[j]) <= largest)) continue;  // NaN fails it too
       // Fill the gap (previous, j) from its finite ends.
       for (std::size_t k = static_cast<std::size_t>(previous + 1); k < j; ++k) {
         float value = 0.0f;

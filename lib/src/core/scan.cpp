@@ -74,6 +74,27 @@ ReadingsLook look_at_readings(const Array& measurement) {
 
 }  // namespace
 
+float largest_reading(const Array& measurement, std::size_t views) {
+  if (views == 0 || measurement.size() == 0) return kLargestReading;
+  const std::size_t per_view = measurement.size() / views;
+  std::vector<float> view_largest;
+  view_largest.reserve(views);
+  for (std::size_t v = 0; v < views; ++v) {
+    float largest = -1.0f;
+    const float* line = measurement.ptr() + v * per_view;
+    for (std::size_t k = 0; k < per_view; ++k) {
+      const float m = std::fabs(line[k]);
+      if (m <= kLargestReading && m > largest) largest = m;
+    }
+    if (largest >= 0.0f) view_largest.push_back(largest);
+  }
+  if (view_largest.empty()) return kLargestReading;
+  const auto middle = view_largest.begin() + static_cast<std::ptrdiff_t>(view_largest.size() / 2);
+  std::nth_element(view_largest.begin(), middle, view_largest.end());
+  const double limit = std::max(kLeastSpikeLimit, kSpikeFactor * static_cast<double>(*middle));
+  return static_cast<float>(std::min(limit, static_cast<double>(kLargestReading)));
+}
+
 void check_scan(const Scan& scan, std::string_view what) {
   check_array(scan.measurement, what);
   scan.geometry.check_measurement_shape(scan.measurement.shape, what);

@@ -426,10 +426,11 @@ Array destripe(const Array& measurement, const Geometry& g, const DestripeOption
   // An element with no finite reading is dead as surely as a stuck one (the training says
   // "no finite reading"); the repair below fills it, and the report names it.
   std::vector<bool> unread(rows * columns, true);
+  const float largest = largest_reading(measurement, views);
   for (std::size_t v = 0; v < views; ++v) {
     const float* line = measurement.data.data() + v * rows * columns;
     for (std::size_t e = 0; e < rows * columns; ++e) {
-      if (std::fabs(line[e]) <= kLargestReading) unread[e] = false;
+      if (std::fabs(line[e]) <= largest) unread[e] = false;
     }
   }
   local.non_finite_replaced = analytic::repair_non_finite(out, columns, rows);

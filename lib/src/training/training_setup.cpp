@@ -91,8 +91,9 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
   check_scan(scan);
   // A reading beyond any line integral is a corrupt value: dead for training as a non-finite
   // one is (FBP repairs both alike), not a target a field and alpha chase.
+  const float largest = largest_reading(scan.measurement, scan.geometry.n_views());
   for (float& x : scan.measurement.data) {
-    if (std::isfinite(x) && !(std::fabs(x) <= kLargestReading)) {
+    if (std::isfinite(x) && !(std::fabs(x) <= largest)) {
       x = NAN;
       ++scan.non_finite;
     }
