@@ -178,6 +178,18 @@ void note_missing_lines(const Console& console, const Geometry& g) {
       "turn plus the fan): the field along the lines never measured rests on no reading");
 }
 
+void note_unphysical_readings(const Console& console, const Scan& scan) {
+  const double largest = median_view_largest(scan.measurement, scan.geometry.n_views());
+  if (!(largest > kMostLineIntegral)) return;
+  char line[320];
+  std::snprintf(line, sizeof(line),
+                "note: the views' largest readings are about %.3g, beyond any detector's -ln(I/I0) "
+                "(under %.0f): readings stored scaled (x1000, as integers) should be divided back "
+                "first, or the detector's responses cannot be learnt",
+                largest, kMostLineIntegral);
+  console.line(line);
+}
+
 void note_non_finite(const Console& console, std::size_t non_finite) {
   if (non_finite == 0) return;
   console.line(std::to_string(non_finite) +

@@ -14,6 +14,7 @@
 #include "riner/engine.hpp"
 #include "riner/geometry.hpp"
 #include "riner/quality.hpp"
+#include "riner/scan.hpp"
 
 namespace riner::app {
 
@@ -80,5 +81,11 @@ void note_filled_rows(const Console& console, const std::vector<std::size_t>& ro
 // Before training: a warning when the views leave lines never measured (views_miss_lines), as
 // riner fbp warns (before, reconstruct said nothing of a 0.5-degree arc).
 void note_missing_lines(const Console& console, const Geometry& g);
+// Before training: a note when the median view's largest reading is beyond any detector's
+// -ln(I/I0) (kMostLineIntegral): readings stored scaled (x1000 integers) train with rings left,
+// since alpha's offsets would need responses of e^(hundreds) (the audit: 21.8 dB, ring index
+// 0.067 against FBP's 0.070).
+constexpr double kMostLineIntegral = 30.0;
+void note_unphysical_readings(const Console& console, const Scan& scan);
 
 }  // namespace riner::app

@@ -176,6 +176,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   LoadedScan loaded = scan_from(args, console);
   const std::optional<CentreEstimate> centre_check = check_centre(loaded, console);
   note_missing_lines(console, loaded.scan.geometry);
+  note_unphysical_readings(console, loaded.scan);
   Scan& scan = loaded.scan;
   require_quality_grid(scan.geometry);
   require_memory(scan.geometry);
@@ -277,6 +278,14 @@ int run_reconstruct(int argc, char** argv, int first) {
       console.line("not skipping the air: " + setup.air_note);
     }
     note_filled_rows(console, setup.filled_rows);
+    if (setup.field_per_mu != 1.0) {
+      char line[240];
+      std::snprintf(line, sizeof(line),
+                    "the readings' attenuation is %.3g /mm, far from the usual 0.001-0.06: the "
+                    "field learns it times %g (summary.json field_per_mu)",
+                    setup.typical_mu, setup.field_per_mu);
+      console.line(line);
+    }
   }
   {
     Progress progress("reconstruct",

@@ -202,6 +202,7 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
       {"parameters", stats.parameters},
       {"non_finite_measurements", stats.non_finite},
       {"filled_rows", stats.filled_rows},
+      {"field_per_mu", stats.field_per_mu},
       {"dead_elements", dead},
       {"dead_element_reasons", dead_elements_json(dead_report)},
       {"changing_elements", changing_elements_json(r.changing_elements())},

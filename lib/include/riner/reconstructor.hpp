@@ -133,6 +133,10 @@ struct TrainingStats {
   // 3D: detector rows that read nothing in any view, trained on the line between the rows
   // beside them in each view (as FBP fills them); their elements are dead.
   std::vector<std::size_t> filled_rows;
+  // The field learnt mu times this (a power of two): 1 unless the scan's typical attenuation per
+  // mm lies far from what the defaults were chosen on (model/field_scale.hpp).
+  double field_per_mu = 1.0;
+  double typical_mu = 0.0;  // per mm: the median view's largest reading over the grid's width
   std::size_t parameters = 0;
   std::string engine;
   std::string device;                 // device name, or "CPU reference"

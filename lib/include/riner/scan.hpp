@@ -24,6 +24,9 @@ constexpr float kLargestReading = 1e6f;
 constexpr double kSpikeFactor = 100.0;
 constexpr double kLeastSpikeLimit = 50.0;
 float largest_reading(const Array& measurement, std::size_t views);
+// The median over views of each view's largest finite magnitude (readings beyond kLargestReading
+// left out); 0 when no view reads any.
+double median_view_largest(const Array& measurement, std::size_t views);
 
 struct Scan {
   Array measurement;  // [views, elements] in 2D, [views, rows, columns] in 3D

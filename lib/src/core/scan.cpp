@@ -74,8 +74,8 @@ ReadingsLook look_at_readings(const Array& measurement) {
 
 }  // namespace
 
-float largest_reading(const Array& measurement, std::size_t views) {
-  if (views == 0 || measurement.size() == 0) return kLargestReading;
+double median_view_largest(const Array& measurement, std::size_t views) {
+  if (views == 0 || measurement.size() == 0) return 0.0;
   const std::size_t per_view = measurement.size() / views;
   std::vector<float> view_largest;
   view_largest.reserve(views);
@@ -88,10 +88,15 @@ float largest_reading(const Array& measurement, std::size_t views) {
     }
     if (largest >= 0.0f) view_largest.push_back(largest);
   }
-  if (view_largest.empty()) return kLargestReading;
+  if (view_largest.empty()) return 0.0;
   const auto middle = view_largest.begin() + static_cast<std::ptrdiff_t>(view_largest.size() / 2);
   std::nth_element(view_largest.begin(), middle, view_largest.end());
-  const double limit = std::max(kLeastSpikeLimit, kSpikeFactor * static_cast<double>(*middle));
+  return *middle;
+}
+
+float largest_reading(const Array& measurement, std::size_t views) {
+  const double limit =
+      std::max(kLeastSpikeLimit, kSpikeFactor * median_view_largest(measurement, views));
   return static_cast<float>(std::min(limit, static_cast<double>(kLargestReading)));
 }
 

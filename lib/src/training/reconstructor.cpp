@@ -233,6 +233,11 @@ Array Reconstructor::field_image() const {
   const Geometry& g = impl_->setup.scan.geometry;
   Array out(g.volume_shape);
   out.data = impl_->trainer->evaluate_grid();
+  // The field learns mu times field_per_mu (a power of two; 1 for most scans).
+  if (impl_->setup.field_per_mu != 1.0) {
+    const auto per_mu = static_cast<float>(impl_->setup.field_per_mu);
+    for (float& v : out.data) v /= per_mu;
+  }
   model::fade_into_skipped_air(impl_->setup.occupancy, g.volume_shape,
                                model::air_taper_px(impl_->setup.config.training.air_margin_px),
                                out.data);
@@ -509,6 +514,8 @@ TrainingStats Reconstructor::stats() const {
   s.samples = impl_->samples;
   s.non_finite = impl_->setup.scan.non_finite;
   s.filled_rows = impl_->setup.filled_rows;
+  s.field_per_mu = impl_->setup.field_per_mu;
+  s.typical_mu = impl_->setup.typical_mu;
   s.parameters = impl_->setup.layout.total;
   s.engine = engine_name(impl_->setup.config.engine);
   s.device = impl_->trainer->device_name();

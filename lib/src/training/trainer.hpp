@@ -28,7 +28,13 @@ struct TrainingSetup {
   Scan scan;
   RinerConfig config;
   model::ParameterLayout layout;
+  // The rays as trained: their lengths in the field's unit (model/field_scale.hpp), so that a
+  // ray's sum of the field's values times dx is its reading.
   model::RaySegments segments;
+  // The field learns mu times this (model::field_per_mu; 1 for most scans); field images are
+  // divided by it.
+  double field_per_mu = 1.0;
+  double typical_mu = 0.0;  // model::typical_mu, what field_per_mu was chosen from
   std::size_t elements_per_view = 0;
   std::uint32_t seed = 0;
   std::vector<std::uint32_t> invalid_readings;  // per response slot: its non-finite measurements

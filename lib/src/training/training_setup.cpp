@@ -3,6 +3,7 @@
 
 #include "model/dead_rows.hpp"
 #include "model/factor_evidence.hpp"
+#include "model/field_scale.hpp"
 #include "model/response_changes.hpp"
 #include "model/stripe_evidence.hpp"
 #include "model/stuck_elements.hpp"
@@ -101,7 +102,10 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
   filled_rows = model::fill_dead_rows(scan.measurement, scan.geometry);
   const Geometry& g = scan.geometry;
   elements_per_view = g.n_u * (g.is_3d() ? g.n_v : 1);
-  segments = model::RaySegments(g, config.training.sample_spacing * g.voxel_mm,
+  typical_mu = model::typical_mu(scan.measurement, g);
+  field_per_mu = model::field_per_mu(scan.measurement, g);
+  const Geometry field_units = model::lengths_divided(g, field_per_mu);
+  segments = model::RaySegments(field_units, config.training.sample_spacing * field_units.voxel_mm,
                                 config.training.circle_region);
   std::size_t hit = 0;
   for (std::size_t r = 0; r < segments.size(); ++r) {

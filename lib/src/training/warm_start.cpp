@@ -81,7 +81,10 @@ TrainingSetup image_fit_setup(const TrainingSetup& setup, const Array& image,
   std::vector<model::RaySegment> segments(pixels.size());
   for (std::size_t k = 0; k < pixels.size(); ++k) {
     const std::size_t i = pixels[k];
-    fit.scan.measurement.data[k] = std::isfinite(image.data[i]) ? image.data[i] : 0.0f;
+    // In the field's unit (model/field_scale.hpp): mu times field_per_mu.
+    fit.scan.measurement.data[k] = std::isfinite(image.data[i])
+                                       ? static_cast<float>(image.data[i] * setup.field_per_mu)
+                                       : 0.0f;
     model::RaySegment& s = segments[k];
     for (std::size_t d = 0; d < 3; ++d) {
       s.start[d] = d < dims ? positions[i * dims + d] : 0.5f;
