@@ -128,6 +128,27 @@ TEST_SUITE("cli") {
           riner::test::read_bytes(out + "2/sino.npy"));
   }
 
+  TEST_CASE("a scan whose readings are all one value is refused, saying why") {
+    riner::test::TempDir dir;
+    const std::string sim = riner::test::simulate_small_parallel2d(dir, 2);
+    for (const auto& [value, why] :
+         {std::pair{0.0f, "every reading is 0: the rays crossed nothing"},
+          std::pair{1.0f, "every reading is 1: no object reads alike"}}) {
+      riner::Array flat({90, 70}, value);
+      flat.data[5] = NAN;  // a dead reading does not make a scan
+      riner::write_array(dir / "flat.npy", flat);
+      for (const char* command : {"reconstruct", "fbp"}) {
+        CAPTURE(command);
+        const Run run =
+            riner_cli(std::string(command) + " " + (dir / "flat.npy").string() + " --geometry " +
+                          sim + "/geometry.json --out " + (dir / "out.npy").string(),
+                      dir);
+        CHECK(run.code == 2);
+        CHECK(run.err.find(why) != std::string::npos);
+      }
+    }
+  }
+
   TEST_CASE("a scan in another length unit trains to the same image in that unit") {
     // Before (the audit): the image depended on the numbers' scale, FBP's did not. Micrometre
     // pixels given in mm (mu x 1000) lost 6.7 dB and flagged ten live elements dead; readings

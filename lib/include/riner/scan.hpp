@@ -79,4 +79,11 @@ void require_slice_geometry(const Geometry& g);
 // wall seen edge-on at the detector's ends reads like that too.
 std::optional<std::string> transmission_note(const Scan& scan);
 
+// When every finite reading of a whole scan is one value, why that is no scan to reconstruct
+// (an InputError's text); nullopt otherwise. All 0: the rays crossed nothing (an empty or wrong
+// dataset); any other value: no object reads alike on every ray (a flat or dark frame given as
+// the scan, or readings that are no line integrals). Before: an all-zero scan wrote a zero image
+// and an all-ones scan trained to an 11 dB pattern, both with exit 0 (the audit).
+std::optional<std::string> uniform_readings(const Scan& scan);
+
 }  // namespace riner

@@ -100,6 +100,31 @@ float largest_reading(const Array& measurement, std::size_t views) {
   return static_cast<float>(std::min(limit, static_cast<double>(kLargestReading)));
 }
 
+std::optional<std::string> uniform_readings(const Scan& scan) {
+  float low = 0.0f, high = 0.0f;
+  bool any = false;
+  for (float x : scan.measurement.data) {
+    if (!std::isfinite(x)) continue;
+    if (!any) low = high = x;
+    low = std::min(low, x);
+    high = std::max(high, x);
+    any = true;
+    if (high > low) return std::nullopt;
+  }
+  if (!any) return std::nullopt;  // check_scan says so
+  if (low == 0.0f) {
+    return std::string(
+        "every reading is 0: the rays crossed nothing (an empty or wrong dataset?); there is no "
+        "object to reconstruct");
+  }
+  char line[240];
+  std::snprintf(line, sizeof(line),
+                "every reading is %.6g: no object reads alike on every ray (a flat or dark frame "
+                "given as the scan, or readings that are not -ln(I/I0)?)",
+                low);
+  return std::string(line);
+}
+
 void check_scan(const Scan& scan, std::string_view what) {
   check_array(scan.measurement, what);
   scan.geometry.check_measurement_shape(scan.measurement.shape, what);

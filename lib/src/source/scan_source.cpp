@@ -265,6 +265,9 @@ LoadedScan load_scan_source(ScanSource source) {
         raw_array_frames(source.path, std::nullopt), std::nullopt, source.row, &report);
     loaded.flat_field = report;
   }
+  if (std::optional<std::string> why = uniform_readings(loaded.scan)) {
+    throw InputError(source.path + ": " + *why);
+  }
   if (loaded.flat_field) {
     std::vector<std::string> notes = flat_field_notes(*loaded.flat_field);
     notes.front() = layout + notes.front();
