@@ -386,7 +386,9 @@ TEST_SUITE("cli") {
       riner::test::write_bytes(dir / "huge.json", R"({"type": "parallel2d",
         "detector": {"count": 2000, "pitch_mm": 20.0}, "angles": {"count": 10,
         "range_rad": 3.14159}, "volume": {"shape": [30000, 30000], "voxel_mm": 1.0}})");
-      riner::write_array(dir / "huge_sino.npy", riner::Array({10, 2000}, 0.5f));
+      riner::Array readings({10, 2000}, 0.5f);
+      readings.data[7] = 0.7f;  // not one value throughout (refused as such first)
+      riner::write_array(dir / "huge_sino.npy", readings);
       const Run huge =
           riner_cli("reconstruct " + (dir / "huge_sino.npy").string() + " --geometry " +
                         (dir / "huge.json").string() + " --out " + (dir / "huge").string(),
