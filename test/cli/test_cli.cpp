@@ -128,6 +128,26 @@ TEST_SUITE("cli") {
           riner::test::read_bytes(out + "2/sino.npy"));
   }
 
+  TEST_CASE("readings far below zero are said: the wrong sign, or another exposure's flat") {
+    riner::test::TempDir dir;
+    const std::string sim = riner::test::simulate_small_parallel2d(dir, 2);
+    const std::string note = "more light than the flat field gives, far beyond noise";
+    const auto fbp_of = [&](const std::filesystem::path& sino) {
+      const Run run = riner_cli("fbp " + sino.string() + " --geometry " + sim +
+                                    "/geometry.json --out " + (dir / "f.npy").string(),
+                                dir);
+      REQUIRE(run.code == 0);
+      return run.out + run.err;
+    };
+    CHECK(fbp_of(sim + "/sino.npy").find(note) == std::string::npos);
+    riner::Array flipped = riner::read_array(sim + "/sino.npy").array;
+    for (std::size_t v = 0; v < 90; ++v) {
+      for (std::size_t u = 30; u < 40; ++u) flipped.data[v * 70 + u] *= -1.0f;
+    }
+    riner::write_array(dir / "flipped.npy", flipped);
+    CHECK(fbp_of(dir / "flipped.npy").find(note) != std::string::npos);
+  }
+
   TEST_CASE("a scan whose readings are all one value is refused, saying why") {
     riner::test::TempDir dir;
     const std::string sim = riner::test::simulate_small_parallel2d(dir, 2);

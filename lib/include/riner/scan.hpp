@@ -79,6 +79,15 @@ void require_slice_geometry(const Geometry& g);
 // wall seen edge-on at the detector's ends reads like that too.
 std::optional<std::string> transmission_note(const Scan& scan);
 
+// A note when more than kNegativeShare of the finite readings lie below -max(kLeastNegative,
+// kNegativeOfLargest x the median view's largest reading): more light than the flat field
+// gives, far beyond noise (a band of elements with the wrong sign trained to 9 dB, unsaid; the
+// shared real scans read no lower than -0.17).
+constexpr double kLeastNegative = 0.5;
+constexpr double kNegativeOfLargest = 0.2;
+constexpr double kNegativeShare = 0.001;
+std::optional<std::string> negative_readings_note(const Scan& scan);
+
 // When every finite reading of a whole scan is one value, why that is no scan to reconstruct
 // (an InputError's text); nullopt otherwise. All 0: the rays crossed nothing (an empty or wrong
 // dataset); any other value: no object reads alike on every ray (a flat or dark frame given as

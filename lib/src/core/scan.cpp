@@ -186,6 +186,31 @@ std::optional<std::string> transmission_note(const Scan& scan) {
   return std::string(line);
 }
 
+std::optional<std::string> negative_readings_note(const Scan& scan) {
+  const Array& m = scan.measurement;
+  const double below = -std::max(
+      kLeastNegative, kNegativeOfLargest * median_view_largest(m, scan.geometry.n_views()));
+  std::size_t finite = 0, negative = 0;
+  float least = 0.0f;
+  for (float v : m.data) {
+    if (!(std::fabs(v) <= kLargestReading)) continue;
+    ++finite;
+    if (v < below) ++negative, least = std::min(least, v);
+  }
+  if (finite == 0 || negative < 10 ||
+      static_cast<double>(negative) <= kNegativeShare * static_cast<double>(finite)) {
+    return std::nullopt;
+  }
+  char line[320];
+  std::snprintf(line, sizeof(line),
+                "note: %.2g%% of the readings lie below %.2g (down to %.3g), more light than the "
+                "flat field gives, far beyond noise: readings of the wrong sign, or a flat or "
+                "dark of another exposure?",
+                100.0 * static_cast<double>(negative) / static_cast<double>(finite), below,
+                static_cast<double>(least));
+  return std::string(line);
+}
+
 std::filesystem::path find_geometry(const std::filesystem::path& measurement,
                                     const std::filesystem::path& geometry) {
   if (const auto named = split_hdf5_dataset(measurement)) {

@@ -259,6 +259,9 @@ LoadedScan load_scan_source(ScanSource source) {
     if (std::optional<std::string> note = transmission_note(loaded.scan)) {
       loaded.notes.push_back(std::move(*note));
     }
+    if (std::optional<std::string> note = negative_readings_note(loaded.scan)) {
+      loaded.notes.push_back(std::move(*note));
+    }
   } else {
     loaded.scan = raw_frames_scan(
         source, Geometry::load(find_geometry(source.path, source.geometry)),
