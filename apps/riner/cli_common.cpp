@@ -194,8 +194,7 @@ void note_non_finite(const Console& console, std::size_t non_finite) {
   if (non_finite == 0) return;
   console.line(std::to_string(non_finite) +
                " measurements are NaN, infinite or corrupt (dead elements?): they count as 0 and "
-               "their elements' "
-               "beta learns to switch them off");
+               "their elements' beta learns to switch them off");
 }
 
 }  // namespace riner::app

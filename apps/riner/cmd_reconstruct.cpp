@@ -200,10 +200,8 @@ int run_reconstruct(int argc, char** argv, int first) {
   refuse_overwriting_input(out / kCheckpointName);
   // With the spikes training leaves out as it does NaN (riner/scan.hpp largest_reading), so the
   // count is summary.json's non_finite (before: 360 said, 365 recorded).
-  std::size_t spikes = 0;
-  const float largest = largest_reading(scan.measurement, scan.geometry.n_views());
-  for (float x : scan.measurement.data) spikes += std::isfinite(x) && !(std::fabs(x) <= largest);
-  note_non_finite(console, scan.non_finite + spikes);
+  note_non_finite(
+      console, scan.non_finite + count_corrupt_readings(scan.measurement, scan.geometry.n_views()));
 
   const std::optional<Device> device = device_from(args, config.engine);
   const double checkpoint_every = checkpoint_seconds(args);

@@ -14,17 +14,18 @@ TEST_SUITE("field_scale") {
     // Views' largest readings 1, 2, 3 and a spike of 1000: the median view reads 3.
     for (std::size_t v = 0; v < 4; ++v) m.data[v * 10 + 5] = v < 3 ? 1.0f + v : 1000.0f;
     CHECK(riner::model::typical_mu(m, g) == doctest::Approx(3.0 / 100.0));
-    CHECK(riner::model::field_per_mu(m, g) == 1.0);  // 0.03 /mm: inside the band
+    CHECK(riner::model::field_per_mu(riner::model::typical_mu(m, g)) ==
+          1.0);                                      // 0.03 /mm: inside the band
     g.voxel_mm = 1.0 / 1024.0;                       // micrometre voxels: 30.7 /mm
-    const double per_mu = riner::model::field_per_mu(m, g);
+    const double per_mu = riner::model::field_per_mu(riner::model::typical_mu(m, g));
     CHECK(per_mu == std::ldexp(1.0, -11));
     CHECK(riner::model::typical_mu(m, g) * per_mu >= riner::model::kLeastTypicalMu);
     CHECK(riner::model::typical_mu(m, g) * per_mu <= riner::model::kMostTypicalMu);
     for (float& x : m.data) x *= 1e-6f;  // nearly transparent
     g.voxel_mm = 1.0;
-    CHECK(riner::model::field_per_mu(m, g) == std::ldexp(1.0, 19));
+    CHECK(riner::model::field_per_mu(riner::model::typical_mu(m, g)) == std::ldexp(1.0, 19));
     m = riner::Array({4, 10}, 0.0f);  // reads nothing: left alone
-    CHECK(riner::model::field_per_mu(m, g) == 1.0);
+    CHECK(riner::model::field_per_mu(riner::model::typical_mu(m, g)) == 1.0);
   }
 
   TEST_CASE("lengths divided: every length, nothing else") {

@@ -27,6 +27,10 @@ float largest_reading(const Array& measurement, std::size_t views);
 // The median over views of each view's largest finite magnitude (readings beyond kLargestReading
 // left out); 0 when no view reads any.
 double median_view_largest(const Array& measurement, std::size_t views);
+// The finite readings beyond largest_reading: counted, or set to NaN (and counted) for those
+// that treat them as unread (training, the centre's search).
+std::size_t count_corrupt_readings(const Array& measurement, std::size_t views);
+std::size_t mark_corrupt_readings(Array& measurement, std::size_t views);
 
 struct Scan {
   Array measurement;  // [views, elements] in 2D, [views, rows, columns] in 3D

@@ -100,6 +100,22 @@ float largest_reading(const Array& measurement, std::size_t views) {
   return static_cast<float>(std::min(limit, static_cast<double>(kLargestReading)));
 }
 
+std::size_t count_corrupt_readings(const Array& measurement, std::size_t views) {
+  const float largest = largest_reading(measurement, views);
+  return static_cast<std::size_t>(
+      std::count_if(measurement.data.begin(), measurement.data.end(),
+                    [&](float x) { return std::isfinite(x) && !(std::fabs(x) <= largest); }));
+}
+
+std::size_t mark_corrupt_readings(Array& measurement, std::size_t views) {
+  const float largest = largest_reading(measurement, views);
+  std::size_t marked = 0;
+  for (float& x : measurement.data) {
+    if (std::isfinite(x) && !(std::fabs(x) <= largest)) x = NAN, ++marked;
+  }
+  return marked;
+}
+
 std::optional<std::string> uniform_readings(const Scan& scan) {
   float low = 0.0f, high = 0.0f;
   bool any = false;

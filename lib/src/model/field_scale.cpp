@@ -15,8 +15,7 @@ double typical_mu(const Array& measurement, const Geometry& g) {
   return median_view_largest(measurement, g.n_views()) / width_mm;
 }
 
-double field_per_mu(const Array& measurement, const Geometry& g) {
-  const double mu = typical_mu(measurement, g);
+double field_per_mu(double mu) {
   if (!(mu > 0.0) || !std::isfinite(mu)) return 1.0;
   if (mu >= kLeastTypicalMu && mu <= kMostTypicalMu) return 1.0;
   return std::exp2(std::round(std::log2(kTargetTypicalMu / mu)));

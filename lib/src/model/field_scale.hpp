@@ -19,10 +19,10 @@ namespace riner::model {
 double typical_mu(const Array& measurement, const Geometry& g);
 constexpr double kLeastTypicalMu = 1.0 / 1024.0;
 constexpr double kMostTypicalMu = 1.0 / 16.0;
-// Outside [kLeastTypicalMu, kMostTypicalMu]: the power of two that puts typical_mu * it nearest
-// kTargetTypicalMu; 1 inside, or when the scan reads nothing.
+// For a typical_mu outside [kLeastTypicalMu, kMostTypicalMu]: the power of two that puts
+// typical_mu * it nearest kTargetTypicalMu; 1 inside, or when the scan reads nothing (0).
 constexpr double kTargetTypicalMu = 1.0 / 64.0;
-double field_per_mu(const Array& measurement, const Geometry& g);
+double field_per_mu(double typical_mu);
 
 // The geometry with every length divided by `factor` (pitches, distances, voxel, grid height):
 // the same rays and grid in another unit, so that a ray's sum of y * dx is its reading.

@@ -384,10 +384,7 @@ Scan centre_rows(const Scan& scan) {
 // Spikes (riner/scan.hpp's largest_reading) left out as unread readings are: five readings of
 // 1e5 among readings of 3 moved a fan scan's axis 12 px.
 Scan without_spikes(Scan scan) {
-  const float largest = largest_reading(scan.measurement, scan.geometry.n_views());
-  for (float& x : scan.measurement.data) {
-    if (std::isfinite(x) && !(std::fabs(x) <= largest)) x = NAN;
-  }
+  mark_corrupt_readings(scan.measurement, scan.geometry.n_views());
   return scan;
 }
 

@@ -92,18 +92,12 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
   check_scan(scan);
   // A reading beyond any line integral is a corrupt value: dead for training as a non-finite
   // one is (FBP repairs both alike), not a target a field and alpha chase.
-  const float largest = largest_reading(scan.measurement, scan.geometry.n_views());
-  for (float& x : scan.measurement.data) {
-    if (std::isfinite(x) && !(std::fabs(x) <= largest)) {
-      x = NAN;
-      ++scan.non_finite;
-    }
-  }
+  scan.non_finite += mark_corrupt_readings(scan.measurement, scan.geometry.n_views());
   filled_rows = model::fill_dead_rows(scan.measurement, scan.geometry);
   const Geometry& g = scan.geometry;
   elements_per_view = g.n_u * (g.is_3d() ? g.n_v : 1);
   typical_mu = model::typical_mu(scan.measurement, g);
-  field_per_mu = model::field_per_mu(scan.measurement, g);
+  field_per_mu = model::field_per_mu(typical_mu);
   const Geometry field_units = model::lengths_divided(g, field_per_mu);
   segments = model::RaySegments(field_units, config.training.sample_spacing * field_units.voxel_mm,
                                 config.training.circle_region);
