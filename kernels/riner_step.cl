@@ -195,7 +195,8 @@ __kernel void riner_step_loss(const StepParams p, __global const uint* batch,
     for (uint b = lid; b < p.n_batch; b += size) {
       const uint ray = batch[p.rays_at + b];
       const uint slot = response_slot(response_slots, ray, p.elements_per_view);
-      scratch[b] = ray_mismatch(sums[b], params[p.alpha_offset + slot], batch_rho(batch, &p, b));
+      scratch[b] = ray_mismatch(sums[b], params[p.alpha_offset + slot], batch_rho(batch, &p, b),
+                                p.starved_floor);
     }
   }
   if (lid == 0) reduce[0] = 0.0f;  // stays 0 only if NaNs leave no rank k
@@ -223,8 +224,8 @@ __kernel void riner_step_loss(const StepParams p, __global const uint* batch,
     float d_alpha0;
     float d_beta0;
     data += ray_loss(sums[b], params[p.alpha_offset + slot], params[p.beta_offset + slot],
-                     batch_rho(batch, &p, b), as_float(batch[p.weights_at + b]), &d_sum, &d_alpha0,
-                     &d_beta0);
+                     batch_rho(batch, &p, b), as_float(batch[p.weights_at + b]), p.starved_floor,
+                     &d_sum, &d_alpha0, &d_beta0);
     d_sums[b] = d_sum;
     ray_grads[b] = (float2)(d_alpha0, d_beta0);
   }

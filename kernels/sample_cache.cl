@@ -38,7 +38,7 @@
 #define CACHE_POS (CACHE_DIN + N_ENCODED)
 #define CACHE_ROWS (CACHE_POS + DIMS)
 
-// One training step's shape and scalars (host mirror: riner::ops::StepParams, 28 four-byte
+// One training step's shape and scalars (host mirror: riner::ops::StepParams, 29 four-byte
 // members).
 typedef struct {
   uint n_batch;
@@ -69,6 +69,7 @@ typedef struct {
   uint cache_stride;
   uint segments_at;
   uint rho_at;
+  float starved_floor;  // the bound of a +inf reading (ray_sum.cl)
 } StepParams;
 
 // Batch ray b's segment and reading.

@@ -190,6 +190,17 @@ void note_unphysical_readings(const Console& console, const Scan& scan) {
   console.line(line);
 }
 
+void note_starved_readings(const Console& console, std::size_t count, float floor) {
+  if (count == 0) return;
+  char line[320];
+  std::snprintf(line, sizeof(line),
+                "%zu readings of +inf (no light) are a beam the object stopped (metal?): trained "
+                "as at least %.4g, the largest finite reading, not as 0 (summary.json "
+                "starved_readings)",
+                count, static_cast<double>(floor));
+  console.line(line);
+}
+
 void note_non_finite(const Console& console, std::size_t non_finite) {
   if (non_finite == 0) return;
   console.line(std::to_string(non_finite) +

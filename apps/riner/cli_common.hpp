@@ -76,6 +76,8 @@ void print_quality_doubts(Console& console, const QualityReport& q);
 void note_large_stripes(Console& console, const DestripeReport& report);
 // The measurement's NaN/inf readings, counted for a reconstruction (nothing when there are none).
 void note_non_finite(const Console& console, std::size_t non_finite);
+// The +inf readings training keeps as bounds (TrainingStats::starved_readings).
+void note_starved_readings(const Console& console, std::size_t count, float floor);
 // The detector rows training filled from the rows beside them (TrainingStats::filled_rows).
 void note_filled_rows(const Console& console, const std::vector<std::size_t>& rows);
 // Before training: a warning when the views leave lines never measured (views_miss_lines), as

@@ -281,6 +281,7 @@ int run_reconstruct(int argc, char** argv, int first) {
       console.line("not skipping the air: " + setup.air_note);
     }
     note_filled_rows(console, setup.filled_rows);
+    note_starved_readings(console, setup.starved_readings, setup.starved_floor);
     if (setup.field_per_mu != 1.0) {
       char line[240];
       std::snprintf(line, sizeof(line),

@@ -485,8 +485,12 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   // The readings, as a whole scan's run reports them: its slabs' non-finite readings and raw
   // projections' normalisation (the drift of the slab where the air moved most).
   std::size_t non_finite = 0;
+  std::size_t starved = 0;
+  float starved_floor = 0.0f;  // the largest of the slabs' floors
   std::optional<FlatFieldReport> flat;
   for (const nlohmann::json& entry : run.manifest()["slabs"]) {
+    starved += entry.value("starved_readings", std::size_t{0});
+    starved_floor = std::max(starved_floor, entry.value("starved_floor", 0.0f));
     const nlohmann::json readings = entry.value("readings", nlohmann::json());
     if (!readings.is_object()) continue;
     non_finite += readings.value("non_finite", std::size_t{0});
@@ -520,6 +524,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
     for (const std::string& line : flat_field_notes(*flat)) console.line(line);
   }
   note_non_finite(console, non_finite);
+  note_starved_readings(console, starved, starved_floor);
   // Rows a slab's training filled from the rows beside them, by the detector's numbering.
   std::vector<std::size_t> filled_rows;
   for (const Slab& s : run.slabs()) {
@@ -596,6 +601,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       {"changing_elements", changing},
       {"slabs_without_readings", without_readings},
       {"non_finite_measurements", non_finite},
+      {"starved_readings", starved},
       {"inputs", inputs_json(args)},
       {"flat_field", flat ? flat_field_json(*flat) : nlohmann::json(nullptr)},
       {"centre",

@@ -201,6 +201,8 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
       {"samples_per_second", stats.seconds > 0 ? stats.samples / stats.seconds : 0.0},
       {"parameters", stats.parameters},
       {"non_finite_measurements", stats.non_finite},
+      {"starved_readings", stats.starved_readings},
+      {"starved_floor", stats.starved_floor},
       {"filled_rows", stats.filled_rows},
       {"field_per_mu", stats.field_per_mu},
       {"dead_elements", dead},

@@ -218,7 +218,7 @@ void ray_sum_ops(const riner::Device& device, const Options& o, const Peaks& pea
   riner::ops::RaySumOp ray_sum(ctx);
   const riner::ops::RaySumOp::Rays r{&offsets_b, &dx, &elements_b, &rho};
   const OpTiming t = riner::bench::time_op(device, o.warmup, o.runs, [&] {
-    ray_sum.loss(r, mu, alpha0, beta0, 1.0f, d_mu, loss, d_alpha0, d_beta0);
+    ray_sum.loss(r, mu, alpha0, beta0, 1.0f, 0.0f, d_mu, loss, d_alpha0, d_beta0);
   });
   out->push_back(row("ray_sum_loss", std::to_string(rays) + " rays x 128", t,
                      {static_cast<double>(rays), "rays/s", 0.0,

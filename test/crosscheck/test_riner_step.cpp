@@ -136,7 +136,7 @@ TEST_SUITE("riner_step") {
       t.jitter = sc.jitter;
       const std::size_t per_view = g.n_u * (g.is_3d() ? g.n_v : 1);
       const std::size_t views = g.n_views();
-      // Element 40 changes once, 45 twice, 50 dies half-way (its readings +inf from there on).
+      // Element 40 changes once, 45 twice, 50 dies half-way (its readings NaN from there on).
       std::vector<riner::model::ResponseChange> changes;
       if (sc.changing_responses) {
         changes = {
@@ -157,15 +157,20 @@ TEST_SUITE("riner_step") {
       }
       std::vector<float> rho(views * per_view);
       for (float& v : rho) v = measured(rng);
-      for (std::size_t e = 3; e < per_view; e += 17) {  // a few elements with +inf readings
-        for (std::size_t v = 0; v < views; ++v) rho[v * per_view + e] = INFINITY;
+      for (std::size_t e = 3; e < per_view; e += 17) {  // a few elements with unread readings
+        for (std::size_t v = 0; v < views; ++v) rho[v * per_view + e] = NAN;
       }
       if (sc.changing_responses) {
-        for (std::size_t v = views / 2; v < views; ++v) rho[v * per_view + 50] = INFINITY;
+        for (std::size_t v = views / 2; v < views; ++v) rho[v * per_view + 50] = NAN;
+      }
+      // Bounds (+inf: a beam the object stopped) at a floor some rays meet and some do not.
+      const float starved_floor = 1.0f;
+      for (std::size_t ray = 5; ray < rho.size(); ray += 7) {
+        if (!std::isnan(rho[ray])) rho[ray] = INFINITY;
       }
       std::vector<std::uint32_t> invalid(map.slots(), 0);
       for (std::size_t ray = 0; ray < rho.size(); ++ray) {
-        if (std::isinf(rho[ray])) ++invalid[map.slot(ray % per_view, ray / per_view)];
+        if (std::isnan(rho[ray])) ++invalid[map.slot(ray % per_view, ray / per_view)];
       }
       std::vector<float> level_weights(static_cast<std::size_t>(l.levels), 1.0f);
       if (sc.coarse_to_fine) level_weights.back() = 0.3f;
@@ -207,6 +212,7 @@ TEST_SUITE("riner_step") {
           p.relative_beta_threshold = static_cast<float>(sc.relative_beta_threshold);
           p.data_weight = 0.7f;
           p.ring_lambda = static_cast<float>(sc.ring_lambda);
+          p.starved_floor = starved_floor;
           p.block_first = batch.block_first;
           p.block_views = batch.block_views;
           p.block_elements = batch.block_elements;
@@ -226,6 +232,7 @@ TEST_SUITE("riner_step") {
           in.layout = &l;
           in.segments = &segments;
           in.measurement = &rho;
+          in.starved_floor = starved_floor;
           in.elements_per_view = per_view;
           in.jitter = sc.jitter;
           in.seed = 12345;

@@ -33,7 +33,7 @@ TEST_SUITE("ray_sum_precision") {
       g_a.write(std::vector<float>{0.0f});
       g_b.write(std::vector<float>{0.0f});
       riner::ops::RaySumOp(ctx).loss({&d_offsets, &d_dx, &d_e, &d_rho}, d_mu, d_alpha, d_beta, 1.0f,
-                                     d_dmu, d_loss, g_a, g_b);
+                                     0.0f, d_dmu, d_loss, g_a, g_b);
       const double got = d_loss.read()[0];
       MESSAGE(n << " samples: relative error " << std::fabs(got - exact) / exact);
       CHECK(std::fabs(got - exact) <= 1e-5 * exact);

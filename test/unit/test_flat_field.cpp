@@ -1,10 +1,11 @@
 // Raw projections to the measurement: -ln((I - D) / (F - D)), frames averaged, invalid
-// readings NaN and counted.
+// readings +inf (no light) or NaN and counted.
 #include <doctest/doctest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -66,9 +67,10 @@ TEST_SUITE("flat_field") {
     CHECK(report.dark_frames == 0);
   }
 
-  TEST_CASE("readings at or below the dark and pixels without beam become NaN, counted") {
-    // Pixel 0: flat equals dark (no beam): both of its readings invalid. Pixel 1: one reading
-    // below the dark, one NaN. Pixel 2: valid, reading above the flat (rho < 0 is kept).
+  TEST_CASE("readings at or below the dark read +inf, pixels without beam NaN, counted") {
+    // Pixel 0: flat equals dark (no beam): both of its readings NaN. Pixel 1: one reading
+    // below the dark (no light: -ln 0 = +inf), one NaN. Pixel 2: valid, reading above the flat (rho
+    // < 0 is kept).
     const Array raw({2, 3}, {50.0f, 5.0f, 150.0f, 60.0f, NAN, 80.0f});
     const Array flat({3}, {10.0f, 100.0f, 110.0f});
     const Array dark({3}, {10.0f, 10.0f, 10.0f});
@@ -76,7 +78,7 @@ TEST_SUITE("flat_field") {
     const Array rho = riner::flat_field_normalise(raw, flat, dark, &report);
     CHECK(std::isnan(rho.data[0]));
     CHECK(std::isnan(rho.data[3]));
-    CHECK(std::isnan(rho.data[1]));
+    CHECK(rho.data[1] == std::numeric_limits<float>::infinity());
     CHECK(std::isnan(rho.data[4]));
     CHECK(rho.data[2] == doctest::Approx(-std::log(140.0 / 100.0)));
     CHECK(rho.data[5] == doctest::Approx(-std::log(70.0 / 100.0)));

@@ -18,8 +18,9 @@ namespace riner {
 struct FlatFieldReport {
   std::size_t flat_frames = 0;
   std::size_t dark_frames = 0;  // 0: no dark given, D = 0
-  // Readings that became NaN (invalid readings, which beta switches off and FBP interpolates):
-  // I - D <= 0 (no light left to take a logarithm of) or a non-finite I.
+  // Readings with no logarithm (invalid readings, which FBP interpolates): +inf where I - D <= 0
+  // under a beam (no light left: metal, or a dead pixel; training keeps the first as a bound,
+  // the library's model/starved_readings.hpp), NaN for a non-finite I (beta switches those off).
   std::size_t invalid_readings = 0;
   // Detector pixels with F - D <= 0 or no finite flat or dark frame: all their readings are NaN.
   std::size_t pixels_without_beam = 0;

@@ -10,8 +10,8 @@ RaySumOp::RaySumOp(cl::Context& context)
       kernel_(*program_, "ray_sum_loss") {}
 
 void RaySumOp::loss(const Rays& rays, const cl::Buffer<float>& mu, const cl::Buffer<float>& alpha0,
-                    const cl::Buffer<float>& beta0, float weight, cl::Buffer<float>& d_mu,
-                    cl::Buffer<float>& loss, cl::Buffer<float>& d_alpha0,
+                    const cl::Buffer<float>& beta0, float weight, float floor,
+                    cl::Buffer<float>& d_mu, cl::Buffer<float>& loss, cl::Buffer<float>& d_alpha0,
                     cl::Buffer<float>& d_beta0) {
   const auto n = static_cast<cl_uint>(rays.dx->size());
   if (rays.offsets->size() != n + 1u || rays.elements->size() != n || rays.rho->size() != n ||
@@ -19,7 +19,7 @@ void RaySumOp::loss(const Rays& rays, const cl::Buffer<float>& mu, const cl::Buf
     throw Error("ray_sum_loss: buffer sizes disagree");
   }
   kernel_.set_args(n, *rays.offsets, mu, *rays.dx, *rays.elements, *rays.rho, alpha0, beta0, weight,
-                   d_mu, loss, d_alpha0, d_beta0);
+                   floor, d_mu, loss, d_alpha0, d_beta0);
   context_.launch(kernel_, n);
 }
 

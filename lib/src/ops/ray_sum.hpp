@@ -20,9 +20,9 @@ class RaySumOp {
     const cl::Buffer<float>* rho;         // n
   };
   // d_mu per sample and loss per ray; alpha0/beta0 gradients added (atomically) into d_alpha0,
-  // d_beta0 (per element).
+  // d_beta0 (per element). A reading of +inf is a bound, rho >= floor.
   void loss(const Rays& rays, const cl::Buffer<float>& mu, const cl::Buffer<float>& alpha0,
-            const cl::Buffer<float>& beta0, float weight, cl::Buffer<float>& d_mu,
+            const cl::Buffer<float>& beta0, float weight, float floor, cl::Buffer<float>& d_mu,
             cl::Buffer<float>& loss, cl::Buffer<float>& d_alpha0, cl::Buffer<float>& d_beta0);
 
  private:

@@ -13,7 +13,7 @@
 
 namespace riner::ops {
 
-// Host mirror of StepParams in kernels/sample_cache.cl (28 four-byte members).
+// Host mirror of StepParams in kernels/sample_cache.cl (29 four-byte members).
 struct StepParams {
   cl_uint n_batch = 0;
   cl_uint n_samples = 0;
@@ -43,8 +43,9 @@ struct StepParams {
   cl_uint cache_stride = 0;  // set by RinerStepOp
   cl_uint segments_at = 0;
   cl_uint rho_at = 0;
+  float starved_floor = 0.0f;  // the bound of a +inf reading (model/starved_readings.hpp)
 };
-static_assert(sizeof(StepParams) == 112);
+static_assert(sizeof(StepParams) == 116);
 
 // Host mirror of FieldGrid in kernels/riner_step.cl: which voxels of which grid one launch of
 // riner_step_field_evaluate evaluates.

@@ -285,7 +285,11 @@ Array flat_field_normalise(const Array& projections, const Array& flats, const A
       const std::size_t i = v * pixels + p;
       const double light = static_cast<double>(projections.data[i]) - dark[p];
       if (!(light > 0.0) || no_beam[p]) {
-        rho.data[i] = std::numeric_limits<float>::quiet_NaN();
+        // No light left (at or below the dark) under a beam: -ln 0, a beam the object stopped
+        // or a dead pixel, which model/starved_readings.hpp tells apart.
+        const bool dark_only = !no_beam[p] && !std::isnan(light);
+        rho.data[i] = dark_only ? std::numeric_limits<float>::infinity()
+                                : std::numeric_limits<float>::quiet_NaN();
         ++r.invalid_readings;
         continue;
       }

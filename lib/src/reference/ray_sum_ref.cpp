@@ -1,18 +1,31 @@
 #include "reference/ray_sum_ref.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace riner::ref {
 
-RayLoss ray_loss(double ray_sum, double alpha0, double beta0, double rho, double weight) {
-  if (!std::isfinite(rho)) rho = 0.0;
+namespace {
+
+bool is_bound(double rho) { return std::isinf(rho) && rho > 0.0; }
+
+double target(double rho, double floor) {
+  return is_bound(rho) ? floor : (std::isfinite(rho) ? rho : 0.0);
+}
+
+}  // namespace
+
+RayLoss ray_loss(double ray_sum, double alpha0, double beta0, double rho, double weight,
+                 double floor) {
+  const bool bound = is_bound(rho);
+  rho = target(rho, floor);
   const bool clamped = !(alpha0 > kAlphaEpsilon);
   const double alpha = clamped ? kAlphaEpsilon : alpha0;
   const double beta = 1.0 / (1.0 + std::exp(-beta0));
   const double inside = -std::log(alpha) + ray_sum;
   RayLoss out;
   out.rho_hat = inside * beta;
-  const double residual = beta * (inside - rho);
+  const double residual = bound ? std::min(beta * (inside - rho), 0.0) : beta * (inside - rho);
   out.loss = weight * std::fabs(residual);
   const double sign = residual > 0.0 ? 1.0 : (residual < 0.0 ? -1.0 : 0.0);
   const double g = weight * sign;  // dloss / d residual
@@ -22,9 +35,10 @@ RayLoss ray_loss(double ray_sum, double alpha0, double beta0, double rho, double
   return out;
 }
 
-double ray_mismatch(double ray_sum, double alpha0, double rho) {
-  if (!std::isfinite(rho)) rho = 0.0;
-  return std::fabs(-std::log(alpha0 > kAlphaEpsilon ? alpha0 : kAlphaEpsilon) + ray_sum - rho);
+double ray_mismatch(double ray_sum, double alpha0, double rho, double floor) {
+  const double d =
+      -std::log(alpha0 > kAlphaEpsilon ? alpha0 : kAlphaEpsilon) + ray_sum - target(rho, floor);
+  return is_bound(rho) ? std::max(-d, 0.0) : std::fabs(d);
 }
 
 double beta_penalty(double beta0, double lambda, double* d_beta0) {

@@ -70,8 +70,8 @@ double penalty_weight(const StepInputs& in, const model::Batch& batch,
   std::vector<double> mismatch(n);
   for (std::size_t b = 0; b < n; ++b) {
     const std::uint32_t ray = batch.rays[b];
-    mismatch[b] =
-        ray_mismatch(sums[b], params[l.alpha_offset + in.slot(ray)], (*in.measurement)[ray]);
+    mismatch[b] = ray_mismatch(sums[b], params[l.alpha_offset + in.slot(ray)],
+                               (*in.measurement)[ray], in.starved_floor);
   }
   std::nth_element(mismatch.begin(), mismatch.begin() + static_cast<long>((n - 1) / 2),
                    mismatch.end());
@@ -98,7 +98,7 @@ void losses(const StepInputs& in, const model::Batch& batch, const std::vector<d
     touched[slot] = 1;
     const RayLoss rl =
         ray_loss(result.sums[b], params[l.alpha_offset + slot], params[l.beta_offset + slot],
-                 (*in.measurement)[ray], batch.weights[b]);
+                 (*in.measurement)[ray], batch.weights[b], in.starved_floor);
     result.data_loss += rl.loss;
     result.d_sums[b] = rl.d_sum;
     if (with_gradient) {

@@ -17,6 +17,7 @@ struct StepInputs {
   const model::ParameterLayout* layout = nullptr;
   const model::RaySegments* segments = nullptr;
   const std::vector<float>* measurement = nullptr;  // rho per ray id
+  double starved_floor = 0.0;                       // the bound of a +inf reading
   std::size_t elements_per_view = 0;                // n_u * n_v
   bool jitter = true;
   std::uint32_t seed = 0;

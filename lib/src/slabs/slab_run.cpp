@@ -472,6 +472,9 @@ void SlabRun::write_slab(const Slab& slab, const Reconstructor& r, const Summari
   entry["finished_unix"] = unix_seconds();
   entry["device"] = stats.device;
   entry["dead_elements"] = r.dead_elements().size();
+  entry["starved_readings"] =
+      stats.starved_readings;  // +inf kept as bounds (model/starved_readings.hpp)
+  entry["starved_floor"] = stats.starved_floor;
   // A slice trained in 2D names its dead elements by column, for every row of the slab.
   entry["trained_as"] = slices_2d_ ? "slice_2d" : "field_3d";
   entry["summary"] = summarise ? summarise(r, result, device) : nlohmann::json(nullptr);

@@ -71,6 +71,7 @@ class OpenclTrainer final : public Trainer {
     p.relative_beta_threshold = static_cast<float>(t.relative_beta_threshold);
     p.data_weight = static_cast<float>(t.data_weight);
     p.ring_lambda = static_cast<float>(t.ring_lambda);
+    p.starved_floor = setup_.starved.floor;
     p.block_first = batch.block_first;
     p.block_views = batch.block_views;
     p.block_elements = batch.block_elements;

@@ -513,6 +513,8 @@ TrainingStats Reconstructor::stats() const {
   s.seconds = impl_->seconds;
   s.samples = impl_->samples;
   s.non_finite = impl_->setup.scan.non_finite;
+  s.starved_readings = impl_->setup.starved.count;
+  s.starved_floor = impl_->setup.starved.floor;
   s.filled_rows = impl_->setup.filled_rows;
   s.field_per_mu = impl_->setup.field_per_mu;
   s.typical_mu = impl_->setup.typical_mu;

@@ -20,6 +20,7 @@ class ReferenceTrainer final : public Trainer {
     inputs_.layout = &setup_.layout;
     inputs_.segments = &setup_.segments;
     inputs_.measurement = &setup_.scan.measurement.data;
+    inputs_.starved_floor = setup_.starved.floor;
     inputs_.elements_per_view = setup_.elements_per_view;
     inputs_.jitter = setup_.config.training.jitter;
     inputs_.seed = setup_.seed;

@@ -15,6 +15,7 @@
 #include "model/parameter_layout.hpp"
 #include "model/ray_segments.hpp"
 #include "model/response_map.hpp"
+#include "model/starved_readings.hpp"
 #include "model/tail_average.hpp"
 #include "riner/device.hpp"
 #include "riner/execution_plan.hpp"
@@ -35,9 +36,12 @@ struct TrainingSetup {
   // divided by it.
   double field_per_mu = 1.0;
   double typical_mu = 0.0;  // model::typical_mu, what field_per_mu was chosen from
+  // The +inf readings kept as bounds (a beam the object stopped; model/starved_readings.hpp) and
+  // their floor; the other +inf readings were set to NaN.
+  model::StarvedReadings starved;
   std::size_t elements_per_view = 0;
   std::uint32_t seed = 0;
-  std::vector<std::uint32_t> invalid_readings;  // per response slot: its non-finite measurements
+  std::vector<std::uint32_t> invalid_readings;  // per response slot: its unread measurements
   // Which alpha0/beta0 each reading uses: one per element, or per segment of views for the
   // elements whose response changes part-way (training.partial_responses).
   model::ResponseMap responses;

@@ -5,6 +5,7 @@
 #include "model/factor_evidence.hpp"
 #include "model/field_scale.hpp"
 #include "model/response_changes.hpp"
+#include "model/starved_readings.hpp"
 #include "model/stripe_evidence.hpp"
 #include "model/stuck_elements.hpp"
 #include "riner/error.hpp"
@@ -93,6 +94,9 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
   // A reading beyond any line integral is a corrupt value: dead for training as a non-finite
   // one is (FBP repairs both alike), not a target a field and alpha chase.
   scan.non_finite += mark_corrupt_readings(scan.measurement, scan.geometry.n_views());
+  // A beam the object stopped (+inf beside rays near the largest reading) is a bound, not a
+  // dead element's 0: metal read as air where it was taken as one.
+  starved = model::mark_starved_readings(scan.measurement, scan.geometry.n_views());
   filled_rows = model::fill_dead_rows(scan.measurement, scan.geometry);
   const Geometry& g = scan.geometry;
   elements_per_view = g.n_u * (g.is_3d() ? g.n_v : 1);
@@ -184,7 +188,8 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
   }
   seed = static_cast<std::uint32_t>(config.training.seed ^ (config.training.seed >> 32));
   invalid_readings.assign(responses.slots(), 0);
-  // A filled row's elements read nothing themselves: dead, as those with no finite reading.
+  // A filled row's elements read nothing themselves: dead, as those with no finite reading. A
+  // bound is a reading.
   std::vector<bool> filled(elements_per_view, false);
   for (const std::size_t r : filled_rows) {
     std::fill(filled.begin() + static_cast<std::ptrdiff_t>(r * g.n_u),
@@ -192,7 +197,8 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
   }
   const std::vector<float>& rho = scan.measurement.data;
   for (std::size_t ray = 0; ray < rho.size(); ++ray) {
-    if (!std::isfinite(rho[ray]) || filled[ray % elements_per_view]) {
+    if ((!std::isfinite(rho[ray]) && !model::is_starved(rho[ray])) ||
+        filled[ray % elements_per_view]) {
       ++invalid_readings[responses.slot(ray % elements_per_view, ray / elements_per_view)];
     }
   }

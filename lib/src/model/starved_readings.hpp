@@ -1,0 +1,39 @@
+// Readings of +inf (no light reached the element: -ln 0) mean one of two things. Where the object
+// stopped the beam (metal, photon starvation) the ray's line integral is at least about the
+// scan's largest finite reading: a bound training keeps (a censored reading; kernels/ray_sum.cl,
+// ray_loss). Where an element read nothing while the rays beside it saw light, it is dead or
+// dying: unread, as NaN is, which beta switches off.
+//
+// Along each detector line, a run of +inf is a stopped beam when it is wider than
+// kWidestDeadRun elements (a 9-pixel metal disc: runs of 7-9; a dead element: 1), or when a
+// reading beside it (the nearest finite one on either side) reaches kStarvedNeighbourShare of the
+// largest (the few photons at a dense edge) and its element is not dark for a run of
+// response_change_min_views views or more there (an element dying part-way in the middle of a
+// body, whose rays read near the largest; the dead columns of the shared neutron scan sit among
+// rays at 0.36 of it). An element that reads nothing in any view is dead whatever its neighbours
+// read.
+#pragma once
+
+#include <cstddef>
+#include <limits>
+
+#include "riner/array.hpp"
+
+namespace riner::model {
+
+constexpr std::size_t kWidestDeadRun = 2;
+constexpr double kStarvedNeighbourShare = 0.75;
+
+struct StarvedReadings {
+  std::size_t count = 0;  // +inf readings kept as bounds
+  float floor = 0.0f;     // the bound: the largest finite reading (0 when none is kept)
+};
+
+// `measurement` is [views, elements] or [views, rows, columns]. Sets the +inf readings that are
+// no bound to NaN. Finite readings beyond riner::largest_reading are left out of the largest.
+StarvedReadings mark_starved_readings(Array& measurement, std::size_t views);
+
+// A kept bound: +inf after mark_starved_readings.
+inline bool is_starved(float reading) { return reading == std::numeric_limits<float>::infinity(); }
+
+}  // namespace riner::model

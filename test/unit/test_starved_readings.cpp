@@ -1,0 +1,114 @@
+// Which +inf readings training keeps as bounds (a beam the object stopped) and which it leaves
+// unread (a dead element): model/starved_readings.hpp.
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include "model/starved_readings.hpp"
+
+namespace {
+
+// 6 views of 12 elements reading 1 (air at 0 at the ends), a metal band at elements 5-6 in
+// views 0-3 whose edges (4 and 7) read near the largest reading, 16.
+riner::Array metal_scan() {
+  riner::Array a({6, 12});
+  for (std::size_t v = 0; v < 6; ++v) {
+    for (std::size_t e = 0; e < 12; ++e) {
+      a(v, e) = (e < 2 || e > 9) ? 0.0f : 1.0f;
+    }
+    if (v > 3) continue;
+    a(v, 4) = 15.0f;
+    a(v, 5) = INFINITY;
+    a(v, 6) = INFINITY;
+    a(v, 7) = v == 0 ? 16.0f : 14.0f;
+  }
+  return a;
+}
+
+}  // namespace
+
+TEST_SUITE("starved_readings") {
+  TEST_CASE("+inf beside rays near the largest reading is a bound at it") {
+    riner::Array a = metal_scan();
+    const riner::model::StarvedReadings s = riner::model::mark_starved_readings(a, 6);
+    CHECK(s.count == 8);
+    CHECK(s.floor == 16.0f);
+    for (std::size_t v = 0; v < 4; ++v) {
+      CHECK(riner::model::is_starved(a(v, 5)));
+      CHECK(riner::model::is_starved(a(v, 6)));
+    }
+  }
+
+  TEST_CASE("+inf among rays well below the largest is a dead element: NaN") {
+    riner::Array a = metal_scan();
+    a(2, 1) = INFINITY;  // in air
+    a(4, 8) = INFINITY;  // in the object (reads 1 around), far below 16
+    a(4, 9) = NAN;       // a NaN beside it is skipped: the run's neighbours are 1 and 0
+    const riner::model::StarvedReadings s = riner::model::mark_starved_readings(a, 6);
+    CHECK(s.count == 8);
+    CHECK(std::isnan(a(2, 1)));
+    CHECK(std::isnan(a(4, 8)));
+  }
+
+  TEST_CASE("a run wider than two elements is a stopped beam whatever its neighbours read") {
+    riner::Array a = metal_scan();
+    a(4, 3) = a(4, 4) = a(4, 5) = INFINITY;  // 3 wide, among readings of 1
+    a(5, 3) = a(5, 4) = INFINITY;            // 2 wide: dead elements' width
+    const riner::model::StarvedReadings s = riner::model::mark_starved_readings(a, 6);
+    CHECK(s.count == 11);
+    CHECK(riner::model::is_starved(a(4, 4)));
+    CHECK(std::isnan(a(5, 3)));
+    CHECK(std::isnan(a(5, 4)));
+  }
+
+  TEST_CASE("an element dark for views / 12 views in a row among dense rays is dying, not metal") {
+    // 48 views; elements 4-7 read 15 (near the largest, 16: a body's thickest rays). Element 5
+    // goes dark from view 20 on (28 views, past max(24, 48 / 12)); element 6 for 3 views only.
+    riner::Array a({48, 12}, 1.0f);
+    for (std::size_t v = 0; v < 48; ++v) {
+      for (std::size_t e = 4; e < 8; ++e) a(v, e) = 15.0f;
+      a(v, 9) = 16.0f;
+      if (v >= 20) a(v, 5) = INFINITY;
+      if (v >= 30 && v < 33) a(v, 6) = INFINITY;
+    }
+    const riner::model::StarvedReadings s = riner::model::mark_starved_readings(a, 48);
+    CHECK(s.count == 3);
+    CHECK(std::isnan(a(25, 5)));
+    CHECK(std::isnan(a(31, 5)));  // the run 5-6 in view 31 is 2 wide: each element on its own
+    CHECK(riner::model::is_starved(a(31, 6)));
+  }
+
+  TEST_CASE("an element that reads nothing in any view is dead, whatever its neighbours read") {
+    riner::Array a = metal_scan();
+    for (std::size_t v = 0; v < 6; ++v) a(v, 6) = INFINITY, a(v, 5) = 15.5f;
+    const riner::model::StarvedReadings s = riner::model::mark_starved_readings(a, 6);
+    CHECK(s.count == 0);
+    CHECK(s.floor == 0.0f);  // no bound kept
+    for (std::size_t v = 0; v < 6; ++v) CHECK(std::isnan(a(v, 6)));
+  }
+
+  TEST_CASE("corrupt spikes do not set the floor; a scan of nothing finite keeps no bound") {
+    riner::Array a = metal_scan();
+    a(1, 9) = 1e5f;  // beyond largest_reading: left out of the largest
+    riner::model::StarvedReadings s = riner::model::mark_starved_readings(a, 6);
+    CHECK(s.floor == 16.0f);
+    CHECK(s.count == 8);
+    riner::Array none({2, 3}, std::vector<float>(6, INFINITY));
+    s = riner::model::mark_starved_readings(none, 2);
+    CHECK(s.count == 0);
+    for (float x : none.data) CHECK(std::isnan(x));
+  }
+
+  TEST_CASE("3D: runs are looked for along each detector row") {
+    riner::Array a({2, 2, 4}, std::vector<float>{1, 9, INFINITY, 1,   // view 0, row 0: bound
+                                                 1, INFINITY, 1, 1,   // row 1: dead
+                                                 1, INFINITY, 10, 1,  // view 1, row 0: bound
+                                                 1, 1, 1, 1});
+    const riner::model::StarvedReadings s = riner::model::mark_starved_readings(a, 2);
+    CHECK(s.count == 2);
+    CHECK(s.floor == 10.0f);
+    CHECK(riner::model::is_starved(a.data[2]));
+    CHECK(std::isnan(a.data[5]));
+    CHECK(riner::model::is_starved(a.data[9]));
+  }
+}
