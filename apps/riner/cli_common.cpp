@@ -12,6 +12,7 @@
 #include "riner/error.hpp"
 #include "riner/fbp.hpp"
 #include "riner/io.hpp"
+#include "riner/rays.hpp"
 #include "riner/simulate.hpp"
 
 namespace riner::app {
@@ -169,6 +170,31 @@ void note_filled_rows(const Console& console, const std::vector<std::size_t>& ro
   console.line("note: detector row" + std::string(rows.size() > 1 ? "s " : " ") + list +
                " read nothing in any view: trained on the line between the rows beside them, as "
                "FBP fills them; the slices only they see are interpolated, not measured");
+}
+
+void note_grid_beyond_rays(const Console& console, const Geometry& g) {
+  const double ratio = grid_beyond_rays(g);
+  if (!(ratio > kGridBeyondRaysNoted)) return;
+  char line[320];
+  std::snprintf(line, sizeof(line),
+                "note: the grid reaches %.3g times as far from the axis as the detector's rays: "
+                "its outer part is seen by no ray (check volume.voxel_mm and volume.shape, in mm "
+                "like detector.pitch_mm)",
+                ratio);
+  console.line(line);
+}
+
+void note_object_beyond_detector(const Console& console, const Scan& scan) {
+  if (is_half_acquisition(scan.geometry)) return;  // one end under the object by design
+  const double share = edge_reading_share(scan.measurement);
+  if (!(share > kEdgeShareNoted)) return;
+  char line[320];
+  std::snprintf(line, sizeof(line),
+                "note: the object reaches the detector's ends (they read %.0f%% of each view's "
+                "largest reading): it is wider than the field of view, so FBP's image cups and "
+                "what lies outside it is not measured",
+                100.0 * share);
+  console.line(line);
 }
 
 void note_missing_lines(const Console& console, const Geometry& g) {

@@ -83,6 +83,14 @@ void note_filled_rows(const Console& console, const std::vector<std::size_t>& ro
 // Before training: a warning when the views leave lines never measured (views_miss_lines), as
 // riner fbp warns (before, reconstruct said nothing of a 0.5-degree arc).
 void note_missing_lines(const Console& console, const Geometry& g);
+// A grid reaching kGridBeyondRaysNoted times as far from the axis as the rays (grid_beyond_rays):
+// a unit's mistake, most likely (an audit's grid 8 times too wide drew no word).
+constexpr double kGridBeyondRaysNoted = 3.0;
+void note_grid_beyond_rays(const Console& console, const Geometry& g);
+// An object wider than the field of view (edge_reading_share above this; the shared scans read
+// 0.001-0.053, an audit's truncated scans 0.6-0.9); not for a half acquisition.
+constexpr double kEdgeShareNoted = 0.25;
+void note_object_beyond_detector(const Console& console, const Scan& scan);
 // Before training: a note when the median view's largest reading is beyond any detector's
 // -ln(I/I0) (kMostLineIntegral): readings stored scaled (x1000 integers) train with rings left,
 // since alpha's offsets would need responses of e^(hundreds) (the audit: 21.8 dB, ring index

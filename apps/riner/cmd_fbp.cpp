@@ -136,6 +136,7 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
   }
   note_short_scan(console, report.fbp);
   note_half_acquisition(console, report.fbp.half_acquisition_overlap_mm);
+  note_grid_beyond_rays(console, g);
   console.line("fbp (" + std::string(fbp_filter_name(options.filter)) + ", " +
                engine_name(options.engine) + "): " + shape_string(g.volume_shape) + " in " +
                std::to_string(report.slabs) + " slab(s) of up to " +
@@ -246,6 +247,8 @@ int run_fbp(int argc, char** argv, int first) {
   }
   note_short_scan(console, report);
   note_half_acquisition(console, report.half_acquisition_overlap_mm);
+  note_grid_beyond_rays(console, scan.geometry);
+  note_object_beyond_detector(console, scan);
   console.line("fbp (" + std::string(fbp_filter_name(options.filter)) + ", " +
                engine_name(options.engine) + "): " + shape_string(image.shape) + " in " +
                std::to_string(seconds) + " s, " + std::to_string(report.non_finite_replaced) +

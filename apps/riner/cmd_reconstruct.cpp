@@ -176,6 +176,8 @@ int run_reconstruct(int argc, char** argv, int first) {
   LoadedScan loaded = scan_from(args, console);
   const std::optional<CentreEstimate> centre_check = check_centre(loaded, console);
   note_missing_lines(console, loaded.scan.geometry);
+  note_grid_beyond_rays(console, loaded.scan.geometry);
+  note_object_beyond_detector(console, loaded.scan);
   note_unphysical_readings(console, loaded.scan);
   Scan& scan = loaded.scan;
   require_quality_grid(scan.geometry);

@@ -247,6 +247,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   }
   if (source.centre() && speak) console.line(centre_line(*source.centre()));
   if (speak) note_missing_lines(console, source.geometry());
+  if (speak) note_grid_beyond_rays(console, source.geometry());
   require_quality_grid(source.geometry());
   require_training(settings);
   refuse_limit_below_one_slice(options, slab_bytes(source.geometry(), 1));

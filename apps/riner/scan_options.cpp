@@ -30,11 +30,12 @@ void add_scan_options(Args& args) {
               "flats taken after the scan (--flat: before it): each view's flat field is "
               "interpolated between the two, for a beam that drifts during the scan",
               "")
-      .option("row", "N",
-              "reconstruct detector row N of a projection stack with a 2D geometry (one slice)", "")
+      .option("row", "N", "use detector row N of a projection stack with a 2D geometry (one slice)",
+              "")
       .option("offset-px", "PX|auto",
               "the detector's centre-of-rotation offset instead of the geometry's; auto: "
-              "estimated from the scan's own sinogram (parallel beam, `riner center`)",
+              "estimated from the scan itself as `riner center` does (a parallel beam's whole "
+              "sinogram, a fan or cone beam's conjugate rays over a full turn)",
               "");
 }
 

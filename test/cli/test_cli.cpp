@@ -192,6 +192,48 @@ TEST_SUITE("cli") {
     CHECK(summary["dead_elements"] == simulation["dead_elements"]);
   }
 
+  TEST_CASE("a grid far beyond the detector's rays, an object beyond its ends: both said") {
+    // An audit's grid 8 times too wide drew no word; its outer part is seen by no ray.
+    riner::test::TempDir dir;
+    const std::string sim = riner::test::simulate_small_parallel2d(dir, 2);
+    const auto fbp_with_voxel = [&](double voxel) {
+      char json[300];
+      std::snprintf(json, sizeof(json), R"({"type": "parallel2d",
+          "detector": {"count": 70, "pitch_mm": 1.0},
+          "angles": {"count": 90, "range_rad": 3.141592653589793},
+          "volume": {"shape": [64, 64], "voxel_mm": %g}})",
+                    voxel);
+      riner::test::write_bytes(dir / "g.json", json);
+      const Run run = riner_cli("fbp " + sim + "/sino.npy --geometry " + (dir / "g.json").string() +
+                                    " --out " + (dir / "f.npy").string(),
+                                dir);
+      REQUIRE(run.code == 0);
+      return run.out + run.err;
+    };
+    const std::string note = "times as far from the axis as the detector's rays";
+    CHECK(fbp_with_voxel(1.0).find(note) == std::string::npos);
+    CHECK(fbp_with_voxel(2.0).find(note) == std::string::npos);  // 1.8 times: no word
+    const std::string wide = fbp_with_voxel(8.0);
+    CAPTURE(wide);
+    CHECK(wide.find("the grid reaches 7.31 " + note) != std::string::npos);
+    // And the other way: an object wider than the field of view (40 columns under a phantom
+    // 61 wide) is said, where FBP cups.
+    CHECK(fbp_with_voxel(1.0).find("reaches the detector's ends") == std::string::npos);
+    riner::test::write_bytes(dir / "narrow.json", R"({"type": "parallel2d",
+        "detector": {"count": 40, "pitch_mm": 1.0},
+        "angles": {"count": 90, "range_rad": 3.141592653589793},
+        "volume": {"shape": [64, 64], "voxel_mm": 1.0}})");
+    REQUIRE(riner_cli("simulate --quiet --geometry " + (dir / "narrow.json").string() + " --out " +
+                          (dir / "cut").string(),
+                      dir)
+                .code == 0);
+    const Run cut = riner_cli(
+        "fbp " + (dir / "cut" / "sino.npy").string() + " --out " + (dir / "cut.npy").string(), dir);
+    REQUIRE(cut.code == 0);
+    CHECK((cut.out + cut.err).find("note: the object reaches the detector's ends") !=
+          std::string::npos);
+  }
+
   TEST_CASE("a scan whose readings are all one value is refused, saying why") {
     riner::test::TempDir dir;
     const std::string sim = riner::test::simulate_small_parallel2d(dir, 2);

@@ -163,6 +163,24 @@ TEST_SUITE("geometry_json") {
     check_error(fan_with("\"start_rad\"", "\"start\""),
                 "g.json: angles.start is not a geometry field (angles takes count, start_rad, "
                 "range_rad)");
+    // A parallel beam with a source's distances: another geometry's (they were dropped).
+    check_error(fan_with("\"fan2d\"", "\"parallel2d\""),
+                "g.json: source_origin_mm belongs to a fan or cone beam (type \"fan2d\" or "
+                "\"cone3d\"); a parallel beam has none");
+    // Every view at one angle (FBP drew streaks with only a warning).
+    check_error(fan_with("\"angles\": {\"count\": 360, \"start_rad\": 0.0, \"range_rad\": "
+                         "6.283185307179586}",
+                         "\"angles_rad\": [0.5, 0.5, 0.5]"),
+                "g.json: angles: all 3 views are at one angle (0.500000 rad): a scan turns the "
+                "object");
+    // NaN, as Python's json.dump writes it, is named as no JSON number.
+    try {
+      riner::Geometry::from_json(fan_with("\"start_rad\": 0.0", "\"start_rad\": NaN"), "g.json");
+      FAIL("accepted NaN");
+    } catch (const riner::InputError& e) {
+      CHECK(std::string(e.what()).find("NaN and Infinity are no JSON numbers") !=
+            std::string::npos);
+    }
     // Documentation is not a field.
     CHECK_NOTHROW(riner::Geometry::from_json(
         fan_with("\"type\"", "\"comment\": \"scanner A\", \"_source\": 1, \"type\""), "g.json"));

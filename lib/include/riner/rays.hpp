@@ -43,6 +43,11 @@ Ray detector_ray(const Geometry& g, const ViewRotation& rotation, double u, doub
 // d and -d, and a ray at d has its conjugate at -d.
 std::vector<double> column_ray_distances(const Geometry& g);
 
+// How many times farther from the axis the grid reaches (half its wider axial side) than the
+// detector's rays do (the farthest column's ray, to its element's edge): about 1 for a grid
+// fitted to the field of view, and far above it when a length is in another unit.
+double grid_beyond_rays(const Geometry& g);
+
 // Where detector row v (fractional: an element's edges at v -+ 0.5) sits above the source's
 // plane, in mm on the detector (3D; before any grid_centre_z_mm).
 double detector_row_mm(const Geometry& g, double v);

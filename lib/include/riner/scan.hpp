@@ -32,6 +32,12 @@ double median_view_largest(const Array& measurement, std::size_t views);
 std::size_t count_corrupt_readings(const Array& measurement, std::size_t views);
 std::size_t mark_corrupt_readings(Array& measurement, std::size_t views);
 
+// How far the object reaches the detector's ends: over detector lines (each view's row), the
+// median of the larger of the two ends' readings (each the median of its 3 outermost finite
+// columns) over the line's largest. About 0 where air lies beyond the object at both ends (the
+// shared scans: 0.001-0.053); an object wider than the field of view reads a good share there.
+double edge_reading_share(const Array& measurement);
+
 struct Scan {
   Array measurement;  // [views, elements] in 2D, [views, rows, columns] in 3D
   Geometry geometry;

@@ -94,6 +94,33 @@ double median_view_largest(const Array& measurement, std::size_t views) {
   return *middle;
 }
 
+double edge_reading_share(const Array& measurement) {
+  if (measurement.rank() < 2 || measurement.shape.back() < 8) return 0.0;
+  const std::size_t n = measurement.shape.back();
+  const std::size_t lines = measurement.size() / n;
+  std::vector<double> shares;
+  const auto end_reading = [](const float* line, std::size_t n, bool from_left) {
+    std::vector<double> outer;
+    for (std::size_t k = 0; k < n && outer.size() < 3; ++k) {
+      const float x = line[from_left ? k : n - 1 - k];
+      if (std::fabs(x) <= kLargestReading) outer.push_back(x);
+    }
+    if (outer.empty()) return std::nan("");
+    std::sort(outer.begin(), outer.end());
+    return outer[outer.size() / 2];
+  };
+  for (std::size_t l = 0; l < lines; ++l) {
+    const float* line = measurement.ptr() + l * n;
+    float largest = 0.0f;
+    for (std::size_t k = 0; k < n; ++k) {
+      if (std::fabs(line[k]) <= kLargestReading) largest = std::max(largest, line[k]);
+    }
+    const double edge = std::fmax(end_reading(line, n, true), end_reading(line, n, false));
+    if (largest > 0.0f && std::isfinite(edge)) shares.push_back(edge / largest);
+  }
+  return shares.empty() ? 0.0 : util::quantile(shares, 0.5);
+}
+
 float largest_reading(const Array& measurement, std::size_t views) {
   const double limit =
       std::max(kLeastSpikeLimit, kSpikeFactor * median_view_largest(measurement, views));

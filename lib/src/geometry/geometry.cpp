@@ -58,6 +58,13 @@ void Geometry::validate() const {
     if (!std::isfinite(a)) fail("angles must be finite");
     widest = std::max(widest, std::fabs(a));
   }
+  // Views all at one angle see the object from one side only: nothing to reconstruct (FBP
+  // gave an image of streaks with only a warning).
+  if (angles.size() > 1 &&
+      std::all_of(angles.begin(), angles.end(), [&](double a) { return a == angles[0]; })) {
+    fail("angles: all " + std::to_string(angles.size()) + " views are at one angle (" +
+         std::to_string(angles[0]) + " rad): a scan turns the object");
+  }
   // Degrees read as radians (a range of 180 or 360) would be 29 or 57 turns, reconstructed
   // without a word into garbage; no scan turns more than a few times.
   if (widest > kLargestAngleRad) {

@@ -165,6 +165,16 @@ Geometry Geometry::from_json(std::string_view json_text, std::string_view source
         p.positive(p.member(root, "source_origin_mm", "source_origin_mm"), "source_origin_mm");
     g.origin_detector_mm = p.positive(p.member(root, "origin_detector_mm", "origin_detector_mm"),
                                       "origin_detector_mm");
+  } else {
+    // A parallel beam has no source: distances given with it are another geometry's (a fan
+    // or cone beam's type forgotten?), not to be dropped without a word.
+    for (const char* key : {"source_origin_mm", "origin_detector_mm"}) {
+      if (root.contains(key)) {
+        p.fail(key,
+               "belongs to a fan or cone beam (type \"fan2d\" or \"cone3d\"); a parallel beam has "
+               "none");
+      }
+    }
   }
 
   const bool has_uniform = root.contains("angles");

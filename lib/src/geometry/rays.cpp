@@ -62,6 +62,20 @@ std::vector<double> column_ray_distances(const Geometry& g) {
   return d;
 }
 
+double grid_beyond_rays(const Geometry& g) {
+  const std::vector<double> d = column_ray_distances(g);
+  double reach = 0.0;
+  for (double x : d) reach = std::max(reach, std::fabs(x));
+  // Half an element at the axis beyond the farthest column's centre.
+  const double sdd = g.source_origin_mm + g.origin_detector_mm;
+  reach += 0.5 * g.pitch_u * (g.is_divergent() ? g.source_origin_mm / sdd : 1.0);
+  const std::size_t rank = g.volume_shape.size();
+  const double half_width =
+      0.5 * g.voxel_mm *
+      static_cast<double>(std::max(g.volume_shape[rank - 1], g.volume_shape[rank - 2]));
+  return reach > 0.0 ? half_width / reach : 0.0;
+}
+
 Ray detector_ray(const Geometry& g, std::size_t view, double u, double v) {
   return detector_ray(g, ViewRotation::of(g, view), u, v);
 }

@@ -20,14 +20,27 @@ struct ConjugateAxis {
   double offset_px = 0.0;  // the detector offset (geometry's u) that puts the axis there
   std::size_t rays = 0;    // ray pairs compared at the best offset of the half-pixel grid
   bool half_acquisition = false;  // found beyond the detector's central half
+  // The best at an end of the search around the geometry's offset (not beyond the central
+  // half): no answer, the axis lies farther (offset_px that end).
+  bool at_search_end = false;
 };
 
-// Fan beam (2D). Searches the geometry's offset +- search_px; where the geometry puts the axis
+// Fan beam (2D). Searches the geometry's offset +- search_px, and on from an end of it where the
+// best lies there, up to the detector's central half (kCentreSearchShare of its width either
+// way; a search of 32 px on 240 elements said 34.50 for an axis 40 px off, its end taken for an
+// answer; at_search_end when it ends there); where the geometry puts the axis
 // in the detector's central half, also the offsets beyond it (a half acquisition: the axis near
 // one end, only the rays around it have conjugates on the detector), by the mismatch relative
 // to the spread of the readings compared, taken where that is under a quarter of the best
 // around the geometry's offset. nullopt when the views do not cover a full turn less two steps,
 // evenly spaced (within 10% of the step), or the detector is under 8 elements.
-std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, double search_px = 32.0);
+// The search around the geometry's offset reads `scan`: the object's mean per element, which
+// a full turn's stripes share, gives its cost a basin about the axis (without it, an axis 40 px
+// off was taken for one 58 px the other way). The half-pixel search, and the one beyond the
+// central half, read `fine_scan`: the readings less each element's mean over the turn
+// (centre.cpp), in which a ring's stripes (an element and its conjugate offset alike at no
+// candidate) no longer pull the best (1.7 px on a ringed fan scan of a faint object).
+std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, const Scan& fine_scan,
+                                            double search_px = 32.0);
 
 }  // namespace riner::preprocessing

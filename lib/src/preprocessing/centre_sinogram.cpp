@@ -26,10 +26,8 @@ constexpr std::size_t kCoarseViews = 128;
 // The fine search at full width: this step (px) within one coarse column of the coarse minimum.
 constexpr double kFineStepPx = 0.25;
 constexpr std::size_t kMostRows = 8;
-// The stripes' check (stripes_dominate): the two measures' axes this close (px) stand for the
-// measure on the readings as they are; the stripes' part of a column's mean is its difference
+// The stripes' check (stripes_dominate): the stripes' part of a column's mean is its difference
 // from the median of the columns within this many on either side.
-constexpr double kStripesAgreePx = 1.0;
 constexpr std::size_t kStripeNeighbours = 2;
 // object_columns: a column the object reaches spreads over its views by more than this share of
 // the most any column does; air lies beyond them by this many columns at both ends.
@@ -373,7 +371,7 @@ std::optional<double> row_axis(const std::vector<std::vector<Row>>& turns) {
 // the detector those breaks outweigh the object's (a 12-column object among 160 ringed
 // columns: 28.85 px off, the stripes' own axis). The object's half-turn mean is not symmetric
 // about the axis (a half-turn sees it from one side), so the measure then leans by a few
-// tenths of a pixel (0.22 px on that object's clean scan): the readings as they are stay first.
+// tenths of a pixel (0.22 px on that object's clean scan), so only where the stripes dominate.
 std::vector<std::vector<Row>> without_column_means(std::vector<std::vector<Row>> turns) {
   for (std::vector<Row>& s : turns) {
     Row mean(s[0].size(), 0.0);
@@ -417,33 +415,14 @@ bool stripes_dominate(const std::vector<std::vector<Row>>& turns) {
   return stripes > object;
 }
 
-// The spectral measure's best on the readings as they are within kStripesAgreePx of `near`
-// (its vertex), nullopt where it lies at the window's end.
-std::optional<double> fine_axis_near(const std::vector<std::vector<Row>>& turns, double near) {
-  const std::size_t by_views = std::max<std::size_t>(1, turns[0].size() / kMostViews);
-  std::vector<WedgeEnergy> wide;
-  for (const std::vector<Row>& s : turns) wide.emplace_back(binned(s, by_views, 1));
-  std::vector<double> fine;
-  for (double a = near - kStripesAgreePx; a <= near + kStripesAgreePx + 1e-9; a += kFineStepPx) {
-    fine.push_back(a);
-  }
-  const Minimum m = minimise(wide, fine);
-  if (m.index == 0 || m.index + 1 == fine.size()) return std::nullopt;
-  return vertex(m, fine, kFineStepPx);
-}
-
-// The row's axis: from the readings as they are, unless the stripes dominate and the readings
-// without their column means put it more than kStripesAgreePx away; then the readings' best
-// near that one, where they have one (the lean of the means taken out, 0.22 px on a narrow
-// object's ringed scans: seeds 3 and 5 to -0.07 and 0.06), else that one.
+// The row's axis: from the readings without their column means where the stripes dominate
+// (on ringed scans of faint objects: 3.48 px for 3.5 and -7.26 for -7.25 where the readings as
+// they are said 2.87 and -6.98; a 12-column object's 2.2-39.2 px astray to 0.22), else from the
+// readings as they are.
 std::optional<double> row_axis_past_stripes(const std::vector<std::vector<Row>>& turns) {
-  const std::optional<double> as_read = row_axis(turns);
-  if (!stripes_dominate(turns)) return as_read;
+  if (!stripes_dominate(turns)) return row_axis(turns);
   const std::optional<double> centred = row_axis(without_column_means(turns));
-  if (!centred) return as_read;
-  if (as_read && std::fabs(*as_read - *centred) <= kStripesAgreePx) return as_read;
-  const std::optional<double> near = fine_axis_near(turns, *centred);
-  return near ? near : centred;
+  return centred ? centred : row_axis(turns);
 }
 
 // The scan's half-turns of evenly spaced views: the first view of each (the second starts at

@@ -39,7 +39,16 @@ nlohmann::json parse_user_json(std::string_view text, const std::string& source)
     throw InputError(source + ": the key \"" + d.key +
                      "\" appears twice in one object (which one is meant?)");
   } catch (const nlohmann::json::exception& e) {
-    throw InputError(source + ": invalid JSON: " + e.what());
+    // Python's json.dump writes NaN and Infinity, which JSON has no word for.
+    const std::string what = e.what();
+    const bool non_number =
+        what.find("last read: '") != std::string::npos &&
+        (what.find("N'") != std::string::npos || what.find("I'") != std::string::npos ||
+         what.find("-I'") != std::string::npos);
+    throw InputError(source + ": invalid JSON: " + what +
+                     (non_number ? " (NaN and Infinity are no JSON numbers: every value must be a "
+                                   "finite number)"
+                                 : ""));
   }
 }
 
