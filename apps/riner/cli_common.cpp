@@ -220,9 +220,9 @@ void note_starved_readings(const Console& console, std::size_t count, float floo
   if (count == 0) return;
   char line[320];
   std::snprintf(line, sizeof(line),
-                "%zu readings of +inf (no light) are a beam the object stopped (metal?): trained "
-                "as at least %.4g, the largest finite reading, not as 0 (summary.json "
-                "starved_readings)",
+                "of the readings not finite, %zu of +inf (no light) are a beam the object stopped "
+                "(metal?): trained as at least %.4g, the largest finite reading, not as 0 "
+                "(summary.json starved_readings)",
                 count, static_cast<double>(floor));
   console.line(line);
 }
@@ -230,8 +230,8 @@ void note_starved_readings(const Console& console, std::size_t count, float floo
 void note_non_finite(const Console& console, std::size_t non_finite) {
   if (non_finite == 0) return;
   console.line(std::to_string(non_finite) +
-               " measurements are NaN, infinite or corrupt (dead elements?): they count as 0 and "
-               "their elements' beta learns to switch them off");
+               " measurements are NaN, infinite or corrupt (dead elements?): the unread ones count "
+               "as 0 and their elements' beta learns to switch them off");
 }
 
 }  // namespace riner::app

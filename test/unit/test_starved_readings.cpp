@@ -78,6 +78,28 @@ TEST_SUITE("starved_readings") {
     CHECK(riner::model::is_starved(a(31, 6)));
   }
 
+  TEST_CASE("a module failing part-way, a blank frame: unread, not metal") {
+    // 48 views of 20 elements reading 1, a metal band (+inf, 4 wide, edges at 15-16) moving
+    // one element every 6 views. Elements 2-5 go dark together from view 20 on (a module);
+    // view 10 reads nothing at all (a blank frame).
+    riner::Array a({48, 20}, 1.0f);
+    for (std::size_t v = 0; v < 48; ++v) {
+      const std::size_t m = 8 + v / 6;
+      a(v, m - 1) = 15.0f;
+      for (std::size_t e = m; e < m + 4; ++e) a(v, e) = INFINITY;
+      a(v, m + 4) = 16.0f;
+      if (v >= 20) {
+        for (std::size_t e = 2; e < 6; ++e) a(v, e) = INFINITY;
+      }
+    }
+    for (std::size_t e = 0; e < 20; ++e) a(10, e) = INFINITY;
+    const riner::model::StarvedReadings s = riner::model::mark_starved_readings(a, 48);
+    CHECK(s.count == 47 * 4);  // the band in every view but the blank one
+    CHECK(riner::model::is_starved(a(40, 8 + 40 / 6)));
+    for (std::size_t e = 2; e < 6; ++e) CHECK(std::isnan(a(40, e)));
+    for (std::size_t e = 0; e < 20; ++e) CHECK(std::isnan(a(10, e)));
+  }
+
   TEST_CASE("an element that reads nothing in any view is dead, whatever its neighbours read") {
     riner::Array a = metal_scan();
     for (std::size_t v = 0; v < 6; ++v) a(v, 6) = INFINITY, a(v, 5) = 15.5f;

@@ -2,6 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include "model/response_changes.hpp"
@@ -19,11 +22,11 @@ float nearest_finite(const float* line, long from, long step, long n) {
   return NAN;
 }
 
-// Per reading: whether it lies in a run of at least `views_needed` consecutive views in which
-// its element reads +inf.
-std::vector<char> in_long_dark_run(const Array& m, std::size_t views, std::size_t views_needed) {
+// Each element's runs of at least `views_needed` consecutive views reading +inf, [first, end).
+using DarkRuns = std::vector<std::vector<std::pair<std::size_t, std::size_t>>>;
+DarkRuns long_dark_runs(const Array& m, std::size_t views, std::size_t views_needed) {
   const std::size_t per_view = m.size() / views;
-  std::vector<char> out(m.size(), 0);
+  DarkRuns out(per_view);
   for (std::size_t e = 0; e < per_view; ++e) {
     for (std::size_t v = 0; v < views;) {
       if (!is_starved(m.data[v * per_view + e])) {
@@ -32,13 +35,20 @@ std::vector<char> in_long_dark_run(const Array& m, std::size_t views, std::size_
       }
       std::size_t w = v;
       while (w < views && is_starved(m.data[w * per_view + e])) ++w;
-      if (w - v >= views_needed) {
-        for (std::size_t k = v; k < w; ++k) out[k * per_view + e] = 1;
-      }
+      if (w - v >= views_needed) out[e].emplace_back(v, w);
       v = w;
     }
   }
   return out;
+}
+
+// The long dark run of element e that holds view v; nullopt where none does.
+std::optional<std::pair<std::size_t, std::size_t>> dark_run_at(const DarkRuns& runs, std::size_t e,
+                                                               std::size_t v) {
+  for (const auto& r : runs[e]) {
+    if (r.first <= v && v < r.second) return r;
+  }
+  return std::nullopt;
 }
 
 }  // namespace
@@ -59,8 +69,7 @@ StarvedReadings mark_starved_readings(Array& measurement, std::size_t views) {
   for (std::size_t i = 0; i < measurement.size(); ++i) {
     if (std::isfinite(measurement.data[i])) reads[i % per_view] = 1;
   }
-  const std::vector<char> dying =
-      in_long_dark_run(measurement, views, response_change_min_views(views));
+  const DarkRuns dark = long_dark_runs(measurement, views, response_change_min_views(views));
   const float bar = static_cast<float>(kStarvedNeighbourShare) * largest;
   for (std::size_t l = 0; l < lines; ++l) {
     const std::size_t at = l * static_cast<std::size_t>(n);
@@ -72,12 +81,31 @@ StarvedReadings mark_starved_readings(Array& measurement, std::size_t views) {
       }
       long end = k;
       while (end < n && is_starved(line[end])) ++end;
+      const float left = nearest_finite(line, k - 1, -1, n),
+                  right = nearest_finite(line, end, 1, n);
+      // A line with no finite reading (a blank frame, a lost view) says nothing of the object.
+      const bool blank = std::isnan(left) && std::isnan(right);
       const bool wide = static_cast<std::size_t>(end - k) > kWidestDeadRun;
-      const bool dense_beside =
-          nearest_finite(line, k - 1, -1, n) >= bar || nearest_finite(line, end, 1, n) >= bar;
+      const bool dense_beside = left >= bar || right >= bar;
+      // Each element's long dark run here, if any: an element dying part-way (to the scan's end,
+      // or alive only from some view) is no metal, nor is a block of kWidestDeadRun + 1 or more
+      // in the run dying at one view (a module failing: an audit's 8 elements dark from view 100
+      // on were read as metal, bright bands and the error outside x7); metal's band moves with
+      // the views, its elements going dark at different ones.
+      const std::size_t view =
+          (at / static_cast<std::size_t>(n)) / (per_view / static_cast<std::size_t>(n));
+      std::vector<std::optional<std::pair<std::size_t, std::size_t>>> runs;
+      std::map<std::pair<std::size_t, std::size_t>, std::size_t> together;
+      for (long j = k; j < end; ++j) {
+        runs.push_back(dark_run_at(dark, (at + static_cast<std::size_t>(j)) % per_view, view));
+        if (runs.back()) ++together[*runs.back()];
+      }
       for (long j = k; j < end; ++j) {
         const std::size_t i = at + static_cast<std::size_t>(j);
-        const bool stopped = wide || (dense_beside && !dying[i]);
+        const auto& run = runs[static_cast<std::size_t>(j - k)];
+        const bool failing =
+            run && (run->first == 0 || run->second == views) && together[*run] > kWidestDeadRun;
+        const bool stopped = !blank && !failing && (wide || (dense_beside && !run));
         if (largest > 0.0f && stopped && reads[i % per_view]) {
           ++out.count;
         } else {
