@@ -538,6 +538,29 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   std::sort(filled_rows.begin(), filled_rows.end());
   filled_rows.erase(std::unique(filled_rows.begin(), filled_rows.end()), filled_rows.end());
   note_filled_rows(console, filled_rows);
+  // The field's unit (model/field_scale.hpp), as a single scan's run says it: the slabs'
+  // distinct factors (before, a slab run said nothing of it).
+  std::vector<double> field_per_mu;
+  for (const nlohmann::json& entry : run.manifest()["slabs"]) {
+    if (!entry.contains("summary") || !entry["summary"].is_object()) continue;
+    const double f = entry["summary"].value("field_per_mu", 1.0);
+    if (std::find(field_per_mu.begin(), field_per_mu.end(), f) == field_per_mu.end()) {
+      field_per_mu.push_back(f);
+    }
+  }
+  std::sort(field_per_mu.begin(), field_per_mu.end());
+  if (!field_per_mu.empty() && (field_per_mu.size() > 1 || field_per_mu[0] != 1.0)) {
+    std::string factors;
+    for (double f : field_per_mu) {
+      char one[32];
+      std::snprintf(one, sizeof(one), "%s%g", factors.empty() ? "" : ", ", f);
+      factors += one;
+    }
+    console.line(
+        "the readings' attenuation lies far from the usual 0.001-0.06 /mm: the slabs' "
+        "fields learn it times " +
+        factors + " (summary.json field_per_mu)");
+  }
   // Slabs with nothing to reconstruct (a dead detector row): written as NaN, said here.
   nlohmann::json without_readings = nlohmann::json::array();
   for (const Slab& s : run.slabs()) {
@@ -603,6 +626,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       {"slabs_without_readings", without_readings},
       {"non_finite_measurements", non_finite},
       {"starved_readings", starved},
+      {"field_per_mu", field_per_mu},
       {"inputs", inputs_json(args)},
       {"flat_field", flat ? flat_field_json(*flat) : nlohmann::json(nullptr)},
       {"centre",

@@ -268,6 +268,27 @@ TEST_SUITE("cli") {
     CHECK(summary["peak_host_bytes"].get<std::size_t>() == sum);
   }
 
+  TEST_CASE("by slabs, the field's unit is said as a single scan's run says it") {
+    // Voxels of 2^-10 mm (micrometres given as mm): the readings' attenuation per mm far from
+    // the usual, the slabs' fields learn mu times a power of two. A slab run said nothing.
+    riner::test::TempDir dir;
+    const std::string sim = riner::test::simulate_small_parallel3d(dir);
+    riner::test::write_bytes(dir / "um.json", R"({"type": "parallel3d",
+        "detector": {"count": [30, 20], "pitch_mm": [0.0009765625, 0.0009765625]},
+        "angles": {"count": 36, "range_rad": 3.141592653589793},
+        "volume": {"shape": [20, 24, 24], "voxel_mm": 0.0009765625}})");
+    const Run run =
+        riner_cli("reconstruct " + sim + "/sino.npy --geometry " + (dir / "um.json").string() +
+                      " --slab-slices 10 --steps 200 --out " + (dir / "out").string(),
+                  dir);
+    REQUIRE(run.code == 0);
+    CHECK(run.out.find("the slabs' fields learn it times") != std::string::npos);
+    const nlohmann::json summary =
+        nlohmann::json::parse(riner::test::read_bytes(dir / "out" / "summary.json"));
+    REQUIRE(summary["field_per_mu"].size() == 1);
+    CHECK(summary["field_per_mu"][0].get<double>() < 1.0);
+  }
+
   TEST_CASE("slab options name their mistakes") {
     riner::test::TempDir dir;
     riner::test::write_bytes(dir / "geometry.json", R"({"type": "parallel2d",
