@@ -14,15 +14,18 @@
 
 #define ALPHA_EPSILON 1e-8f
 
+// A reading of +inf: a bound (model/starved_readings.hpp).
+RINER_INLINE int is_bound(float rho) { return isinf(rho) && rho > 0.0f; }
+
 // The reading a ray is compared with: a bound's floor, 0 for another non-finite reading.
 RINER_INLINE float ray_target(float rho, float floor) {
-  return isinf(rho) && rho > 0.0f ? floor : (isfinite(rho) ? rho : 0.0f);
+  return is_bound(rho) ? floor : (isfinite(rho) ? rho : 0.0f);
 }
 
 // Returns the ray's loss; writes the gradients with respect to the ray sum, alpha0, beta0.
 RINER_INLINE float ray_loss(float ray_sum, float alpha0, float beta0, float rho, float weight,
                             float floor, float* d_sum, float* d_alpha0, float* d_beta0) {
-  const int bound = isinf(rho) && rho > 0.0f;
+  const int bound = is_bound(rho);
   rho = ray_target(rho, floor);
   const int clamped = !(alpha0 > ALPHA_EPSILON);
   const float alpha = clamped ? ALPHA_EPSILON : alpha0;
@@ -40,7 +43,7 @@ RINER_INLINE float ray_loss(float ray_sum, float alpha0, float beta0, float rho,
 // bound's floor only below it).
 RINER_INLINE float ray_mismatch(float ray_sum, float alpha0, float rho, float floor) {
   const float d = -log(fmax(alpha0, ALPHA_EPSILON)) + ray_sum - ray_target(rho, floor);
-  return isinf(rho) && rho > 0.0f ? fmax(-d, 0.0f) : fabs(d);
+  return is_bound(rho) ? fmax(-d, 0.0f) : fabs(d);
 }
 
 RINER_INLINE float beta_penalty(float beta0, float lambda, float* d_beta0) {

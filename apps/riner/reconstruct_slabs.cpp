@@ -488,10 +488,18 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   std::size_t non_finite = 0;
   std::size_t starved = 0;
   float starved_floor = 0.0f;  // the largest of the slabs' floors
+  // The field's unit (model/field_scale.hpp): the slabs' distinct factors.
+  std::vector<double> field_per_mu;
   std::optional<FlatFieldReport> flat;
   for (const nlohmann::json& entry : run.manifest()["slabs"]) {
     starved += entry.value("starved_readings", std::size_t{0});
     starved_floor = std::max(starved_floor, entry.value("starved_floor", 0.0f));
+    if (entry.contains("summary") && entry["summary"].is_object()) {
+      const double f = entry["summary"].value("field_per_mu", 1.0);
+      if (std::find(field_per_mu.begin(), field_per_mu.end(), f) == field_per_mu.end()) {
+        field_per_mu.push_back(f);
+      }
+    }
     const nlohmann::json readings = entry.value("readings", nlohmann::json());
     if (!readings.is_object()) continue;
     non_finite += readings.value("non_finite", std::size_t{0});
@@ -538,16 +546,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   std::sort(filled_rows.begin(), filled_rows.end());
   filled_rows.erase(std::unique(filled_rows.begin(), filled_rows.end()), filled_rows.end());
   note_filled_rows(console, filled_rows);
-  // The field's unit (model/field_scale.hpp), as a single scan's run says it: the slabs'
-  // distinct factors (before, a slab run said nothing of it).
-  std::vector<double> field_per_mu;
-  for (const nlohmann::json& entry : run.manifest()["slabs"]) {
-    if (!entry.contains("summary") || !entry["summary"].is_object()) continue;
-    const double f = entry["summary"].value("field_per_mu", 1.0);
-    if (std::find(field_per_mu.begin(), field_per_mu.end(), f) == field_per_mu.end()) {
-      field_per_mu.push_back(f);
-    }
-  }
+  // The field's unit, as a single scan's run says it (before, a slab run said nothing of it).
   std::sort(field_per_mu.begin(), field_per_mu.end());
   if (!field_per_mu.empty() && (field_per_mu.size() > 1 || field_per_mu[0] != 1.0)) {
     std::string factors;

@@ -130,8 +130,8 @@ struct TrainingStats {
   double seconds = 0.0;             // wall time inside step()/run()
   double samples = 0.0;             // field evaluations trained on (forward + backward)
   std::size_t non_finite = 0;       // measurements that were NaN/inf (treated as 0)
-  // Of those, the +inf readings beside rays near the largest reading, trained as at least
-  // starved_floor (a beam the object stopped: model/starved_readings.hpp in the library).
+  // Of those, the +inf readings taken for a beam the object stopped, trained as at least
+  // starved_floor (the rule: model/starved_readings.hpp in the library).
   std::size_t starved_readings = 0;
   float starved_floor = 0.0f;
   // 3D: detector rows that read nothing in any view, trained on the line between the rows

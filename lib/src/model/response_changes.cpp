@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "model/starved_readings.hpp"
 #include "riner/error.hpp"
 #include "util/parallel.hpp"
 #include "util/robust_statistics.hpp"
@@ -86,23 +87,21 @@ std::vector<double> minus_neighbours(const std::vector<double>& a, std::size_t r
   return out;
 }
 
-bool unread(double x) { return !std::isfinite(x) && !(x > 0.0); }
-
 // Runs of at least min_views unread readings of element e, as segment starts (a bound, +inf,
 // is a beam the object stopped, no element dying: model/starved_readings.hpp).
 std::vector<std::size_t> dead_runs(const std::vector<double>& rho, std::size_t views,
                                    std::size_t elements, std::size_t e, std::size_t min_views) {
   std::vector<std::size_t> starts;
   std::size_t invalid = 0;
-  for (std::size_t v = 0; v < views; ++v) invalid += unread(rho[v * elements + e]);
+  for (std::size_t v = 0; v < views; ++v) invalid += is_unread(rho[v * elements + e]);
   if (invalid == 0 || invalid + min_views > views) return starts;
   for (std::size_t v = 0; v < views;) {
-    if (!unread(rho[v * elements + e])) {
+    if (!is_unread(rho[v * elements + e])) {
       ++v;
       continue;
     }
     std::size_t w = v;
-    while (w < views && unread(rho[w * elements + e])) ++w;
+    while (w < views && is_unread(rho[w * elements + e])) ++w;
     if (w - v >= min_views) {
       if (v > 0) starts.push_back(v);
       if (w < views) starts.push_back(w);

@@ -16,6 +16,7 @@
 // element that reads nothing in any view is dead whatever its neighbours read.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <limits>
 
@@ -37,5 +38,7 @@ StarvedReadings mark_starved_readings(Array& measurement, std::size_t views);
 
 // A kept bound: +inf after mark_starved_readings.
 inline bool is_starved(float reading) { return reading == std::numeric_limits<float>::infinity(); }
+// An unread reading (NaN, -inf): not finite, and no bound.
+inline bool is_unread(double reading) { return !std::isfinite(reading) && !(reading > 0.0); }
 
 }  // namespace riner::model

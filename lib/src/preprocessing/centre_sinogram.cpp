@@ -365,6 +365,16 @@ std::optional<double> row_axis(const std::vector<std::vector<Row>>& turns) {
   return coarse_axis;
 }
 
+// Each column's mean over a half-turn's views.
+Row column_means(const std::vector<Row>& s) {
+  Row mean(s[0].size(), 0.0);
+  for (const Row& r : s) {
+    for (std::size_t u = 0; u < r.size(); ++u) mean[u] += r[u];
+  }
+  for (double& m : mean) m /= static_cast<double>(s.size());
+  return mean;
+}
+
 // Each column less its mean over the half-turn. A stripe (an element's offset, constant over the
 // views) is then gone from both the half-turn and its mirror image; left in, its mirror image
 // breaks the stacked turn at every seam as a wrong axis does, and on an object narrow against
@@ -374,12 +384,9 @@ std::optional<double> row_axis(const std::vector<std::vector<Row>>& turns) {
 // tenths of a pixel (0.22 px on that object's clean scan), so only where the stripes dominate.
 std::vector<std::vector<Row>> without_column_means(std::vector<std::vector<Row>> turns) {
   for (std::vector<Row>& s : turns) {
-    Row mean(s[0].size(), 0.0);
-    for (const Row& r : s) {
-      for (std::size_t u = 0; u < r.size(); ++u) mean[u] += r[u];
-    }
+    const Row mean = column_means(s);
     for (Row& r : s) {
-      for (std::size_t u = 0; u < r.size(); ++u) r[u] -= mean[u] / static_cast<double>(s.size());
+      for (std::size_t u = 0; u < r.size(); ++u) r[u] -= mean[u];
     }
   }
   return turns;
@@ -392,10 +399,7 @@ bool stripes_dominate(const std::vector<std::vector<Row>>& turns) {
   double stripes = 0.0, object = 0.0;
   for (const std::vector<Row>& s : turns) {
     const std::size_t n = s[0].size();
-    Row mean(n, 0.0);
-    for (const Row& r : s) {
-      for (std::size_t u = 0; u < n; ++u) mean[u] += r[u] / static_cast<double>(s.size());
-    }
+    const Row mean = column_means(s);
     for (const Row& r : s) {
       for (std::size_t u = 0; u < n; ++u) {
         object += (r[u] - mean[u]) * (r[u] - mean[u]) / static_cast<double>(s.size());

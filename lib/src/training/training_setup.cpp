@@ -197,8 +197,7 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
   }
   const std::vector<float>& rho = scan.measurement.data;
   for (std::size_t ray = 0; ray < rho.size(); ++ray) {
-    if ((!std::isfinite(rho[ray]) && !model::is_starved(rho[ray])) ||
-        filled[ray % elements_per_view]) {
+    if (model::is_unread(rho[ray]) || filled[ray % elements_per_view]) {
       ++invalid_readings[responses.slot(ray % elements_per_view, ray / elements_per_view)];
     }
   }
