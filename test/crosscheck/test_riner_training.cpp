@@ -18,6 +18,7 @@
 #include "support/partial_scan.hpp"
 #include "support/tiny_problem.hpp"
 #include "support/tolerances.hpp"
+#include "training/trainer.hpp"
 
 namespace {
 
@@ -72,8 +73,13 @@ TEST_SUITE("riner_training") {
   }
 
   TEST_CASE("the beta warm-up holds every element without invalid readings, on both engines") {
-    // One dead element (+inf readings): its beta learns from step 0; every other stays put.
-    const riner::test::TinyProblem t = riner::test::tiny_problem(5);
+    // One dead element (+inf readings but one 0, as the paper's dead elements read: an element
+    // reading nothing at all starts switched off): its beta learns from step 0; every other
+    // stays put.
+    riner::test::TinyProblem t = riner::test::tiny_problem(5);
+    for (std::size_t e = 0; e < t.alpha.size(); ++e) {
+      if (t.alpha.data[e] == 0.0f) t.scan.measurement.data[e] = 0.0f;  // view 0
+    }
     riner::RinerConfig c = riner::test::tiny_config();
     c.training.beta_warmup_steps = 1000;
     auto [device, reference] = both_engines(t.scan, c);
@@ -429,6 +435,7 @@ TEST_SUITE("riner_training") {
   }
 
   TEST_CASE("zero steps leave the initial field; alpha and beta start at 1 and sigmoid(1)") {
+    // But the dead element, which reads nothing: its beta starts near 0.
     const riner::test::TinyProblem t = riner::test::tiny_problem(7);
     riner::RinerConfig c = riner::test::tiny_config();
     c.training.steps = 0;
@@ -437,7 +444,11 @@ TEST_SUITE("riner_training") {
     CHECK(r.steps_done() == 0);
     // trained_alpha(): alpha() also carries the ring corrections of the initial field's noise.
     for (float a : r.trained_alpha().data) CHECK(a == 1.0f);
-    for (float b : r.trained_beta().data) CHECK(b == doctest::Approx(1.0 / (1.0 + std::exp(-1.0))));
+    const riner::Array beta = r.trained_beta();
+    for (std::size_t e = 0; e < beta.size(); ++e) {
+      const double beta0 = t.alpha.data[e] == 0.0f ? riner::TrainingConfig{}.unread_beta0 : 1.0;
+      CHECK(beta.data[e] == doctest::Approx(1.0 / (1.0 + std::exp(-beta0))));
+    }
     CHECK(r.history().empty());
   }
 

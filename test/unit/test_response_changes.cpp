@@ -164,4 +164,29 @@ TEST_SUITE("response changes") {
     CHECK(off.layout.elements == 128);
     CHECK_FALSE(off.responses.varies());
   }
+
+  TEST_CASE("the slots that read nothing start with beta near 0: dead, and a dying one's end") {
+    // Two dead elements (+inf in every view) and one dying part-way: its segment after it died
+    // reads nothing either. At the paper's beta0 = 1 their readings, counted as 0, pulled the
+    // field down along their rays; every other slot starts there.
+    const PartialScan s = partial_scan(0, 1, 6);
+    riner::RinerConfig c;
+    c.engine = riner::Engine::kReference;
+    c.training.skip_air = false;
+    const riner::detail::TrainingSetup setup(s.scan, c);
+    REQUIRE(setup.responses.slots() == 128 + 1);
+    std::vector<std::size_t> dead;
+    for (std::size_t e = 0; e < 128; ++e) {
+      if (s.alpha(0, e) == 0.0f) dead.push_back(e);
+    }
+    REQUIRE(dead.size() == 2);
+    dead.push_back(128);  // the dying element's last segment
+    CHECK(setup.unread_slots == dead);
+    const std::vector<float> p = setup.initial_parameters();
+    for (std::size_t slot = 0; slot < setup.responses.slots(); ++slot) {
+      const bool unread = std::find(dead.begin(), dead.end(), slot) != dead.end();
+      CHECK(p[setup.layout.beta_offset + slot] ==
+            (unread ? riner::TrainingConfig{}.unread_beta0 : 1.0f));
+    }
+  }
 }

@@ -100,6 +100,26 @@ TEST_SUITE("starved_readings") {
     for (std::size_t e = 0; e < 20; ++e) CHECK(std::isnan(a(10, e)));
   }
 
+  TEST_CASE("an element dark since before the module failed is of the module: unread") {
+    // The module above, and element 6 beside it dark from view 14 on, before the module (as the
+    // metal's trace darkens an element just before a module fails): its run of its own was kept
+    // as bounds, wide with the module's elements, and the field took them as streaks.
+    riner::Array a({48, 20}, 1.0f);
+    for (std::size_t v = 0; v < 48; ++v) {
+      const std::size_t m = 8 + v / 6;
+      a(v, m - 1) = 15.0f;
+      for (std::size_t e = m; e < m + 4; ++e) a(v, e) = INFINITY;
+      a(v, m + 4) = 16.0f;
+      if (v >= 20) {
+        for (std::size_t e = 2; e < 6; ++e) a(v, e) = INFINITY;
+      }
+      if (v >= 14) a(v, 6) = INFINITY;
+    }
+    const riner::model::StarvedReadings s = riner::model::mark_starved_readings(a, 48);
+    CHECK(s.count == 48 * 4);
+    for (std::size_t v = 14; v < 48; ++v) CHECK(std::isnan(a(v, 6)));
+  }
+
   TEST_CASE("an element that reads nothing in any view is dead, whatever its neighbours read") {
     riner::Array a = metal_scan();
     for (std::size_t v = 0; v < 6; ++v) a(v, 6) = INFINITY, a(v, 5) = 15.5f;
@@ -107,6 +127,22 @@ TEST_SUITE("starved_readings") {
     CHECK(s.count == 0);
     CHECK(s.floor == 0.0f);  // no bound kept
     for (std::size_t v = 0; v < 6; ++v) CHECK(std::isnan(a(v, 6)));
+  }
+
+  TEST_CASE("a block dark in every view whose edges come and go is behind metal on the axis") {
+    // 24 views of 20 elements reading 1: elements 8-11 dark in every view, and the metal's
+    // edge darkens element 7 or 12 as well in 14 views of 24. The same block with its
+    // neighbours always lit is a dead module.
+    riner::Array a({24, 20}, 1.0f), module({24, 20}, 1.0f);
+    for (std::size_t v = 0; v < 24; ++v) {
+      for (std::size_t e = 8; e < 12; ++e) a(v, e) = module(v, e) = INFINITY;
+      if (v % 12 < 7) a(v, v % 2 ? 7 : 12) = INFINITY;
+    }
+    const riner::model::StarvedReadings s = riner::model::mark_starved_readings(a, 24);
+    CHECK(s.count == 24 * 4 + 14);
+    for (std::size_t v = 0; v < 24; ++v) CHECK(riner::model::is_starved(a(v, 9)));
+    CHECK(riner::model::mark_starved_readings(module, 24).count == 0);
+    CHECK(std::isnan(module(5, 9)));
   }
 
   TEST_CASE("corrupt spikes do not set the floor; a scan of nothing finite keeps no bound") {

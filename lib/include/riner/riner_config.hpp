@@ -180,6 +180,12 @@ struct TrainingConfig {
   // pattern's energy (model/factor_evidence.hpp).
   double alpha_factor_evidence = 0.9;
   double beta_lr_scale = 3.0;
+  // beta0 of a response slot that reads nothing (no finite reading, no bound: a dead element, a
+  // stuck one, a changing element's views after it died); the paper starts every element at 1.
+  // There its readings, counted as 0, pull the field down along its rays until beta falls: where
+  // such a ray crosses metal, held only from below by its bounds, the field took that as
+  // streaks (three dead elements across a metal disc's trace: the error outside it x5).
+  double unread_beta0 = -12.0;
   // -1: the scan's: kWideAlphaWarmup steps on a slice whose detector row has at least
   // kWideDetectorElements elements (not after a warm start), 0 otherwise. Before the field has
   // drawn the object, every element whose rays cross it reads more than the field gives, and

@@ -13,7 +13,9 @@
 // rays at 0.36 of it). But kWidestDeadRun + 1 or more elements of a run dark together from
 // one view to the scan's end (or from its start to one view), for that many views, are a
 // module failing, and a run filling a whole line (a blank frame) says nothing: both unread. An
-// element that reads nothing in any view is dead whatever its neighbours read.
+// element that reads nothing in any view is dead whatever its neighbours read, unless it is one
+// of a block of more than kWidestDeadRun whose live neighbours read +inf too in at least half the
+// views: that block lies behind the object (metal on the rotation axis), its readings bounds.
 #pragma once
 
 #include <cmath>

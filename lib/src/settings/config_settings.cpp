@@ -169,6 +169,10 @@ void add_training_schedule(Table& t) {
                        &C::training, &T::alpha_factor_evidence));
   t.push_back(field<C>("training", "beta_lr_scale", closed_open(0, 1000),
                        "beta's learning rate over the field's", &C::training, &T::beta_lr_scale));
+  t.push_back(field<C>("training", "unread_beta0", closed(-30, 30),
+                       "beta0 of an element that reads nothing (a dead one): it starts "
+                       "switched off (the paper: 1, as every element)",
+                       &C::training, &T::unread_beta0));
   t.push_back(field<C>("training", "alpha_warmup_steps", closed(-1, kMaxSteps),
                        "alpha stays at its initial value for these steps; -1: 300 on a slice "
                        "whose detector row has at least 1000 elements, else 0",

@@ -202,6 +202,7 @@ RinerConfig RinerConfig::paper() {
   c.training.alpha_stripe_scale = 0.0;  // the paper's alpha learns at the field's rate
   c.training.alpha_warmup_steps = 0;    // and from the first step
   c.training.beta_lr_scale = 1.0;
+  c.training.unread_beta0 = 1.0;  // every element starts at beta0 = 1
   c.training.level_warmup_steps = 0;
   c.training.tail_average_steps = 0;  // the paper's result is the last step's
   c.training.stuck_elements = false;

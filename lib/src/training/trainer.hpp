@@ -42,6 +42,9 @@ struct TrainingSetup {
   std::size_t elements_per_view = 0;
   std::uint32_t seed = 0;
   std::vector<std::uint32_t> invalid_readings;  // per response slot: its unread measurements
+  // The response slots that read nothing (no finite reading, no bound: a dead element, a stuck
+  // one, a changing element's views after it died): they start at training.unread_beta0.
+  std::vector<std::size_t> unread_slots;
   // Which alpha0/beta0 each reading uses: one per element, or per segment of views for the
   // elements whose response changes part-way (training.partial_responses).
   model::ResponseMap responses;

@@ -195,17 +195,25 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
     std::fill(filled.begin() + static_cast<std::ptrdiff_t>(r * g.n_u),
               filled.begin() + static_cast<std::ptrdiff_t>((r + 1) * g.n_u), true);
   }
+  std::vector<std::uint8_t> read(responses.slots(), 0);
   const std::vector<float>& rho = scan.measurement.data;
   for (std::size_t ray = 0; ray < rho.size(); ++ray) {
-    if (model::is_unread(rho[ray]) || filled[ray % elements_per_view]) {
-      ++invalid_readings[responses.slot(ray % elements_per_view, ray / elements_per_view)];
-    }
+    const std::size_t slot = responses.slot(ray % elements_per_view, ray / elements_per_view);
+    if (model::is_unread(rho[ray]) || filled[ray % elements_per_view]) ++invalid_readings[slot];
+    if (!model::is_unread(rho[ray])) read[slot] = 1;
+  }
+  for (std::size_t slot = 0; slot < read.size(); ++slot) {
+    if (!read[slot]) unread_slots.push_back(slot);
   }
 }
 
 std::vector<float> TrainingSetup::initial_parameters() const {
   if (!initial.empty()) return initial;
-  return model::initial_parameters(layout, config.training.seed);
+  std::vector<float> p = model::initial_parameters(layout, config.training.seed);
+  for (const std::size_t slot : unread_slots) {
+    p[layout.beta_offset + slot] = static_cast<float>(config.training.unread_beta0);
+  }
+  return p;
 }
 
 double TrainingSetup::learning_rate(int step) const {
