@@ -3,8 +3,11 @@
 #include <cmath>
 #include <cstdio>
 
+#include <filesystem>
+
 #include "riner/error.hpp"
 #include "riner/io.hpp"
+#include "riner/scan.hpp"
 #include "riner/tomo_file.hpp"
 #include "summary_json.hpp"
 
@@ -79,8 +82,18 @@ nlohmann::json inputs_json(const Args& args) {
   const auto named = [](const std::string& name) {
     return name.empty() ? nlohmann::json(nullptr) : nlohmann::json(name);
   };
+  // The geometry as read: beside the scan when not given (a scan JSON is its own).
+  std::string geometry = s.geometry;
+  if (geometry.empty()) {
+    try {
+      geometry = std::filesystem::path(s.path).extension() == ".json"
+                     ? s.path
+                     : find_geometry(s.path).string();
+    } catch (const InputError&) {
+    }
+  }
   return {{"scan", s.path},
-          {"geometry", named(s.geometry)},
+          {"geometry", named(geometry)},
           {"flat", named(s.flat)},
           {"dark", named(s.dark)},
           {"flat_after", named(s.flat_after)},

@@ -85,6 +85,8 @@ nlohmann::json quality_summary(const QualityCheck& check) {
                         {"lost_object",
                          {{"share", q.lost.share},
                           {"pixels", q.lost.pixels},
+                          {"arc_share", q.lost.arc_share},
+                          {"arc_pixels", q.lost.arc_pixels},
                           {"fbp_noise_per_mm", q.lost.fbp_noise}}},
                         {"slices_measured", check.slices},
                         {"volume_slices", check.volume_slices},

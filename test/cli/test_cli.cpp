@@ -917,6 +917,13 @@ TEST_SUITE("cli") {
                                raw + "/x.nii",
                            dir),
                  2, raw + "/nothing_*.tif: no file matches the pattern");
+    // A pattern matching the other series' files: an audit's 'flat_*.tif' took the flats
+    // after the scan ('flat_end_*.tif') for flats before it, the drift halved without a word.
+    std::filesystem::copy_file(dir / "raw" / "flat_0.tif", dir / "raw" / "flat_end_0.tif");
+    expect_error(riner_cli("fbp " + raw + "/projections --flat '" + raw + "/flat_*.tif' " +
+                               "--flat-after " + raw + "/flat_end_0.tif --out " + raw + "/x.nii",
+                           dir),
+                 2, raw + "/flat_end_0.tif is read as the flat field and as the flat field after");
   }
 
   TEST_CASE("center finds a forgotten offset; --offset-px auto uses it") {
@@ -1108,10 +1115,17 @@ TEST_SUITE("cli") {
     const Run compare = riner_cli("compare " + out + "/raw.nii " + out + "/shared.nii --json", dir);
     REQUIRE(compare.code == 0);
     CHECK(nlohmann::json::parse(compare.out)["mae"].get<double>() < 1e-6);
-    expect_error(riner_cli("fbp " + tooth.string() + " --out " + out + "/x.nii", dir), 2,
-                 tooth.string() +
-                     " is a stack [181, 2, 640] and the parallel2d geometry is 2D: "
-                     "pick a detector row with --row");
+    // The whole stack under its 2D geometry: one slice per row, as reconstruct takes it (it
+    // was refused: "pick a detector row with --row"); its row 0 is the row's own FBP.
+    REQUIRE(riner_cli("fbp " + tooth.string() + " --out " + out + "/rows.nii --quiet", dir).code ==
+            0);
+    const riner::Array rows = riner::read_array(out + "/rows.nii").array;
+    const riner::Array row0 = riner::read_array(out + "/raw.nii").array;
+    REQUIRE(rows.shape == std::vector<std::size_t>{2, row0.shape[0], row0.shape[1]});
+    double worst = 0.0;
+    for (std::size_t i = 0; i < row0.size(); ++i)
+      worst = std::max(worst, static_cast<double>(std::fabs(rows.data[i] - row0.data[i])));
+    CHECK(worst < 1e-5);
     expect_error(riner_cli("fbp " + tooth.string() + " --row 2 --out " + out + "/x.nii", dir), 2,
                  tooth.string() + ": no detector row 2: the stack [181, 2, 640] has rows 0..1");
     // A row under a 3D geometry, and a row of a single sinogram: said what --row is for (they

@@ -4,14 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "riner/error.hpp"
-#include "riner/fbp.hpp"
-#include "riner/io.hpp"
-#include "riner/metrics.hpp"
-#include "riner/phantom.hpp"
-#include "riner/reconstructor.hpp"
-#include "riner/simulate.hpp"
-#include "riner/version.hpp"
+#include "riner/riner.hpp"  // the whole library; the single headers work too
 
 int main(int argc, char** argv) {
   if (argc < 2) return 2;

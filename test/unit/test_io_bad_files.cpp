@@ -199,7 +199,8 @@ TEST_SUITE("io_bad_files") {
     expect_sidecar(R"({"dtype": "float32", "shape": [2, 3], "endian": "big"})",
                    sidecar +
                        ": unknown key \"endian\" (a sidecar takes dtype, shape, byte_order, "
-                       "order, offset_bytes, trailing_bytes)");
+                       "order, offset_bytes, trailing_bytes, voxel_size_mm; comments as "
+                       "comment, description, notes or a key starting with _)");
     riner::test::write_bytes(dir / "a.raw.json",
                              R"({"dtype": "float32", "shape": [2, 2], "trailing_bytes": 8,
                                  "comment": "a footer of 8 bytes"})");

@@ -101,6 +101,29 @@ TEST_SUITE("quality: lost object") {
     CHECK(riner::lost_object(image, fbp).pixels > 10);
   }
 
+  TEST_CASE("a thin arc about the axis the FBP shows and the image has not: counted apart") {
+    // A ring of one element in the FBP (1 px wide at 80 px from the axis, over a third of the
+    // turn), in the air beside the sample: the built-in demo's rings were called lost object.
+    const std::size_t n = 200;
+    riner::Array fbp = square_sample(n, 2e-3, 1e-3, 5, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t k = 0; k < n; ++k) {
+        const double y = i - 0.5 * (n - 1.0), x = k - 0.5 * (n - 1.0);
+        const double angle = std::atan2(y, x);
+        if (std::fabs(std::hypot(x, y) - 80.0) < 0.5 && angle > 0.0 && angle < 2.1)
+          fbp(i, k) += 1e-2f;
+      }
+    }
+    const riner::LostObject arcs = riner::lost_object(square_sample(n, 2e-3, 0.0, 6, 0), fbp);
+    CHECK(arcs.pixels == 0);
+    CHECK(arcs.arc_pixels > 100);
+    CHECK(arcs.arc_share > 0.0);
+    // A corner cut off the sample is no arc (it is compact, not thin along a circle).
+    const riner::LostObject cut = riner::lost_object(square_sample(n, 2e-3, 0.0, 6, 20), fbp);
+    CHECK(cut.pixels > 120);
+    CHECK(cut.arc_pixels > 100);
+  }
+
   TEST_CASE("the FBP's bright rim at the field's edge is not object") {
     const std::size_t n = 200;
     riner::Array fbp = square_sample(n, 2e-3, 1e-3, 5, 0);

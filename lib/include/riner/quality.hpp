@@ -26,8 +26,10 @@
 //                a tenth of its 99.5th percentile); object is over 5 of those sigmas, and air
 //                in the image is less than a quarter of what the FBP shows there; only inside
 //                the field every view sees, when it is given (FBP's bright rim at its edge is
-//                not object). A ring in the FBP that the image has not counts as lost: read
-//                the pixels with the PNG pair
+//                not object). A lost region that is a thin arc about the axis (5.5 px wide at
+//                most at half its peak, 4 times as long) is counted apart, as arcs: a ring of the
+//                FBP the image has not, or a thin concentric structure taken for one; read them
+//                with the PNG pair
 #pragma once
 
 #include <limits>
@@ -74,6 +76,10 @@ struct LostObject {
   std::size_t pixels = 0;  // where the FBP sees object and the image air
   double share = 0.0;      // of the disc's pixels
   double fbp_noise = 0.0;  // the blurred FBP's noise sigma in the image's air (1/mm)
+  // Of those, the ones in thin arcs about the axis (not in `pixels`): the FBP's rings the image
+  // has not, or a thin concentric structure (a tube's wall) taken for a ring.
+  std::size_t arc_pixels = 0;
+  double arc_share = 0.0;
 };
 
 constexpr double kWholeDisc = std::numeric_limits<double>::infinity();

@@ -162,9 +162,18 @@ DeviceEntry select_device(std::string_view selector) {
   for (const DeviceEntry& entry : entries) {
     if (lower(entry.info.type) == needle) return entry;
   }
-  throw Error(origin + "=" + chosen +
-              ": no device name contains it, nor is it a device kind (cpu, gpu; see `riner "
-              "devices`)");
+  // A kind this machine has none of (a GPU where there is only PoCL) is said as such.
+  std::string kinds;
+  for (const DeviceEntry& entry : entries) {
+    if (kinds.find(lower(entry.info.type)) == std::string::npos)
+      kinds += (kinds.empty() ? "" : ", ") + lower(entry.info.type);
+  }
+  if (needle == "cpu" || needle == "gpu" || needle == "accelerator") {
+    throw Error(origin + "=" + chosen + ": this machine has no " + needle +
+                " device (its kinds: " + kinds + "; see `riner devices`)");
+  }
+  throw Error(origin + "=" + chosen + ": no device name contains it and it is no device kind " +
+              "(this machine's: " + kinds + "; see `riner devices`)");
 }
 
 }  // namespace riner::cl

@@ -55,7 +55,8 @@ RawLayout read_sidecar(const std::filesystem::path& path) {
     if (!known_sidecar_key(key)) {
       throw bad("unknown key \"" + key +
                 "\" (a sidecar takes dtype, shape, byte_order, order, offset_bytes, "
-                "trailing_bytes)");
+                "trailing_bytes, voxel_size_mm; comments as comment, description, notes or a "
+                "key starting with _)");
     }
   }
   if (!meta.contains("dtype") || !meta["dtype"].is_string()) throw bad("needs \"dtype\" (string)");

@@ -38,6 +38,10 @@ constexpr std::size_t kLostMinAirPixels = 100;
 // window of 31: 159 and 68 pixels, up to 10 sigmas).
 constexpr std::size_t kLostWideRegionPixels = 20;
 constexpr double kLostHighSigmas = 10.0;
+// mark_arcs: a ring of one element blurred by kLostBlurPx is 4.7 px wide at half its height.
+constexpr double kLostArcWidthPx = 5.5;
+constexpr double kLostArcLengthToWidth = 4.0;
+constexpr double kLostArcLeastRadiusPx = 8.0;
 
 // "at least 16 x 16"
 std::string smallest_sides() {
@@ -178,8 +182,72 @@ void keep_clear_regions(std::vector<double>& lost, std::size_t rows, std::size_t
   }
 }
 
+// Sets each lost region (1 in `lost`, 8-connected) that is a thin arc about the grid centre to
+// 2: where the FBP shows at least half the region's peak (`strength`), no wider radially than
+// kLostArcWidthPx and kLostArcLengthToWidth times as long along the circle, kLostArcLeastRadiusPx
+// or more from the centre. Such an arc is a ring of the FBP the image has not (the built-in
+// demo's: four arcs 2.3-3.3 px wide, 55-123 degrees long, 0.64% of the field), or a thin
+// concentric structure taken for one: said apart from the lost object. At half its peak a ring
+// of one element blurred by kLostBlurPx is 4.7 px wide whatever its height; the region's
+// own extent grows with it.
+void mark_arcs(std::vector<double>& lost, const Array& image,
+               const std::function<double(std::size_t)>& strength) {
+  const std::size_t rows = image.shape[0], columns = image.shape[1];
+  std::vector<std::uint8_t> seen(lost.size(), 0);
+  std::vector<std::size_t> region, pending;
+  std::vector<double> angles;
+  for (std::size_t start = 0; start < lost.size(); ++start) {
+    if (lost[start] != 1.0 || seen[start]) continue;
+    region.clear();
+    pending.assign(1, start);
+    seen[start] = 1;
+    double peak = 0.0;
+    while (!pending.empty()) {
+      const std::size_t p = pending.back();
+      pending.pop_back();
+      region.push_back(p);
+      peak = std::max(peak, strength(p));
+      const long i = static_cast<long>(p / columns), k = static_cast<long>(p % columns);
+      for (long di = -1; di <= 1; ++di) {
+        for (long dk = -1; dk <= 1; ++dk) {
+          const long ni = i + di, nk = k + dk;
+          if (ni < 0 || nk < 0 || ni >= static_cast<long>(rows) || nk >= static_cast<long>(columns))
+            continue;
+          const std::size_t q =
+              static_cast<std::size_t>(ni) * columns + static_cast<std::size_t>(nk);
+          if (lost[q] == 1.0 && !seen[q]) {
+            seen[q] = 1;
+            pending.push_back(q);
+          }
+        }
+      }
+    }
+    double r_low = std::numeric_limits<double>::infinity(), r_high = 0.0;
+    angles.clear();
+    for (const std::size_t p : region) {
+      if (strength(p) < 0.5 * peak) continue;
+      const std::size_t i = p / columns, k = p % columns;
+      const double r = radius_of(image, i, k);
+      r_low = std::min(r_low, r);
+      r_high = std::max(r_high, r);
+      angles.push_back(std::atan2(static_cast<double>(i) - 0.5 * (rows - 1.0),
+                                  static_cast<double>(k) - 0.5 * (columns - 1.0)));
+    }
+    // The arc's angular span: the full turn less the widest gap between its pixels' angles.
+    std::sort(angles.begin(), angles.end());
+    double gap = 2.0 * M_PI - (angles.back() - angles.front());
+    for (std::size_t a = 1; a < angles.size(); ++a) gap = std::max(gap, angles[a] - angles[a - 1]);
+    const double width = r_high - r_low, length = (2.0 * M_PI - gap) * 0.5 * (r_low + r_high);
+    if (r_low >= kLostArcLeastRadiusPx && width <= kLostArcWidthPx &&
+        length >= kLostArcLengthToWidth * std::max(width, 1.0)) {
+      for (const std::size_t p : region) lost[p] = 2.0;
+    }
+  }
+}
+
 // Where the FBP sees object and the image air, per pixel of one 2D image (-1 outside the disc,
-// 1 lost, 0 not); the noise it measured into `noise`.
+// 1 lost, 2 lost in a thin arc about the centre (mark_arcs), 0 not); the noise it measured into
+// `noise`.
 std::vector<double> lost_pixels(const Array& image, const Array& fbp, double field_radius_px,
                                 double* noise) {
   const Array shown = Array(image.shape, util::gaussian_blur(image.data, image.shape, kLostBlurPx));
@@ -220,6 +288,7 @@ std::vector<double> lost_pixels(const Array& image, const Array& fbp, double fie
   keep_clear_regions(out, image.shape[0], image.shape[1], [&](std::size_t p) {
     return (seen.data[p] - level_seen) / std::max(sigma, 1e-30);
   });
+  mark_arcs(out, image, [&](std::size_t p) { return seen.data[p] - level_seen; });
   return out;
 }
 
@@ -237,7 +306,8 @@ LostObject lost_object(const Array& image, const Array& fbp, double field_radius
     for (double v : lost_pixels(a, f, field_radius_px, &noise)) {
       if (v < 0.0) continue;
       ++disc;
-      lost.pixels += v > 0.0;
+      lost.pixels += v == 1.0;
+      lost.arc_pixels += v == 2.0;
     }
     noise_sum += noise;
     ++images;
@@ -249,6 +319,8 @@ LostObject lost_object(const Array& image, const Array& fbp, double field_radius
       per_image(axial_slice(image, z), axial_slice(fbp, z));
   }
   lost.share = disc > 0 ? static_cast<double>(lost.pixels) / static_cast<double>(disc) : 0.0;
+  lost.arc_share =
+      disc > 0 ? static_cast<double>(lost.arc_pixels) / static_cast<double>(disc) : 0.0;
   lost.fbp_noise = images > 0 ? noise_sum / static_cast<double>(images) : 0.0;
   return lost;
 }

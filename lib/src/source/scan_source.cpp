@@ -4,6 +4,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <map>
 
 #include "io/stack.hpp"
 #include "riner/error.hpp"
@@ -60,6 +62,47 @@ Array frames_rows(const std::filesystem::path& path, RowRange rows) {
   return cut;
 }
 
+// What `name` reads, one key per file (an HDF5 dataset with its file: a file's flats beside its
+// projections are no overlap).
+std::vector<std::string> files_read(const std::string& name) {
+  const auto key = [](const std::filesystem::path& file) {
+    std::error_code ignored;
+    const std::filesystem::path canonical = std::filesystem::weakly_canonical(file, ignored);
+    return (canonical.empty() ? file : canonical).string();
+  };
+  if (name.empty()) return {};
+  if (const auto h5 = split_hdf5_dataset(name)) return {key(h5->first) + ":" + h5->second};
+  if (is_tomo_file(name)) return {};  // a tomography file: its own flats, darks or projections
+  if (!io::is_stack_path(name)) return {key(name)};
+  std::vector<std::string> out;
+  try {
+    for (const std::filesystem::path& file : io::stack_files(name)) out.push_back(key(file));
+  } catch (const InputError&) {
+    return {};  // no such files: reading them says so, in its own words
+  }
+  return out;
+}
+
+// One file read as two things: a pattern matching another's files ('flat_*.tif' matches the
+// 'flat_end_*.tif' of --flat-after: an audit's drift then read +4.8% for +10%, without a word).
+void check_no_file_twice(const ScanSource& source) {
+  const std::pair<const std::string*, const char*> fields[] = {
+      {&source.path, "the scan"},
+      {&source.flat, "the flat field"},
+      {&source.dark, "the dark field"},
+      {&source.flat_after, "the flat field after the scan"}};
+  std::map<std::string, const char*> seen;
+  for (const auto& [name, what] : fields) {
+    for (const std::string& file : files_read(*name)) {
+      const auto [at, fresh] = seen.emplace(file, what);
+      if (!fresh && at->second != what) {
+        throw InputError(file + " is read as " + at->second + " and as " + what +
+                         ": make the file patterns exclusive");
+      }
+    }
+  }
+}
+
 // Resolves a scan JSON into its files and checks the flat and dark fit SCAN; true when SCAN is
 // a tomography file, which holds its own flats and darks (a flat, dark or flats-after field
 // given beside it replaces or adds to the file's own).
@@ -72,6 +115,7 @@ bool resolve_files(ScanSource& source) {
   if (!source.flat_after.empty() && source.flat.empty() && !tomo_file) {
     throw InputError("flats after the scan need the flats before them");
   }
+  check_no_file_twice(source);
   return tomo_file;
 }
 
