@@ -129,22 +129,6 @@ TEST_SUITE("starved_readings") {
     for (std::size_t v = 0; v < 6; ++v) CHECK(std::isnan(a(v, 6)));
   }
 
-  TEST_CASE("a block dark in every view whose edges come and go is behind metal on the axis") {
-    // 24 views of 20 elements reading 1: elements 8-11 dark in every view, and the metal's
-    // edge darkens element 7 or 12 as well in 14 views of 24. The same block with its
-    // neighbours always lit is a dead module.
-    riner::Array a({24, 20}, 1.0f), module({24, 20}, 1.0f);
-    for (std::size_t v = 0; v < 24; ++v) {
-      for (std::size_t e = 8; e < 12; ++e) a(v, e) = module(v, e) = INFINITY;
-      if (v % 12 < 7) a(v, v % 2 ? 7 : 12) = INFINITY;
-    }
-    const riner::model::StarvedReadings s = riner::model::mark_starved_readings(a, 24);
-    CHECK(s.count == 24 * 4 + 14);
-    for (std::size_t v = 0; v < 24; ++v) CHECK(riner::model::is_starved(a(v, 9)));
-    CHECK(riner::model::mark_starved_readings(module, 24).count == 0);
-    CHECK(std::isnan(module(5, 9)));
-  }
-
   TEST_CASE("corrupt spikes do not set the floor; a scan of nothing finite keeps no bound") {
     riner::Array a = metal_scan();
     a(1, 9) = 1e5f;  // beyond largest_reading: left out of the largest

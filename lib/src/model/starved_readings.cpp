@@ -51,35 +51,6 @@ std::optional<std::pair<std::size_t, std::size_t>> dark_run_at(const DarkRuns& r
   return std::nullopt;
 }
 
-// Elements dark in every view (reads 0) that lie behind an object, not dead: a block of more
-// than kWidestDeadRun along a detector line whose live neighbours read +inf too in at least half
-// the views (metal on the rotation axis: its trace's edges come and go beside elements it darkens
-// in every view; a dead module's neighbours see the object, and a trace crossing one touches it in
-// a few views: in a test's, a quarter). Sets `behind` for them.
-void mark_dark_behind_object(const Array& m, std::size_t views, const std::vector<char>& reads,
-                             std::vector<char>& behind) {
-  const auto n = static_cast<std::size_t>(m.shape.back());
-  const std::size_t per_view = m.size() / views;
-  for (std::size_t e = 0; e < per_view;) {
-    if (reads[e]) {
-      ++e;
-      continue;
-    }
-    std::size_t end = e;
-    while (end < per_view && !reads[end] && end / n == e / n) ++end;
-    const bool left = e % n > 0, right = end % n > 0 && end < per_view;
-    std::size_t touched = 0;
-    for (std::size_t v = 0; v < views; ++v) {
-      const float* view = m.data.data() + v * per_view;
-      touched += (left && is_starved(view[e - 1])) || (right && is_starved(view[end]));
-    }
-    // A block of one or two is a dead element or a pair, whose dying neighbour says nothing.
-    if (end - e > kWidestDeadRun && 2 * touched >= views)
-      std::fill(behind.begin() + e, behind.begin() + end, 1);
-    e = end;
-  }
-}
-
 }  // namespace
 
 StarvedReadings mark_starved_readings(Array& measurement, std::size_t views) {
@@ -98,8 +69,6 @@ StarvedReadings mark_starved_readings(Array& measurement, std::size_t views) {
   for (std::size_t i = 0; i < measurement.size(); ++i) {
     if (std::isfinite(measurement.data[i])) reads[i % per_view] = 1;
   }
-  std::vector<char> behind(per_view, 0);
-  mark_dark_behind_object(measurement, views, reads, behind);
   const DarkRuns dark = long_dark_runs(measurement, views, response_change_min_views(views));
   const float bar = static_cast<float>(kStarvedNeighbourShare) * largest;
   for (std::size_t l = 0; l < lines; ++l) {
@@ -128,8 +97,7 @@ StarvedReadings mark_starved_readings(Array& measurement, std::size_t views) {
       std::vector<std::optional<std::pair<std::size_t, std::size_t>>> runs;
       std::map<std::pair<std::size_t, std::size_t>, std::size_t> together;
       for (long j = k; j < end; ++j) {
-        const std::size_t e = (at + static_cast<std::size_t>(j)) % per_view;
-        runs.push_back(behind[e] ? std::nullopt : dark_run_at(dark, e, view));
+        runs.push_back(dark_run_at(dark, (at + static_cast<std::size_t>(j)) % per_view, view));
         if (runs.back()) ++together[*runs.back()];
       }
       // The module's runs: kWidestDeadRun + 1 or more elements dark from one view to the end
@@ -152,7 +120,7 @@ StarvedReadings mark_starved_readings(Array& measurement, std::size_t views) {
         const auto& run = runs[static_cast<std::size_t>(j - k)];
         const bool failing = run && of_module(*run);
         const bool stopped = !blank && !failing && (wide || (dense_beside && !run));
-        if (largest > 0.0f && stopped && (reads[i % per_view] || behind[i % per_view])) {
+        if (largest > 0.0f && stopped && reads[i % per_view]) {
           ++out.count;
         } else {
           line[j] = NAN;

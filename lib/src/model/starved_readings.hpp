@@ -13,9 +13,10 @@
 // rays at 0.36 of it). But kWidestDeadRun + 1 or more elements of a run dark together from
 // one view to the scan's end (or from its start to one view), for that many views, are a
 // module failing, and a run filling a whole line (a blank frame) says nothing: both unread. An
-// element that reads nothing in any view is dead whatever its neighbours read, unless it is one
-// of a block of more than kWidestDeadRun whose live neighbours read +inf too in at least half the
-// views: that block lies behind the object (metal on the rotation axis), its readings bounds.
+// element that reads nothing in any view is dead whatever its neighbours read (metal on the
+// rotation axis, dark in every view, is read so too: a rule that took a block whose neighbours
+// were dark in half the views for metal made an audit's dead modules beside a metal's trace, or
+// beside a dying element, into bright bounds).
 #pragma once
 
 #include <cmath>
