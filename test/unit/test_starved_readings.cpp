@@ -25,6 +25,22 @@ riner::Array metal_scan() {
   return a;
 }
 
+// 48 views of 20 elements reading 1, a metal band (+inf, 4 wide, edges at 15-16) moving one
+// element every 6 views; elements 2-5 go dark together from view 20 on (a module failing).
+riner::Array failing_module_scan() {
+  riner::Array a({48, 20}, 1.0f);
+  for (std::size_t v = 0; v < 48; ++v) {
+    const std::size_t m = 8 + v / 6;
+    a(v, m - 1) = 15.0f;
+    for (std::size_t e = m; e < m + 4; ++e) a(v, e) = INFINITY;
+    a(v, m + 4) = 16.0f;
+    if (v >= 20) {
+      for (std::size_t e = 2; e < 6; ++e) a(v, e) = INFINITY;
+    }
+  }
+  return a;
+}
+
 }  // namespace
 
 TEST_SUITE("starved_readings") {
@@ -79,19 +95,8 @@ TEST_SUITE("starved_readings") {
   }
 
   TEST_CASE("a module failing part-way, a blank frame: unread, not metal") {
-    // 48 views of 20 elements reading 1, a metal band (+inf, 4 wide, edges at 15-16) moving
-    // one element every 6 views. Elements 2-5 go dark together from view 20 on (a module);
-    // view 10 reads nothing at all (a blank frame).
-    riner::Array a({48, 20}, 1.0f);
-    for (std::size_t v = 0; v < 48; ++v) {
-      const std::size_t m = 8 + v / 6;
-      a(v, m - 1) = 15.0f;
-      for (std::size_t e = m; e < m + 4; ++e) a(v, e) = INFINITY;
-      a(v, m + 4) = 16.0f;
-      if (v >= 20) {
-        for (std::size_t e = 2; e < 6; ++e) a(v, e) = INFINITY;
-      }
-    }
+    // failing_module_scan's module; view 10 reads nothing at all (a blank frame).
+    riner::Array a = failing_module_scan();
     for (std::size_t e = 0; e < 20; ++e) a(10, e) = INFINITY;
     const riner::model::StarvedReadings s = riner::model::mark_starved_readings(a, 48);
     CHECK(s.count == 47 * 4);  // the band in every view but the blank one
@@ -104,17 +109,8 @@ TEST_SUITE("starved_readings") {
     // The module above, and element 6 beside it dark from view 14 on, before the module (as the
     // metal's trace darkens an element just before a module fails): its run of its own was kept
     // as bounds, wide with the module's elements, and the field took them as streaks.
-    riner::Array a({48, 20}, 1.0f);
-    for (std::size_t v = 0; v < 48; ++v) {
-      const std::size_t m = 8 + v / 6;
-      a(v, m - 1) = 15.0f;
-      for (std::size_t e = m; e < m + 4; ++e) a(v, e) = INFINITY;
-      a(v, m + 4) = 16.0f;
-      if (v >= 20) {
-        for (std::size_t e = 2; e < 6; ++e) a(v, e) = INFINITY;
-      }
-      if (v >= 14) a(v, 6) = INFINITY;
-    }
+    riner::Array a = failing_module_scan();
+    for (std::size_t v = 14; v < 48; ++v) a(v, 6) = INFINITY;
     const riner::model::StarvedReadings s = riner::model::mark_starved_readings(a, 48);
     CHECK(s.count == 48 * 4);
     for (std::size_t v = 14; v < 48; ++v) CHECK(std::isnan(a(v, 6)));

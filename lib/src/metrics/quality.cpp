@@ -143,24 +143,21 @@ double quantile(std::vector<double>& v, double q) {
   return v[static_cast<std::size_t>(at)];
 }
 
-// Clears the lost pixels (1 in `lost`, rows x columns) of each 8-connected region that is
-// neither wide nor high: fewer than kLostWideRegionPixels and nowhere `sigmas`(p) above
-// kLostHighSigmas.
-void keep_clear_regions(std::vector<double>& lost, std::size_t rows, std::size_t columns,
-                        const std::function<double(std::size_t)>& sigmas) {
+// The 8-connected regions of the pixels where `lost` (rows x columns) equals 1.
+std::vector<std::vector<std::size_t>> lost_regions(const std::vector<double>& lost,
+                                                   std::size_t rows, std::size_t columns) {
+  std::vector<std::vector<std::size_t>> regions;
   std::vector<std::uint8_t> seen(lost.size(), 0);
-  std::vector<std::size_t> region, pending;
+  std::vector<std::size_t> pending;
   for (std::size_t start = 0; start < lost.size(); ++start) {
-    if (lost[start] <= 0.0 || seen[start]) continue;
-    region.clear();
+    if (lost[start] != 1.0 || seen[start]) continue;
+    std::vector<std::size_t>& region = regions.emplace_back();
     pending.assign(1, start);
     seen[start] = 1;
-    double highest = 0.0;
     while (!pending.empty()) {
       const std::size_t p = pending.back();
       pending.pop_back();
       region.push_back(p);
-      highest = std::max(highest, sigmas(p));
       const long i = static_cast<long>(p / columns), k = static_cast<long>(p % columns);
       for (long di = -1; di <= 1; ++di) {
         for (long dk = -1; dk <= 1; ++dk) {
@@ -169,13 +166,25 @@ void keep_clear_regions(std::vector<double>& lost, std::size_t rows, std::size_t
             continue;
           const std::size_t q =
               static_cast<std::size_t>(ni) * columns + static_cast<std::size_t>(nk);
-          if (lost[q] > 0.0 && !seen[q]) {
+          if (lost[q] == 1.0 && !seen[q]) {
             seen[q] = 1;
             pending.push_back(q);
           }
         }
       }
     }
+  }
+  return regions;
+}
+
+// Clears the lost pixels (1 in `lost`, rows x columns) of each 8-connected region that is
+// neither wide nor high: fewer than kLostWideRegionPixels and nowhere `sigmas`(p) above
+// kLostHighSigmas.
+void keep_clear_regions(std::vector<double>& lost, std::size_t rows, std::size_t columns,
+                        const std::function<double(std::size_t)>& sigmas) {
+  for (const std::vector<std::size_t>& region : lost_regions(lost, rows, columns)) {
+    double highest = 0.0;
+    for (const std::size_t p : region) highest = std::max(highest, sigmas(p));
     if (region.size() < kLostWideRegionPixels && highest < kLostHighSigmas) {
       for (const std::size_t p : region) lost[p] = 0.0;
     }
@@ -193,35 +202,10 @@ void keep_clear_regions(std::vector<double>& lost, std::size_t rows, std::size_t
 void mark_arcs(std::vector<double>& lost, const Array& image,
                const std::function<double(std::size_t)>& strength) {
   const std::size_t rows = image.shape[0], columns = image.shape[1];
-  std::vector<std::uint8_t> seen(lost.size(), 0);
-  std::vector<std::size_t> region, pending;
   std::vector<double> angles;
-  for (std::size_t start = 0; start < lost.size(); ++start) {
-    if (lost[start] != 1.0 || seen[start]) continue;
-    region.clear();
-    pending.assign(1, start);
-    seen[start] = 1;
+  for (const std::vector<std::size_t>& region : lost_regions(lost, rows, columns)) {
     double peak = 0.0;
-    while (!pending.empty()) {
-      const std::size_t p = pending.back();
-      pending.pop_back();
-      region.push_back(p);
-      peak = std::max(peak, strength(p));
-      const long i = static_cast<long>(p / columns), k = static_cast<long>(p % columns);
-      for (long di = -1; di <= 1; ++di) {
-        for (long dk = -1; dk <= 1; ++dk) {
-          const long ni = i + di, nk = k + dk;
-          if (ni < 0 || nk < 0 || ni >= static_cast<long>(rows) || nk >= static_cast<long>(columns))
-            continue;
-          const std::size_t q =
-              static_cast<std::size_t>(ni) * columns + static_cast<std::size_t>(nk);
-          if (lost[q] == 1.0 && !seen[q]) {
-            seen[q] = 1;
-            pending.push_back(q);
-          }
-        }
-      }
-    }
+    for (const std::size_t p : region) peak = std::max(peak, strength(p));
     double r_low = std::numeric_limits<double>::infinity(), r_high = 0.0;
     angles.clear();
     for (const std::size_t p : region) {
