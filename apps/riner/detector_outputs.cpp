@@ -1,6 +1,7 @@
 #include "detector_outputs.hpp"
 
 #include <algorithm>
+#include <vector>
 
 #include "riner/io.hpp"
 #include "riner/plot.hpp"
@@ -40,18 +41,23 @@ void write_detector_outputs(const std::filesystem::path& dir, Array alpha, Array
     plot.horizontal_lines = {{Reconstructor::kDeadBelowBeta, "dead below 0.5"}};
     write_plot_png(dir / "detector.png", plot);
   } else {
-    // 3D: the two maps side by side, each windowed on its own.
+    // 3D: the two maps side by side, each windowed on its own. A detector of few rows (a stack
+    // of two slices: a 1284 x 2 strip) has each row drawn kRowsAtLeast / rows pixels tall.
+    constexpr std::size_t kRowsAtLeast = 64;
     const std::size_t rows = alpha.shape[0];
     const std::size_t cols = alpha.shape[1];
-    Array both({rows, 2 * cols + 4}, 0.0f);
+    const std::size_t tall = std::max<std::size_t>(1, kRowsAtLeast / rows);
+    Array both({rows * tall, 2 * cols + 4}, 0.0f);
     const Window wa = percentile_window(alpha);
-    for (std::size_t r = 0; r < rows; ++r) {
+    std::vector<char> is_dead(rows * cols, 0);
+    for (std::size_t e : dead) is_dead[e] = 1;
+    for (std::size_t r = 0; r < rows * tall; ++r) {
       for (std::size_t c = 0; c < cols; ++c) {
-        both(r, c) = (alpha(r, c) - wa.lo) / (wa.hi - wa.lo);
-        both(r, cols + 4 + c) = beta(r, c);
+        const std::size_t e = (r / tall) * cols + c;
+        both(r, c) = (alpha.data[e] - wa.lo) / (wa.hi - wa.lo);
+        both(r, cols + 4 + c) = is_dead[e] ? 0.0f : beta.data[e];
       }
     }
-    for (std::size_t e : dead) both(e / cols, cols + 4 + e % cols) = 0.0f;
     write_png(dir / "detector.png", both, Window{0.0f, 1.0f});
   }
 }
