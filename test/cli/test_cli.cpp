@@ -1126,6 +1126,11 @@ TEST_SUITE("cli") {
     for (std::size_t i = 0; i < row0.size(); ++i)
       worst = std::max(worst, static_cast<double>(std::fabs(rows.data[i] - row0.data[i])));
     CHECK(worst < 1e-5);
+    // riner center (and destripe) take the stack alike (they asked for --row): both rows.
+    const Run centre = riner_cli("center " + tooth.string() + " --json", dir);
+    REQUIRE(centre.code == 0);
+    CHECK(nlohmann::json::parse(centre.out)["offset_px"].get<double>() ==
+          doctest::Approx(23.98).epsilon(0.002));
     expect_error(riner_cli("fbp " + tooth.string() + " --row 2 --out " + out + "/x.nii", dir), 2,
                  tooth.string() + ": no detector row 2: the stack [181, 2, 640] has rows 0..1");
     // A row under a 3D geometry, and a row of a single sinogram: said what --row is for (they

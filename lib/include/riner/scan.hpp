@@ -50,7 +50,9 @@ struct Scan {
 std::filesystem::path find_geometry(const std::filesystem::path& measurement,
                                     const std::filesystem::path& geometry = {});
 
-// Reads both files and checks they belong together; the geometry as find_geometry finds it.
+// Reads both files and checks they belong together; the geometry as find_geometry finds it. A
+// stack of rows under a parallel2d geometry (without `row`) is read under stack_of_slices of it:
+// one slice per row.
 // The measurement is a file, a folder of TIFFs or a pattern (read_array); with `row`, only that
 // detector row of a stack (a 2D slice). Throws InputError when the shapes disagree or no
 // measurement is finite.

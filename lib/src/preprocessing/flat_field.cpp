@@ -374,9 +374,13 @@ Scan raw_scan(Geometry geometry, const Array& projections, const Array& flats, c
   }
   scan.non_finite = compute_stats(scan.measurement).non_finite();
   if (!row && scan.measurement.rank() == 3 && !scan.geometry.is_3d()) {
-    throw InputError(what + " is a stack " + shape_string(scan.measurement.shape) + " and the " +
-                     geometry_type_name(scan.geometry.type) +
-                     " geometry is 2D: pick a detector row with --row");
+    // A stack of rows under a slice's geometry: one slice per row (riner/scan.hpp, load_scan).
+    if (scan.geometry.type != GeometryType::kParallel2d) {
+      throw InputError(what + " is a stack " + shape_string(scan.measurement.shape) + " and the " +
+                       geometry_type_name(scan.geometry.type) +
+                       " geometry is 2D: pick a detector row with --row");
+    }
+    scan.geometry = stack_of_slices(scan.geometry, scan.measurement.shape[1]);
   }
   check_scan(scan, what);
   if (report) *report = r;
