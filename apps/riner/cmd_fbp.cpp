@@ -52,19 +52,8 @@ bool fbp_wants_slabs(const Args& args, const std::function<const FbpOptions&()>&
   const bool asked = !args.get("slab-slices").empty() || !args.get("memory-limit").empty();
   const bool folder = std::filesystem::path(args.get("out")).extension().empty();
   const std::optional<Geometry> g = stack_geometry(args);
-  // A stack of rows under a slice's geometry (tooth.h5 beside its 2D geometry.json) is one
-  // slice per row, as reconstruct takes it: the whole-scan path reads one slice only.
-  bool rows_of_slices = false;
-  if (g && g->is_3d()) {
-    try {
-      const ScanSource s = source_from(args);
-      rows_of_slices = !Geometry::load(find_geometry(s.path, s.geometry)).is_3d();
-    } catch (const InputError&) {
-    }
-  }
   return g && g->is_3d() &&
-         (asked || folder || rows_of_slices ||
-          fbp_slab_bytes(*g, g->volume_shape[0]) > default_memory_limit() ||
+         (asked || folder || fbp_slab_bytes(*g, g->volume_shape[0]) > default_memory_limit() ||
           fbp_device_slices(*g, SlabOptions{}, options()) < g->volume_shape[0]);
 }
 

@@ -26,6 +26,14 @@ std::vector<riner::model::ResponseChange> changes_in(riner::Array rho) {
   return riner::model::find_response_changes(rho, {});
 }
 
+// A training setup's settings on the reference engine, the whole grid sampled.
+riner::RinerConfig setup_config() {
+  riner::RinerConfig c;
+  c.engine = riner::Engine::kReference;
+  c.training.skip_air = false;
+  return c;
+}
+
 }  // namespace
 
 TEST_SUITE("response changes") {
@@ -152,9 +160,7 @@ TEST_SUITE("response changes") {
 
   TEST_CASE("training gives each changing element a slot per segment, off by the setting") {
     const PartialScan s = partial_scan(3, 1, 6);
-    riner::RinerConfig c;
-    c.engine = riner::Engine::kReference;
-    c.training.skip_air = false;
+    riner::RinerConfig c = setup_config();
     const riner::detail::TrainingSetup on(s.scan, c);
     CHECK(on.responses.slots() == 128 + 4);
     CHECK(on.layout.elements == 128 + 4);
@@ -170,10 +176,7 @@ TEST_SUITE("response changes") {
     // reads nothing either. At the paper's beta0 = 1 their readings, counted as 0, pulled the
     // field down along their rays; every other slot starts there.
     const PartialScan s = partial_scan(0, 1, 6);
-    riner::RinerConfig c;
-    c.engine = riner::Engine::kReference;
-    c.training.skip_air = false;
-    const riner::detail::TrainingSetup setup(s.scan, c);
+    const riner::detail::TrainingSetup setup(s.scan, setup_config());
     REQUIRE(setup.responses.slots() == 128 + 1);
     std::vector<std::size_t> dead;
     for (std::size_t e = 0; e < 128; ++e) {

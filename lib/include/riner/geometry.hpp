@@ -107,6 +107,11 @@ Geometry axial_slice_geometry(const Geometry& g);
 // a voxel apart, are each a row's 2D scan (axial_slice_geometry gives the 2D one back).
 Geometry stack_of_slices(const Geometry& g, std::size_t rows);
 
+// The geometry a measurement of `shape` is read under: a stack of rows under a parallel2d
+// geometry ([views, rows, columns]; tooth.h5 beside its 2D geometry.json) as stack_of_slices of
+// it, one slice per row; any other as it is.
+Geometry geometry_for_shape(const Geometry& g, const std::vector<std::size_t>& shape);
+
 // Uniform angles start + range * i / count, i = 0..count-1.
 std::vector<double> uniform_angles(const UniformAngles& spec);
 

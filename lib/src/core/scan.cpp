@@ -308,11 +308,7 @@ Scan load_scan(const std::filesystem::path& measurement, const std::filesystem::
     scan.measurement = std::move(file.array);
     scan.non_finite = file.non_finite;
   }
-  // A stack of rows under a slice's geometry (tooth.h5 beside its 2D geometry.json): one slice
-  // per row, as reconstruct's slabs read it (riner center and destripe asked for --row).
-  if (!row && scan.geometry.type == GeometryType::kParallel2d && scan.measurement.rank() == 3) {
-    scan.geometry = stack_of_slices(scan.geometry, scan.measurement.shape[1]);
-  }
+  if (!row) scan.geometry = geometry_for_shape(scan.geometry, scan.measurement.shape);
   check_scan(scan, measurement.string());
   return scan;
 }

@@ -227,6 +227,11 @@ FieldOfView field_of_view(const Geometry& g) {
   return f;
 }
 
+Geometry geometry_for_shape(const Geometry& g, const std::vector<std::size_t>& shape) {
+  return g.type == GeometryType::kParallel2d && shape.size() == 3 ? stack_of_slices(g, shape[1])
+                                                                  : g;
+}
+
 Geometry stack_of_slices(const Geometry& g, std::size_t rows) {
   if (g.type != GeometryType::kParallel2d || rows == 0) {
     throw InputError("a stack of slices is made of a parallel2d geometry and one row or more");

@@ -38,7 +38,7 @@ constexpr std::size_t kLostMinAirPixels = 100;
 // window of 31: 159 and 68 pixels, up to 10 sigmas).
 constexpr std::size_t kLostWideRegionPixels = 20;
 constexpr double kLostHighSigmas = 10.0;
-// mark_arcs: a ring of one element blurred by kLostBlurPx is 4.7 px wide at half its height.
+// is_thin_arc: a ring of one element blurred by kLostBlurPx is 4.7 px wide at half its height.
 constexpr double kLostArcWidthPx = 5.5;
 constexpr double kLostArcLengthToWidth = 4.0;
 constexpr double kLostArcLeastRadiusPx = 8.0;
@@ -177,60 +177,57 @@ std::vector<std::vector<std::size_t>> lost_regions(const std::vector<double>& lo
   return regions;
 }
 
-// Clears the lost pixels (1 in `lost`, rows x columns) of each 8-connected region that is
-// neither wide nor high: fewer than kLostWideRegionPixels and nowhere `sigmas`(p) above
-// kLostHighSigmas.
-void keep_clear_regions(std::vector<double>& lost, std::size_t rows, std::size_t columns,
-                        const std::function<double(std::size_t)>& sigmas) {
-  for (const std::vector<std::size_t>& region : lost_regions(lost, rows, columns)) {
-    double highest = 0.0;
-    for (const std::size_t p : region) highest = std::max(highest, sigmas(p));
-    if (region.size() < kLostWideRegionPixels && highest < kLostHighSigmas) {
-      for (const std::size_t p : region) lost[p] = 0.0;
-    }
+// Whether a lost region is a thin arc about the grid centre: where the FBP shows at least half
+// the region's peak (`sigmas`), no wider radially than kLostArcWidthPx and kLostArcLengthToWidth
+// times as long along the circle, kLostArcLeastRadiusPx or more from the centre. Such an arc is
+// a ring of the FBP the image has not (the built-in demo's: four arcs 2.3-3.3 px wide, 55-123
+// degrees long, 0.64% of the field), or a thin concentric structure taken for one. At half its
+// peak a ring of one element blurred by kLostBlurPx is 4.7 px wide whatever its height; the
+// region's own extent grows with it.
+bool is_thin_arc(const std::vector<std::size_t>& region, const Array& image,
+                 const std::function<double(std::size_t)>& sigmas) {
+  const std::size_t rows = image.shape[0], columns = image.shape[1];
+  double peak = 0.0;
+  for (const std::size_t p : region) peak = std::max(peak, sigmas(p));
+  double r_low = std::numeric_limits<double>::infinity(), r_high = 0.0;
+  std::vector<double> angles;
+  for (const std::size_t p : region) {
+    if (sigmas(p) < 0.5 * peak) continue;
+    const std::size_t i = p / columns, k = p % columns;
+    const double r = radius_of(image, i, k);
+    r_low = std::min(r_low, r);
+    r_high = std::max(r_high, r);
+    angles.push_back(std::atan2(static_cast<double>(i) - 0.5 * (rows - 1.0),
+                                static_cast<double>(k) - 0.5 * (columns - 1.0)));
   }
+  // The arc's angular span: the full turn less the widest gap between its pixels' angles.
+  std::sort(angles.begin(), angles.end());
+  double gap = 2.0 * M_PI - (angles.back() - angles.front());
+  for (std::size_t a = 1; a < angles.size(); ++a) gap = std::max(gap, angles[a] - angles[a - 1]);
+  const double width = r_high - r_low, length = (2.0 * M_PI - gap) * 0.5 * (r_low + r_high);
+  return r_low >= kLostArcLeastRadiusPx && width <= kLostArcWidthPx &&
+         length >= kLostArcLengthToWidth * std::max(width, 1.0);
 }
 
-// Sets each lost region (1 in `lost`, 8-connected) that is a thin arc about the grid centre to
-// 2: where the FBP shows at least half the region's peak (`strength`), no wider radially than
-// kLostArcWidthPx and kLostArcLengthToWidth times as long along the circle, kLostArcLeastRadiusPx
-// or more from the centre. Such an arc is a ring of the FBP the image has not (the built-in
-// demo's: four arcs 2.3-3.3 px wide, 55-123 degrees long, 0.64% of the field), or a thin
-// concentric structure taken for one: said apart from the lost object. At half its peak a ring
-// of one element blurred by kLostBlurPx is 4.7 px wide whatever its height; the region's
-// own extent grows with it.
-void mark_arcs(std::vector<double>& lost, const Array& image,
-               const std::function<double(std::size_t)>& strength) {
-  const std::size_t rows = image.shape[0], columns = image.shape[1];
-  std::vector<double> angles;
-  for (const std::vector<std::size_t>& region : lost_regions(lost, rows, columns)) {
-    double peak = 0.0;
-    for (const std::size_t p : region) peak = std::max(peak, strength(p));
-    double r_low = std::numeric_limits<double>::infinity(), r_high = 0.0;
-    angles.clear();
-    for (const std::size_t p : region) {
-      if (strength(p) < 0.5 * peak) continue;
-      const std::size_t i = p / columns, k = p % columns;
-      const double r = radius_of(image, i, k);
-      r_low = std::min(r_low, r);
-      r_high = std::max(r_high, r);
-      angles.push_back(std::atan2(static_cast<double>(i) - 0.5 * (rows - 1.0),
-                                  static_cast<double>(k) - 0.5 * (columns - 1.0)));
-    }
-    // The arc's angular span: the full turn less the widest gap between its pixels' angles.
-    std::sort(angles.begin(), angles.end());
-    double gap = 2.0 * M_PI - (angles.back() - angles.front());
-    for (std::size_t a = 1; a < angles.size(); ++a) gap = std::max(gap, angles[a] - angles[a - 1]);
-    const double width = r_high - r_low, length = (2.0 * M_PI - gap) * 0.5 * (r_low + r_high);
-    if (r_low >= kLostArcLeastRadiusPx && width <= kLostArcWidthPx &&
-        length >= kLostArcLengthToWidth * std::max(width, 1.0)) {
-      for (const std::size_t p : region) lost[p] = 2.0;
-    }
+// Each 8-connected region of lost pixels (1 in `lost`, the image's shape): cleared where it is
+// neither wide nor high (fewer than kLostWideRegionPixels and nowhere `sigmas`(p) above
+// kLostHighSigmas), set to 2 where it is a thin arc about the centre (is_thin_arc): said apart
+// from the lost object.
+void classify_regions(std::vector<double>& lost, const Array& image,
+                      const std::function<double(std::size_t)>& sigmas) {
+  for (const std::vector<std::size_t>& region :
+       lost_regions(lost, image.shape[0], image.shape[1])) {
+    double highest = 0.0;
+    for (const std::size_t p : region) highest = std::max(highest, sigmas(p));
+    const double kind = region.size() < kLostWideRegionPixels && highest < kLostHighSigmas ? 0.0
+                        : is_thin_arc(region, image, sigmas)                               ? 2.0
+                                                                                           : 1.0;
+    for (const std::size_t p : region) lost[p] = kind;
   }
 }
 
 // Where the FBP sees object and the image air, per pixel of one 2D image (-1 outside the disc,
-// 1 lost, 2 lost in a thin arc about the centre (mark_arcs), 0 not); the noise it measured into
+// 1 lost, 2 lost in a thin arc about the centre (is_thin_arc), 0 not); the noise it measured into
 // `noise`.
 std::vector<double> lost_pixels(const Array& image, const Array& fbp, double field_radius_px,
                                 double* noise) {
@@ -269,10 +266,9 @@ std::vector<double> lost_pixels(const Array& image, const Array& fbp, double fie
     out[p] = object > kLostObjectSigmas * sigma &&
              shown.data[p] - level_shown < kLostShownShare * object;
   }
-  keep_clear_regions(out, image.shape[0], image.shape[1], [&](std::size_t p) {
+  classify_regions(out, image, [&](std::size_t p) {
     return (seen.data[p] - level_seen) / std::max(sigma, 1e-30);
   });
-  mark_arcs(out, image, [&](std::size_t p) { return seen.data[p] - level_seen; });
   return out;
 }
 

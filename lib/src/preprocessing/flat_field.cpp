@@ -373,14 +373,11 @@ Scan raw_scan(Geometry geometry, const Array& projections, const Array& flats, c
     throw InputError(what + ": " + e.what());
   }
   scan.non_finite = compute_stats(scan.measurement).non_finite();
+  if (!row) scan.geometry = geometry_for_shape(scan.geometry, scan.measurement.shape);
   if (!row && scan.measurement.rank() == 3 && !scan.geometry.is_3d()) {
-    // A stack of rows under a slice's geometry: one slice per row (riner/scan.hpp, load_scan).
-    if (scan.geometry.type != GeometryType::kParallel2d) {
-      throw InputError(what + " is a stack " + shape_string(scan.measurement.shape) + " and the " +
-                       geometry_type_name(scan.geometry.type) +
-                       " geometry is 2D: pick a detector row with --row");
-    }
-    scan.geometry = stack_of_slices(scan.geometry, scan.measurement.shape[1]);
+    throw InputError(what + " is a stack " + shape_string(scan.measurement.shape) + " and the " +
+                     geometry_type_name(scan.geometry.type) +
+                     " geometry is 2D: pick a detector row with --row");
   }
   check_scan(scan, what);
   if (report) *report = r;

@@ -340,11 +340,7 @@ ScanRows::ScanRows(ScanSource source) : source_(std::move(source)) {
   if (source_.row) throw InputError("a single detector row is read whole: no slabs needed");
   geometry_ = Geometry::load(find_geometry(source_.path, source_.geometry));
   shape_ = read_array_shape(source_.path);
-  if (geometry_.type == GeometryType::kParallel2d && shape_.size() == 3) {
-    // A stack of rows under a slice's geometry (tooth.h5 with its 2D geometry.json): each
-    // row is a slice of its own, a voxel apart.
-    geometry_ = stack_of_slices(geometry_, shape_[1]);
-  }
+  geometry_ = geometry_for_shape(geometry_, shape_);
   if (!geometry_.is_3d()) {
     throw InputError(source_.path + ": the geometry is " + geometry_type_name(geometry_.type) +
                      "; slabs of detector rows need a 3D geometry");
