@@ -924,6 +924,12 @@ TEST_SUITE("cli") {
                                "--flat-after " + raw + "/flat_end_0.tif --out " + raw + "/x.nii",
                            dir),
                  2, raw + "/flat_end_0.tif is read as the flat field and as the flat field after");
+    // The same flats before and after: no drift, no mistake.
+    const Run same = riner_cli("fbp " + raw + "/projections --flat " + raw + "/flat_0.tif " +
+                                   "--flat-after " + raw + "/flat_0.tif --out " + raw + "/same.nii",
+                               dir);
+    CHECK(same.code == 0);
+    CHECK(same.err == "");
   }
 
   TEST_CASE("center finds a forgotten offset; --offset-px auto uses it") {
@@ -1126,6 +1132,20 @@ TEST_SUITE("cli") {
     for (std::size_t i = 0; i < row0.size(); ++i)
       worst = std::max(worst, static_cast<double>(std::fabs(rows.data[i] - row0.data[i])));
     CHECK(worst < 1e-5);
+    // A stack of one row is that row's 2D scan (it read as a volume of one slice).
+    riner::Array one = riner::read_array(tooth.parent_path() / "sino_row0.npy").array;
+    one.shape = {one.shape[0], 1, one.shape[1]};
+    std::filesystem::create_directories(dir / "one");
+    riner::write_array(dir / "one" / "stack.npy", one);
+    std::filesystem::copy_file(tooth.parent_path() / "geometry.json",
+                               dir / "one" / "geometry.json");
+    REQUIRE(riner_cli("fbp " + (dir / "one" / "stack.npy").string() + " --out " + out +
+                          "/one.nii --quiet",
+                      dir)
+                .code == 0);
+    const riner::Array one_image = riner::read_array(out + "/one.nii").array;
+    REQUIRE(one_image.shape == row0.shape);
+    CHECK(one_image.data == riner::read_array(out + "/shared.nii").array.data);
     // riner center (and destripe) take the stack alike (they asked for --row): both rows.
     const Run centre = riner_cli("center " + tooth.string() + " --json", dir);
     REQUIRE(centre.code == 0);

@@ -45,6 +45,20 @@ def test_parallel_beam_puts_the_axis_at_center():
     assert g3["detector"]["offset_px"] == [0.0, 0.0]
 
 
+def test_a_stack_of_rows_beside_a_2d_geometry_is_a_slice_per_row():
+    # As the CLI reads tooth.h5 beside its 2D geometry.json; one row is that row's 2D scan.
+    g = riner.parallel_beam(np.linspace(0, np.pi, 60, endpoint=False), columns=48, center=23.5)
+    rng = np.random.default_rng(3)
+    rows = rng.uniform(0.0, 0.1, size=(60, 2, 48)).astype(np.float32)
+    both = riner.fbp(rows, g)
+    assert both.shape == (2, 48, 48)
+    first = riner.fbp(np.ascontiguousarray(rows[:, 0, :]), g)
+    assert np.allclose(both[0], first, atol=1e-6)
+    one = riner.fbp(np.ascontiguousarray(rows[:, :1, :]), g)
+    assert one.shape == (48, 48)
+    assert np.array_equal(one, first)
+
+
 def test_geometry_from_preset_file_and_dict(tmp_path):
     preset = riner.geometry("fan2d-paper")
     path = tmp_path / "g.json"

@@ -22,6 +22,7 @@ namespace riner::python {
 Scan scan_from(const py::handle& measurement, const std::string& geometry_json) {
   Scan scan{to_array(measurement, "sino"), Geometry::from_json(geometry_json, "geometry"), 0};
   scan.non_finite = compute_stats(scan.measurement).non_finite();
+  fit_geometry_to_measurement(scan);  // as the CLI reads a stack of rows beside a 2D geometry
   check_scan(scan, "sino");
   return scan;
 }

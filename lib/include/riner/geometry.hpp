@@ -109,7 +109,8 @@ Geometry stack_of_slices(const Geometry& g, std::size_t rows);
 
 // The geometry a measurement of `shape` is read under: a stack of rows under a parallel2d
 // geometry ([views, rows, columns]; tooth.h5 beside its 2D geometry.json) as stack_of_slices of
-// it, one slice per row; any other as it is.
+// it, one slice per row; a stack of one row, and any other, as it is (one row is a 2D scan:
+// fit_geometry_to_measurement in riner/scan.hpp drops its axis).
 Geometry geometry_for_shape(const Geometry& g, const std::vector<std::size_t>& shape);
 
 // Uniform angles start + range * i / count, i = 0..count-1.

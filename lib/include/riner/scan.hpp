@@ -82,6 +82,10 @@ std::optional<ScanFiles> read_scan_files(const std::filesystem::path& scan_json)
 // NaN or infinite, when nearly all are (or beyond kLargestReading), or when nearly all exceed
 // what any line integral reaches (raw intensities: give the flat field).
 void check_scan(const Scan& scan, std::string_view what = "measurement");
+
+// A whole measurement read under its geometry (geometry_for_shape): a stack of rows beside a
+// parallel2d geometry is a slice per row, and a stack of one row is that row's 2D scan.
+void fit_geometry_to_measurement(Scan& scan);
 // InputError unless `g` is a 2D geometry, the one a single detector row is a slice of.
 void require_slice_geometry(const Geometry& g);
 

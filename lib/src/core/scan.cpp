@@ -308,9 +308,15 @@ Scan load_scan(const std::filesystem::path& measurement, const std::filesystem::
     scan.measurement = std::move(file.array);
     scan.non_finite = file.non_finite;
   }
-  if (!row) scan.geometry = geometry_for_shape(scan.geometry, scan.measurement.shape);
+  if (!row) fit_geometry_to_measurement(scan);
   check_scan(scan, measurement.string());
   return scan;
+}
+
+void fit_geometry_to_measurement(Scan& scan) {
+  std::vector<std::size_t>& shape = scan.measurement.shape;
+  scan.geometry = geometry_for_shape(scan.geometry, shape);
+  if (!scan.geometry.is_3d() && shape.size() == 3 && shape[1] == 1) shape.erase(shape.begin() + 1);
 }
 
 std::optional<ScanFiles> read_scan_files(const std::filesystem::path& scan_json) {

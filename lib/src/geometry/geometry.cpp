@@ -228,8 +228,9 @@ FieldOfView field_of_view(const Geometry& g) {
 }
 
 Geometry geometry_for_shape(const Geometry& g, const std::vector<std::size_t>& shape) {
-  return g.type == GeometryType::kParallel2d && shape.size() == 3 ? stack_of_slices(g, shape[1])
-                                                                  : g;
+  return g.type == GeometryType::kParallel2d && shape.size() == 3 && shape[1] > 1
+             ? stack_of_slices(g, shape[1])
+             : g;
 }
 
 Geometry stack_of_slices(const Geometry& g, std::size_t rows) {

@@ -373,7 +373,7 @@ Scan raw_scan(Geometry geometry, const Array& projections, const Array& flats, c
     throw InputError(what + ": " + e.what());
   }
   scan.non_finite = compute_stats(scan.measurement).non_finite();
-  if (!row) scan.geometry = geometry_for_shape(scan.geometry, scan.measurement.shape);
+  if (!row) fit_geometry_to_measurement(scan);
   if (!row && scan.measurement.rank() == 3 && !scan.geometry.is_3d()) {
     throw InputError(what + " is a stack " + shape_string(scan.measurement.shape) + " and the " +
                      geometry_type_name(scan.geometry.type) +

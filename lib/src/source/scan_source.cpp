@@ -62,21 +62,21 @@ Array frames_rows(const std::filesystem::path& path, RowRange rows) {
   return cut;
 }
 
-// What `name` reads, one key per file (an HDF5 dataset with its file: a file's flats beside its
-// projections are no overlap).
-std::vector<std::string> files_read(const std::string& name) {
+// What `name` reads: per file, a key (its canonical path; an HDF5 dataset's with the dataset: a
+// file's flats beside its projections are no overlap) and the name to show.
+std::map<std::string, std::string> files_read(const std::string& name) {
   const auto key = [](const std::filesystem::path& file) {
     std::error_code ignored;
     const std::filesystem::path canonical = std::filesystem::weakly_canonical(file, ignored);
     return (canonical.empty() ? file : canonical).string();
   };
   if (name.empty()) return {};
-  if (const auto h5 = split_hdf5_dataset(name)) return {key(h5->first) + ":" + h5->second};
+  if (const auto h5 = split_hdf5_dataset(name)) return {{key(h5->first) + ":" + h5->second, name}};
   if (is_tomo_file(name)) return {};  // a tomography file: its own flats, darks or projections
-  if (!io::is_stack_path(name)) return {key(name)};
-  std::vector<std::string> out;
+  if (!io::is_stack_path(name)) return {{key(name), name}};
+  std::map<std::string, std::string> out;
   try {
-    for (const std::filesystem::path& file : io::stack_files(name)) out.push_back(key(file));
+    for (const std::filesystem::path& file : io::stack_files(name)) out.emplace(key(file), file);
   } catch (const InputError&) {
     return {};  // no such files: reading them says so, in its own words
   }
@@ -85,18 +85,22 @@ std::vector<std::string> files_read(const std::string& name) {
 
 // One file read as two things: a pattern matching another's files ('flat_*.tif' matches the
 // 'flat_end_*.tif' of --flat-after: an audit's drift then read +4.8% for +10%, without a word).
+// The same flats before and after the scan are no such mistake: no drift.
 void check_no_file_twice(const ScanSource& source) {
+  const std::map<std::string, std::string> flats_after = files_read(source.flat_after);
+  const bool same_flats = !flats_after.empty() && flats_after == files_read(source.flat);
   const std::pair<const std::string*, const char*> fields[] = {
       {&source.path, "the scan"},
       {&source.flat, "the flat field"},
       {&source.dark, "the dark field"},
-      {&source.flat_after, "the flat field after the scan"}};
+      {same_flats ? nullptr : &source.flat_after, "the flat field after the scan"}};
   std::map<std::string, const char*> seen;
   for (const auto& [name, what] : fields) {
-    for (const std::string& file : files_read(*name)) {
+    if (!name) continue;
+    for (const auto& [file, shown] : files_read(*name)) {
       const auto [at, fresh] = seen.emplace(file, what);
       if (!fresh && at->second != what) {
-        throw InputError(file + " is read as " + at->second + " and as " + what +
+        throw InputError(shown + " is read as " + at->second + " and as " + what +
                          ": make the file patterns exclusive");
       }
     }
