@@ -250,6 +250,8 @@ nlohmann::json real_scan_run(const riner::Scan& scan, const riner::Array& fbp_im
           {"elements_switched_off", off},
           {"residual_detail_applied", result.residual_detail.applied},
           {"residual_detail_consistent_share", result.residual_detail.consistent_share},
+          {"residual_detail_misfit",
+           {result.residual_detail.misfit_before, result.residual_detail.misfit_after}},
           {"seconds", r.stats().seconds},
           {"steps", r.stats().steps}};
 }

@@ -134,6 +134,7 @@ std::vector<Result> size_scaling(const Options& o) {
           (is_dead ? dead_found : live_off) += 1;
       }
       const std::string name = scene + "/" + std::to_string(index);
+      const riner::ResidualDetail detail = r.result().residual_detail;
       if (const std::string dir = o.get("save", ""); !dir.empty()) {
         riner::bench::save_training(
             std::filesystem::path(dir) /
@@ -195,6 +196,8 @@ std::vector<Result> size_scaling(const Options& o) {
             {"live_elements_off", live_off},
             {"dead_elements_found", dead_found},
             {"dead_elements", dead},
+            {"residual_detail_applied", detail.applied},
+            {"residual_detail_misfit", {detail.misfit_before, detail.misfit_after}},
             {"config", nlohmann::json::parse(config.to_json())}},
            riner::bench::format("%s %5zu columns (%4zu^2, %4zu views): riner %.2f dB / %.3f, "
                                 "edges %.3f | oracle %.2f / %.3f, edges %.3f | FBP %.2f | "

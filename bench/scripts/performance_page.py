@@ -18,7 +18,7 @@ import sys
 
 # The current measurement of each table: file under bench/results/ and what to take from it.
 SOURCES = {
-    "deeplesion_cpu": "unread_beta_off.jsonl",
+    "deeplesion_cpu": "residual_detail_held_out_centred.jsonl",
     "deeplesion_gpu": "issue30_throughput.jsonl",
     "deeplesion_gpu_h100": "issue12_gpu.jsonl",
     "classical": "destripe_own_fluctuation.jsonl",

@@ -80,17 +80,21 @@ Geometry with_views(const Geometry& g, const std::vector<std::size_t>& views) {
   return out;
 }
 
-// Mean |residual - change| over the readings used in `views`; `change` (nullptr: no change)
-// holds those views only, in order.
-double held_out_misfit(const Array& residual, const Array* change, const std::vector<char>& used,
-                       std::size_t n, const std::vector<std::size_t>& views) {
+// Mean |residual - mean - change| over the readings used in `views`, less each element's mean
+// residual as the detail was made without it (alpha's leftover offsets would otherwise outweigh
+// the detail: a volume at 12 000 steps whose detail is worth 7.7 dB moved the raw misfit by 6%);
+// `change` (nullptr: no change) holds those views only, in order.
+double held_out_misfit(const Array& residual, const std::vector<double>& means, const Array* change,
+                       const std::vector<char>& used, std::size_t n,
+                       const std::vector<std::size_t>& views) {
   double total = 0.0, count = 0.0;
   for (std::size_t k = 0; k < views.size(); ++k) {
     const float* changed = change ? change->data.data() + k * n : nullptr;
     for (std::size_t e = 0; e < n; ++e) {
       const std::size_t i = views[k] * n + e;
       if (!used[i]) continue;
-      total += std::fabs(static_cast<double>(residual.data[i]) - (changed ? changed[e] : 0.0f));
+      total += std::fabs(static_cast<double>(residual.data[i]) - means[e] -
+                         (changed ? changed[e] : 0.0f));
       count += 1.0;
     }
   }
@@ -219,9 +223,11 @@ ResidualDetailResult detail_of(Array image, const Array& field, const Scan& scan
     added_sq += static_cast<double>(added) * added;
   }
   // Held out: the detail of the even views must fit the odd views' readings better than the
-  // field alone, and the odd views' the even ones'. Detail does; noise, and what FBP draws of
-  // its own where the field is already sharper than FBP (a piecewise-constant phantom's
-  // edges: view aliasing, streaks), does not.
+  // field alone, and the odd views' the even ones', by a clear share. Detail does (DeepLesion at
+  // 256 and 1024 columns: 27-34%, the detail worth 2.4-3.9 dB); noise does not, nor what FBP
+  // draws of its own where the field is already sharper than FBP (a piecewise-constant
+  // phantom's edges at 256 columns: view aliasing, streaks; 4.4-6.9%, the detail costing up to
+  // 1.7 dB).
   // Each half's detail projected at (a share of) the other half's views only.
   const std::size_t stride = held_out_stride(g.n_views(), n, settings.held_out_readings);
   const std::vector<std::size_t> odd_held = views_of(g, 1, stride),
@@ -229,12 +235,17 @@ ResidualDetailResult detail_of(Array image, const Array& field, const Scan& scan
   const Array even_change = Projector(with_views(g, odd_held), engine, device).project(from_even);
   const Array odd_change = Projector(with_views(g, even_held), engine, device).project(from_odd);
   out.report.held_out_views = odd_held.size() + even_held.size();
-  out.report.misfit_before = 0.5 * (held_out_misfit(misfit, nullptr, used, n, odd_held) +
-                                    held_out_misfit(misfit, nullptr, used, n, even_held));
-  out.report.misfit_after = 0.5 * (held_out_misfit(misfit, &even_change, used, n, odd_held) +
-                                   held_out_misfit(misfit, &odd_change, used, n, even_held));
-  if (!(out.report.misfit_after < out.report.misfit_before)) {
-    out.report.note = "the detail of half the views does not fit the other half's readings better";
+  out.report.misfit_before = 0.5 * (held_out_misfit(misfit, means, nullptr, used, n, odd_held) +
+                                    held_out_misfit(misfit, means, nullptr, used, n, even_held));
+  out.report.misfit_after = 0.5 * (held_out_misfit(misfit, means, &even_change, used, n, odd_held) +
+                                   held_out_misfit(misfit, means, &odd_change, used, n, even_held));
+  // Strict, and no evidence (no held-out reading) passes nothing.
+  if (!(out.report.misfit_before > 0.0 &&
+        out.report.misfit_after < (1.0 - settings.min_held_out_fall) * out.report.misfit_before)) {
+    out.report.note =
+        "the detail of half the views does not fit the other half's readings by " +
+        std::to_string(static_cast<int>(std::lround(100.0 * settings.min_held_out_fall))) +
+        "% better";
     return out;
   }
   for (std::size_t p = 0; p < pixels; ++p) {

@@ -298,6 +298,10 @@ void add_residual_detail(Table& t) {
                        "k-th view of the other half, k as large as leaves this many readings (a "
                        "volume's scan; a slice keeps every view)",
                        &C::residual_detail, &D::held_out_readings));
+  t.push_back(field<C>("detail", "min_held_out_fall", closed(0, 1),
+                       "detail.residual: only when each half's detail lowers the other half's "
+                       "readings' misfit (less each element's mean) by this share",
+                       &C::residual_detail, &D::min_held_out_fall));
 }
 
 void add_plan(Table& t) {
