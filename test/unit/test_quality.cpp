@@ -122,6 +122,23 @@ TEST_SUITE("quality: lost object") {
     const riner::LostObject cut = riner::lost_object(square_sample(n, 2e-3, 0.0, 6, 20), fbp);
     CHECK(cut.pixels > 120);
     CHECK(cut.arc_pixels > 100);
+    // A ring ten times brighter touching that corner (54 px from the axis, the corner at 56-70):
+    // the corner is judged apart from the arc it touches (it was all taken for the arc: 0 lost).
+    riner::Array crossed = square_sample(n, 2e-3, 1e-3, 5, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t k = 0; k < n; ++k) {
+        const double y = i - 0.5 * (n - 1.0), x = k - 0.5 * (n - 1.0);
+        const double angle = std::atan2(y, x);
+        if (std::fabs(std::hypot(x, y) - 54.0) < 0.5 && angle > -3.0 && angle < -1.2)
+          crossed(i, k) += 1e-1f;
+      }
+    }
+    const riner::LostObject both = riner::lost_object(square_sample(n, 2e-3, 0.0, 6, 20), crossed);
+    MESSAGE("a corner a bright ring touches: " << both.pixels << " lost, " << both.arc_pixels
+                                               << " in arcs");
+    CHECK(both.pixels > 60);
+    CHECK(both.arc_pixels > 100);
+    CHECK(riner::lost_object(square_sample(n, 2e-3, 0.0, 6, 0), crossed).pixels == 0);
   }
 
   TEST_CASE("the FBP's bright rim at the field's edge is not object") {

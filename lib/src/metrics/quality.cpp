@@ -4,6 +4,9 @@
 #include <array>
 #include <cmath>
 #include <functional>
+#include <limits>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include "metrics/gradient_magnitude.hpp"
@@ -177,15 +180,16 @@ std::vector<std::vector<std::size_t>> lost_regions(const std::vector<double>& lo
   return regions;
 }
 
-// Whether a lost region is a thin arc about the grid centre: where the FBP shows at least half
-// the region's peak (`sigmas`), no wider radially than kLostArcWidthPx and kLostArcLengthToWidth
-// times as long along the circle, kLostArcLeastRadiusPx or more from the centre. Such an arc is
-// a ring of the FBP the image has not (the built-in demo's: four arcs 2.3-3.3 px wide, 55-123
-// degrees long, 0.64% of the field), or a thin concentric structure taken for one. At half its
-// peak a ring of one element blurred by kLostBlurPx is 4.7 px wide whatever its height; the
-// region's own extent grows with it.
-bool is_thin_arc(const std::vector<std::size_t>& region, const Array& image,
-                 const std::function<double(std::size_t)>& sigmas) {
+// The radii [low, high] of a lost region's thin arc about the grid centre, if it is one: where
+// the FBP shows at least half the region's peak (`sigmas`), no wider radially than
+// kLostArcWidthPx and kLostArcLengthToWidth times as long along the circle, kLostArcLeastRadiusPx
+// or more from the centre. Such an arc is a ring of the FBP the image has not (the built-in
+// demo's: four arcs 2.3-3.3 px wide, 55-123 degrees long, 0.64% of the field), or a thin
+// concentric structure taken for one. At half its peak a ring of one element blurred by
+// kLostBlurPx is 4.7 px wide whatever its height; the region's own extent grows with it.
+std::optional<std::pair<double, double>> thin_arc_radii(
+    const std::vector<std::size_t>& region, const Array& image,
+    const std::function<double(std::size_t)>& sigmas) {
   const std::size_t rows = image.shape[0], columns = image.shape[1];
   double peak = 0.0;
   for (const std::size_t p : region) peak = std::max(peak, sigmas(p));
@@ -205,30 +209,50 @@ bool is_thin_arc(const std::vector<std::size_t>& region, const Array& image,
   double gap = 2.0 * M_PI - (angles.back() - angles.front());
   for (std::size_t a = 1; a < angles.size(); ++a) gap = std::max(gap, angles[a] - angles[a - 1]);
   const double width = r_high - r_low, length = (2.0 * M_PI - gap) * 0.5 * (r_low + r_high);
-  return r_low >= kLostArcLeastRadiusPx && width <= kLostArcWidthPx &&
-         length >= kLostArcLengthToWidth * std::max(width, 1.0);
+  if (r_low >= kLostArcLeastRadiusPx && width <= kLostArcWidthPx &&
+      length >= kLostArcLengthToWidth * std::max(width, 1.0))
+    return std::make_pair(r_low, r_high);
+  return std::nullopt;
 }
 
 // Each 8-connected region of lost pixels (1 in `lost`, the image's shape): cleared where it is
 // neither wide nor high (fewer than kLostWideRegionPixels and nowhere `sigmas`(p) above
-// kLostHighSigmas), set to 2 where it is a thin arc about the centre (is_thin_arc): said apart
-// from the lost object.
+// kLostHighSigmas), set to 2 where it is a thin arc about the centre (thin_arc_radii): said apart
+// from the lost object. Only the arc's band of radii (its blur's tails included) is the arc: what
+// else the region holds (a faint corner cut off the sample where a bright ring crosses it) is
+// judged again on its own.
 void classify_regions(std::vector<double>& lost, const Array& image,
                       const std::function<double(std::size_t)>& sigmas) {
-  for (const std::vector<std::size_t>& region :
-       lost_regions(lost, image.shape[0], image.shape[1])) {
-    double highest = 0.0;
-    for (const std::size_t p : region) highest = std::max(highest, sigmas(p));
-    const double kind = region.size() < kLostWideRegionPixels && highest < kLostHighSigmas ? 0.0
-                        : is_thin_arc(region, image, sigmas)                               ? 2.0
-                                                                                           : 1.0;
-    for (const std::size_t p : region) lost[p] = kind;
+  constexpr double kLost = 3.0;  // decided lost, while other regions are still to be judged
+  for (;;) {
+    const std::vector<std::vector<std::size_t>> regions =
+        lost_regions(lost, image.shape[0], image.shape[1]);
+    if (regions.empty()) break;
+    for (const std::vector<std::size_t>& region : regions) {
+      double highest = 0.0;
+      for (const std::size_t p : region) highest = std::max(highest, sigmas(p));
+      if (region.size() < kLostWideRegionPixels && highest < kLostHighSigmas) {
+        for (const std::size_t p : region) lost[p] = 0.0;
+        continue;
+      }
+      const auto arc = thin_arc_radii(region, image, sigmas);
+      for (const std::size_t p : region) {
+        const double r = radius_of(image, p / image.shape[1], p % image.shape[1]);
+        const double margin = 0.5 * kLostArcWidthPx;
+        if (!arc) {
+          lost[p] = kLost;
+        } else if (r >= arc->first - margin && r <= arc->second + margin) {
+          lost[p] = 2.0;
+        }  // else left at 1: judged again without the arc
+      }
+    }
   }
+  for (double& v : lost) v = v == kLost ? 1.0 : v;
 }
 
 // Where the FBP sees object and the image air, per pixel of one 2D image (-1 outside the disc,
-// 1 lost, 2 lost in a thin arc about the centre (is_thin_arc), 0 not); the noise it measured into
-// `noise`.
+// 1 lost, 2 lost in a thin arc about the centre (thin_arc_radii), 0 not); the noise it measured
+// into `noise`.
 std::vector<double> lost_pixels(const Array& image, const Array& fbp, double field_radius_px,
                                 double* noise) {
   const Array shown = Array(image.shape, util::gaussian_blur(image.data, image.shape, kLostBlurPx));
