@@ -82,15 +82,10 @@ nlohmann::json inputs_json(const Args& args) {
   const auto named = [](const std::string& name) {
     return name.empty() ? nlohmann::json(nullptr) : nlohmann::json(name);
   };
-  // The geometry as read: beside the scan when not given (a scan JSON is its own).
-  std::string geometry = s.geometry;
-  if (geometry.empty()) {
-    try {
-      geometry = std::filesystem::path(s.path).extension() == ".json"
-                     ? s.path
-                     : find_geometry(s.path).string();
-    } catch (const InputError&) {
-    }
+  std::string geometry;  // as read; null where there is none (the run says why)
+  try {
+    geometry = geometry_file_of(s).string();
+  } catch (const InputError&) {
   }
   return {{"scan", s.path},
           {"geometry", named(geometry)},

@@ -819,6 +819,7 @@ TEST_SUITE("cli") {
     CHECK(summary["inputs"]["flat"] == raw + "/flat_*.tif");  // what was read, as given
     CHECK(summary["inputs"]["dark"] == raw + "/dark.npy");
     CHECK(summary["inputs"]["row"].is_null());
+    CHECK(summary["inputs"]["geometry"] == raw + "/geometry.json");  // found beside the folder
     CHECK(summary["flat_field"]["dark_frames"] == 2);
     CHECK(summary["flat_field"]["invalid_readings"] == 1);
     CHECK(summary["non_finite_replaced"] == 1);

@@ -36,6 +36,10 @@ struct LoadedScan {
 // a one-line message naming the culprit.
 LoadedScan load_scan_source(ScanSource source);
 
+// The geometry file a source is read under: the one given, a scan JSON itself, or the one found
+// beside the scan; InputError when there is none (or the scan JSON names no files).
+std::filesystem::path geometry_file_of(ScanSource source);
+
 // A scan opened to be read a slab of detector rows at a time: the geometry and the shape come
 // from the files' headers, the data only when rows are asked for, so a scan larger than memory
 // streams (riner/slab_run.hpp). Raw projections are normalised by the flats and darks of the

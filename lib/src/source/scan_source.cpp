@@ -334,6 +334,11 @@ LoadedScan load_scan_source(ScanSource source) {
   return loaded;
 }
 
+std::filesystem::path geometry_file_of(ScanSource source) {
+  if (std::filesystem::path(source.path).extension() == ".json") resolve_scan_json(source);
+  return find_geometry(source.path, source.geometry);
+}
+
 ScanRows::ScanRows(ScanSource source) : source_(std::move(source)) {
   tomo_file_ = resolve_files(source_);
   // Slabs read their rows late: outputs opened before then must already see the inputs.

@@ -188,8 +188,9 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
   }
   seed = static_cast<std::uint32_t>(config.training.seed ^ (config.training.seed >> 32));
   invalid_readings.assign(responses.slots(), 0);
-  // A filled row's elements read nothing themselves: dead, as those with no finite reading. A
-  // bound is a reading.
+  // A filled row's elements read nothing themselves: their readings count as invalid, as those
+  // with no finite reading. Their filled values are finite, so they are no unread slots (they
+  // start at beta0, not at unread_beta0). A bound is a reading.
   std::vector<bool> filled(elements_per_view, false);
   for (const std::size_t r : filled_rows) {
     std::fill(filled.begin() + static_cast<std::ptrdiff_t>(r * g.n_u),
