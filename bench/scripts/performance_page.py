@@ -31,7 +31,7 @@ SOURCES = {
                   "issue29_sl2048_family.jsonl",
                   "issue29_sizes_gradient.jsonl", "issue29_draws10.jsonl"),
     "sizes_gpu": "issue29_sizes_gpu.jsonl",
-    "real_trained": "issue29_real_scans_at_defaults.jsonl",
+    "real_trained": "real_scans_at_defaults_intel.jsonl",
     "real_chain": "issue32_mirror_image_variation_real.jsonl",
     "throughput": "issue30_throughput.jsonl",
     "cores": "issue30_cores16.jsonl",
