@@ -268,6 +268,7 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
         {"rms_added", result.residual_detail.rms_added},
         {"misfit_before", result.residual_detail.misfit_before},
         {"misfit_after", result.residual_detail.misfit_after},
+        {"min_fall", result.residual_detail.min_fall},
         {"held_out_views", result.residual_detail.held_out_views},
         {"seconds", result.residual_detail.seconds},
         {"note", result.residual_detail.note}}},

@@ -37,8 +37,9 @@ struct ResidualDetailSettings {
   // The held-out check projects each half's detail at every k-th view of the other half, k as
   // large as leaves this many readings (a 2D slice's half holds fewer: every view).
   int held_out_readings = 1 << 21;
-  // The held-out misfit must fall by this share: DeepLesion 27-34%, a Shepp-Logan at 256
-  // columns, whose detail is FBP's own edges, 4.4-6.9%.
+  // The held-out misfit must fall by this share times the squared consistent share (the bar
+  // falls where noise fills the residual): DeepLesion 19-34% at bars of 3.6-4.9%, a
+  // Shepp-Logan at 256 columns, whose detail is FBP's own edges, 2-7.4% at bars of 7-10%.
   double min_held_out_fall = 0.15;
 };
 
@@ -51,10 +52,11 @@ struct ResidualDetail {
   // views' detail and the other way round (averaged), and the same without; m is each
   // element's mean residual over the scan (alpha's leftover offset, which the detail was made
   // without). The detail is added only when it fits readings it was not taken from better by
-  // min_held_out_fall. Over every view, or every k-th of each half where that leaves two
+  // min_fall. Over every view, or every k-th of each half where that leaves two
   // million readings or more (a volume's scan).
   double misfit_before = 0.0;
   double misfit_after = 0.0;
+  double min_fall = 0.0;  // the share it had to fall by: min_held_out_fall x consistent_share^2
   std::size_t held_out_views = 0;  // the views the check projected (both halves')
   double seconds = 0.0;  // what the step took
   std::string note;  // why not applied, when it was not

@@ -300,7 +300,8 @@ void add_residual_detail(Table& t) {
                        &C::residual_detail, &D::held_out_readings));
   t.push_back(field<C>("detail", "min_held_out_fall", closed(0, 1),
                        "detail.residual: only when each half's detail lowers the other half's "
-                       "readings' misfit (less each element's mean) by this share",
+                       "readings' misfit (less each element's mean) by this share times the "
+                       "squared consistent share",
                        &C::residual_detail, &D::min_held_out_fall));
 }
 
