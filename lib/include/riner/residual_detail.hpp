@@ -9,10 +9,9 @@
 // above that noise (a local Wiener gain), and only on scans where the two halves agree on a
 // stated share of the residual's energy, and only when the detail of either half fits the
 // other half's readings clearly better than the field alone; on a scan whose residual is noise
-// (every shared real scan) nothing changes. Each
-// element's mean residual is taken out first: a constant offset along a detector column is alpha's,
-// and its FBP would be a ring. (docs/history/RESULTS.md, "Issue 29: the detail the field leaves in
-// the readings".)
+// (every shared real scan) nothing changes. Each element's mean residual is taken out first: a
+// constant offset along a detector column is alpha's, and its FBP would be a ring.
+// (docs/history/RESULTS.md, "Issue 29: the detail the field leaves in the readings".)
 #pragma once
 
 #include <cstdint>

@@ -41,7 +41,7 @@ constexpr std::size_t kLostMinAirPixels = 100;
 // window of 31: 159 and 68 pixels, up to 10 sigmas).
 constexpr std::size_t kLostWideRegionPixels = 20;
 constexpr double kLostHighSigmas = 10.0;
-// is_thin_arc: a ring of one element blurred by kLostBlurPx is 4.7 px wide at half its height.
+// thin_arc_radii: a ring of one element blurred by kLostBlurPx is 4.7 px wide at half its height.
 constexpr double kLostArcWidthPx = 5.5;
 constexpr double kLostArcLengthToWidth = 4.0;
 constexpr double kLostArcLeastRadiusPx = 8.0;
@@ -181,18 +181,16 @@ std::vector<std::vector<std::size_t>> lost_regions(const std::vector<double>& lo
 }
 
 // The radii [low, high] of a lost region's thin arc about the grid centre, if it is one: where
-// the FBP shows at least half the region's peak (`sigmas`), no wider radially than
+// the FBP shows at least half the region's `peak` of `sigmas`, no wider radially than
 // kLostArcWidthPx and kLostArcLengthToWidth times as long along the circle, kLostArcLeastRadiusPx
 // or more from the centre. Such an arc is a ring of the FBP the image has not (the built-in
 // demo's: four arcs 2.3-3.3 px wide, 55-123 degrees long, 0.64% of the field), or a thin
 // concentric structure taken for one. At half its peak a ring of one element blurred by
 // kLostBlurPx is 4.7 px wide whatever its height; the region's own extent grows with it.
 std::optional<std::pair<double, double>> thin_arc_radii(
-    const std::vector<std::size_t>& region, const Array& image,
+    const std::vector<std::size_t>& region, double peak, const Array& image,
     const std::function<double(std::size_t)>& sigmas) {
   const std::size_t rows = image.shape[0], columns = image.shape[1];
-  double peak = 0.0;
-  for (const std::size_t p : region) peak = std::max(peak, sigmas(p));
   double r_low = std::numeric_limits<double>::infinity(), r_high = 0.0;
   std::vector<double> angles;
   for (const std::size_t p : region) {
@@ -235,15 +233,16 @@ void classify_regions(std::vector<double>& lost, const Array& image,
         for (const std::size_t p : region) lost[p] = 0.0;
         continue;
       }
-      const auto arc = thin_arc_radii(region, image, sigmas);
+      const auto arc = thin_arc_radii(region, highest, image, sigmas);
+      if (!arc) {
+        for (const std::size_t p : region) lost[p] = kLost;
+        continue;
+      }
+      const double low = arc->first - 0.5 * kLostArcWidthPx,
+                   high = arc->second + 0.5 * kLostArcWidthPx;
       for (const std::size_t p : region) {
         const double r = radius_of(image, p / image.shape[1], p % image.shape[1]);
-        const double margin = 0.5 * kLostArcWidthPx;
-        if (!arc) {
-          lost[p] = kLost;
-        } else if (r >= arc->first - margin && r <= arc->second + margin) {
-          lost[p] = 2.0;
-        }  // else left at 1: judged again without the arc
+        if (r >= low && r <= high) lost[p] = 2.0;  // the rest left at 1: judged again alone
       }
     }
   }

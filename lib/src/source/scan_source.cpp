@@ -21,8 +21,10 @@ bool is_tomo_file(const std::string& path) {
   return is_hdf5_path(path) && !split_hdf5_dataset(path);
 }
 
-// A scan JSON's "files" replace the path, flat and dark; the JSON is the geometry.
+// Where SCAN is a scan JSON, its "files" replace the path, flat and dark, and the JSON is the
+// geometry; any other SCAN is left as it is.
 void resolve_scan_json(ScanSource& source) {
+  if (std::filesystem::path(source.path).extension() != ".json") return;
   const std::optional<ScanFiles> files = read_scan_files(source.path);
   if (!files) {
     throw InputError(source.path +
@@ -87,17 +89,17 @@ std::map<std::string, std::string> files_read(const std::string& name) {
 // 'flat_end_*.tif' of --flat-after: an audit's drift then read +4.8% for +10%, without a word).
 // The same flats before and after the scan are no such mistake: no drift.
 void check_no_file_twice(const ScanSource& source) {
-  const std::map<std::string, std::string> flats_after = files_read(source.flat_after);
-  const bool same_flats = !flats_after.empty() && flats_after == files_read(source.flat);
-  const std::pair<const std::string*, const char*> fields[] = {
-      {&source.path, "the scan"},
-      {&source.flat, "the flat field"},
-      {&source.dark, "the dark field"},
-      {same_flats ? nullptr : &source.flat_after, "the flat field after the scan"}};
+  const std::map<std::string, std::string> flats = files_read(source.flat);
+  std::map<std::string, std::string> flats_after = files_read(source.flat_after);
+  if (flats_after == flats) flats_after.clear();
+  const std::pair<std::map<std::string, std::string>, const char*> fields[] = {
+      {files_read(source.path), "the scan"},
+      {flats, "the flat field"},
+      {files_read(source.dark), "the dark field"},
+      {std::move(flats_after), "the flat field after the scan"}};
   std::map<std::string, const char*> seen;
-  for (const auto& [name, what] : fields) {
-    if (!name) continue;
-    for (const auto& [file, shown] : files_read(*name)) {
+  for (const auto& [files, what] : fields) {
+    for (const auto& [file, shown] : files) {
       const auto [at, fresh] = seen.emplace(file, what);
       if (!fresh && at->second != what) {
         throw InputError(shown + " is read as " + at->second + " and as " + what +
@@ -111,7 +113,7 @@ void check_no_file_twice(const ScanSource& source) {
 // a tomography file, which holds its own flats and darks (a flat, dark or flats-after field
 // given beside it replaces or adds to the file's own).
 bool resolve_files(ScanSource& source) {
-  if (std::filesystem::path(source.path).extension() == ".json") resolve_scan_json(source);
+  resolve_scan_json(source);
   const bool tomo_file = is_tomo_file(source.path);
   if (!source.dark.empty() && source.flat.empty() && !tomo_file) {
     throw InputError("a dark field needs a flat field (and SCAN holding raw projections)");
@@ -335,7 +337,7 @@ LoadedScan load_scan_source(ScanSource source) {
 }
 
 std::filesystem::path geometry_file_of(ScanSource source) {
-  if (std::filesystem::path(source.path).extension() == ".json") resolve_scan_json(source);
+  resolve_scan_json(source);
   return find_geometry(source.path, source.geometry);
 }
 
