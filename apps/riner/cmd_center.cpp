@@ -18,7 +18,7 @@ int run_center(int argc, char** argv, int first) {
   args.output_flags();
   if (!args.parse(argc, argv, first)) return 0;
   Console console(args);
-  const LoadedScan loaded = scan_from(args, console);
+  const LoadedScan loaded = scan_from(args, console, false);
   const CentreEstimate e = estimate_centre(loaded.scan);
   console.line(centre_line(e) + "; the geometry says " +
                std::to_string(loaded.scan.geometry.offset_u));

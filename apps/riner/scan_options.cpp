@@ -107,14 +107,18 @@ std::optional<Geometry> stack_geometry(const Args& args) {
   }
 }
 
-LoadedScan scan_from(const Args& args, const Console& console) {
+LoadedScan scan_from(const Args& args, const Console& console, bool range_check) {
   LoadedScan loaded = load_scan_source(source_from(args));
   for (const std::string& note : loaded.notes) console.line(note);
+  if (range_check && loaded.angular_range_doubt) {
+    console.line("warning: " + *loaded.angular_range_doubt);
+  }
   return loaded;
 }
 
 std::optional<CentreEstimate> check_centre(const LoadedScan& loaded, const Console& console) {
-  if (loaded.centre) return std::nullopt;
+  // Views that turn otherwise than the angles say pair wrongly: scan_from has warned.
+  if (loaded.centre || loaded.angular_range_doubt) return std::nullopt;
   std::string note;
   std::optional<CentreEstimate> e = check_geometry_centre(loaded.scan, note);
   if (!note.empty()) console.line("note: " + note);

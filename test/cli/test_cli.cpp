@@ -966,6 +966,41 @@ TEST_SUITE("cli") {
                  2, sim + "/missing.json");
   }
 
+  TEST_CASE("a 360-degree scan given 180 degrees of angles: center stops, fbp warns") {
+    // The Shepp-Logan over a full turn with the paper's rings and noise, then the same readings
+    // under a half-turn's angles, a common mistake: center's pairs half a turn apart (by the
+    // angles) put the axis tens of pixels astray, and the reconstruction is garbage.
+    riner::test::TempDir dir;
+    const auto geometry = [&](const char* range) {
+      return std::string(R"({"type": "parallel2d", "detector": {"count": 120, "pitch_mm": 1.0,
+          "offset_px": 2.5}, "angles": {"count": 180, "range_rad": )") +
+             range + R"(}, "volume": {"shape": [96, 96], "voxel_mm": 1.0}})";
+    };
+    riner::test::write_bytes(dir / "full.json", geometry("6.283185307179586"));
+    riner::test::write_bytes(dir / "half.json", geometry("3.141592653589793"));
+    const std::string sim = (dir / "sim").string();
+    REQUIRE(riner_cli("simulate --quiet --seed 3 --geometry " + (dir / "full.json").string() +
+                          " --out " + sim,
+                      dir)
+                .code == 0);
+    const std::string wrong = sim + "/sino.npy --geometry " + (dir / "half.json").string();
+    const std::string doubt =
+        "the views cover a full turn (360 degrees), the geometry's angles 179.0 degrees";
+    expect_error(riner_cli("center " + wrong, dir), 2, "no centre: " + doubt);
+    expect_error(riner_cli("fbp " + wrong + " --offset-px auto --out " + sim + "/a.nii", dir), 2,
+                 "no centre: " + doubt);
+    const Run fbp = riner_cli("fbp " + wrong + " --out " + sim + "/wrong.nii", dir);
+    CHECK(fbp.code == 0);
+    CHECK(fbp.out.find("warning: " + doubt) != std::string::npos);
+    // Under its own angles: no word of it.
+    const Run right = riner_cli("fbp " + sim + "/sino.npy --out " + sim + "/right.nii", dir);
+    CHECK(right.code == 0);
+    CHECK(right.out.find("the views cover") == std::string::npos);
+    const Run center = riner_cli("center " + sim + "/sino.npy --json", dir);
+    REQUIRE(center.code == 0);
+    CHECK(std::fabs(nlohmann::json::parse(center.out)["offset_px"].get<double>() - 2.5) < 0.3);
+  }
+
   TEST_CASE("center: a narrow object, among strong rings or none, 0 to 6 px off the middle") {
     // The built-in phantom at 0.1 mm voxels fills 11-13 of 160 columns. With the detector's
     // responses (+-25%) offsetting every column, the stripes' mirror images outweighed the

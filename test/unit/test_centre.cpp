@@ -11,35 +11,16 @@
 #include "riner/error.hpp"
 #include "riner/phantom.hpp"
 #include "riner/projector.hpp"
+#include "support/asymmetric_object.hpp"
 #include "support/geometries.hpp"
 
 namespace {
 
-// An object with no symmetry about the grid centre: a bar, a disc and a ramp.
-riner::Array asymmetric(const std::vector<std::size_t>& shape) {
-  riner::Array a(shape);
-  const std::size_t ny = shape[shape.size() - 2], nx = shape.back();
-  const std::size_t slices = shape.size() == 3 ? shape[0] : 1;
-  for (std::size_t z = 0; z < slices; ++z) {
-    for (std::size_t i = 0; i < ny; ++i) {
-      for (std::size_t k = 0; k < nx; ++k) {
-        const double x = static_cast<double>(k) - 0.5 * nx, y = static_cast<double>(i) - 0.5 * ny;
-        float v = 0.0f;
-        if (x > 4 && x < 12 && y > -14 && y < 6) v += 0.02f;
-        if (std::hypot(x + 8, y - 7) < 5) v += 0.03f;
-        if (std::hypot(x, y) < 0.4 * nx) v += 0.005f * static_cast<float>(1.0 + x / nx + 0.1 * z);
-        a.data[(z * ny + i) * nx + k] = v;
-      }
-    }
-  }
-  return a;
-}
-
 riner::Scan scan_with_offset(riner::Geometry g, double offset) {
   g.offset_u = offset;
   riner::Scan s;
-  s.measurement =
-      riner::Projector(g, riner::Engine::kReference).project(asymmetric(g.volume_shape));
+  s.measurement = riner::Projector(g, riner::Engine::kReference)
+                      .project(riner::test::asymmetric_object(g.volume_shape));
   s.geometry = g;
   s.geometry.offset_u = 0.0;  // forgotten
   return s;

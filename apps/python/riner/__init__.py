@@ -343,7 +343,9 @@ def load_scan(path, geometry=None, flat=None, dark=None, row=None, center=None,
     row of a stack (a 2D slice); center: the axis's column, or "auto" to estimate it;
     flat_after: flats taken after the scan (each view's flat interpolated between the two).
     Beside a Data Exchange / NXtomo file, flat and dark replace the file's own and flat_after
-    adds to them. Returns (sino, geometry dict, notes dict with flat_field and centre)."""
+    adds to them. Returns (sino, geometry dict, notes dict with flat_field, centre and
+    angular_range_doubt: a line where the views turn twice or half as far as the angles say,
+    else None)."""
     sino, geometry_json, notes = _riner.load_scan(
         os.fspath(path), "" if geometry is None else os.fspath(geometry),
         "" if flat is None else os.fspath(flat), "" if dark is None else os.fspath(dark),

@@ -14,6 +14,7 @@
 #include "bindings.hpp"
 #include "numpy_arrays.hpp"
 #include "python_wording.hpp"
+#include "riner/angular_range.hpp"
 #include "riner/error.hpp"
 #include "riner/io.hpp"
 #include "riner/reconstructor.hpp"
@@ -90,11 +91,19 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
   app::require_training(config);
   // The CLI's check of the geometry's axis against the scan's own, said as a Python warning
   // and kept in the summary (it was missing from both).
+  // Views that turn twice or half as far as the angles say: said first, and no centre check
+  // (its pairs follow the angles).
   std::optional<CentreEstimate> centre_check;
   std::string centre_note;
+  std::optional<std::string> range_doubt;
   {
     py::gil_scoped_release release;
-    centre_check = app::check_geometry_centre(scan, centre_note);
+    range_doubt = angular_range_doubt(scan);
+    if (range_doubt) {
+      centre_note = *range_doubt;
+    } else {
+      centre_check = app::check_geometry_centre(scan, centre_note);
+    }
   }
   if (!centre_note.empty()) {
     const std::string text = python_wording(centre_note);
@@ -149,6 +158,8 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
     nlohmann::json json = app::run_summary(*reconstructor, result, check);
     if (!quality) json["quality"] = nullptr;
     json["centre_check"] = centre_check ? app::centre_json(*centre_check) : nlohmann::json(nullptr);
+    json["angular_range_doubt"] =
+        range_doubt ? nlohmann::json(*range_doubt) : nlohmann::json(nullptr);
     summary = python_wording(json.dump());
   }
   const TrainingStats done = reconstructor->stats();

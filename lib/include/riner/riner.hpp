@@ -3,6 +3,7 @@
 // single headers below are for code that wants fewer.
 #pragma once
 
+#include "riner/angular_range.hpp"
 #include "riner/array.hpp"
 #include "riner/centre.hpp"
 #include "riner/destripe.hpp"

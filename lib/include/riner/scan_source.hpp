@@ -30,6 +30,8 @@ struct LoadedScan {
   std::optional<FlatFieldReport> flat_field;  // set when SCAN held raw projections
   std::optional<CentreEstimate> centre;       // set by offset_px "auto"
   std::vector<std::string> notes;             // what was done, one line each
+  // Where the views turn twice or half as far as the angles say (riner/angular_range.hpp).
+  std::optional<std::string> angular_range_doubt;
 };
 
 // InputError (or std::invalid_argument for a usage mistake, e.g. a dark without a flat) with
@@ -48,6 +50,7 @@ std::filesystem::path geometry_file_of(ScanSource source);
 class ScanRows {
  public:
   static constexpr std::size_t kCentreRows = 8;
+  static constexpr std::size_t kRangeRows = 2;
   // InputError as load_scan_source; also for a 2D scan or a `row` (a slice is read whole). A
   // stack of rows under a parallel2d geometry is read as stack_of_slices of it.
   explicit ScanRows(ScanSource source);
@@ -64,6 +67,9 @@ class ScanRows {
   // What reading the files found worth saying before any slab (a tomography file's own angles
   // against the geometry's).
   const std::vector<std::string>& notes() const { return notes_; }
+  // riner/angular_range.hpp on kRangeRows rows about the middle of the detector (read now):
+  // where the views turn twice or half as far as the angles say.
+  std::optional<std::string> angular_range_doubt() const;
 
  private:
   ScanSource source_;

@@ -15,6 +15,7 @@
 #include "preprocessing/centre_conjugate.hpp"
 #include "preprocessing/centre_sinogram.hpp"
 #include "preprocessing/mismatch_sums.hpp"
+#include "riner/angular_range.hpp"
 #include "riner/array.hpp"
 #include "riner/error.hpp"
 #include "riner/rays.hpp"
@@ -463,6 +464,10 @@ CentreEstimate estimate_from(const Scan& as_read, const Scan& scan) {
     return e;
   }
   if (g.n_u < 8) throw InputError("centre finding needs a detector of at least 8 elements");
+  // Pairs half a turn apart by angles of the wrong range match best at a confident wrong axis.
+  if (std::optional<std::string> doubt = angular_range_doubt(as_read)) {
+    throw InputError("no centre: " + *doubt);
+  }
   const std::optional<CentreEstimate> pairs = from_view_pairs(scan);
   std::optional<preprocessing::SinogramAxis> sinogram = preprocessing::sinogram_axis(scan);
   const bool no_minimum = sinogram && sinogram->rows == 0;

@@ -8,6 +8,7 @@
 #include <map>
 
 #include "io/stack.hpp"
+#include "riner/angular_range.hpp"
 #include "riner/error.hpp"
 #include "riner/flat_field.hpp"
 #include "riner/io.hpp"
@@ -326,6 +327,7 @@ LoadedScan load_scan_source(ScanSource source) {
     notes.front() = layout + notes.front();
     loaded.notes.insert(loaded.notes.end(), notes.begin(), notes.end());
   }
+  loaded.angular_range_doubt = angular_range_doubt(loaded.scan);
   if (source.offset_px == "auto") {
     loaded.centre = estimate_centre(loaded.scan);
     loaded.scan.geometry.offset_u = loaded.centre->offset_px;
@@ -378,6 +380,16 @@ ScanRows::ScanRows(ScanSource source) : source_(std::move(source)) {
     geometry_.offset_u = centre_->offset_px;
   } else if (!source_.offset_px.empty()) {
     geometry_.offset_u = parse_offset(source_.offset_px);
+  }
+}
+
+std::optional<std::string> ScanRows::angular_range_doubt() const {
+  if (geometry_.is_divergent()) return std::nullopt;
+  const std::size_t count = std::min<std::size_t>(kRangeRows, rows());
+  try {
+    return riner::angular_range_doubt(read({(rows() - count) / 2, count}));
+  } catch (const InputError&) {
+    return std::nullopt;  // rows that read nothing: the slabs say so in their own words
   }
 }
 

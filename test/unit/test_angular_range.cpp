@@ -1,0 +1,146 @@
+// Whether the views turn as far as the angles say: scans of half and full turns read as they
+// are, the same scans under angles of the other range (a 360-degree scan given 180 degrees, and
+// the reverse) caught, and objects that cannot tell (a disc on the axis) left undecided.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <random>
+
+#include "riner/angular_range.hpp"
+#include "riner/centre.hpp"
+#include "riner/error.hpp"
+#include "riner/projector.hpp"
+#include "support/asymmetric_object.hpp"
+#include "support/geometries.hpp"
+
+namespace {
+
+riner::Geometry with_angles(riner::Geometry g, std::size_t views, double range, bool endpoint) {
+  g.uniform_angles.reset();
+  g.angles.clear();
+  const double step = range / static_cast<double>(endpoint ? views - 1 : views);
+  for (std::size_t i = 0; i < views; ++i) g.angles.push_back(0.3 + step * static_cast<double>(i));
+  return g;
+}
+
+riner::Scan scan_of(const riner::Geometry& g, const riner::Array& object) {
+  g.validate();
+  return {riner::Projector(g, riner::Engine::kReference).project(object), g, 0};
+}
+
+// The same readings under angles scaled by `factor` about the first.
+riner::Scan relabelled(riner::Scan s, double factor) {
+  s.geometry.uniform_angles.reset();
+  const double first = s.geometry.angles.front();
+  for (double& a : s.geometry.angles) a = first + factor * (a - first);
+  return s;
+}
+
+// Each element offset by its own constant, up to `share` of the largest reading either way, and
+// Gaussian noise of `noise` of it: a ringed, noisy detector.
+riner::Scan ringed(riner::Scan s, double share, double noise) {
+  double top = 0.0;
+  for (float v : s.measurement.data) top = std::max(top, static_cast<double>(v));
+  const std::size_t per_view = s.measurement.size() / s.geometry.n_views();
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> offset(-share * top, share * top);
+  std::normal_distribution<double> gauss(0.0, noise * top);
+  std::vector<double> stripes(per_view);
+  for (double& o : stripes) o = offset(rng);
+  for (std::size_t i = 0; i < s.measurement.size(); ++i) {
+    s.measurement.data[i] += static_cast<float>(stripes[i % per_view] + gauss(rng));
+  }
+  return s;
+}
+
+}  // namespace
+
+TEST_SUITE("angular range") {
+  TEST_CASE("half and full turns read as their angles say; under the other range, a doubt") {
+    const riner::Geometry base = riner::test::small_parallel2d();
+    const riner::Array object = riner::test::asymmetric_object(base.volume_shape);
+    struct Case {
+      std::size_t views;
+      double range;
+      bool endpoint;
+      riner::TurnReading turn;
+    };
+    for (const Case& c : {Case{61, M_PI, true, riner::TurnReading::kHalfTurn},
+                          Case{60, M_PI, false, riner::TurnReading::kHalfTurn},
+                          Case{90, 2.0 * M_PI, false, riner::TurnReading::kFullTurn},
+                          Case{91, 2.0 * M_PI, true, riner::TurnReading::kFullTurn}}) {
+      for (const double rings : {0.0, 0.1}) {
+        CAPTURE(c.views);
+        CAPTURE(rings);
+        const riner::Scan scan =
+            ringed(scan_of(with_angles(base, c.views, c.range, c.endpoint), object), rings, 0.002);
+        const riner::AngularRangeEvidence as_given = riner::read_angular_range(scan);
+        CHECK(as_given.geometry == c.turn);
+        CHECK(as_given.readings == c.turn);
+        CHECK_FALSE(riner::angular_range_doubt(as_given));
+
+        const bool full = c.turn == riner::TurnReading::kFullTurn;
+        const riner::Scan wrong = relabelled(scan, full ? 0.5 : 2.0);
+        const riner::AngularRangeEvidence e = riner::read_angular_range(wrong);
+        CHECK(e.geometry != c.turn);
+        CHECK(e.readings == c.turn);
+        const std::optional<std::string> doubt = riner::angular_range_doubt(e);
+        REQUIRE(doubt);
+        CHECK(doubt->find(full ? "the views cover a full turn (360 degrees)"
+                               : "the views cover a half-turn (180 degrees)") == 0);
+        CHECK(doubt->find("check the geometry's angles") != std::string::npos);
+        // The centre finders pair views by the angles: they stop instead of answering.
+        CHECK_THROWS_WITH_AS(riner::estimate_centre(wrong), doctest::Contains("no centre: "),
+                             riner::InputError);
+      }
+    }
+  }
+
+  TEST_CASE("parallel 3D: the rows read together") {
+    const riner::Geometry g = with_angles(riner::test::small_parallel3d(), 40, 2.0 * M_PI, false);
+    const riner::Scan scan = scan_of(g, riner::test::asymmetric_object(g.volume_shape));
+    CHECK(riner::read_angular_range(scan).readings == riner::TurnReading::kFullTurn);
+    CHECK_FALSE(riner::angular_range_doubt(scan));
+    CHECK(riner::angular_range_doubt(relabelled(scan, 0.5)));
+  }
+
+  TEST_CASE("a disc on the axis looks the same at every angle: undecided, no doubt") {
+    const riner::Geometry g = with_angles(riner::test::small_parallel2d(), 90, 2.0 * M_PI, false);
+    riner::Array disc(g.volume_shape);
+    const std::size_t ny = g.volume_shape[0], nx = g.volume_shape[1];
+    for (std::size_t i = 0; i < ny; ++i) {
+      for (std::size_t k = 0; k < nx; ++k) {
+        const double x = static_cast<double>(k) - 0.5 * (nx - 1.0);
+        const double y = static_cast<double>(i) - 0.5 * (ny - 1.0);
+        disc.data[i * nx + k] = std::hypot(x, y) < 20.0 ? 0.02f : 0.0f;
+      }
+    }
+    const riner::Scan scan = ringed(scan_of(g, disc), 0.1, 0.002);
+    for (const double factor : {1.0, 0.5}) {
+      CAPTURE(factor);
+      const riner::AngularRangeEvidence e = riner::read_angular_range(relabelled(scan, factor));
+      CHECK(e.readings == riner::TurnReading::kUndecided);
+      CHECK_FALSE(riner::angular_range_doubt(e));
+    }
+  }
+
+  TEST_CASE("not checked: a fan beam, a range of neither turn, too few views") {
+    const riner::Geometry fan = riner::test::small_fan2d();
+    const riner::Array object = riner::test::asymmetric_object(fan.volume_shape);
+    CHECK(riner::read_angular_range(scan_of(fan, object)).geometry ==
+          riner::TurnReading::kNotChecked);
+    const riner::Geometry base = riner::test::small_parallel2d();
+    const riner::Array parallel_object = riner::test::asymmetric_object(base.volume_shape);
+    for (const auto& [views, degrees] :
+         {std::pair{60, 120.0}, std::pair{60, 270.0}, std::pair{6, 180.0}}) {
+      CAPTURE(views);
+      CAPTURE(degrees);
+      const riner::Scan scan =
+          scan_of(with_angles(base, static_cast<std::size_t>(views), degrees * M_PI / 180.0, false),
+                  parallel_object);
+      const riner::AngularRangeEvidence e = riner::read_angular_range(scan);
+      CHECK(e.readings == riner::TurnReading::kNotChecked);
+      CHECK_FALSE(riner::angular_range_doubt(e));
+    }
+  }
+}
