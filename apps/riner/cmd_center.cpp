@@ -19,11 +19,15 @@ int run_center(int argc, char** argv, int first) {
   if (!args.parse(argc, argv, first)) return 0;
   Console console(args);
   const LoadedScan loaded = scan_from(args, console, false);
+  // A wrong range stops the centre finders (they pair views by the angles); a fan's distances
+  // doubted leave its axis standing, said after it.
   const CentreEstimate e = estimate_centre(loaded.scan);
   console.line(centre_line(e) + "; the geometry says " +
                std::to_string(loaded.scan.geometry.offset_u));
+  for (const std::string& doubt : loaded.geometry_doubts) console.line("warning: " + doubt);
   nlohmann::json summary = centre_json(e);
   summary["geometry_offset_px"] = loaded.scan.geometry.offset_u;
+  summary["geometry_doubts"] = loaded.geometry_doubts;
   console.summary(summary);
   return 0;
 }

@@ -89,8 +89,8 @@ void note_short_scan(const Console& console, const FbpReport& report) {
 int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions& options) {
   const ScanRows source(source_from(args));
   for (const std::string& note : source.notes()) console.line(note);
-  if (std::optional<std::string> doubt = source.angular_range_doubt()) {
-    console.line("warning: " + *doubt);
+  for (const std::string& doubt : source.geometry_doubts()) {
+    console.line("warning: " + doubt);
   }
   if (source.centre()) console.line(centre_line(*source.centre()));
   const Geometry& g = source.geometry();

@@ -339,9 +339,7 @@ int run_reconstruct(int argc, char** argv, int first) {
   summary["centre"] = loaded.centre ? centre_json(*loaded.centre) : nlohmann::json(nullptr);
   // The scan's own estimate of the axis beside the offset it was given (null: not checked).
   summary["centre_check"] = centre_check ? centre_json(*centre_check) : nlohmann::json(nullptr);
-  summary["angular_range_doubt"] = loaded.angular_range_doubt
-                                       ? nlohmann::json(*loaded.angular_range_doubt)
-                                       : nlohmann::json(nullptr);
+  summary["geometry_doubts"] = loaded.geometry_doubts;
   const double wall =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count();
   summary["wall_seconds"] = wall;  // "seconds" is the training's, before a resume included

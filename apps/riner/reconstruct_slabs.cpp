@@ -244,8 +244,8 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   ScanRows source(source_from(args));
   if (speak) {
     for (const std::string& note : source.notes()) console.line(note);
-    if (std::optional<std::string> doubt = source.angular_range_doubt()) {
-      console.line("warning: " + *doubt);
+    for (const std::string& doubt : source.geometry_doubts()) {
+      console.line("warning: " + doubt);
     }
   }
   if (source.centre() && speak) console.line(centre_line(*source.centre()));

@@ -107,18 +107,17 @@ std::optional<Geometry> stack_geometry(const Args& args) {
   }
 }
 
-LoadedScan scan_from(const Args& args, const Console& console, bool range_check) {
+LoadedScan scan_from(const Args& args, const Console& console, bool doubts) {
   LoadedScan loaded = load_scan_source(source_from(args));
   for (const std::string& note : loaded.notes) console.line(note);
-  if (range_check && loaded.angular_range_doubt) {
-    console.line("warning: " + *loaded.angular_range_doubt);
+  if (doubts) {
+    for (const std::string& doubt : loaded.geometry_doubts) console.line("warning: " + doubt);
   }
   return loaded;
 }
 
 std::optional<CentreEstimate> check_centre(const LoadedScan& loaded, const Console& console) {
-  // Views that turn otherwise than the angles say pair wrongly: scan_from has warned.
-  if (loaded.centre || loaded.angular_range_doubt) return std::nullopt;
+  if (loaded.centre) return std::nullopt;
   std::string note;
   std::optional<CentreEstimate> e = check_geometry_centre(loaded.scan, note);
   if (!note.empty()) console.line("note: " + note);

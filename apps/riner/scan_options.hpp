@@ -25,14 +25,12 @@ std::optional<Geometry> stack_geometry(const Args& args);
 
 // The measurement SCAN names, or, with --flat, raw projections normalised by their flat and
 // dark fields; its detector offset from --offset-px (a number, or auto: estimated).
-// Console lines say what was done, and warn where the views turn twice or half as far as the
-// angles say (riner/angular_range.hpp; not with `range_check` false: the centre finder stops
-// there with the same words).
-LoadedScan scan_from(const Args& args, const Console& console, bool range_check = true);
+// Console lines say what was done, and (with `doubts`) warn of what the readings say against
+// the geometry (riner/geometry_doubts.hpp).
+LoadedScan scan_from(const Args& args, const Console& console, bool doubts = true);
 
 // A scan whose offset was given (not auto): check_geometry_centre (summary_json.hpp), its note
-// on the console. nullopt for auto offsets and where the views turn otherwise than the angles
-// say (the centre finders pair views by the angles).
+// on the console. nullopt for auto offsets.
 std::optional<CentreEstimate> check_centre(const LoadedScan& loaded, const Console& console);
 
 }  // namespace riner::app

@@ -999,6 +999,38 @@ TEST_SUITE("cli") {
     const Run center = riner_cli("center " + sim + "/sino.npy --json", dir);
     REQUIRE(center.code == 0);
     CHECK(std::fabs(nlohmann::json::parse(center.out)["offset_px"].get<double>() - 2.5) < 0.3);
+    CHECK(nlohmann::json::parse(center.out)["geometry_doubts"].empty());
+  }
+
+  TEST_CASE("a fan whose source-detector distance was given as origin_detector_mm: a warning") {
+    // The paper's fan (source and detector 370 mm from the axis) under TIGRE's mistake: 740 mm
+    // given where riner wants the axis-detector distance. Its rays then pair with the wrong
+    // conjugates and the reconstruction is blurred and bent.
+    riner::test::TempDir dir;
+    const std::string sim = (dir / "sim").string();
+    REQUIRE(riner_cli("simulate --quiet --seed 4 --out " + sim, dir).code == 0);
+    nlohmann::json g = nlohmann::json::parse(riner::test::read_bytes(sim + "/geometry.json"));
+    g["origin_detector_mm"] = 740.0;
+    riner::test::write_bytes(dir / "sdd.json", g.dump());
+    const std::string doubt =
+        "warning: the fan's rays meet their conjugates where the source sits 740 mm from the "
+        "detector, 0.67 times the geometry's 1110 mm (source_origin_mm 370 + origin_detector_mm "
+        "740)";
+    const Run fbp = riner_cli("fbp " + sim + "/sino.npy --geometry " + (dir / "sdd.json").string() +
+                                  " --out " + sim + "/wrong.nii",
+                              dir);
+    CHECK(fbp.code == 0);
+    CHECK(fbp.out.find(doubt) != std::string::npos);
+    const Run center = riner_cli(
+        "center " + sim + "/sino.npy --geometry " + (dir / "sdd.json").string() + " --json", dir);
+    REQUIRE(center.code == 0);
+    const nlohmann::json e = nlohmann::json::parse(center.out);
+    REQUIRE(e["geometry_doubts"].size() == 1);
+    CHECK(("warning: " + e["geometry_doubts"][0].get<std::string>()).find(doubt) == 0);
+    CHECK(std::fabs(e["offset_px"].get<double>() - g["detector"]["offset_px"].get<double>()) < 0.5);
+    const Run right = riner_cli("fbp " + sim + "/sino.npy --out " + sim + "/right.nii", dir);
+    CHECK(right.code == 0);
+    CHECK(right.out.find("conjugates") == std::string::npos);
   }
 
   TEST_CASE("center: a narrow object, among strong rings or none, 0 to 6 px off the middle") {

@@ -344,8 +344,8 @@ def load_scan(path, geometry=None, flat=None, dark=None, row=None, center=None,
     flat_after: flats taken after the scan (each view's flat interpolated between the two).
     Beside a Data Exchange / NXtomo file, flat and dark replace the file's own and flat_after
     adds to them. Returns (sino, geometry dict, notes dict with flat_field, centre and
-    angular_range_doubt: a line where the views turn twice or half as far as the angles say,
-    else None)."""
+    geometry_doubts: a line each for what the readings say against the geometry, such as views
+    that turn twice or half as far as the angles say)."""
     sino, geometry_json, notes = _riner.load_scan(
         os.fspath(path), "" if geometry is None else os.fspath(geometry),
         "" if flat is None else os.fspath(flat), "" if dark is None else os.fspath(dark),

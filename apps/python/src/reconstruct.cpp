@@ -14,8 +14,8 @@
 #include "bindings.hpp"
 #include "numpy_arrays.hpp"
 #include "python_wording.hpp"
-#include "riner/angular_range.hpp"
 #include "riner/error.hpp"
+#include "riner/geometry_doubts.hpp"
 #include "riner/io.hpp"
 #include "riner/reconstructor.hpp"
 #include "summary_json.hpp"
@@ -89,26 +89,22 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
   Scan scan = scan_from(measurement, geometry_json);
   const RinerConfig config = config_from(config_json, settings, engine);
   app::require_training(config);
-  // The CLI's check of the geometry's axis against the scan's own, said as a Python warning
-  // and kept in the summary (it was missing from both).
-  // Views that turn twice or half as far as the angles say: said first, and no centre check
-  // (its pairs follow the angles).
+  // The CLI's checks of the geometry against the scan's readings (its range, a fan's distances,
+  // the axis), said as Python warnings and kept in the summary.
   std::optional<CentreEstimate> centre_check;
   std::string centre_note;
-  std::optional<std::string> range_doubt;
+  std::vector<std::string> doubts;
   {
     py::gil_scoped_release release;
-    range_doubt = angular_range_doubt(scan);
-    if (range_doubt) {
-      centre_note = *range_doubt;
-    } else {
-      centre_check = app::check_geometry_centre(scan, centre_note);
-    }
+    doubts = geometry_doubts(scan);
+    centre_check = app::check_geometry_centre(scan, centre_note);
   }
-  if (!centre_note.empty()) {
-    const std::string text = python_wording(centre_note);
+  if (!centre_note.empty()) doubts.push_back(centre_note);
+  for (const std::string& doubt : doubts) {
+    const std::string text = python_wording(doubt);
     if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) < 0) throw py::error_already_set();
   }
+  if (!centre_note.empty()) doubts.pop_back();
 
   std::unique_ptr<Reconstructor> reconstructor;
   std::optional<Device> dev;
@@ -158,8 +154,7 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
     nlohmann::json json = app::run_summary(*reconstructor, result, check);
     if (!quality) json["quality"] = nullptr;
     json["centre_check"] = centre_check ? app::centre_json(*centre_check) : nlohmann::json(nullptr);
-    json["angular_range_doubt"] =
-        range_doubt ? nlohmann::json(*range_doubt) : nlohmann::json(nullptr);
+    json["geometry_doubts"] = doubts;
     summary = python_wording(json.dump());
   }
   const TrainingStats done = reconstructor->stats();

@@ -202,9 +202,7 @@ void bind_scan_functions(py::module_& m) {
         {"flat_field",
          loaded.flat_field ? app::flat_field_json(*loaded.flat_field) : nlohmann::json(nullptr)},
         {"centre", loaded.centre ? app::centre_json(*loaded.centre) : nlohmann::json(nullptr)},
-        {"angular_range_doubt", loaded.angular_range_doubt
-                                    ? nlohmann::json(*loaded.angular_range_doubt)
-                                    : nlohmann::json(nullptr)}};
+        {"geometry_doubts", loaded.geometry_doubts}};
     return py::make_tuple(to_numpy(std::move(loaded.scan.measurement)),
                           loaded.scan.geometry.to_json(), python_wording(notes.dump()));
   });

@@ -12,6 +12,7 @@
 #include "riner/fbp.hpp"
 #include "riner/flat_field.hpp"
 #include "riner/geometry.hpp"
+#include "riner/geometry_doubts.hpp"
 #include "riner/io.hpp"
 #include "riner/metrics.hpp"
 #include "riner/phantom.hpp"

@@ -30,8 +30,8 @@ struct LoadedScan {
   std::optional<FlatFieldReport> flat_field;  // set when SCAN held raw projections
   std::optional<CentreEstimate> centre;       // set by offset_px "auto"
   std::vector<std::string> notes;             // what was done, one line each
-  // Where the views turn twice or half as far as the angles say (riner/angular_range.hpp).
-  std::optional<std::string> angular_range_doubt;
+  // What the readings say against the geometry (riner/geometry_doubts.hpp).
+  std::vector<std::string> geometry_doubts;
 };
 
 // InputError (or std::invalid_argument for a usage mistake, e.g. a dark without a flat) with
@@ -67,9 +67,9 @@ class ScanRows {
   // What reading the files found worth saying before any slab (a tomography file's own angles
   // against the geometry's).
   const std::vector<std::string>& notes() const { return notes_; }
-  // riner/angular_range.hpp on kRangeRows rows about the middle of the detector (read now):
-  // where the views turn twice or half as far as the angles say.
-  std::optional<std::string> angular_range_doubt() const;
+  // riner/geometry_doubts.hpp on kRangeRows rows about the middle of the detector (read now;
+  // a cone's about the source's plane); empty where those rows read nothing.
+  std::vector<std::string> geometry_doubts() const;
 
  private:
   ScanSource source_;

@@ -99,7 +99,7 @@ double edge_reading_share(const Array& measurement) {
   const std::size_t n = measurement.shape.back();
   const std::size_t lines = measurement.size() / n;
   std::vector<double> shares;
-  const auto end_reading = [](const float* line, std::size_t n, bool from_left) {
+  const auto end_reading = [n](const float* line, bool from_left) {
     std::vector<double> outer;
     for (std::size_t k = 0; k < n && outer.size() < 3; ++k) {
       const float x = line[from_left ? k : n - 1 - k];
@@ -115,7 +115,7 @@ double edge_reading_share(const Array& measurement) {
     for (std::size_t k = 0; k < n; ++k) {
       if (std::fabs(line[k]) <= kLargestReading) largest = std::max(largest, line[k]);
     }
-    const double edge = std::fmax(end_reading(line, n, true), end_reading(line, n, false));
+    const double edge = std::fmax(end_reading(line, true), end_reading(line, false));
     if (largest > 0.0f && std::isfinite(edge)) shares.push_back(edge / largest);
   }
   return shares.empty() ? 0.0 : util::quantile(shares, 0.5);

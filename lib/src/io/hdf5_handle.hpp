@@ -8,7 +8,7 @@ namespace riner::io {
 
 class Hid {
  public:
-  Hid(hid_t id, herr_t (*close)(hid_t)) : id_(id), close_(close) {}
+  Hid(hid_t id, herr_t (*closer)(hid_t)) : id_(id), close_(closer) {}
   Hid(const Hid&) = delete;
   Hid& operator=(const Hid&) = delete;
   Hid(Hid&& other) noexcept : id_(other.id_), close_(other.close_) { other.id_ = -1; }

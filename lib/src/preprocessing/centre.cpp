@@ -241,6 +241,11 @@ std::optional<std::pair<double, double>> best_outer_axis(std::span<const LinePai
 // object (about 1 or more), its true axis a few hundredths.
 constexpr double kOuterAxisAdvantage = 0.25;
 
+// A fan's distances are doubted where another source-detector distance, this factor away or
+// more, pairs rays with their conjugates this many times better than the geometry's.
+constexpr double kDistanceDoubtFactor = 1.1;
+constexpr double kDistanceDoubtContrast = 4.0;
+
 }  // namespace
 
 namespace {
@@ -502,6 +507,34 @@ CentreEstimate estimate_from(const Scan& as_read, const Scan& scan) {
 }
 
 }  // namespace
+
+std::optional<std::string> fan_distance_doubt(const Scan& scan) {
+  const Geometry& g = scan.geometry;
+  if (!g.is_divergent() || !holds_structure(scan.measurement)) return std::nullopt;
+  const bool cone = g.type == GeometryType::kCone3d;
+  Scan prepared = without_spikes(without_stuck(
+      g.is_3d() && scan.measurement.size() > kMostCopiedReadings ? centre_rows(scan) : scan));
+  prepared = compared(std::move(prepared));
+  const Scan fan = in_angle_order(cone ? midplane_fan(prepared) : prepared);
+  const std::optional<preprocessing::FanDistanceFit> fit =
+      preprocessing::conjugate_fan_distance(fan, g.offset_u);
+  if (!fit || std::fabs(std::log(fit->scale)) < std::log(kDistanceDoubtFactor) ||
+      fit->cost * kDistanceDoubtContrast > fit->cost_as_given) {
+    return std::nullopt;
+  }
+  const double sdd = g.source_origin_mm + g.origin_detector_mm;
+  char line[600];
+  std::snprintf(
+      line, sizeof(line),
+      "the fan's rays meet their conjugates where the source sits %.0f mm from the detector, "
+      "%.2f times the geometry's %.0f mm (source_origin_mm %g + origin_detector_mm %g), or "
+      "with a detector pitch %.2f times the given %g mm: mismatch %.2f%% of the readings' "
+      "spread, %.2f%% as given; check the distances (origin_detector_mm runs from the axis, "
+      "not the source) and the pitch (after binning)",
+      fit->scale * sdd, fit->scale, sdd, g.source_origin_mm, g.origin_detector_mm, 1.0 / fit->scale,
+      g.pitch_u, 100.0 * fit->cost, 100.0 * fit->cost_as_given);
+  return std::string(line);
+}
 
 bool centre_search_covers(const Geometry& g) {
   if (g.is_divergent() || covers_full_turn(g)) return true;

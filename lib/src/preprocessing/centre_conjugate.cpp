@@ -254,11 +254,11 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, const Scan& fine_s
       fine.push_back(conjugate_cost(fine_scan, *turn, offsets.back(), kFine));
       most_fine = std::max(most_fine, fine.back().rays);
     }
-    for (const Cost& c : fine) {
+    for (const Cost& f : fine) {
       if (half_acquisition) {
-        costs.push_back(c.relative);
+        costs.push_back(f.relative);
       } else {
-        costs.push_back(enough(c, most_fine) ? c.mean : std::numeric_limits<double>::infinity());
+        costs.push_back(enough(f, most_fine) ? f.mean : std::numeric_limits<double>::infinity());
       }
     }
     best = static_cast<std::size_t>(std::min_element(costs.begin(), costs.end()) - costs.begin());
@@ -278,6 +278,63 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, const Scan& fine_s
     }
   }
   return out;
+}
+
+std::optional<FanDistanceFit> conjugate_fan_distance(const Scan& fine_scan, double offset_px) {
+  const Geometry& g = fine_scan.geometry;
+  if (g.type != GeometryType::kFan2d || g.n_u < 8) return std::nullopt;
+  const std::optional<Turn> turn = full_turn(g);
+  if (!turn) return std::nullopt;
+  // The least relative cost over offsets within 2 px of the given, every pixel (the axis is
+  // checked on its own: a distance wrong by 10% moves it by a few hundredths).
+  const auto best_at = [&](double scale, RaySample sample) {
+    Scan scaled = fine_scan;
+    scaled.geometry.pitch_u = g.pitch_u / scale;
+    std::pair<double, double> best{offset_px, std::numeric_limits<double>::infinity()};
+    for (double o = offset_px - 2.0; o <= offset_px + 2.0; o += 1.0) {
+      const double cost = conjugate_cost(scaled, *turn, o, sample).relative;
+      if (cost < best.second) best = {o, cost};
+    }
+    return best;
+  };
+  FanDistanceFit fit;
+  const std::pair<double, double> as_given = best_at(1.0, kCoarse);
+  if (!std::isfinite(as_given.second)) return std::nullopt;
+  fit.cost_as_given = fit.cost = as_given.second;
+  fit.offset_px = as_given.first;
+  // Factors 1/2 to 2 in steps of 2^(1/8) (9%) on a quarter of the rays, then 2^(1/32) (2%)
+  // about the best on all of them, then a parabola in log scale through the best and its
+  // neighbours.
+  double coarse = 1.0, coarse_cost = best_at(1.0, kOuter).second;
+  for (int k = -8; k <= 8; ++k) {
+    if (k == 0) continue;
+    const double scale = std::pow(2.0, k / 8.0);
+    const double cost = best_at(scale, kOuter).second;
+    if (cost < coarse_cost) coarse_cost = cost, coarse = scale;
+  }
+  const double step = std::log(2.0) / 32.0;
+  std::vector<double> costs;
+  for (int k = -4; k <= 4; ++k) {
+    const double scale = coarse * std::exp(k * step);
+    const std::pair<double, double> b =
+        k == 0 && coarse == 1.0 ? as_given : best_at(scale, kCoarse);
+    costs.push_back(b.second);
+    if (b.second < fit.cost) {
+      fit.cost = b.second;
+      fit.scale = scale;
+      fit.offset_px = b.first;
+    }
+  }
+  const auto at =
+      static_cast<std::size_t>(std::min_element(costs.begin(), costs.end()) - costs.begin());
+  if (at > 0 && at + 1 < costs.size() && fit.scale != 1.0) {
+    const double c0 = costs[at - 1], c1 = costs[at], c2 = costs[at + 1];
+    const double curvature = c0 - 2.0 * c1 + c2;
+    if (std::isfinite(curvature) && curvature > 0.0) {
+      fit.scale *= std::exp(0.5 * step * (c0 - c2) / curvature);
+    }
+  }
+  return fit;
 }
 
 }  // namespace riner::preprocessing

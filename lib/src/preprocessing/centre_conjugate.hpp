@@ -43,4 +43,20 @@ struct ConjugateAxis {
 std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, const Scan& fine_scan,
                                             double search_px = 32.0);
 
+// How far the fan's source sits from its detector, read from conjugate rays: a ray meets its
+// conjugate only with the fan angles (element position over the source-detector distance) the
+// scan had, so a distance given wrong (a TIGRE user's source-detector distance given as the
+// origin-detector distance; a detector pitch before binning) pairs rays with the wrong views
+// at every offset. `scale`: the factor on the geometry's source-detector distance (as a factor
+// 1 / scale on the pitch: the fan angles alone count, not where along the ray the source is)
+// whose best offset (within 4 px of offset_px) matches best; the relative costs there and at
+// the geometry's own distance. Fan beam over a full turn only; nullopt otherwise.
+struct FanDistanceFit {
+  double scale = 1.0;
+  double offset_px = 0.0;
+  double cost = 0.0;           // relative, at scale and its best offset
+  double cost_as_given = 0.0;  // relative, at scale 1 and its best offset
+};
+std::optional<FanDistanceFit> conjugate_fan_distance(const Scan& fine_scan, double offset_px);
+
 }  // namespace riner::preprocessing

@@ -8,10 +8,11 @@
 #include <map>
 
 #include "io/stack.hpp"
-#include "riner/angular_range.hpp"
 #include "riner/error.hpp"
 #include "riner/flat_field.hpp"
+#include "riner/geometry_doubts.hpp"
 #include "riner/io.hpp"
+#include "riner/rays.hpp"
 #include "riner/tomo_file.hpp"
 
 namespace riner {
@@ -327,7 +328,7 @@ LoadedScan load_scan_source(ScanSource source) {
     notes.front() = layout + notes.front();
     loaded.notes.insert(loaded.notes.end(), notes.begin(), notes.end());
   }
-  loaded.angular_range_doubt = angular_range_doubt(loaded.scan);
+  loaded.geometry_doubts = geometry_doubts(loaded.scan);
   if (source.offset_px == "auto") {
     loaded.centre = estimate_centre(loaded.scan);
     loaded.scan.geometry.offset_u = loaded.centre->offset_px;
@@ -383,13 +384,19 @@ ScanRows::ScanRows(ScanSource source) : source_(std::move(source)) {
   }
 }
 
-std::optional<std::string> ScanRows::angular_range_doubt() const {
-  if (geometry_.is_divergent()) return std::nullopt;
+std::vector<std::string> ScanRows::geometry_doubts() const {
+  // A cone's conjugate rays lie in the source's plane: the rows about it.
   const std::size_t count = std::min<std::size_t>(kRangeRows, rows());
+  std::size_t first = (rows() - count) / 2;
+  if (geometry_.type == GeometryType::kCone3d) {
+    const double v = project_to_detector(geometry_, 0, Vec3{0.0, 0.0, 0.0}).v;
+    first = static_cast<std::size_t>(
+        std::clamp(std::floor(v), 0.0, static_cast<double>(rows() - count)));
+  }
   try {
-    return riner::angular_range_doubt(read({(rows() - count) / 2, count}));
+    return riner::geometry_doubts(read({first, count}));
   } catch (const InputError&) {
-    return std::nullopt;  // rows that read nothing: the slabs say so in their own words
+    return {};  // rows that read nothing: the slabs say so in their own words
   }
 }
 

@@ -1,14 +1,18 @@
-// Whether the views turn as far as the angles say: scans of half and full turns read as they
-// are, the same scans under angles of the other range (a 360-degree scan given 180 degrees, and
-// the reverse) caught, and objects that cannot tell (a disc on the axis) left undecided.
+// What the readings say against the geometry. Whether the views turn as far as the angles say:
+// scans of half and full turns read as they are, the same scans under angles of the other range
+// (a 360-degree scan given 180 degrees, and the reverse) caught, objects that cannot tell (a disc
+// on the axis) left undecided. Whether a fan's distances pair its rays with their conjugates.
 #include <doctest/doctest.h>
 
 #include <cmath>
 #include <random>
+#include <string>
+#include <vector>
 
 #include "riner/angular_range.hpp"
 #include "riner/centre.hpp"
 #include "riner/error.hpp"
+#include "riner/geometry_doubts.hpp"
 #include "riner/projector.hpp"
 #include "support/asymmetric_object.hpp"
 #include "support/geometries.hpp"
@@ -142,5 +146,53 @@ TEST_SUITE("angular range") {
       CHECK(e.readings == riner::TurnReading::kNotChecked);
       CHECK_FALSE(riner::angular_range_doubt(e));
     }
+  }
+}
+
+TEST_SUITE("fan distance") {
+  // The fan's distances against its conjugate rays: the scan under its own geometry, then under
+  // the source-detector distance given as origin_detector_mm (TIGRE's DSD where riner wants the
+  // axis-detector distance) and under twice its pitch (a detector binned 2x, the pitch not).
+  TEST_CASE("a fan and a cone: a wrong distance or pitch is doubted, the right ones are not") {
+    // The cone with three times the small cone's views: at 9 degrees a step its conjugates,
+    // read between views, miss by as much as a wrong distance's (3x, under the 4x asked).
+    const riner::Geometry cone = riner::test::make_geometry(riner::GeometryType::kCone3d, 120, 61,
+                                                            37, {24, 40, 40}, 1.5, 1.0);
+    for (const riner::Geometry& g : {riner::test::small_fan2d(), cone}) {
+      CAPTURE(riner::geometry_type_name(g.type));
+      const riner::Scan scan =
+          ringed(scan_of(g, riner::test::asymmetric_object(g.volume_shape)), 0.1, 0.002);
+      CHECK_FALSE(riner::fan_distance_doubt(scan));
+      CHECK(riner::geometry_doubts(scan).empty());
+      const double sdd = g.source_origin_mm + g.origin_detector_mm;
+      riner::Scan as_sdd = scan;
+      as_sdd.geometry.origin_detector_mm = sdd;
+      riner::Scan binned = scan;
+      binned.geometry.pitch_u = 2.0 * g.pitch_u;
+      binned.geometry.pitch_v = 2.0 * g.pitch_v;
+      for (const auto& [wrong, factor] :
+           {std::pair{as_sdd, sdd / (g.source_origin_mm + sdd)}, std::pair{binned, 2.0}}) {
+        CAPTURE(factor);
+        const std::optional<std::string> doubt = riner::fan_distance_doubt(wrong);
+        REQUIRE(doubt);
+        // "..., F times the geometry's": F within 2% of the truth.
+        const std::size_t at = doubt->find(" times the geometry's");
+        REQUIRE(at != std::string::npos);
+        const double found = std::stod(doubt->substr(doubt->rfind(", ", at) + 2));
+        CHECK(found == doctest::Approx(factor).epsilon(0.02));
+        CHECK(riner::geometry_doubts(wrong) == std::vector<std::string>{*doubt});
+        // The axis stands: its offset's search reads the geometry's distances near the axis.
+        CHECK(std::fabs(riner::estimate_centre(wrong).offset_px - g.offset_u) < 0.5);
+      }
+    }
+  }
+
+  TEST_CASE("a parallel beam and a fan short of a full turn are not checked") {
+    const riner::Geometry parallel = riner::test::small_parallel2d();
+    CHECK_FALSE(riner::fan_distance_doubt(
+        scan_of(parallel, riner::test::asymmetric_object(parallel.volume_shape))));
+    riner::Geometry short_fan = with_angles(riner::test::small_fan2d(), 60, 1.5 * M_PI, false);
+    CHECK_FALSE(riner::fan_distance_doubt(
+        scan_of(short_fan, riner::test::asymmetric_object(short_fan.volume_shape))));
   }
 }
