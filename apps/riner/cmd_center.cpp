@@ -1,6 +1,7 @@
 // riner center SCAN: the centre-of-rotation offset the scan's own views point to.
 #include "cli_common.hpp"
 #include "commands.hpp"
+#include "riner/geometry_doubts.hpp"
 #include "scan_options.hpp"
 #include "summary_json.hpp"
 
@@ -18,16 +19,21 @@ int run_center(int argc, char** argv, int first) {
   args.output_flags();
   if (!args.parse(argc, argv, first)) return 0;
   Console console(args);
-  const LoadedScan loaded = scan_from(args, console, false);
-  // A wrong range stops the centre finders (they pair views by the angles); a fan's distances
-  // doubted leave its axis standing, said after it.
+  const LoadedScan loaded = scan_from(args, console, GeometryDoubts::kLater);
+  // A wrong range or rotation sense stops the centre finders (they pair views by the angles);
+  // a fan's distances doubted leave its axis standing, read about that axis and said after it.
   const CentreEstimate e = estimate_centre(loaded.scan);
   console.line(centre_line(e) + "; the geometry says " +
                std::to_string(loaded.scan.geometry.offset_u));
-  for (const std::string& doubt : loaded.geometry_doubts) console.line("warning: " + doubt);
+  Scan about_axis = loaded.scan;
+  about_axis.geometry.offset_u = e.offset_px;
+  const std::vector<std::string> doubts = e.offset_px == loaded.scan.geometry.offset_u
+                                              ? loaded.geometry_doubts
+                                              : geometry_doubts(about_axis);
+  for (const std::string& doubt : doubts) console.line("warning: " + doubt);
   nlohmann::json summary = centre_json(e);
   summary["geometry_offset_px"] = loaded.scan.geometry.offset_u;
-  summary["geometry_doubts"] = loaded.geometry_doubts;
+  summary["geometry_doubts"] = doubts;
   console.summary(summary);
   return 0;
 }

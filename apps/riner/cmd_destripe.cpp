@@ -134,6 +134,7 @@ int run_destripe(int argc, char** argv, int first) {
   note_large_stripes(console, report);
   nlohmann::json summary = {{"out", out.string()},
                             {"inputs", inputs_json(args)},
+                            {"geometry_doubts", loaded.geometry_doubts},
                             {"method", destripe_method_name(options.method)},
                             {"size", report.size},
                             {"large_size", report.large_size},

@@ -88,10 +88,9 @@ void note_short_scan(const Console& console, const FbpReport& report) {
 
 int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions& options) {
   const ScanRows source(source_from(args));
+  const std::vector<std::string> doubts = source.geometry_doubts();
   for (const std::string& note : source.notes()) console.line(note);
-  for (const std::string& doubt : source.geometry_doubts()) {
-    console.line("warning: " + doubt);
-  }
+  for (const std::string& doubt : doubts) console.line("warning: " + doubt);
   if (source.centre()) console.line(centre_line(*source.centre()));
   const Geometry& g = source.geometry();
   const SlabOptions asked = slab_size_options(args);
@@ -162,6 +161,7 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
        {"short_scan", report.fbp.short_scan},
        {"parker_weighted", report.fbp.parker_weighted},
        {"half_acquisition_overlap_mm", report.fbp.half_acquisition_overlap_mm},
+       {"geometry_doubts", doubts},
        {"inputs", inputs_json(args)},
        {"flat_field",
         report.flat_field ? flat_field_json(*report.flat_field) : nlohmann::json(nullptr)},
@@ -270,6 +270,7 @@ int run_fbp(int argc, char** argv, int first) {
        {"half_acquisition_overlap_mm", report.half_acquisition_overlap_mm},
        {"destripe",
         stripes ? nlohmann::json(destripe_method_name(stripes->method)) : nlohmann::json(nullptr)},
+       {"geometry_doubts", loaded.geometry_doubts},
        {"inputs", inputs_json(args)},
        {"flat_field",
         loaded.flat_field ? flat_field_json(*loaded.flat_field) : nlohmann::json(nullptr)},

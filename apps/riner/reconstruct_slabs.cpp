@@ -242,11 +242,11 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   const bool leader = ranks.is_leader() && joined.empty();
   const bool speak = leader && !console.quiet();
   ScanRows source(source_from(args));
+  const std::vector<std::string> doubts =
+      leader ? source.geometry_doubts() : std::vector<std::string>{};
   if (speak) {
     for (const std::string& note : source.notes()) console.line(note);
-    for (const std::string& doubt : source.geometry_doubts()) {
-      console.line("warning: " + doubt);
-    }
+    for (const std::string& doubt : doubts) console.line("warning: " + doubt);
   }
   if (source.centre() && speak) console.line(centre_line(*source.centre()));
   if (speak) note_missing_lines(console, source.geometry());
@@ -633,6 +633,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       {"flat_field", flat ? flat_field_json(*flat) : nlohmann::json(nullptr)},
       {"centre",
        run.source().centre() ? centre_json(*run.source().centre()) : nlohmann::json(nullptr)},
+      {"geometry_doubts", doubts},
       {"wall_seconds", wall},
       {"per_slab", run.manifest()["slabs"]}};
   write_text(out / "summary.json", summary.dump(1) + "\n");

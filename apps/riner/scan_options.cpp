@@ -107,10 +107,10 @@ std::optional<Geometry> stack_geometry(const Args& args) {
   }
 }
 
-LoadedScan scan_from(const Args& args, const Console& console, bool doubts) {
+LoadedScan scan_from(const Args& args, const Console& console, GeometryDoubts doubts) {
   LoadedScan loaded = load_scan_source(source_from(args));
   for (const std::string& note : loaded.notes) console.line(note);
-  if (doubts) {
+  if (doubts == GeometryDoubts::kWarn) {
     for (const std::string& doubt : loaded.geometry_doubts) console.line("warning: " + doubt);
   }
   return loaded;

@@ -25,9 +25,11 @@ std::optional<Geometry> stack_geometry(const Args& args);
 
 // The measurement SCAN names, or, with --flat, raw projections normalised by their flat and
 // dark fields; its detector offset from --offset-px (a number, or auto: estimated).
-// Console lines say what was done, and (with `doubts`) warn of what the readings say against
-// the geometry (riner/geometry_doubts.hpp).
-LoadedScan scan_from(const Args& args, const Console& console, bool doubts = true);
+// Console lines say what was done, and (kWarn) warn of what the readings say against the
+// geometry (riner/geometry_doubts.hpp); kLater leaves that to the command.
+enum class GeometryDoubts { kWarn, kLater };
+LoadedScan scan_from(const Args& args, const Console& console,
+                     GeometryDoubts doubts = GeometryDoubts::kWarn);
 
 // A scan whose offset was given (not auto): check_geometry_centre (summary_json.hpp), its note
 // on the console. nullopt for auto offsets.

@@ -4,6 +4,7 @@
 // on the axis) left undecided. Whether a fan's distances pair its rays with their conjugates.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <string>
@@ -149,11 +150,12 @@ TEST_SUITE("angular range") {
   }
 }
 
-TEST_SUITE("fan distance") {
-  // The fan's distances against its conjugate rays: the scan under its own geometry, then under
-  // the source-detector distance given as origin_detector_mm (TIGRE's DSD where riner wants the
-  // axis-detector distance) and under twice its pitch (a detector binned 2x, the pitch not).
-  TEST_CASE("a fan and a cone: a wrong distance or pitch is doubted, the right ones are not") {
+TEST_SUITE("fan geometry") {
+  // The fan's distances and sense against its conjugate rays: the scan under its own geometry,
+  // then under the source-detector distance given as origin_detector_mm (TIGRE's DSD where
+  // riner wants the axis-detector distance), under twice its pitch (a detector binned 2x, the
+  // pitch not), and turning the other way.
+  TEST_CASE("a fan and a cone: a wrong distance, pitch or sense is doubted, the right ones not") {
     // The cone with three times the small cone's views: at 9 degrees a step its conjugates,
     // read between views, miss by as much as a wrong distance's (3x, under the 4x asked).
     const riner::Geometry cone = riner::test::make_geometry(riner::GeometryType::kCone3d, 120, 61,
@@ -162,7 +164,7 @@ TEST_SUITE("fan distance") {
       CAPTURE(riner::geometry_type_name(g.type));
       const riner::Scan scan =
           ringed(scan_of(g, riner::test::asymmetric_object(g.volume_shape)), 0.1, 0.002);
-      CHECK_FALSE(riner::fan_distance_doubt(scan));
+      CHECK_FALSE(riner::fan_geometry_doubt(scan));
       CHECK(riner::geometry_doubts(scan).empty());
       const double sdd = g.source_origin_mm + g.origin_detector_mm;
       riner::Scan as_sdd = scan;
@@ -173,7 +175,7 @@ TEST_SUITE("fan distance") {
       for (const auto& [wrong, factor] :
            {std::pair{as_sdd, sdd / (g.source_origin_mm + sdd)}, std::pair{binned, 2.0}}) {
         CAPTURE(factor);
-        const std::optional<std::string> doubt = riner::fan_distance_doubt(wrong);
+        const std::optional<std::string> doubt = riner::fan_geometry_doubt(wrong);
         REQUIRE(doubt);
         // "..., F times the geometry's": F within 2% of the truth.
         const std::size_t at = doubt->find(" times the geometry's");
@@ -184,15 +186,34 @@ TEST_SUITE("fan distance") {
         // The axis stands: its offset's search reads the geometry's distances near the axis.
         CHECK(std::fabs(riner::estimate_centre(wrong).offset_px - g.offset_u) < 0.5);
       }
+      // Turned the other way: the angles negated, or the detector's columns reversed.
+      riner::Scan reversed = scan;
+      reversed.geometry.uniform_angles.reset();
+      for (double& a : reversed.geometry.angles) a = -a;
+      riner::Scan flipped = scan;
+      const std::size_t n_u = g.n_u;
+      for (std::size_t line = 0; line < flipped.measurement.size() / n_u; ++line) {
+        float* row = flipped.measurement.ptr() + line * n_u;
+        std::reverse(row, row + n_u);
+      }
+      for (const riner::Scan& wrong : {reversed, flipped}) {
+        const std::optional<std::string> doubt = riner::fan_geometry_doubt(wrong);
+        REQUIRE(doubt);
+        CHECK(doubt->find("with the views turning the other way") != std::string::npos);
+        // The centre finder's conjugates would pair the wrong way round: no answer.
+        CHECK_THROWS_WITH_AS(riner::estimate_centre(wrong),
+                             doctest::Contains("no centre: the fan's rays meet their conjugates"),
+                             riner::InputError);
+      }
     }
   }
 
   TEST_CASE("a parallel beam and a fan short of a full turn are not checked") {
     const riner::Geometry parallel = riner::test::small_parallel2d();
-    CHECK_FALSE(riner::fan_distance_doubt(
+    CHECK_FALSE(riner::fan_geometry_doubt(
         scan_of(parallel, riner::test::asymmetric_object(parallel.volume_shape))));
     riner::Geometry short_fan = with_angles(riner::test::small_fan2d(), 60, 1.5 * M_PI, false);
-    CHECK_FALSE(riner::fan_distance_doubt(
+    CHECK_FALSE(riner::fan_geometry_doubt(
         scan_of(short_fan, riner::test::asymmetric_object(short_fan.volume_shape))));
   }
 }

@@ -99,12 +99,12 @@ py::tuple reconstruct(const py::handle& measurement, const std::string& geometry
     doubts = geometry_doubts(scan);
     centre_check = app::check_geometry_centre(scan, centre_note);
   }
-  if (!centre_note.empty()) doubts.push_back(centre_note);
-  for (const std::string& doubt : doubts) {
-    const std::string text = python_wording(doubt);
+  std::vector<std::string> warnings = doubts;
+  if (!centre_note.empty()) warnings.push_back(centre_note);
+  for (const std::string& warning : warnings) {
+    const std::string text = python_wording(warning);
     if (PyErr_WarnEx(PyExc_UserWarning, text.c_str(), 1) < 0) throw py::error_already_set();
   }
-  if (!centre_note.empty()) doubts.pop_back();
 
   std::unique_ptr<Reconstructor> reconstructor;
   std::optional<Device> dev;

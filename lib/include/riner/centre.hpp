@@ -9,7 +9,6 @@
 #pragma once
 
 #include <cstddef>
-#include <optional>
 #include <string>
 
 #include "riner/scan.hpp"
@@ -43,14 +42,6 @@ struct CentreEstimate {
 // acquisition's beyond the detector's central half ("conjugate rays, half acquisition"); a cone
 // beam likewise from the fan of its rays through the source's plane.
 CentreEstimate estimate_centre(const Scan& scan);
-
-// A fan or cone beam (its fan through the source's plane) over a full turn: one line where the
-// readings pair rays with their conjugates several times better (4x) under a source-detector
-// distance at least 10% from the geometry's (a distance or a pitch given wrong: TIGRE's DSD as
-// origin_detector_mm, a pitch before binning; preprocessing/centre_conjugate.hpp), searched
-// from half to twice it about the geometry's offset (within 4 px); nullopt where they agree,
-// for a parallel beam, or where no full turn is read.
-std::optional<std::string> fan_distance_doubt(const Scan& scan);
 
 // A parallel beam's centre finders search offsets within this share of the detector's width
 // either way of its middle. Over a full turn the view pairs also search beyond, up to where a

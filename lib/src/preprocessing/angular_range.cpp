@@ -6,6 +6,8 @@
 #include <limits>
 #include <vector>
 
+#include "preprocessing/angular_range_reading.hpp"
+#include "preprocessing/centre_readings.hpp"
 #include "preprocessing/mismatch_sums.hpp"
 #include "riner/centre.hpp"
 
@@ -40,7 +42,7 @@ Lines binned_lines(const Scan& scan) {
   if (n_v == 1) {
     rows.push_back(0);
   } else {
-    // Spread over the detector's middle, away from rows the beam may not reach.
+    // Spread over the detector, each row a slice of its own.
     const std::size_t count = std::min(kMostRows, n_v);
     for (std::size_t i = 0; i < count; ++i) rows.push_back((n_v * (2 * i + 1)) / (2 * count));
   }
@@ -102,13 +104,21 @@ struct ViewPair {
 // Pairs of views `apart` radians apart within 1.01 mean angular steps (the nearest view to
 // each view's angle plus `apart`), thinned evenly to kMostPairs.
 std::vector<ViewPair> pairs_apart(const std::vector<double>& angles, double apart, double step) {
+  std::vector<std::size_t> order(angles.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t x, std::size_t y) { return angles[x] < angles[y]; });
   std::vector<ViewPair> all;
   for (std::size_t i = 0; i < angles.size(); ++i) {
+    const double target = angles[i] + apart;
+    const auto above = std::lower_bound(order.begin(), order.end(), target,
+                                        [&](std::size_t k, double t) { return angles[k] < t; });
     std::size_t best = angles.size();
     double best_gap = std::numeric_limits<double>::infinity();
-    for (std::size_t j = 0; j < angles.size(); ++j) {
-      const double gap = std::fabs(angles[j] - angles[i] - apart);
-      if (j != i && gap < best_gap) best_gap = gap, best = j;
+    for (auto it = above == order.begin() ? above : above - 1; it != order.end() && it <= above;
+         ++it) {
+      const double gap = std::fabs(angles[*it] - target);
+      if (*it != i && gap < best_gap) best_gap = gap, best = *it;
     }
     if (best < angles.size() && best_gap <= 1.01 * step) all.push_back({i, best});
   }
@@ -172,6 +182,10 @@ const char* turn_name(TurnReading t) {
 }  // namespace
 
 AngularRangeEvidence read_angular_range(const Scan& scan) {
+  return preprocessing::read_prepared_angular_range(preprocessing::prepared(scan));
+}
+
+AngularRangeEvidence preprocessing::read_prepared_angular_range(const Scan& scan) {
   AngularRangeEvidence e;
   const Geometry& g = scan.geometry;
   if (g.is_divergent() || g.n_views() < 8 || g.n_u < 16) return e;
@@ -214,9 +228,13 @@ AngularRangeEvidence read_angular_range(const Scan& scan) {
   const bool ends_same = e.end_same * kClearly <= e.end_mirrored;
   const bool ends_mirrored = e.end_mirrored * kClearly <= e.end_same;
   const bool middles_mirrored = e.middle_mirrored * kClearly <= e.middle_same;
+  // A half-turn needs its middles to match clearly worse than its ends mirrored: the absence of
+  // a full turn's evidence is not enough (a full turn whose sample drifts 4 px spoils its ends
+  // as they are and brings its middles' two ways close, and read as a half-turn).
+  const bool middles_unrelated = e.end_mirrored * kClearly <= e.middle_mirrored;
   if (ends_same && middles_mirrored) {
     e.readings = TurnReading::kFullTurn;
-  } else if (ends_mirrored && !middles_mirrored) {
+  } else if (ends_mirrored && middles_unrelated && !middles_mirrored) {
     e.readings = TurnReading::kHalfTurn;
   }
   return e;
@@ -235,7 +253,7 @@ std::optional<std::string> angular_range_doubt(const AngularRangeEvidence& e) {
       "reconstruction under the wrong range is garbage)",
       turn_name(e.readings), e.span_deg, full ? "as it is" : "mirrored",
       100.0 * (full ? e.end_same : e.end_mirrored), full ? "mirrored" : "as it is",
-      100.0 * (full ? e.end_mirrored : e.end_same), 0.5 * e.span_deg,
+      100.0 * (full ? e.end_mirrored : e.end_same), full ? 90.0 : 180.0,
       full ? "mirrored" : "neither way", 100.0 * e.middle_mirrored, "as they are",
       100.0 * e.middle_same);
   return std::string(line);

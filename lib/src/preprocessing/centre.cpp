@@ -10,10 +10,11 @@
 #include <utility>
 #include <vector>
 
-#include "model/noise_evidence.hpp"
-#include "model/stuck_elements.hpp"
+#include "preprocessing/angular_range_reading.hpp"
 #include "preprocessing/centre_conjugate.hpp"
+#include "preprocessing/centre_readings.hpp"
 #include "preprocessing/centre_sinogram.hpp"
+#include "preprocessing/fan_doubts.hpp"
 #include "preprocessing/mismatch_sums.hpp"
 #include "riner/angular_range.hpp"
 #include "riner/array.hpp"
@@ -23,13 +24,6 @@
 namespace riner {
 
 namespace {
-
-// Whether the finite readings differ at all (a constant scan would match itself at every
-// offset, and the search would report the edge of its range).
-bool holds_structure(const Array& measurement) {
-  const ArrayStats stats = compute_stats(measurement);
-  return stats.max > stats.min;
-}
 
 [[noreturn]] void throw_without_structure() {
   throw InputError(
@@ -241,11 +235,6 @@ std::optional<std::pair<double, double>> best_outer_axis(std::span<const LinePai
 // object (about 1 or more), its true axis a few hundredths.
 constexpr double kOuterAxisAdvantage = 0.25;
 
-// A fan's distances are doubted where another source-detector distance, this factor away or
-// more, pairs rays with their conjugates this many times better than the geometry's.
-constexpr double kDistanceDoubtFactor = 1.1;
-constexpr double kDistanceDoubtContrast = 4.0;
-
 }  // namespace
 
 namespace {
@@ -289,140 +278,6 @@ std::optional<CentreEstimate> from_view_pairs(const Scan& scan) {
   return e;
 }
 
-// A cone beam's rays through the source's plane (z = 0) are a fan: that row of every view (read
-// between the two rows around it) as a fan-beam scan with the cone's distances.
-Scan midplane_fan(const Scan& cone) {
-  const Geometry& g = cone.geometry;
-  const double v = std::clamp(project_to_detector(g, 0, Vec3{0.0, 0.0, 0.0}).v, 0.0,
-                              static_cast<double>(g.n_v - 1));
-  const auto r0 = std::min(static_cast<std::size_t>(v), g.n_v > 1 ? g.n_v - 2 : 0);
-  const std::size_t r1 = std::min(r0 + 1, g.n_v - 1);
-  const double w = v - static_cast<double>(r0);
-  Scan fan;
-  fan.geometry = g;
-  fan.geometry.type = GeometryType::kFan2d;
-  fan.geometry.n_v = 1;
-  fan.geometry.offset_v = 0.0;
-  fan.geometry.volume_shape = {g.volume_shape[1], g.volume_shape[2]};
-  const std::size_t views = g.n_views(), n_u = g.n_u;
-  fan.measurement = Array({views, n_u});
-  for (std::size_t a = 0; a < views; ++a) {
-    const float* row0 = cone.measurement.ptr() + (a * g.n_v + r0) * n_u;
-    const float* row1 = cone.measurement.ptr() + (a * g.n_v + r1) * n_u;
-    for (std::size_t e = 0; e < n_u; ++e) {
-      fan.measurement.data[a * n_u + e] = static_cast<float>((1.0 - w) * row0[e] + w * row1[e]);
-    }
-  }
-  return fan;
-}
-
-// A 2D scan's views in order of angle (a shuffled or interleaved acquisition): the conjugate
-// rays are read between neighbouring views. The same scan where its angles already run one way.
-Scan in_angle_order(Scan scan) {
-  const std::vector<double>& a = scan.geometry.angles;
-  const bool rising = std::is_sorted(a.begin(), a.end());
-  const bool falling = std::is_sorted(a.rbegin(), a.rend());
-  if (rising || falling || scan.geometry.is_3d()) return scan;
-  std::vector<std::size_t> order(a.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t x, std::size_t y) { return a[x] < a[y]; });
-  const std::size_t n_u = scan.geometry.n_u;
-  Scan sorted = scan;
-  sorted.geometry.uniform_angles.reset();
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    sorted.geometry.angles[i] = a[order[i]];
-    std::copy_n(scan.measurement.ptr() + order[i] * n_u, n_u, sorted.measurement.ptr() + i * n_u);
-  }
-  return sorted;
-}
-
-// A hot or dead element reading a steady value matches its own mirror image only about itself,
-// and pulls the axis onto it (a 180-degree scan with one column at 50: the axis at that
-// column): such elements are left out, as non-finite ones are. The scan itself where none is.
-Scan without_stuck(const Scan& scan) {
-  const std::vector<std::uint8_t> stuck =
-      model::stuck_elements(scan, model::reading_noise(scan).sigma);
-  if (std::find(stuck.begin(), stuck.end(), 1) == stuck.end()) return scan;
-  Scan without = scan;
-  std::vector<float>& rho = without.measurement.data;
-  for (std::size_t e = 0; e < stuck.size(); ++e) {
-    if (!stuck[e]) continue;
-    for (std::size_t i = e; i < rho.size(); i += stuck.size()) rho[i] = NAN;
-  }
-  without.non_finite = compute_stats(without.measurement).non_finite();
-  return without;
-}
-
-// Beyond this many readings a 3D scan's centre is found on the rows its methods use.
-constexpr std::size_t kMostCopiedReadings = std::size_t{1} << 25;
-
-// A 3D scan cut to the rows the centre is found on: a cone's four rows about the source's
-// plane; a parallel beam's kMostRows evenly spread (each row a slice of its own).
-Scan centre_rows(const Scan& scan) {
-  const Geometry& g = scan.geometry;
-  const std::size_t views = g.n_views(), n_u = g.n_u;
-  std::vector<std::size_t> rows;
-  Scan cut;
-  if (g.type == GeometryType::kCone3d) {
-    const double v = std::clamp(project_to_detector(g, 0, Vec3{0.0, 0.0, 0.0}).v, 0.0,
-                                static_cast<double>(g.n_v - 1));
-    const std::size_t first =
-        std::min(static_cast<std::size_t>(std::max(0.0, v - 1.0)), g.n_v > 4 ? g.n_v - 4 : 0);
-    const std::size_t count = std::min<std::size_t>(4, g.n_v);
-    for (std::size_t r = first; r < first + count; ++r) rows.push_back(r);
-    cut.geometry = detector_rows_geometry(g, first, count);
-  } else {
-    rows = evenly(g.n_v, kMostRows);
-    cut.geometry = g;
-    cut.geometry.n_v = rows.size();
-  }
-  cut.measurement = Array({views, rows.size(), n_u});
-  for (std::size_t a = 0; a < views; ++a) {
-    for (std::size_t i = 0; i < rows.size(); ++i) {
-      std::copy_n(scan.measurement.ptr() + (a * g.n_v + rows[i]) * n_u, n_u,
-                  cut.measurement.ptr() + (a * rows.size() + i) * n_u);
-    }
-  }
-  cut.non_finite = compute_stats(cut.measurement).non_finite();
-  return cut;
-}
-
-// Spikes (riner/scan.hpp's largest_reading) left out as unread readings are: five readings of
-// 1e5 among readings of 3 moved a fan scan's axis 12 px.
-Scan without_spikes(Scan scan) {
-  mark_corrupt_readings(scan.measurement, scan.geometry.n_views());
-  return scan;
-}
-
-// Each detector element's readings less their mean over a full turn. A stripe (an element's
-// offset, constant over the views) then reads 0, where a conjugate reading, on another element,
-// differs from it by the two elements' offsets at every candidate axis: on ringed scans of a
-// faint object (line integrals up to 1.5, responses +-25%) the conjugate rays put a fan's axis
-// 1.7 px off, a cone's 1.9, and a parallel half acquisition's on the wrong side (+27.8 px for
-// -45). Over a full turn an element and its conjugate see the same lines, so their means agree
-// about the true axis: the object's matching is unchanged (those scans: 0.00 px off).
-Scan without_element_means(Scan scan) {
-  const std::size_t views = scan.geometry.n_views();
-  const std::size_t per_view = scan.measurement.size() / views;
-  std::vector<double> sum(per_view, 0.0);
-  std::vector<std::size_t> count(per_view, 0);
-  const std::vector<float>& rho = scan.measurement.data;
-  for (std::size_t i = 0; i < rho.size(); ++i) {
-    if (std::isfinite(rho[i])) sum[i % per_view] += rho[i], ++count[i % per_view];
-  }
-  for (std::size_t i = 0; i < rho.size(); ++i) {
-    const std::size_t e = i % per_view;
-    if (count[e] > 0) scan.measurement.data[i] -= static_cast<float>(sum[e] / count[e]);
-  }
-  return scan;
-}
-
-// The readings the methods compare: a full turn's without its elements' means.
-Scan compared(Scan scan) {
-  return covers_full_turn(scan.geometry) ? without_element_means(std::move(scan)) : scan;
-}
-
 // estimate_centre before the check of the readings (the geometry's reasons come first):
 // `as_read` the readings, `scan` those the methods compare (compared()).
 CentreEstimate estimate_from(const Scan& as_read, const Scan& scan) {
@@ -430,14 +285,16 @@ CentreEstimate estimate_from(const Scan& as_read, const Scan& scan) {
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
   if (g.is_divergent()) {
     const bool cone = g.type == GeometryType::kCone3d;
-    const Scan fan = in_angle_order(cone ? midplane_fan(as_read) : as_read);
-    const Scan fan_compared = in_angle_order(cone ? midplane_fan(scan) : scan);
+    const Scan fan =
+        preprocessing::in_angle_order(cone ? preprocessing::midplane_fan(as_read) : as_read);
+    const Scan fan_compared =
+        preprocessing::in_angle_order(cone ? preprocessing::midplane_fan(scan) : scan);
     const std::optional<preprocessing::ConjugateAxis> axis =
         preprocessing::conjugate_axis(fan, fan_compared);
     // A cone's rows about the source's plane unread or flat (the rest of the scan may not be),
     // after the geometry's own reasons.
     if (cone && (axis || (g.n_u >= 8 && covers_full_turn(g))) &&
-        !holds_structure(fan.measurement)) {
+        !preprocessing::holds_structure(fan.measurement)) {
       throw InputError(
           "the detector rows through the source's plane, where conjugate rays meet, read no two "
           "different finite values: nothing to find the centre from; pass the offset with "
@@ -457,6 +314,14 @@ CentreEstimate estimate_from(const Scan& as_read, const Scan& scan) {
                     std::fabs(axis->offset_px - g.offset_u));
       throw InputError(line);
     }
+    // Conjugates paired the wrong way round match best at a confident wrong axis (16 px off
+    // on the paper's fan): the sense is read about the geometry's offset and the one found.
+    for (const double offset : {g.offset_u, axis->offset_px}) {
+      if (std::optional<std::string> doubt =
+              preprocessing::reversed_fan_doubt(fan_compared, offset)) {
+        throw InputError("no centre: " + *doubt);
+      }
+    }
     CentreEstimate e;
     e.offset_px = axis->offset_px;
     e.axis_column = 0.5 * (static_cast<double>(g.n_u) - 1.0) - e.offset_px;
@@ -470,7 +335,8 @@ CentreEstimate estimate_from(const Scan& as_read, const Scan& scan) {
   }
   if (g.n_u < 8) throw InputError("centre finding needs a detector of at least 8 elements");
   // Pairs half a turn apart by angles of the wrong range match best at a confident wrong axis.
-  if (std::optional<std::string> doubt = angular_range_doubt(as_read)) {
+  if (std::optional<std::string> doubt =
+          angular_range_doubt(preprocessing::read_prepared_angular_range(as_read))) {
     throw InputError("no centre: " + *doubt);
   }
   const std::optional<CentreEstimate> pairs = from_view_pairs(scan);
@@ -478,7 +344,7 @@ CentreEstimate estimate_from(const Scan& as_read, const Scan& scan) {
   const bool no_minimum = sinogram && sinogram->rows == 0;
   if (no_minimum) sinogram.reset();
   if (!pairs && !sinogram) {
-    if (!holds_structure(scan.measurement)) throw_without_structure();
+    if (!preprocessing::holds_structure(scan.measurement)) throw_without_structure();
     if (no_minimum) {
       throw InputError(
           "the whole sinogram matches its mirror image best at an end of the search (the axis "
@@ -508,34 +374,6 @@ CentreEstimate estimate_from(const Scan& as_read, const Scan& scan) {
 
 }  // namespace
 
-std::optional<std::string> fan_distance_doubt(const Scan& scan) {
-  const Geometry& g = scan.geometry;
-  if (!g.is_divergent() || !holds_structure(scan.measurement)) return std::nullopt;
-  const bool cone = g.type == GeometryType::kCone3d;
-  Scan prepared = without_spikes(without_stuck(
-      g.is_3d() && scan.measurement.size() > kMostCopiedReadings ? centre_rows(scan) : scan));
-  prepared = compared(std::move(prepared));
-  const Scan fan = in_angle_order(cone ? midplane_fan(prepared) : prepared);
-  const std::optional<preprocessing::FanDistanceFit> fit =
-      preprocessing::conjugate_fan_distance(fan, g.offset_u);
-  if (!fit || std::fabs(std::log(fit->scale)) < std::log(kDistanceDoubtFactor) ||
-      fit->cost * kDistanceDoubtContrast > fit->cost_as_given) {
-    return std::nullopt;
-  }
-  const double sdd = g.source_origin_mm + g.origin_detector_mm;
-  char line[600];
-  std::snprintf(
-      line, sizeof(line),
-      "the fan's rays meet their conjugates where the source sits %.0f mm from the detector, "
-      "%.2f times the geometry's %.0f mm (source_origin_mm %g + origin_detector_mm %g), or "
-      "with a detector pitch %.2f times the given %g mm: mismatch %.2f%% of the readings' "
-      "spread, %.2f%% as given; check the distances (origin_detector_mm runs from the axis, "
-      "not the source) and the pitch (after binning)",
-      fit->scale * sdd, fit->scale, sdd, g.source_origin_mm, g.origin_detector_mm, 1.0 / fit->scale,
-      g.pitch_u, 100.0 * fit->cost, 100.0 * fit->cost_as_given);
-  return std::string(line);
-}
-
 bool centre_search_covers(const Geometry& g) {
   if (g.is_divergent() || covers_full_turn(g)) return true;
   return std::fabs(g.offset_u) <= kCentreSearchShare * static_cast<double>(g.n_u);
@@ -543,18 +381,14 @@ bool centre_search_covers(const Geometry& g) {
 
 CentreEstimate estimate_centre(const Scan& scan) {
   check_array(scan.measurement, "the centre's scan");
-  if (!holds_structure(scan.measurement)) {
+  if (!preprocessing::holds_structure(scan.measurement)) {
     (void)estimate_from(scan, scan);  // the geometry's reasons first
     throw_without_structure();
   }
   // A large 3D scan is read on the rows the methods use: the elements left out below would
   // otherwise copy all of it (a whole scan that fits in memory, doubled).
-  if (scan.geometry.is_3d() && scan.measurement.size() > kMostCopiedReadings) {
-    const Scan rows = without_spikes(without_stuck(centre_rows(scan)));
-    return estimate_from(rows, compared(rows));
-  }
-  const Scan prepared = without_spikes(without_stuck(scan));
-  return estimate_from(prepared, compared(prepared));
+  const Scan read = preprocessing::prepared(scan);
+  return estimate_from(read, preprocessing::compared(read));
 }
 
 }  // namespace riner

@@ -77,8 +77,9 @@ struct Cost {
   double relative = std::numeric_limits<double>::infinity();  // MismatchSums::relative
 };
 
-Cost conjugate_cost(const Scan& scan, const Turn& turn, double offset_px, RaySample sample) {
-  Geometry g = scan.geometry;
+Cost conjugate_cost(const Geometry& geometry, const Array& rho, const Turn& turn, double offset_px,
+                    RaySample sample) {
+  Geometry g = geometry;
   g.offset_u = offset_px;
   const std::size_t n_u = g.n_u;
   const std::size_t view_step = std::max<std::size_t>(1, turn.views / sample.views);
@@ -86,7 +87,7 @@ Cost conjugate_cost(const Scan& scan, const Turn& turn, double offset_px, RaySam
   MismatchSums sums;
   for (std::size_t v = 0; v < turn.views; v += view_step) {
     for (std::size_t e = 0; e < n_u; e += element_step) {
-      const double here = scan.measurement.data[v * n_u + e];
+      const double here = rho.data[v * n_u + e];
       if (!std::isfinite(here)) continue;
       const Ray ray = detector_ray(g, v, static_cast<double>(e));
       const Vec3& s = ray.origin;
@@ -103,14 +104,30 @@ Cost conjugate_cost(const Scan& scan, const Turn& turn, double offset_px, RaySam
       const auto v0 = static_cast<std::size_t>(f) % turn.views;
       const std::size_t v1 = (v0 + 1) % turn.views;
       const double w = f - std::floor(f);
-      const double a = reading_at(scan.measurement, v0, project_to_detector(g, v0, nearest).u, n_u);
-      const double b = reading_at(scan.measurement, v1, project_to_detector(g, v1, nearest).u, n_u);
+      const double a = reading_at(rho, v0, project_to_detector(g, v0, nearest).u, n_u);
+      const double b = reading_at(rho, v1, project_to_detector(g, v1, nearest).u, n_u);
       const double there = (1.0 - w) * a + w * b;
       if (!std::isfinite(there)) continue;
       sums.add(here, there);
     }
   }
   return {sums.mean(), sums.pairs, sums.relative()};
+}
+
+Cost conjugate_cost(const Scan& scan, const Turn& turn, double offset_px, RaySample sample) {
+  return conjugate_cost(scan.geometry, scan.measurement, turn, offset_px, sample);
+}
+
+// The offset within 2 px of `around`, every pixel, with the least relative cost, and that cost
+// (the axis is checked on its own: a distance wrong by 10% moves it by a few hundredths).
+std::pair<double, double> least_cost_near(const Geometry& g, const Array& rho, const Turn& turn,
+                                          double around, RaySample sample) {
+  std::pair<double, double> best{around, std::numeric_limits<double>::infinity()};
+  for (double o = around - 2.0; o <= around + 2.0; o += 1.0) {
+    const double cost = conjugate_cost(g, rho, turn, o, sample).relative;
+    if (cost < best.second) best = {o, cost};
+  }
+  return best;
 }
 
 // The offsets a half acquisition's axis can have: beyond the detector's central half
@@ -285,17 +302,10 @@ std::optional<FanDistanceFit> conjugate_fan_distance(const Scan& fine_scan, doub
   if (g.type != GeometryType::kFan2d || g.n_u < 8) return std::nullopt;
   const std::optional<Turn> turn = full_turn(g);
   if (!turn) return std::nullopt;
-  // The least relative cost over offsets within 2 px of the given, every pixel (the axis is
-  // checked on its own: a distance wrong by 10% moves it by a few hundredths).
   const auto best_at = [&](double scale, RaySample sample) {
-    Scan scaled = fine_scan;
-    scaled.geometry.pitch_u = g.pitch_u / scale;
-    std::pair<double, double> best{offset_px, std::numeric_limits<double>::infinity()};
-    for (double o = offset_px - 2.0; o <= offset_px + 2.0; o += 1.0) {
-      const double cost = conjugate_cost(scaled, *turn, o, sample).relative;
-      if (cost < best.second) best = {o, cost};
-    }
-    return best;
+    Geometry scaled = g;
+    scaled.pitch_u = g.pitch_u / scale;
+    return least_cost_near(scaled, fine_scan.measurement, *turn, offset_px, sample);
   };
   FanDistanceFit fit;
   const std::pair<double, double> as_given = best_at(1.0, kCoarse);
@@ -335,6 +345,27 @@ std::optional<FanDistanceFit> conjugate_fan_distance(const Scan& fine_scan, doub
     }
   }
   return fit;
+}
+
+std::optional<FanSense> conjugate_sense(const Scan& fine_scan, double offset_px) {
+  const Geometry& g = fine_scan.geometry;
+  if (g.type != GeometryType::kFan2d || g.n_u < 8) return std::nullopt;
+  const std::optional<Turn> turn = full_turn(g);
+  Geometry reversed = g;
+  reversed.uniform_angles.reset();
+  for (double& a : reversed.angles) a = -a;
+  const std::optional<Turn> back = full_turn(reversed);
+  if (!turn || !back) return std::nullopt;
+  FanSense sense;
+  sense.cost_as_given = least_cost_near(g, fine_scan.measurement, *turn, offset_px, kCoarse).second;
+  // The detector's columns reversed pair rays as the angles negated, the offset mirrored.
+  for (const double around : {offset_px, -offset_px}) {
+    sense.cost_reversed =
+        std::min(sense.cost_reversed,
+                 least_cost_near(reversed, fine_scan.measurement, *back, around, kCoarse).second);
+  }
+  if (!std::isfinite(sense.cost_as_given)) return std::nullopt;
+  return sense;
 }
 
 }  // namespace riner::preprocessing

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <cstddef>
+#include <limits>
 #include <optional>
 
 #include "riner/scan.hpp"
@@ -49,7 +50,7 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, const Scan& fine_s
 // origin-detector distance; a detector pitch before binning) pairs rays with the wrong views
 // at every offset. `scale`: the factor on the geometry's source-detector distance (as a factor
 // 1 / scale on the pitch: the fan angles alone count, not where along the ray the source is)
-// whose best offset (within 4 px of offset_px) matches best; the relative costs there and at
+// whose best offset (within 2 px of offset_px) matches best; the relative costs there and at
 // the geometry's own distance. Fan beam over a full turn only; nullopt otherwise.
 struct FanDistanceFit {
   double scale = 1.0;
@@ -58,5 +59,15 @@ struct FanDistanceFit {
   double cost_as_given = 0.0;  // relative, at scale 1 and its best offset
 };
 std::optional<FanDistanceFit> conjugate_fan_distance(const Scan& fine_scan, double offset_px);
+
+// Which way the fan turned: views that turned the other way (or a detector whose columns run the
+// other way) pair every ray with the wrong conjugate. The relative costs as given and with the
+// angles negated, each at its best offset within 2 px of offset_px (or of -offset_px, the
+// columns reversed). Fan beam over a full turn only; nullopt otherwise.
+struct FanSense {
+  double cost_as_given = 0.0;
+  double cost_reversed = std::numeric_limits<double>::infinity();
+};
+std::optional<FanSense> conjugate_sense(const Scan& fine_scan, double offset_px);
 
 }  // namespace riner::preprocessing

@@ -328,7 +328,6 @@ LoadedScan load_scan_source(ScanSource source) {
     notes.front() = layout + notes.front();
     loaded.notes.insert(loaded.notes.end(), notes.begin(), notes.end());
   }
-  loaded.geometry_doubts = geometry_doubts(loaded.scan);
   if (source.offset_px == "auto") {
     loaded.centre = estimate_centre(loaded.scan);
     loaded.scan.geometry.offset_u = loaded.centre->offset_px;
@@ -336,6 +335,8 @@ LoadedScan load_scan_source(ScanSource source) {
   } else if (!source.offset_px.empty()) {
     loaded.scan.geometry.offset_u = parse_offset(source.offset_px);
   }
+  // After the offset: a fan's conjugates are read about the axis the run will use.
+  loaded.geometry_doubts = geometry_doubts(loaded.scan);
   return loaded;
 }
 
