@@ -2,9 +2,11 @@
 # stated exception. Run by ctest (label python) with the build's package on PYTHONPATH.
 import json
 import os
+import re
 import signal
 import subprocess
 import threading
+import warnings
 
 import numpy as np
 import pytest
@@ -477,6 +479,29 @@ def test_the_librarys_warnings_and_the_centre_check_reach_python():
     with pytest.warns(UserWarning, match="puts the rotation axis at offset"):
         r = riner.reconstruct(sim["sino"], wrong, steps=20, quality=False)
     assert r.summary["centre_check"]["offset_px"] == pytest.approx(g["detector"]["offset_px"], abs=0.5)
+
+
+def test_a_360_degree_scan_under_180_degrees_of_angles_is_doubted_in_python():
+    # The same lines as the command line's: fbp and reconstruct warn and keep them, center
+    # raises; under the scan's own angles nothing is said.
+    full = riner.parallel_beam(np.linspace(0, 2 * np.pi, 180, endpoint=False), columns=120,
+                               center=59.5 + 2.5, image_shape=(96, 96))
+    half = riner.parallel_beam(np.linspace(0, np.pi, 180, endpoint=False), columns=120,
+                               center=59.5 + 2.5, image_shape=(96, 96))
+    sino = riner.simulate(None, full, seed=3)["sino"]
+    doubt = "the views cover a full turn (360 degrees), the geometry's angles 179.0 degrees"
+    with pytest.warns(UserWarning, match=re.escape(doubt)):
+        riner.fbp(sino, half)
+    with pytest.warns(UserWarning, match="the views cover a full turn"):
+        r = riner.reconstruct(sino, half, steps=20, quality=False)
+    assert len(r.summary["geometry_doubts"]) == 1
+    assert r.summary["geometry_doubts"][0].startswith(doubt)
+    with pytest.raises(riner.InputError, match="no centre: the views cover a full turn"):
+        riner.center(sino, half)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        riner.fbp(sino, full)
+        assert riner.reconstruct(sino, full, steps=20, quality=False).summary["geometry_doubts"] == []
 
 
 def test_bad_arguments_raise_input_error_with_one_line(fan_scan):

@@ -10,7 +10,9 @@
 #include "riner/error.hpp"
 #include "riner/fbp.hpp"
 #include "riner/flat_field.hpp"
+#include "riner/geometry_doubts.hpp"
 #include "riner/io.hpp"
+#include "riner/log.hpp"
 #include "riner/metrics.hpp"
 #include "riner/phantom.hpp"
 #include "riner/scan_source.hpp"
@@ -29,9 +31,19 @@ Scan scan_from(const py::handle& measurement, const std::string& geometry_json) 
 
 namespace {
 
+void warn_geometry_doubts(const Scan& scan) {
+  std::vector<std::string> doubts;
+  {
+    py::gil_scoped_release release;
+    doubts = geometry_doubts(scan);
+  }
+  for (const std::string& doubt : doubts) warn(doubt);  // the module's handler: UserWarning
+}
+
 py::array fbp_of(const py::handle& measurement, const std::string& geometry_json,
                  const std::string& filter, const std::string& engine, const std::string& device) {
   const Scan scan = scan_from(measurement, geometry_json);
+  warn_geometry_doubts(scan);
   FbpOptions options;
   options.filter = parse_fbp_filter(filter);
   options.engine = parse_engine(engine);
@@ -50,6 +62,7 @@ py::dict destripe_of(const py::handle& measurement, const std::string& geometry_
                      std::size_t rank_window, double snr, double sigma, int fit_order, int levels,
                      int wavelet_order, const std::string& engine, const std::string& device) {
   const Scan scan = scan_from(measurement, geometry_json);
+  warn_geometry_doubts(scan);
   DestripeOptions options;
   options.engine = parse_engine(engine);
   options.method = parse_destripe_method(method);
