@@ -1067,6 +1067,31 @@ TEST_SUITE("cli") {
         riner_cli("center " + sim + "/sino.npy --geometry " + (dir / "reversed.json").string(),
                   dir),
         2, "no centre: the fan's rays meet their conjugates with the views turning the other way");
+    // An offset whose sign alone is wrong (60 px, and a half acquisition's 200) is no reversed
+    // sense, and the axis is found at its mirror image (a review's: -155.10 for 60, and "no
+    // centre: ... turning the other way" for 200).
+    for (const double offset : {60.0, 200.0}) {
+      CAPTURE(offset);
+      nlohmann::json shifted =
+          nlohmann::json::parse(riner::test::read_bytes(sim + "/geometry.json"));
+      shifted["detector"]["offset_px"] = offset;
+      riner::test::write_bytes(dir / "shifted.json", shifted.dump());
+      const std::string moved = (dir / "moved").string();
+      std::filesystem::remove_all(moved);
+      REQUIRE(riner_cli("simulate --quiet --seed 2 --geometry " + (dir / "shifted.json").string() +
+                            " --out " + moved,
+                        dir)
+                  .code == 0);
+      shifted["detector"]["offset_px"] = -offset;
+      riner::test::write_bytes(dir / "sign.json", shifted.dump());
+      const Run found = riner_cli(
+          "center " + moved + "/sino.npy --geometry " + (dir / "sign.json").string() + " --json",
+          dir);
+      CAPTURE(found.err);
+      REQUIRE(found.code == 0);
+      CHECK(std::fabs(nlohmann::json::parse(found.out)["offset_px"].get<double>() - offset) < 0.5);
+      CHECK(found.out.find("turning the other way") == std::string::npos);
+    }
   }
 
   TEST_CASE("center: a narrow object, among strong rings or none, 0 to 6 px off the middle") {

@@ -208,6 +208,19 @@ TEST_SUITE("fan geometry") {
     }
   }
 
+  TEST_CASE("a cone whose source plane projects off its rows: no fan read, no centre") {
+    // A band of rows cut off the middle of a cone's detector: the rows read as the source's
+    // plane were an edge row (a wrong distance said of a right geometry, the axis 2.9 px off).
+    riner::Geometry g = riner::test::make_geometry(riner::GeometryType::kCone3d, 120, 61, 37,
+                                                   {24, 40, 40}, 1.5, 1.0);
+    g.offset_v = -30.0;
+    const riner::Scan scan = scan_of(g, riner::test::asymmetric_object(g.volume_shape));
+    CHECK_FALSE(riner::fan_geometry_doubt(scan));
+    CHECK_THROWS_WITH_AS(riner::estimate_centre(scan),
+                         doctest::Contains("the source's plane projects off the detector's rows"),
+                         riner::InputError);
+  }
+
   TEST_CASE("a parallel beam and a fan short of a full turn are not checked") {
     const riner::Geometry parallel = riner::test::small_parallel2d();
     CHECK_FALSE(riner::fan_geometry_doubt(

@@ -26,10 +26,6 @@ void bind_reconstruct(py::module_& m);
 // readings counted.
 Scan scan_from(const py::handle& measurement, const std::string& geometry_json);
 
-// What the readings say against the geometry (riner/geometry_doubts.hpp), each a UserWarning,
-// as the command line warns; read with the GIL released.
-void warn_geometry_doubts(const Scan& scan);
-
 // The device an engine runs on: none for the reference engine, else Device::open(selector).
 std::optional<Device> device_for(Engine engine, const std::string& selector);
 

@@ -31,6 +31,8 @@ Scan scan_from(const py::handle& measurement, const std::string& geometry_json) 
 
 namespace {
 
+// What the readings say against the geometry (riner/geometry_doubts.hpp), each a UserWarning
+// through the module's warning handler, as the command line warns.
 void warn_geometry_doubts(const Scan& scan) {
   std::vector<std::string> doubts;
   {

@@ -46,7 +46,8 @@ std::filesystem::path geometry_file_of(ScanSource source);
 // from the files' headers, the data only when rows are asked for, so a scan larger than memory
 // streams (riner/slab_run.hpp). Raw projections are normalised by the flats and darks of the
 // same rows. The centre offset is applied like load_scan_source's; "auto" is estimated once,
-// from up to kCentreRows rows around the middle of the detector.
+// from up to kCentreRows rows around the middle of the detector (a cone's: about its source's
+// plane).
 class ScanRows {
  public:
   static constexpr std::size_t kCentreRows = 8;
@@ -68,7 +69,7 @@ class ScanRows {
   // against the geometry's).
   const std::vector<std::string>& notes() const { return notes_; }
   // riner/geometry_doubts.hpp on kRangeRows rows about the middle of the detector (read now;
-  // a cone's about the source's plane); empty where those rows read nothing.
+  // a cone's: about its source's plane); empty where those rows read nothing.
   std::vector<std::string> geometry_doubts() const;
 
  private:

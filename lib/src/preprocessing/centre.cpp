@@ -33,7 +33,6 @@ namespace {
 
 // Enough pairs and rows for a stable sum, few enough to stay a fraction of a second.
 constexpr std::size_t kMostPairs = 32;
-constexpr std::size_t kMostRows = 24;
 constexpr double kCoarseStepPx = 0.5;
 constexpr double kFineStepPx = 0.02;
 
@@ -246,7 +245,7 @@ std::optional<CentreEstimate> from_view_pairs(const Scan& scan) {
   if (all.empty()) return std::nullopt;
   std::vector<ViewPair> pairs;
   for (std::size_t i : evenly(all.size(), kMostPairs)) pairs.push_back(all[i]);
-  const std::vector<std::size_t> rows = evenly(g.is_3d() ? g.n_v : 1, kMostRows);
+  const std::vector<std::size_t> rows = evenly(g.is_3d() ? g.n_v : 1, preprocessing::kCentreRows);
 
   CentreEstimate e;
   e.pairs = pairs.size();
@@ -278,61 +277,72 @@ std::optional<CentreEstimate> from_view_pairs(const Scan& scan) {
   return e;
 }
 
+// A fan's (a cone's through the source's plane) axis from conjugate rays; as estimate_from.
+CentreEstimate estimate_from_conjugates(const Scan& as_read, const Scan& scan) {
+  const Geometry& g = scan.geometry;
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  const bool cone = g.type == GeometryType::kCone3d;
+  if (cone && !preprocessing::source_plane_on_detector(g)) {
+    throw InputError(
+        "the source's plane projects off the detector's rows (a band of rows cut off the "
+        "middle?): no row holds the conjugate rays to find the centre from; pass the offset "
+        "with --offset-px");
+  }
+  const Scan fan =
+      preprocessing::in_angle_order(cone ? preprocessing::midplane_fan(as_read) : as_read);
+  const Scan fan_compared =
+      preprocessing::in_angle_order(cone ? preprocessing::midplane_fan(scan) : scan);
+  const std::optional<preprocessing::ConjugateAxis> axis =
+      preprocessing::conjugate_axis(fan, fan_compared);
+  // A cone's rows about the source's plane unread or flat (the rest of the scan may not be),
+  // after the geometry's own reasons.
+  if (cone && (axis || (g.n_u >= 8 && covers_full_turn(g))) &&
+      !preprocessing::holds_structure(fan.measurement)) {
+    throw InputError(
+        "the detector rows through the source's plane, where conjugate rays meet, read no two "
+        "different finite values: nothing to find the centre from; pass the offset with "
+        "--offset-px");
+  }
+  if (!axis) {
+    throw InputError(
+        "centre finding in a fan or cone beam needs views that step evenly over a full turn "
+        "and a detector of at least 8 elements; pass the offset with --offset-px");
+  }
+  if (axis->at_search_end) {
+    char line[300];
+    std::snprintf(line, sizeof(line),
+                  "conjugate rays match best at the end of the search, %.1f px from the "
+                  "geometry's offset: the axis lies beyond, or the readings do not show the "
+                  "object turning; pass the offset with --offset-px",
+                  std::fabs(axis->offset_px - g.offset_u));
+    throw InputError(line);
+  }
+  // Conjugates paired the wrong way round match best at a confident wrong axis (16 px off
+  // on the paper's fan): the sense is read about the geometry's offset and the one found.
+  for (const double offset : {g.offset_u, axis->offset_px}) {
+    if (std::optional<std::string> doubt =
+            preprocessing::reversed_fan_doubt(fan_compared, offset)) {
+      throw InputError("no centre: " + *doubt);
+    }
+  }
+  CentreEstimate e;
+  e.offset_px = axis->offset_px;
+  e.axis_column = 0.5 * (static_cast<double>(g.n_u) - 1.0) - e.offset_px;
+  e.rows = 1;
+  e.pairs = axis->rays;
+  e.half_acquisition = axis->half_acquisition;
+  e.method = axis->half_acquisition ? "conjugate rays, half acquisition" : "conjugate rays";
+  e.sinogram_offset_px = kNaN;
+  e.pairs_offset_px = kNaN;
+  return e;
+}
+
 // estimate_centre before the check of the readings (the geometry's reasons come first):
 // `as_read` the readings, `scan` those the methods compare (compared()).
 CentreEstimate estimate_from(const Scan& as_read, const Scan& scan) {
   const Geometry& g = scan.geometry;
   constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-  if (g.is_divergent()) {
-    const bool cone = g.type == GeometryType::kCone3d;
-    const Scan fan =
-        preprocessing::in_angle_order(cone ? preprocessing::midplane_fan(as_read) : as_read);
-    const Scan fan_compared =
-        preprocessing::in_angle_order(cone ? preprocessing::midplane_fan(scan) : scan);
-    const std::optional<preprocessing::ConjugateAxis> axis =
-        preprocessing::conjugate_axis(fan, fan_compared);
-    // A cone's rows about the source's plane unread or flat (the rest of the scan may not be),
-    // after the geometry's own reasons.
-    if (cone && (axis || (g.n_u >= 8 && covers_full_turn(g))) &&
-        !preprocessing::holds_structure(fan.measurement)) {
-      throw InputError(
-          "the detector rows through the source's plane, where conjugate rays meet, read no two "
-          "different finite values: nothing to find the centre from; pass the offset with "
-          "--offset-px");
-    }
-    if (!axis) {
-      throw InputError(
-          "centre finding in a fan or cone beam needs views that step evenly over a full turn "
-          "and a detector of at least 8 elements; pass the offset with --offset-px");
-    }
-    if (axis->at_search_end) {
-      char line[300];
-      std::snprintf(line, sizeof(line),
-                    "conjugate rays match best at the end of the search, %.1f px from the "
-                    "geometry's offset: the axis lies beyond, or the readings do not show the "
-                    "object turning; pass the offset with --offset-px",
-                    std::fabs(axis->offset_px - g.offset_u));
-      throw InputError(line);
-    }
-    // Conjugates paired the wrong way round match best at a confident wrong axis (16 px off
-    // on the paper's fan): the sense is read about the geometry's offset and the one found.
-    for (const double offset : {g.offset_u, axis->offset_px}) {
-      if (std::optional<std::string> doubt =
-              preprocessing::reversed_fan_doubt(fan_compared, offset)) {
-        throw InputError("no centre: " + *doubt);
-      }
-    }
-    CentreEstimate e;
-    e.offset_px = axis->offset_px;
-    e.axis_column = 0.5 * (static_cast<double>(g.n_u) - 1.0) - e.offset_px;
-    e.rows = 1;
-    e.pairs = axis->rays;
-    e.half_acquisition = axis->half_acquisition;
-    e.method = axis->half_acquisition ? "conjugate rays, half acquisition" : "conjugate rays";
-    e.sinogram_offset_px = kNaN;
-    e.pairs_offset_px = kNaN;
-    return e;
-  }
+  if (g.is_divergent()) return estimate_from_conjugates(as_read, scan);
   if (g.n_u < 8) throw InputError("centre finding needs a detector of at least 8 elements");
   // Pairs half a turn apart by angles of the wrong range match best at a confident wrong axis.
   if (std::optional<std::string> doubt =

@@ -222,6 +222,13 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, const Scan& fine_s
   // read 34.50 from a search of 32 px). The search moves on that way while the central half
   // reaches, its end no answer past it.
   Coarse c = search_around(g.offset_u);
+  // An offset with the wrong sign (a convention's slip) matched far from the truth (a review's:
+  // -216.06 for 200, -155.10 for 60): where the search does not reach its mirror image, that is
+  // searched too.
+  if (declared_half || std::fabs(g.offset_u) > search_px) {
+    const Coarse mirrored = search_around(-g.offset_u);
+    if (mirrored.least < c.least) c = mirrored;
+  }
   for (double centre = g.offset_u; c.at_end && std::fabs(c.best - g.offset_u) < inner &&
                                    (c.best - centre) * (c.best - g.offset_u) > 0.0;) {
     centre = c.best;
@@ -356,10 +363,14 @@ std::optional<FanSense> conjugate_sense(const Scan& fine_scan, double offset_px)
   for (double& a : reversed.angles) a = -a;
   const std::optional<Turn> back = full_turn(reversed);
   if (!turn || !back) return std::nullopt;
+  // The detector's columns reversed pair rays as the angles negated, the offset mirrored; an
+  // offset whose sign alone is wrong (a half acquisition's, say) is no reversed sense: both
+  // ways are read about either sign.
   FanSense sense;
-  sense.cost_as_given = least_cost_near(g, fine_scan.measurement, *turn, offset_px, kCoarse).second;
-  // The detector's columns reversed pair rays as the angles negated, the offset mirrored.
   for (const double around : {offset_px, -offset_px}) {
+    sense.cost_as_given =
+        std::min(sense.cost_as_given,
+                 least_cost_near(g, fine_scan.measurement, *turn, around, kCoarse).second);
     sense.cost_reversed =
         std::min(sense.cost_reversed,
                  least_cost_near(reversed, fine_scan.measurement, *back, around, kCoarse).second);

@@ -62,10 +62,11 @@ std::optional<FanDistanceFit> conjugate_fan_distance(const Scan& fine_scan, doub
 
 // Which way the fan turned: views that turned the other way (or a detector whose columns run the
 // other way) pair every ray with the wrong conjugate. The relative costs as given and with the
-// angles negated, each at its best offset within 2 px of offset_px (or of -offset_px, the
-// columns reversed). Fan beam over a full turn only; nullopt otherwise.
+// angles negated, each at its best offset within 2 px of offset_px or of -offset_px (the
+// columns reversed mirror the offset; a sign slip alone is not a reversed sense). Fan beam over
+// a full turn only; nullopt otherwise.
 struct FanSense {
-  double cost_as_given = 0.0;
+  double cost_as_given = std::numeric_limits<double>::infinity();
   double cost_reversed = std::numeric_limits<double>::infinity();
 };
 std::optional<FanSense> conjugate_sense(const Scan& fine_scan, double offset_px);

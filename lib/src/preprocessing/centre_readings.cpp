@@ -114,6 +114,11 @@ Scan in_angle_order(Scan scan) {
   return sorted;
 }
 
+bool source_plane_on_detector(const Geometry& cone) {
+  const double v = project_to_detector(cone, 0, Vec3{0.0, 0.0, 0.0}).v;
+  return v >= -0.5 && v <= static_cast<double>(cone.n_v) - 0.5;
+}
+
 Scan centre_rows(const Scan& scan) {
   const Geometry& g = scan.geometry;
   const std::size_t views = g.n_views(), n_u = g.n_u;

@@ -33,6 +33,10 @@ Scan compared(Scan scan);
 // A cone beam's rays through the source's plane as a fan-beam scan with the cone's distances.
 Scan midplane_fan(const Scan& cone);
 
+// Whether a cone's source plane projects onto its detector (within half a row of its rows):
+// where it does not (a band of rows cropped off the middle), no row holds the conjugate rays.
+bool source_plane_on_detector(const Geometry& cone);
+
 // A 2D scan's views in order of angle; the same scan where its angles already run one way.
 Scan in_angle_order(Scan scan);
 

@@ -12,6 +12,9 @@ namespace riner {
 std::optional<std::string> fan_geometry_doubt(const Scan& scan) {
   const Geometry& g = scan.geometry;
   if (!g.is_divergent() || !preprocessing::holds_structure(scan.measurement)) return std::nullopt;
+  if (g.type == GeometryType::kCone3d && !preprocessing::source_plane_on_detector(g)) {
+    return std::nullopt;
+  }
   const Scan fan = preprocessing::compared_fan(scan);
   if (std::optional<std::string> doubt = preprocessing::reversed_fan_doubt(fan, g.offset_u)) {
     return doubt;

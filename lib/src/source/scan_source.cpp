@@ -345,6 +345,23 @@ std::filesystem::path geometry_file_of(ScanSource source) {
   return find_geometry(source.path, source.geometry);
 }
 
+namespace {
+
+// `count` rows to read a stack's centre or geometry doubts from: a cone's about its source's
+// plane (its conjugate rays lie there; a band of rows cut off the middle has it elsewhere),
+// else the middle ones.
+RowRange reading_rows(const Geometry& g, std::size_t most) {
+  const std::size_t count = std::min(most, g.n_v);
+  double first = 0.5 * static_cast<double>(g.n_v - count);
+  if (g.type == GeometryType::kCone3d) {
+    first = project_to_detector(g, 0, Vec3{0.0, 0.0, 0.0}).v - 0.5 * (count - 1.0);
+  }
+  const double last_first = static_cast<double>(g.n_v - count);
+  return {static_cast<std::size_t>(std::clamp(std::round(first), 0.0, last_first)), count};
+}
+
+}  // namespace
+
 ScanRows::ScanRows(ScanSource source) : source_(std::move(source)) {
   tomo_file_ = resolve_files(source_);
   // Slabs read their rows late: outputs opened before then must already see the inputs.
@@ -376,9 +393,7 @@ ScanRows::ScanRows(ScanSource source) : source_(std::move(source)) {
       check_field_shape(read_array_shape(*name), {shape_[1], shape_[2]}, *name, what);
   }
   if (source_.offset_px == "auto") {
-    const std::size_t count = std::min(kCentreRows, rows());
-    const Scan middle = read({(rows() - count) / 2, count});
-    centre_ = estimate_centre(middle);
+    centre_ = estimate_centre(read(reading_rows(geometry_, kCentreRows)));
     geometry_.offset_u = centre_->offset_px;
   } else if (!source_.offset_px.empty()) {
     geometry_.offset_u = parse_offset(source_.offset_px);
@@ -386,16 +401,8 @@ ScanRows::ScanRows(ScanSource source) : source_(std::move(source)) {
 }
 
 std::vector<std::string> ScanRows::geometry_doubts() const {
-  // A cone's conjugate rays lie in the source's plane: the rows about it.
-  const std::size_t count = std::min<std::size_t>(kRangeRows, rows());
-  std::size_t first = (rows() - count) / 2;
-  if (geometry_.type == GeometryType::kCone3d) {
-    const double v = project_to_detector(geometry_, 0, Vec3{0.0, 0.0, 0.0}).v;
-    first = static_cast<std::size_t>(
-        std::clamp(std::floor(v), 0.0, static_cast<double>(rows() - count)));
-  }
   try {
-    return riner::geometry_doubts(read({first, count}));
+    return riner::geometry_doubts(read(reading_rows(geometry_, kRangeRows)));
   } catch (const InputError&) {
     return {};  // rows that read nothing: the slabs say so in their own words
   }
