@@ -1,4 +1,6 @@
 // riner center SCAN: the centre-of-rotation offset the scan's own views point to.
+#include <cmath>
+
 #include "cli_common.hpp"
 #include "commands.hpp"
 #include "riner/geometry_doubts.hpp"
@@ -27,9 +29,10 @@ int run_center(int argc, char** argv, int first) {
                std::to_string(loaded.scan.geometry.offset_u));
   Scan about_axis = loaded.scan;
   about_axis.geometry.offset_u = e.offset_px;
-  const std::vector<std::string> doubts = e.offset_px == loaded.scan.geometry.offset_u
-                                              ? loaded.geometry_doubts
-                                              : geometry_doubts(about_axis);
+  // The fan checks search 2 px about the offset: within a pixel, the load's reading stands.
+  const bool near = std::fabs(e.offset_px - loaded.scan.geometry.offset_u) <= 1.0;
+  const std::vector<std::string> doubts =
+      near ? loaded.geometry_doubts : geometry_doubts(about_axis);
   for (const std::string& doubt : doubts) console.line("warning: " + doubt);
   nlohmann::json summary = centre_json(e);
   summary["geometry_offset_px"] = loaded.scan.geometry.offset_u;

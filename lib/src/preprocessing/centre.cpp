@@ -319,7 +319,9 @@ CentreEstimate estimate_from_conjugates(const Scan& as_read, const Scan& scan) {
   }
   // Conjugates paired the wrong way round match best at a confident wrong axis (16 px off
   // on the paper's fan): the sense is read about the geometry's offset and the one found.
-  for (const double offset : {g.offset_u, axis->offset_px}) {
+  std::vector<double> offsets{g.offset_u};
+  if (std::fabs(axis->offset_px - g.offset_u) > 1.0) offsets.push_back(axis->offset_px);
+  for (const double offset : offsets) {
     if (std::optional<std::string> doubt =
             preprocessing::reversed_fan_doubt(fan_compared, offset)) {
       throw InputError("no centre: " + *doubt);

@@ -367,7 +367,11 @@ std::optional<FanSense> conjugate_sense(const Scan& fine_scan, double offset_px)
   // offset whose sign alone is wrong (a half acquisition's, say) is no reversed sense: both
   // ways are read about either sign.
   FanSense sense;
-  for (const double around : {offset_px, -offset_px}) {
+  // Offsets within a pixel of 0 are their own mirror image within the 2 px searched.
+  const std::vector<double> arounds = std::fabs(offset_px) > 1.0
+                                          ? std::vector<double>{offset_px, -offset_px}
+                                          : std::vector<double>{offset_px};
+  for (const double around : arounds) {
     sense.cost_as_given =
         std::min(sense.cost_as_given,
                  least_cost_near(g, fine_scan.measurement, *turn, around, kCoarse).second);
