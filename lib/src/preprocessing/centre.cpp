@@ -351,8 +351,11 @@ CentreEstimate estimate_from(const Scan& as_read, const Scan& scan) {
           angular_range_doubt(preprocessing::read_prepared_angular_range(as_read))) {
     throw InputError("no centre: " + *doubt);
   }
-  const std::optional<CentreEstimate> pairs = from_view_pairs(scan);
-  std::optional<preprocessing::SinogramAxis> sinogram = preprocessing::sinogram_axis(scan);
+  // An interleaved acquisition (0, 2, 4, ... degrees, then 1, 3, 5, ...) is a half-turn in
+  // angle order: the sinogram needs its views in order (it was "no evenly spaced half-turn").
+  const Scan ordered = preprocessing::in_angle_order(scan);
+  const std::optional<CentreEstimate> pairs = from_view_pairs(ordered);
+  std::optional<preprocessing::SinogramAxis> sinogram = preprocessing::sinogram_axis(ordered);
   const bool no_minimum = sinogram && sinogram->rows == 0;
   if (no_minimum) sinogram.reset();
   if (!pairs && !sinogram) {
