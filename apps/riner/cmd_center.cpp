@@ -27,12 +27,13 @@ int run_center(int argc, char** argv, int first) {
   const CentreEstimate e = estimate_centre(loaded.scan);
   console.line(centre_line(e) + "; the geometry says " +
                std::to_string(loaded.scan.geometry.offset_u));
-  Scan about_axis = loaded.scan;
-  about_axis.geometry.offset_u = e.offset_px;
   // The fan checks search 2 px about the offset: within a pixel, the load's reading stands.
-  const bool near = std::fabs(e.offset_px - loaded.scan.geometry.offset_u) <= 1.0;
-  const std::vector<std::string> doubts =
-      near ? loaded.geometry_doubts : geometry_doubts(about_axis);
+  std::vector<std::string> doubts = loaded.geometry_doubts;
+  if (std::fabs(e.offset_px - loaded.scan.geometry.offset_u) > 1.0) {
+    Scan about_axis = loaded.scan;
+    about_axis.geometry.offset_u = e.offset_px;
+    doubts = geometry_doubts(about_axis);
+  }
   for (const std::string& doubt : doubts) console.line("warning: " + doubt);
   nlohmann::json summary = centre_json(e);
   summary["geometry_offset_px"] = loaded.scan.geometry.offset_u;

@@ -42,4 +42,14 @@ inline Geometry small_parallel3d() {
   return make_geometry(GeometryType::kParallel3d, 30, 47, 21, {20, 32, 32}, 1.0, 1.0, M_PI);
 }
 
+// `g` with `views` angles stepping evenly over `range` radians from 0.3 (with or without the
+// endpoint), listed (no uniform form).
+inline Geometry with_angles(Geometry g, std::size_t views, double range, bool endpoint) {
+  g.uniform_angles.reset();
+  g.angles.clear();
+  const double step = range / static_cast<double>(endpoint ? views - 1 : views);
+  for (std::size_t i = 0; i < views; ++i) g.angles.push_back(0.3 + step * static_cast<double>(i));
+  return g;
+}
+
 }  // namespace riner::test

@@ -42,13 +42,7 @@ riner::Scan striped(riner::Scan s, double share) {
   return s;
 }
 
-riner::Geometry with_angles(riner::Geometry g, std::size_t views, double range, bool endpoint) {
-  g.uniform_angles.reset();
-  g.angles.clear();
-  const double step = range / static_cast<double>(endpoint ? views - 1 : views);
-  for (std::size_t i = 0; i < views; ++i) g.angles.push_back(0.3 + step * static_cast<double>(i));
-  return g;
-}
+using riner::test::with_angles;
 
 }  // namespace
 

@@ -20,13 +20,7 @@
 
 namespace {
 
-riner::Geometry with_angles(riner::Geometry g, std::size_t views, double range, bool endpoint) {
-  g.uniform_angles.reset();
-  g.angles.clear();
-  const double step = range / static_cast<double>(endpoint ? views - 1 : views);
-  for (std::size_t i = 0; i < views; ++i) g.angles.push_back(0.3 + step * static_cast<double>(i));
-  return g;
-}
+using riner::test::with_angles;
 
 riner::Scan scan_of(const riner::Geometry& g, const riner::Array& object) {
   g.validate();

@@ -175,6 +175,23 @@ double mirrored_mismatch(const Lines& l, const std::vector<ViewPair>& pairs) {
   return best;
 }
 
+// What the angles say: their span and which turn it is (kNotChecked for a divergent beam,
+// fewer than 8 views or 16 columns, or a span of neither turn within 4 steps).
+AngularRangeEvidence by_angles(const Geometry& g) {
+  AngularRangeEvidence e;
+  if (g.is_divergent() || g.n_views() < 8 || g.n_u < 16) return e;
+  const auto [lo, hi] = std::minmax_element(g.angles.begin(), g.angles.end());
+  const double span = *hi - *lo;
+  const double step = span / static_cast<double>(g.angles.size() - 1);
+  e.span_deg = span * 180.0 / M_PI;
+  if (std::fabs(span - M_PI) <= 4.0 * step) {
+    e.geometry = TurnReading::kHalfTurn;
+  } else if (std::fabs(span - 2.0 * M_PI) <= 4.0 * step) {
+    e.geometry = TurnReading::kFullTurn;
+  }
+  return e;
+}
+
 const char* turn_name(TurnReading t) {
   return t == TurnReading::kHalfTurn ? "a half-turn (180 degrees)" : "a full turn (360 degrees)";
 }
@@ -182,25 +199,19 @@ const char* turn_name(TurnReading t) {
 }  // namespace
 
 AngularRangeEvidence read_angular_range(const Scan& scan) {
+  // Readings are prepared (stuck elements found over the whole scan) only where the angles
+  // call for a reading: a fan beam's load paid for it and read nothing.
+  const AngularRangeEvidence angles_alone = by_angles(scan.geometry);
+  if (angles_alone.geometry == TurnReading::kNotChecked) return angles_alone;
   return preprocessing::read_prepared_angular_range(preprocessing::prepared(scan));
 }
 
 AngularRangeEvidence preprocessing::read_prepared_angular_range(const Scan& scan) {
-  AngularRangeEvidence e;
-  const Geometry& g = scan.geometry;
-  if (g.is_divergent() || g.n_views() < 8 || g.n_u < 16) return e;
-  const std::vector<double>& angles = g.angles;
+  AngularRangeEvidence e = by_angles(scan.geometry);
+  if (e.geometry == TurnReading::kNotChecked) return e;
+  const std::vector<double>& angles = scan.geometry.angles;
   const auto [lo, hi] = std::minmax_element(angles.begin(), angles.end());
-  const double span = *hi - *lo;
-  const double step = span / static_cast<double>(angles.size() - 1);
-  e.span_deg = span * 180.0 / M_PI;
-  if (std::fabs(span - M_PI) <= 4.0 * step) {
-    e.geometry = TurnReading::kHalfTurn;
-  } else if (std::fabs(span - 2.0 * M_PI) <= 4.0 * step) {
-    e.geometry = TurnReading::kFullTurn;
-  } else {
-    return e;
-  }
+  const double step = (*hi - *lo) / static_cast<double>(angles.size() - 1);
   const double turn = e.geometry == TurnReading::kHalfTurn ? M_PI : 2.0 * M_PI;
   // The end pairs: the geometry's span apart (the last view lies a step short of it when the
   // angles leave out their endpoint).

@@ -352,10 +352,8 @@ namespace {
 // else the middle ones.
 RowRange reading_rows(const Geometry& g, std::size_t most) {
   const std::size_t count = std::min(most, g.n_v);
-  double first = 0.5 * static_cast<double>(g.n_v - count);
-  if (g.type == GeometryType::kCone3d) {
-    first = project_to_detector(g, 0, Vec3{0.0, 0.0, 0.0}).v - 0.5 * (count - 1.0);
-  }
+  if (g.type != GeometryType::kCone3d) return {(g.n_v - count) / 2, count};
+  const double first = project_to_detector(g, 0, Vec3{0.0, 0.0, 0.0}).v - 0.5 * (count - 1.0);
   const double last_first = static_cast<double>(g.n_v - count);
   return {static_cast<std::size_t>(std::clamp(std::round(first), 0.0, last_first)), count};
 }
