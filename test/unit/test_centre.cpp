@@ -44,6 +44,35 @@ riner::Scan striped(riner::Scan s, double share) {
 
 using riner::test::with_angles;
 
+// The scan's views in the order `from` lists them (a view may come twice), each with its angle,
+// `shift` added to a view's angle the second time it comes (an encoder's reading on the way back).
+riner::Scan reordered(const riner::Scan& scan, const std::vector<std::size_t>& from,
+                      double shift = 0.0) {
+  const std::size_t per_view = scan.measurement.size() / scan.geometry.n_views();
+  riner::Scan out = scan;
+  out.geometry.uniform_angles.reset();
+  out.geometry.angles.clear();
+  std::vector<std::size_t> shape = scan.measurement.shape;
+  shape[0] = from.size();
+  out.measurement = riner::Array(shape);
+  std::vector<bool> seen(scan.geometry.n_views(), false);
+  for (std::size_t i = 0; i < from.size(); ++i) {
+    out.geometry.angles.push_back(scan.geometry.angles[from[i]] + (seen[from[i]] ? shift : 0.0));
+    seen[from[i]] = true;
+    std::copy_n(scan.measurement.ptr() + from[i] * per_view, per_view,
+                out.measurement.ptr() + i * per_view);
+  }
+  return out;
+}
+
+// 0, 2, 4, ... then 1, 3, 5, ...
+std::vector<std::size_t> interleaved_order(std::size_t views) {
+  std::vector<std::size_t> from;
+  for (std::size_t i = 0; i < views; i += 2) from.push_back(i);
+  for (std::size_t i = 1; i < views; i += 2) from.push_back(i);
+  return from;
+}
+
 }  // namespace
 
 TEST_SUITE("centre") {
@@ -88,20 +117,44 @@ TEST_SUITE("centre") {
     // no evenly spaced half-turn in file order, and the pairs none half a turn apart.
     const riner::Geometry g = with_angles(riner::test::small_parallel2d(), 60, M_PI, false);
     const riner::Scan scan = scan_with_offset(g, 3.4);
-    riner::Scan interleaved = scan;
-    interleaved.geometry.uniform_angles.reset();
-    const std::size_t views = g.n_views(), n_u = g.n_u;
-    for (std::size_t i = 0; i < views; ++i) {
-      const std::size_t from = i < views / 2 ? 2 * i : 2 * (i - views / 2) + 1;
-      interleaved.geometry.angles[i] = scan.geometry.angles[from];
-      std::copy_n(scan.measurement.ptr() + from * n_u, n_u,
-                  interleaved.measurement.ptr() + i * n_u);
-    }
+    const riner::Scan interleaved = reordered(scan, interleaved_order(g.n_views()));
     const riner::CentreEstimate in_order = riner::estimate_centre(scan);
     const riner::CentreEstimate e = riner::estimate_centre(interleaved);
     CHECK(e.method == "sinogram");
     CHECK(e.offset_px == doctest::Approx(in_order.offset_px).epsilon(1e-9));
     CHECK(std::fabs(e.offset_px - 3.4) < 0.1);
+  }
+
+  TEST_CASE(
+      "a scan that turns back over its angles (0 to 180 degrees and back) reads each angle "
+      "once") {
+    // Each angle twice read "no evenly spaced half-turn": the second pass is left out, also
+    // where the way back reads its angles a little differently.
+    const riner::Geometry g = with_angles(riner::test::small_parallel2d(), 60, M_PI, false);
+    const riner::Scan scan = scan_with_offset(g, 3.4);
+    std::vector<std::size_t> there_and_back(g.n_views());
+    std::iota(there_and_back.begin(), there_and_back.end(), std::size_t{0});
+    there_and_back.insert(there_and_back.end(), there_and_back.rbegin(), there_and_back.rend());
+    const riner::CentreEstimate in_order = riner::estimate_centre(scan);
+    for (const double shift : {0.0, 1e-4, -1e-4}) {
+      CAPTURE(shift);
+      const riner::CentreEstimate e =
+          riner::estimate_centre(reordered(scan, there_and_back, shift));
+      CHECK(e.method == "sinogram");
+      CHECK(std::fabs(e.offset_px - in_order.offset_px) < 0.01);
+      CHECK(std::fabs(e.offset_px - 3.4) < 0.1);
+    }
+  }
+
+  TEST_CASE("an interleaved parallel 3D stack reads as one in order") {
+    const riner::Geometry g = with_angles(riner::test::small_parallel3d(), 30, M_PI, false);
+    const riner::Scan scan = scan_with_offset(g, -2.7);
+    const riner::CentreEstimate in_order = riner::estimate_centre(scan);
+    const riner::CentreEstimate e =
+        riner::estimate_centre(reordered(scan, interleaved_order(g.n_views())));
+    CHECK(e.offset_px == doctest::Approx(in_order.offset_px).epsilon(1e-9));
+    CHECK(std::fabs(e.offset_px + 2.7) < 0.1);
+    CHECK(e.rows > 1);
   }
 
   TEST_CASE("parallel 3D: every row shares the axis") {

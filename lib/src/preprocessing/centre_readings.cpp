@@ -95,22 +95,38 @@ Scan midplane_fan(const Scan& cone) {
 }
 
 // A shuffled or interleaved acquisition: the conjugate rays are read between neighbouring views.
+// A view whose angle repeats an earlier one (a scan that turns back over its own angles) within
+// a quarter of the mean step is left out: the methods need each angle once, evenly spaced.
 Scan in_angle_order(Scan scan) {
   const std::vector<double>& a = scan.geometry.angles;
-  const bool rising = std::is_sorted(a.begin(), a.end());
-  const bool falling = std::is_sorted(a.rbegin(), a.rend());
-  if (rising || falling || scan.geometry.is_3d()) return scan;
-  std::vector<std::size_t> order(a.size());
-  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  const std::size_t n = a.size();
+  if (n < 2) return scan;
+  std::vector<std::size_t> order(n);
+  for (std::size_t i = 0; i < n; ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(),
                    [&](std::size_t x, std::size_t y) { return a[x] < a[y]; });
-  const std::size_t n_u = scan.geometry.n_u;
-  Scan sorted = scan;
-  sorted.geometry.uniform_angles.reset();
-  for (std::size_t i = 0; i < order.size(); ++i) {
-    sorted.geometry.angles[i] = a[order[i]];
-    std::copy_n(scan.measurement.ptr() + order[i] * n_u, n_u, sorted.measurement.ptr() + i * n_u);
+  const double close = 0.25 * (a[order.back()] - a[order.front()]) / static_cast<double>(n - 1);
+  std::vector<std::size_t> kept{order.front()};
+  for (std::size_t i = 1; i < n; ++i) {
+    if (a[order[i]] - a[kept.back()] > close) kept.push_back(order[i]);
   }
+  const bool rising = std::is_sorted(a.begin(), a.end());
+  const bool falling = std::is_sorted(a.rbegin(), a.rend());
+  if ((rising || falling) && kept.size() == n) return scan;
+  const std::size_t per_view = scan.measurement.size() / n;
+  std::vector<std::size_t> shape = scan.measurement.shape;
+  shape[0] = kept.size();
+  Scan sorted;
+  sorted.geometry = scan.geometry;
+  sorted.geometry.uniform_angles.reset();
+  sorted.geometry.angles.resize(kept.size());
+  sorted.measurement = Array(shape);
+  for (std::size_t i = 0; i < kept.size(); ++i) {
+    sorted.geometry.angles[i] = a[kept[i]];
+    std::copy_n(scan.measurement.ptr() + kept[i] * per_view, per_view,
+                sorted.measurement.ptr() + i * per_view);
+  }
+  sorted.non_finite = compute_stats(sorted.measurement).non_finite();
   return sorted;
 }
 
