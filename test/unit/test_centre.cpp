@@ -409,6 +409,26 @@ TEST_SUITE("centre") {
     CHECK(std::fabs(centred.offset_px - 2.2) < 0.15);
   }
 
+  TEST_CASE("a fan whose geometry's offset is far from its axis: the axis found all the same") {
+    // The search went about the geometry's offset and its mirror image only: 20 px given as
+    // 150 (a half acquisition declared) read -176.00 px on 500 elements, 150 given as 200 read
+    // -233.30, 60 given as -120 no answer.
+    const riner::Geometry g =
+        riner::test::make_geometry(riner::GeometryType::kFan2d, 180, 241, 1, {96, 96}, 1.5, 1.0);
+    for (const auto& [offset, told] :
+         {std::pair{8.3, 75.0}, std::pair{8.3, -95.0}, std::pair{-21.6, 45.0},
+          std::pair{-21.6, -80.0}, std::pair{84.4, 104.0}, std::pair{84.4, 140.0},
+          std::pair{-92.7, 45.0}, std::pair{-92.7, -70.0}}) {
+      CAPTURE(offset);
+      CAPTURE(told);
+      riner::Scan scan = scan_with_offset(g, offset);
+      scan.geometry.offset_u = told;
+      const riner::CentreEstimate e = riner::estimate_centre(scan);
+      CHECK(e.half_acquisition == (std::fabs(offset) > 60.0));
+      CHECK(std::fabs(e.offset_px - offset) < 0.5);
+    }
+  }
+
   TEST_CASE("a cone beam over a full turn: the offset from the fan through the source's plane") {
     const riner::Geometry cone = with_angles(riner::test::small_cone3d(), 120, 2.0 * M_PI, false);
     for (const double offset : {2.2, -3.4}) {

@@ -176,7 +176,6 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, const Scan& fine_s
   // them, then a parabola through the best and its neighbours.
   constexpr double kCoarseStep = 2.0;
   constexpr double kStep = 0.5;
-  const auto coarse_steps = static_cast<long>(std::ceil(search_px / kCoarseStep));
   // A geometry that already puts the axis beyond the detector's central half is a half
   // acquisition: around its offset only the few rays near the axis have conjugates, and the
   // absolute mismatch, which counts only offsets with most rays paired, would pull the axis
@@ -191,50 +190,79 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, const Scan& fine_s
     double least = std::numeric_limits<double>::infinity();
     bool at_end = false;  // the best is the search's first or last offset
   };
-  const auto search_around = [&](double centre) {
+  // Every `step` px within `half_width` of `centre`; a half acquisition's offsets by the
+  // relative cost (`outer`), others by the absolute one over offsets with most rays paired.
+  const auto search_around = [&](double centre, double half_width, bool outer, double step) {
+    const auto steps = static_cast<long>(std::ceil(half_width / step));
     std::vector<double> at;
     std::vector<Cost> costs;
     std::size_t most_rays = 0;
-    for (long k = -coarse_steps; k <= coarse_steps; ++k) {
-      const double offset = centre + static_cast<double>(k) * kCoarseStep;
-      if (declared_half && std::fabs(offset) > farthest_outer_offset(g.n_u)) continue;
+    for (long k = -steps; k <= steps; ++k) {
+      const double offset = centre + static_cast<double>(k) * step;
+      if (outer && std::fabs(offset) > farthest_outer_offset(g.n_u)) continue;
       at.push_back(offset);
-      costs.push_back(conjugate_cost(scan, *turn, at.back(), declared_half ? kOuter : kCoarse));
+      costs.push_back(conjugate_cost(scan, *turn, at.back(), outer ? kOuter : kCoarse));
       most_rays = std::max(most_rays, costs.back().rays);
     }
     Coarse out;
     out.best = centre;
     std::size_t index = 0;
     for (std::size_t k = 0; k < costs.size(); ++k) {
-      const double cost = declared_half ? costs[k].relative : costs[k].mean;
-      if ((declared_half || enough(costs[k], most_rays)) && std::isfinite(cost) &&
-          cost < out.least) {
+      const double cost = outer ? costs[k].relative : costs[k].mean;
+      if ((outer || enough(costs[k], most_rays)) && std::isfinite(cost) && cost < out.least) {
         out.least = cost;
         out.best = at[k];
         index = k;
       }
     }
-    out.at_end =
-        !declared_half && std::isfinite(out.least) && (index == 0 || index + 1 == costs.size());
+    out.at_end = !outer && std::isfinite(out.least) && (index == 0 || index + 1 == costs.size());
     return out;
   };
-  // The best at the search's end: the axis may lie beyond (an audit's 40 px off on 240 elements
-  // read 34.50 from a search of 32 px). The search moves on that way while the central half
-  // reaches, its end no answer past it.
-  Coarse c = search_around(g.offset_u);
-  // An offset with the wrong sign (a convention's slip) matched far from the truth (a review's:
-  // -216.06 for 200, -155.10 for 60): where the search does not reach its mirror image, that is
-  // searched too.
-  if (declared_half || std::fabs(g.offset_u) > search_px) {
-    const Coarse mirrored = search_around(-g.offset_u);
+  // The whole central half in at most 129 steps (a wide detector's basin is as wide), which
+  // the half-pixel search below moves on from.
+  const auto search_central = [&]() {
+    return search_around(0.0, inner, false, std::max(kCoarseStep, inner / 64.0));
+  };
+  const auto relative_at = [&](double offset) {
+    return conjugate_cost(fine_scan, *turn, offset, kOuter).relative;
+  };
+  Coarse c;
+  bool half_acquisition = declared_half;
+  if (declared_half) {
+    // An offset with the wrong sign (a convention's slip) matched far from the truth (a
+    // review's: -216.06 for 200, -155.10 for 60): its mirror image is searched too.
+    c = search_around(g.offset_u, search_px, true, kCoarseStep);
+    const Coarse mirrored = search_around(-g.offset_u, search_px, true, kCoarseStep);
     if (mirrored.least < c.least) c = mirrored;
-  }
-  for (double centre = g.offset_u; c.at_end && std::fabs(c.best - g.offset_u) < inner &&
-                                   (c.best - centre) * (c.best - g.offset_u) > 0.0;) {
-    centre = c.best;
-    const Coarse next = search_around(centre);
-    if (!(next.least <= c.least)) break;
-    c = next;
+    // An offset guessed a few tens of pixels off (150 given as 200 read -233.30 px, where a
+    // few pairs happened to match) or off the detector: every offset beyond the central half.
+    const std::optional<std::pair<double, double>> far = outer_offset(fine_scan, *turn);
+    if (far && !(relative_at(c.best) <= far->second)) c = Coarse{far->first, far->second, false};
+    // A half acquisition declared where the axis lies in the detector's central half (an
+    // offset mistyped or guessed: 20 px given as 150 read -176.00 px, half acquisition): the
+    // central half is searched too, and taken where it matches clearly better.
+    const Coarse central = search_central();
+    if (std::isfinite(central.least) && !central.at_end &&
+        relative_at(central.best) < kOuterAdvantage * relative_at(c.best)) {
+      c = central;
+      half_acquisition = false;
+    }
+  } else if (std::fabs(g.offset_u) > search_px) {
+    // Neither the geometry's offset nor its mirror image reaches the middle: the whole central
+    // half (60 px given as 120 went on from the wrong end of the mirror's search, to no answer).
+    c = search_central();
+  } else {
+    c = search_around(g.offset_u, search_px, false, kCoarseStep);
+    // The best at the search's end: the axis may lie beyond (an audit's 40 px off on 240
+    // elements read 34.50 from a search of 32 px). The search moves on that way while the
+    // central half reaches, its end no answer past it.
+    for (double centre = g.offset_u; c.at_end && std::fabs(c.best - g.offset_u) < inner &&
+                                     (c.best - centre) * (c.best - g.offset_u) > 0.0;) {
+      centre = c.best;
+      const Coarse next = search_around(centre, search_px, false, kCoarseStep);
+      if (!(next.least <= c.least)) break;
+      c = next;
+    }
   }
   double coarse_best = c.best;
   double coarse_least = c.least;
@@ -242,12 +270,10 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, const Scan& fine_s
   // A half acquisition's axis beyond the detector's central half: where its conjugates meet
   // far better than at the best offset around the geometry's, relatively, the fine search
   // goes there, and every offset around it counts (its few pairs are all the scan has).
-  bool half_acquisition = declared_half;
   if (!declared_half) {
     const std::optional<std::pair<double, double>> far = outer_offset(fine_scan, *turn);
-    const double central = std::isfinite(coarse_least)
-                               ? conjugate_cost(fine_scan, *turn, coarse_best, kOuter).relative
-                               : std::numeric_limits<double>::infinity();
+    const double central = std::isfinite(coarse_least) ? relative_at(coarse_best)
+                                                       : std::numeric_limits<double>::infinity();
     if (far && far->second < kOuterAdvantage * central) {
       coarse_best = far->first;
       coarse_least = far->second;

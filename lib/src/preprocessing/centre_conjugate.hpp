@@ -29,7 +29,10 @@ struct ConjugateAxis {
 // Fan beam (2D). Searches the geometry's offset +- search_px, and on from an end of it where the
 // best lies there, up to the detector's central half (kCentreSearchShare of its width either
 // way; a search of 32 px on 240 elements said 34.50 for an axis 40 px off, its end taken for an
-// answer; at_search_end when it ends there); where the geometry puts the axis
+// answer; at_search_end when it ends there); the whole central half where the geometry's
+// offset lies farther than search_px from 0, and also where it declares a half acquisition
+// (taken over the search about that offset and its mirror image where it matches 4 times
+// better, relatively); where the geometry puts the axis
 // in the detector's central half, also the offsets beyond it (a half acquisition: the axis near
 // one end, only the rays around it have conjugates on the detector), by the mismatch relative
 // to the spread of the readings compared, taken where that is under a quarter of the best
