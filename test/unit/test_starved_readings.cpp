@@ -3,6 +3,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <limits>
 
 #include "model/starved_readings.hpp"
 
@@ -41,9 +42,65 @@ riner::Array failing_module_scan() {
   return a;
 }
 
+// 24 views of 16 elements reading 1, the axis at 7.5; a metal pin on it stops elements 6-9 in
+// every view, and its edges (5, 10) read near the largest, 15-16, or nothing (every third view).
+riner::Array pin_on_axis_scan() {
+  riner::Array a({24, 16}, 1.0f);
+  for (std::size_t v = 0; v < 24; ++v) {
+    for (std::size_t e = 6; e < 10; ++e) a(v, e) = INFINITY;
+    a(v, 5) = v % 3 == 0 ? INFINITY : 15.0f;
+    a(v, 10) = v % 3 == 1 ? INFINITY : 16.0f;
+  }
+  return a;
+}
+
 }  // namespace
 
 TEST_SUITE("starved_readings") {
+  TEST_CASE(
+      "elements dark in every view, centred on the axis, their edges dense or dark: metal "
+      "on the axis, bounds") {
+    // They were dead: a 3/mm pin on the axis of a simulated fan scan read 0.62 (now 2.23).
+    riner::Array a = pin_on_axis_scan();
+    const riner::model::StarvedReadings s = riner::model::mark_starved_readings(a, 24, 7.5);
+    CHECK(s.floor == 16.0f);
+    for (std::size_t v = 0; v < 24; ++v) {
+      for (std::size_t e = 6; e < 10; ++e) CHECK(riner::model::is_starved(a(v, e)));
+    }
+    CHECK(s.count == 24 * 4 + 8 + 8);  // the edges' dark readings join the run: wide
+    // The axis a pixel and a half off the run's centre, or unknown: dead, as before.
+    for (const double axis : {6.0, 9.0, std::numeric_limits<double>::quiet_NaN()}) {
+      CAPTURE(axis);
+      riner::Array b = pin_on_axis_scan();
+      riner::model::mark_starved_readings(b, 24, axis);
+      for (std::size_t v = 0; v < 24; ++v) {
+        for (std::size_t e = 6; e < 10; ++e) CHECK(std::isnan(b(v, e)));
+      }
+    }
+  }
+
+  TEST_CASE("on the axis, a lone dead element, or a dead module whose edges never starve: dead") {
+    // A lone dead element among dense rays (a bound would draw a dense dot on the axis).
+    riner::Array lone = pin_on_axis_scan();
+    for (std::size_t v = 0; v < 24; ++v) lone(v, 6) = lone(v, 9) = 15.0f;
+    riner::Array narrow = lone;
+    riner::model::mark_starved_readings(narrow, 24, 7.5);
+    for (std::size_t v = 0; v < 24; ++v) CHECK(std::isnan(narrow(v, 7)));
+    // Four dead elements in a thick body whose rays beside them read near the largest but
+    // never nothing (a uniform disc's middle: bounds at the largest made it 11% too dense).
+    riner::Array module = pin_on_axis_scan();
+    for (std::size_t v = 0; v < 24; ++v) module(v, 5) = 15.0f, module(v, 10) = 16.0f;
+    riner::model::mark_starved_readings(module, 24, 7.5);
+    for (std::size_t v = 0; v < 24; ++v) {
+      for (std::size_t e = 6; e < 10; ++e) CHECK(std::isnan(module(v, e)));
+    }
+    // Edges dense in fewer than three quarters of the views: dead.
+    riner::Array sparse = pin_on_axis_scan();
+    for (std::size_t v = 0; v < 24; v += 2) sparse(v, 5) = 2.0f;
+    riner::model::mark_starved_readings(sparse, 24, 7.5);
+    CHECK(std::isnan(sparse(1, 7)));
+  }
+
   TEST_CASE("+inf beside rays near the largest reading is a bound at it") {
     riner::Array a = metal_scan();
     const riner::model::StarvedReadings s = riner::model::mark_starved_readings(a, 6);

@@ -51,9 +51,59 @@ std::optional<std::pair<std::size_t, std::size_t>> dark_run_at(const DarkRuns& r
   return std::nullopt;
 }
 
+// Elements that read nothing in any view, a run wider than kWidestDeadRun centred on the
+// rotation axis (within kAxisRunTolerance of `axis_column`), whose elements on both sides read
+// `bar` or more or nothing (+inf) in kAxisDenseShare of the views or more, and nothing in one
+// view at least: the beam stopped on the axis in every view (a metal pin there, its edges'
+// elements lit by a few photons, or dark, view by view). A dead element or module off the axis
+// leaves its conjugate rays, across the axis, lit; a lone dead element on it stays dead (a
+// bound there would draw a dense dot), and so does a dead module on the axis of a thick body
+// whose rays beside it never starve (a uniform disc's central rays near the largest: the
+// bound at the largest made its middle 11% too dense).
+constexpr double kAxisRunTolerance = 1.0;
+constexpr double kAxisDenseShare = 0.75;
+std::vector<char> stopped_on_axis(const Array& m, std::size_t views, const std::vector<char>& reads,
+                                  double axis_column, float bar) {
+  const std::size_t per_view = m.size() / views;
+  std::vector<char> out(per_view, 0);
+  if (!std::isfinite(axis_column)) return out;
+  const auto n = static_cast<long>(m.shape.back());
+  const std::size_t rows = per_view / static_cast<std::size_t>(n);
+  const auto dense_or_dark = [&](float x) { return is_starved(x) || x >= bar; };
+  for (std::size_t r = 0; r < rows; ++r) {
+    const std::size_t first = r * static_cast<std::size_t>(n);
+    for (long k = 0; k < n;) {
+      if (reads[first + static_cast<std::size_t>(k)]) {
+        ++k;
+        continue;
+      }
+      long end = k;
+      while (end < n && !reads[first + static_cast<std::size_t>(end)]) ++end;
+      const double centre = 0.5 * static_cast<double>(k + end - 1);
+      const bool wide = static_cast<std::size_t>(end - k) > kWidestDeadRun;
+      if (wide && k > 0 && end < n && std::fabs(centre - axis_column) <= kAxisRunTolerance) {
+        std::size_t dense = 0, dark_left = 0, dark_right = 0;
+        for (std::size_t v = 0; v < views; ++v) {
+          const float* line = m.ptr() + v * per_view + first;
+          dense += dense_or_dark(line[k - 1]) && dense_or_dark(line[end]);
+          dark_left += is_starved(line[k - 1]);
+          dark_right += is_starved(line[end]);
+        }
+        if (static_cast<double>(dense) >= kAxisDenseShare * static_cast<double>(views) &&
+            dark_left > 0 && dark_right > 0) {
+          std::fill(out.begin() + static_cast<std::ptrdiff_t>(first) + k,
+                    out.begin() + static_cast<std::ptrdiff_t>(first) + end, 1);
+        }
+      }
+      k = end;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
-StarvedReadings mark_starved_readings(Array& measurement, std::size_t views) {
+StarvedReadings mark_starved_readings(Array& measurement, std::size_t views, double axis_column) {
   StarvedReadings out;
   if (measurement.size() == 0 || views == 0 || measurement.rank() < 2) return out;
   const float limit = largest_reading(measurement, views);
@@ -71,6 +121,7 @@ StarvedReadings mark_starved_readings(Array& measurement, std::size_t views) {
   }
   const DarkRuns dark = long_dark_runs(measurement, views, response_change_min_views(views));
   const float bar = static_cast<float>(kStarvedNeighbourShare) * largest;
+  const std::vector<char> on_axis = stopped_on_axis(measurement, views, reads, axis_column, bar);
   for (std::size_t l = 0; l < lines; ++l) {
     const std::size_t at = l * static_cast<std::size_t>(n);
     float* line = measurement.ptr() + at;
@@ -119,8 +170,9 @@ StarvedReadings mark_starved_readings(Array& measurement, std::size_t views) {
         const std::size_t i = at + static_cast<std::size_t>(j);
         const auto& run = runs[static_cast<std::size_t>(j - k)];
         const bool failing = run && of_module(*run);
-        const bool stopped = !blank && !failing && (wide || (dense_beside && !run));
-        if (largest > 0.0f && stopped && reads[i % per_view]) {
+        const bool axis = on_axis[i % per_view] != 0;
+        const bool stopped = !blank && (axis || (!failing && (wide || (dense_beside && !run))));
+        if (largest > 0.0f && stopped && (reads[i % per_view] || axis)) {
           ++out.count;
         } else {
           line[j] = NAN;

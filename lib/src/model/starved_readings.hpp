@@ -13,10 +13,14 @@
 // rays at 0.36 of it). But kWidestDeadRun + 1 or more elements of a run dark together from
 // one view to the scan's end (or from its start to one view), for that many views, are a
 // module failing, and a run filling a whole line (a blank frame) says nothing: both unread. An
-// element that reads nothing in any view is dead whatever its neighbours read (metal on the
-// rotation axis, dark in every view, is read so too: a rule that took a block whose neighbours
-// were dark in half the views for metal made an audit's dead modules beside a metal's trace, or
-// beside a dying element, into bright bounds).
+// element that reads nothing in any view is dead whatever its neighbours read (a rule that
+// took a block whose neighbours were dark in half the views for metal made an audit's dead
+// modules beside a metal's trace, or beside a dying element, into bright bounds), except in a
+// run wider than kWidestDeadRun centred on the rotation axis (within a pixel) whose elements on
+// both sides read kStarvedNeighbourShare of the largest or nothing in three quarters of the
+// views or more, and nothing in some: metal on the axis stops those rays in every view (a 3/mm pin
+// there read 0.62 for 3.0 as dead elements), where a dead element or module off the axis leaves its
+// conjugate rays across the axis lit.
 #pragma once
 
 #include <cmath>
@@ -37,7 +41,11 @@ struct StarvedReadings {
 
 // `measurement` is [views, elements] or [views, rows, columns]. Sets the +inf readings that are
 // no bound to NaN. Finite readings beyond riner::largest_reading are left out of the largest.
-StarvedReadings mark_starved_readings(Array& measurement, std::size_t views);
+// `axis_column`: the column the rotation axis projects onto (NaN: unknown, no run is read as
+// stopped on the axis).
+StarvedReadings mark_starved_readings(
+    Array& measurement, std::size_t views,
+    double axis_column = std::numeric_limits<double>::quiet_NaN());
 
 // A kept bound: +inf after mark_starved_readings.
 inline bool is_starved(float reading) { return reading == std::numeric_limits<float>::infinity(); }
