@@ -7,6 +7,7 @@
 #include <numeric>
 #include <random>
 
+#include "preprocessing/centre_readings.hpp"
 #include "riner/centre.hpp"
 #include "riner/error.hpp"
 #include "riner/phantom.hpp"
@@ -144,6 +145,39 @@ TEST_SUITE("centre") {
       CHECK(std::fabs(e.offset_px - in_order.offset_px) < 0.01);
       CHECK(std::fabs(e.offset_px - 3.4) < 0.1);
     }
+  }
+
+  TEST_CASE("views left out as repeats: a way back over the angles, not random or few views") {
+    const riner::Geometry g = with_angles(riner::test::small_parallel2d(), 60, M_PI, false);
+    const riner::Scan scan = scan_with_offset(g, 3.4);
+    const double step = M_PI / 60.0;
+    std::vector<std::size_t> there_and_back(60);
+    std::iota(there_and_back.begin(), there_and_back.end(), std::size_t{0});
+    there_and_back.insert(there_and_back.end(), there_and_back.rbegin(), there_and_back.rend());
+    // The way back's angles 0.15 of a step off: one view each (it was 1/8 of a step, the mean
+    // step taken over both ways).
+    for (const double shift : {0.0, 0.15 * step, -0.15 * step}) {
+      CAPTURE(shift);
+      const riner::Scan once =
+          riner::preprocessing::in_angle_order(reordered(scan, there_and_back, shift));
+      CHECK(once.geometry.n_views() == 60);
+      CHECK(once.measurement.shape[0] == 60);
+    }
+    // Three times over the angles, exactly: one view each.
+    std::vector<std::size_t> thrice = there_and_back;
+    thrice.insert(thrice.end(), there_and_back.begin(), there_and_back.begin() + 60);
+    CHECK(riner::preprocessing::in_angle_order(reordered(scan, thrice)).geometry.n_views() == 60);
+    // A few clustered views (0, 1, 2 and 3 steps and 177 on): all kept (a review's; the mean
+    // step's quarter, 15 steps, left out two and the pairs lost the opposite one).
+    const riner::Scan few = reordered(scan, {0, 1, 2, 3, 59});
+    CHECK(riner::preprocessing::in_angle_order(few).geometry.n_views() == 5);
+    // Views at random angles, some close together: all kept.
+    riner::Scan random = scan;
+    random.geometry.uniform_angles.reset();
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> angle(0.0, M_PI);
+    for (double& a : random.geometry.angles) a = angle(rng);
+    CHECK(riner::preprocessing::in_angle_order(random).geometry.n_views() == 60);
   }
 
   TEST_CASE("an interleaved parallel 3D stack reads as one in order") {
@@ -407,18 +441,29 @@ TEST_SUITE("centre") {
     const riner::CentreEstimate centred = riner::estimate_centre(scan_with_offset(g, 2.2));
     CHECK_FALSE(centred.half_acquisition);
     CHECK(std::fabs(centred.offset_px - 2.2) < 0.15);
+    // A half acquisition declared (20 px) whose search reaches the middle and finds the axis
+    // there: no half acquisition (it said one).
+    riner::Scan told = scan_with_offset(g, 0.0);
+    told.geometry.offset_u = 20.0;
+    const riner::CentreEstimate middle = riner::estimate_centre(told);
+    CHECK(std::fabs(middle.offset_px) < 0.15);
+    CHECK_FALSE(middle.half_acquisition);
+    CHECK(middle.method == "conjugate rays");
   }
 
   TEST_CASE("a fan whose geometry's offset is far from its axis: the axis found all the same") {
-    // The search went about the geometry's offset and its mirror image only: 20 px given as
-    // 150 (a half acquisition declared) read -176.00 px on 500 elements, 150 given as 200 read
-    // -233.30, 60 given as -120 no answer.
+    // The search went about the geometry's offset and its mirror image only, by the absolute
+    // cost: on 500 elements 20 px given as 150 (a half acquisition declared) read -176.00 px,
+    // 150 given as 200 read -233.30, 20 given as -120 -181.53, 120 given as 0 -124.71; on 2000,
+    // 400 given as 0 read 7.50.
     const riner::Geometry g =
         riner::test::make_geometry(riner::GeometryType::kFan2d, 180, 241, 1, {96, 96}, 1.5, 1.0);
     for (const auto& [offset, told] :
          {std::pair{8.3, 75.0}, std::pair{8.3, -95.0}, std::pair{-21.6, 45.0},
           std::pair{-21.6, -80.0}, std::pair{84.4, 104.0}, std::pair{84.4, 140.0},
-          std::pair{-92.7, 45.0}, std::pair{-92.7, -70.0}}) {
+          std::pair{-92.7, 45.0}, std::pair{-92.7, -70.0}, std::pair{8.3, -50.0},
+          std::pair{-21.6, 50.0}, std::pair{45.2, 0.0}, std::pair{-52.6, 0.0},
+          std::pair{55.1, 55.1}, std::pair{-57.3, 40.0}}) {
       CAPTURE(offset);
       CAPTURE(told);
       riner::Scan scan = scan_with_offset(g, offset);

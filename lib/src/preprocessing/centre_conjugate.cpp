@@ -247,12 +247,14 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, const Scan& fine_s
       c = central;
       half_acquisition = false;
     }
-  } else if (std::fabs(g.offset_u) > search_px) {
-    // Neither the geometry's offset nor its mirror image reaches the middle: the whole central
-    // half (60 px given as 120 went on from the wrong end of the mirror's search, to no answer).
-    c = search_central();
   } else {
     c = search_around(g.offset_u, search_px, false, kCoarseStep);
+    // An offset with the wrong sign (a convention's slip): where the search does not reach its
+    // mirror image, that is searched too.
+    if (std::fabs(g.offset_u) > search_px) {
+      const Coarse mirrored = search_around(-g.offset_u, search_px, false, kCoarseStep);
+      if (mirrored.least < c.least) c = mirrored;
+    }
     // The best at the search's end: the axis may lie beyond (an audit's 40 px off on 240
     // elements read 34.50 from a search of 32 px). The search moves on that way while the
     // central half reaches, its end no answer past it.
@@ -262,6 +264,32 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, const Scan& fine_s
       const Coarse next = search_around(centre, search_px, false, kCoarseStep);
       if (!(next.least <= c.least)) break;
       c = next;
+    }
+    // The whole central half by the relative cost too, which (unlike the absolute one, over
+    // offsets with most rays paired) compares an offset near the middle fairly with one near
+    // the half's end; taken where the searches above end at an end, or where it matches 4
+    // times better than their best. Before, a search's end, or a poor match near the half's
+    // end, lost to a spurious one beyond (20 px given as -120 on 500 elements read -181.53, a
+    // half acquisition; -60 given as 120 read 172.38; 90 given as 120, -145.47), and an axis
+    // far from the geometry's went to a spurious basin near it (250 px given as 0 on 2000
+    // elements read 84.50; 400 px, 7.50; 120 px on 500, -124.71).
+    {
+      const double step = std::max(kCoarseStep, inner / 64.0);
+      const auto steps = static_cast<long>(std::floor(inner / step));
+      Coarse relative;
+      for (long k = -steps; k <= steps; ++k) {
+        const double offset = static_cast<double>(k) * step;
+        const double cost = relative_at(offset);
+        if (cost < relative.least) {
+          relative.least = cost;
+          relative.best = offset;
+          relative.at_end = k == -steps || k == steps;
+        }
+      }
+      if (std::isfinite(relative.least) && !relative.at_end &&
+          (c.at_end || relative.least < kOuterAdvantage * relative_at(c.best))) {
+        c = relative;
+      }
     }
   }
   double coarse_best = c.best;
@@ -319,7 +347,6 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, const Scan& fine_s
   ConjugateAxis out;
   out.offset_px = offsets[best];
   out.rays = fine[best].rays;
-  out.half_acquisition = half_acquisition;
   if (best > 0 && best + 1 < costs.size()) {
     const double c0 = costs[best - 1], c1 = costs[best], c2 = costs[best + 1];
     const double curvature = c0 - 2.0 * c1 + c2;
@@ -327,6 +354,12 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, const Scan& fine_s
       out.offset_px += 0.5 * kStep * (c0 - c2) / curvature;
     }
   }
+  // A declared half acquisition whose search, on a small detector, reached the middle and
+  // found the axis there is none (a review's: 0 given as 20 on 64 elements said "half
+  // acquisition").
+  Geometry found = g;
+  found.offset_u = out.offset_px;
+  out.half_acquisition = half_acquisition && is_half_acquisition(found);
   return out;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -95,8 +96,11 @@ Scan midplane_fan(const Scan& cone) {
 }
 
 // A shuffled or interleaved acquisition: the conjugate rays are read between neighbouring views.
-// A view whose angle repeats an earlier one (a scan that turns back over its own angles) within
-// a quarter of the mean step is left out: the methods need each angle once, evenly spaced.
+// A scan that turns back over its own angles has them twice: the methods need each angle once,
+// evenly spaced. A view is left out where its angle repeats its neighbour's exactly, or where
+// it lies within a quarter of the gaps on either side of the pair and a quarter of the views
+// or more do so (a way back whose encoder reads its angles a little differently); views at
+// random angles (a ninth of their gaps so small) or a few clustered ones keep every view.
 Scan in_angle_order(Scan scan) {
   const std::vector<double>& a = scan.geometry.angles;
   const std::size_t n = a.size();
@@ -105,10 +109,22 @@ Scan in_angle_order(Scan scan) {
   for (std::size_t i = 0; i < n; ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(),
                    [&](std::size_t x, std::size_t y) { return a[x] < a[y]; });
-  const double close = 0.25 * (a[order.back()] - a[order.front()]) / static_cast<double>(n - 1);
+  std::vector<double> gap(n - 1);
+  for (std::size_t i = 0; i + 1 < n; ++i) gap[i] = a[order[i + 1]] - a[order[i]];
+  std::vector<char> exact(n - 1, 0), near(n - 1, 0);
+  std::size_t nears = 0;
+  for (std::size_t i = 0; i + 1 < n; ++i) {
+    exact[i] = gap[i] <= 1e-9 * std::max(1.0, std::fabs(a[order[i]]));
+    double beside = std::numeric_limits<double>::infinity();
+    if (i > 0) beside = std::min(beside, gap[i - 1]);
+    if (i + 2 < n) beside = std::min(beside, gap[i + 1]);
+    near[i] = std::isfinite(beside) && gap[i] < 0.25 * beside;
+    nears += near[i] || exact[i];
+  }
+  const bool repeats = 4 * nears >= n - 1;
   std::vector<std::size_t> kept{order.front()};
-  for (std::size_t i = 1; i < n; ++i) {
-    if (a[order[i]] - a[kept.back()] > close) kept.push_back(order[i]);
+  for (std::size_t i = 0; i + 1 < n; ++i) {
+    if (!(exact[i] || (repeats && near[i]))) kept.push_back(order[i + 1]);
   }
   const bool rising = std::is_sorted(a.begin(), a.end());
   const bool falling = std::is_sorted(a.rbegin(), a.rend());
