@@ -441,14 +441,17 @@ TEST_SUITE("centre") {
     const riner::CentreEstimate centred = riner::estimate_centre(scan_with_offset(g, 2.2));
     CHECK_FALSE(centred.half_acquisition);
     CHECK(std::fabs(centred.offset_px - 2.2) < 0.15);
-    // A half acquisition declared (20 px) whose search reaches the middle and finds the axis
-    // there: no half acquisition (it said one).
-    riner::Scan told = scan_with_offset(g, 0.0);
-    told.geometry.offset_u = 20.0;
-    const riner::CentreEstimate middle = riner::estimate_centre(told);
-    CHECK(std::fabs(middle.offset_px) < 0.15);
-    CHECK_FALSE(middle.half_acquisition);
-    CHECK(middle.method == "conjugate rays");
+    // A half acquisition declared (20 px) whose search reaches the central half and finds the
+    // axis there: no half acquisition (it said one).
+    for (const double axis : {0.0, 6.0, -12.0}) {
+      CAPTURE(axis);
+      riner::Scan told = scan_with_offset(g, axis);
+      told.geometry.offset_u = 20.0;
+      const riner::CentreEstimate middle = riner::estimate_centre(told);
+      CHECK(std::fabs(middle.offset_px - axis) < 0.15);
+      CHECK_FALSE(middle.half_acquisition);
+      CHECK(middle.method == "conjugate rays");
+    }
   }
 
   TEST_CASE("a fan whose geometry's offset is far from its axis: the axis found all the same") {

@@ -51,46 +51,69 @@ std::optional<std::pair<std::size_t, std::size_t>> dark_run_at(const DarkRuns& r
   return std::nullopt;
 }
 
-// Elements that read nothing in any view, a run wider than kWidestDeadRun centred on the
-// rotation axis (within kAxisRunTolerance of `axis_column`), whose elements on both sides read
-// `bar` or more or nothing (+inf) in kAxisDenseShare of the views or more, and nothing in one
-// view at least: the beam stopped on the axis in every view (a metal pin there, its edges'
-// elements lit by a few photons, or dark, view by view). A dead element or module off the axis
-// leaves its conjugate rays, across the axis, lit; a lone dead element on it stays dead (a
-// bound there would draw a dense dot), and so does a dead module on the axis of a thick body
-// whose rays beside it never starve (a uniform disc's central rays near the largest: the
-// bound at the largest made its middle 11% too dense).
+// Elements dark (+inf) in every view they read, a run wider than kWidestDeadRun centred on the
+// rotation axis (within kAxisRunTolerance of `axis_column`), beside which, in kAxisEdgeShare
+// of the views with light or more, the element on either side is dark, or reads `bar` or more
+// and a step of kAxisEdgeStep of the largest above the median of the kAxisBeyond readings
+// beyond it: the beam stopped on the axis in every view by something far denser than what
+// lies around it (a metal pin there, its edges' elements lit by a few photons, or dark, view
+// by view). A dead element or module off the axis leaves its conjugate rays, across the axis,
+// lit; a lone dead element on the axis stays dead (a bound there would draw a dense dot), and
+// so do dead elements on the axis of a thick body, whose rays beside them read as much as
+// those beyond (a review's disc of 0.14/mm at 10^4 photons, its rays beside them dark now and
+// then: bounds at the largest, a noisy reading above its middle's, made that 0.46).
 constexpr double kAxisRunTolerance = 1.0;
-constexpr double kAxisDenseShare = 0.75;
-std::vector<char> stopped_on_axis(const Array& m, std::size_t views, const std::vector<char>& reads,
-                                  double axis_column, float bar) {
+constexpr double kAxisEdgeShare = 0.75;
+constexpr double kAxisEdgeStep = 0.25;
+constexpr long kAxisBeyond = 3;
+std::vector<char> stopped_on_axis(const Array& m, std::size_t views, double axis_column,
+                                  float largest) {
   const std::size_t per_view = m.size() / views;
   std::vector<char> out(per_view, 0);
-  if (!std::isfinite(axis_column)) return out;
+  if (!std::isfinite(axis_column) || !(largest > 0.0f)) return out;
   const auto n = static_cast<long>(m.shape.back());
   const std::size_t rows = per_view / static_cast<std::size_t>(n);
-  const auto dense_or_dark = [&](float x) { return is_starved(x) || x >= bar; };
+  // Dark in every view it reads: +inf somewhere, finite nowhere (NaN, unread, is no darkness).
+  std::vector<char> dark(per_view, 1), seen(per_view, 0);
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    if (std::isfinite(m.data[i])) dark[i % per_view] = 0;
+    if (is_starved(m.data[i])) seen[i % per_view] = 1;
+  }
+  for (std::size_t e = 0; e < per_view; ++e) dark[e] = dark[e] && seen[e];
+  const float bar = static_cast<float>(kStarvedNeighbourShare) * largest;
+  const float step = static_cast<float>(kAxisEdgeStep) * largest;
+  // The element beside the run at `at`, the readings beyond it stepping by `dir`.
+  const auto edge = [&](const float* line, long at, long dir) {
+    if (is_starved(line[at])) return true;
+    if (!(line[at] >= bar)) return false;
+    std::vector<float> beyond;
+    for (long j = at + dir; j >= 0 && j < n && beyond.size() < kAxisBeyond; j += dir) {
+      if (std::isfinite(line[j])) beyond.push_back(line[j]);
+    }
+    if (beyond.empty()) return false;
+    std::nth_element(beyond.begin(), beyond.begin() + beyond.size() / 2, beyond.end());
+    return line[at] - beyond[beyond.size() / 2] >= step;
+  };
   for (std::size_t r = 0; r < rows; ++r) {
     const std::size_t first = r * static_cast<std::size_t>(n);
     for (long k = 0; k < n;) {
-      if (reads[first + static_cast<std::size_t>(k)]) {
+      if (!dark[first + static_cast<std::size_t>(k)]) {
         ++k;
         continue;
       }
       long end = k;
-      while (end < n && !reads[first + static_cast<std::size_t>(end)]) ++end;
+      while (end < n && dark[first + static_cast<std::size_t>(end)]) ++end;
       const double centre = 0.5 * static_cast<double>(k + end - 1);
       const bool wide = static_cast<std::size_t>(end - k) > kWidestDeadRun;
       if (wide && k > 0 && end < n && std::fabs(centre - axis_column) <= kAxisRunTolerance) {
-        std::size_t dense = 0, dark_left = 0, dark_right = 0;
+        std::size_t lit = 0, dense = 0;
         for (std::size_t v = 0; v < views; ++v) {
           const float* line = m.ptr() + v * per_view + first;
-          dense += dense_or_dark(line[k - 1]) && dense_or_dark(line[end]);
-          dark_left += is_starved(line[k - 1]);
-          dark_right += is_starved(line[end]);
+          if (std::none_of(line, line + n, [](float x) { return std::isfinite(x); })) continue;
+          ++lit;  // a blank frame says nothing
+          dense += edge(line, k - 1, -1) && edge(line, end, 1);
         }
-        if (static_cast<double>(dense) >= kAxisDenseShare * static_cast<double>(views) &&
-            dark_left > 0 && dark_right > 0) {
+        if (lit > 0 && static_cast<double>(dense) >= kAxisEdgeShare * static_cast<double>(lit)) {
           std::fill(out.begin() + static_cast<std::ptrdiff_t>(first) + k,
                     out.begin() + static_cast<std::ptrdiff_t>(first) + end, 1);
         }
@@ -121,7 +144,7 @@ StarvedReadings mark_starved_readings(Array& measurement, std::size_t views, dou
   }
   const DarkRuns dark = long_dark_runs(measurement, views, response_change_min_views(views));
   const float bar = static_cast<float>(kStarvedNeighbourShare) * largest;
-  const std::vector<char> on_axis = stopped_on_axis(measurement, views, reads, axis_column, bar);
+  const std::vector<char> on_axis = stopped_on_axis(measurement, views, axis_column, largest);
   for (std::size_t l = 0; l < lines; ++l) {
     const std::size_t at = l * static_cast<std::size_t>(n);
     float* line = measurement.ptr() + at;

@@ -16,11 +16,13 @@
 // element that reads nothing in any view is dead whatever its neighbours read (a rule that
 // took a block whose neighbours were dark in half the views for metal made an audit's dead
 // modules beside a metal's trace, or beside a dying element, into bright bounds), except in a
-// run wider than kWidestDeadRun centred on the rotation axis (within a pixel) whose elements on
-// both sides read kStarvedNeighbourShare of the largest or nothing in three quarters of the
-// views or more, and nothing in some: metal on the axis stops those rays in every view (a 3/mm pin
-// there read 0.62 for 3.0 as dead elements), where a dead element or module off the axis leaves its
-// conjugate rays across the axis lit.
+// run wider than kWidestDeadRun, dark in every view it reads, centred on the rotation axis
+// (within a pixel), whose elements on both sides, in three quarters of the views with light,
+// are dark or read kStarvedNeighbourShare of the largest and a step above the readings beyond
+// them: metal on the axis stops those rays in every view (a 3/mm pin there read 0.62 for 3.0
+// as dead elements), where a dead element or module off the axis leaves its conjugate rays
+// across the axis lit, and one on the axis of a thick body has rays beside it that read as
+// much as those beyond.
 #pragma once
 
 #include <cmath>

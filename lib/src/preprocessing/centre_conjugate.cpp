@@ -354,12 +354,10 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, const Scan& fine_s
       out.offset_px += 0.5 * kStep * (c0 - c2) / curvature;
     }
   }
-  // A declared half acquisition whose search, on a small detector, reached the middle and
-  // found the axis there is none (a review's: 0 given as 20 on 64 elements said "half
-  // acquisition").
-  Geometry found = g;
-  found.offset_u = out.offset_px;
-  out.half_acquisition = half_acquisition && is_half_acquisition(found);
+  // A declared half acquisition whose search, on a small detector, reached the central half
+  // and found the axis there is none (a review's: 0, 6 and 12 given as 20 on 64 elements said
+  // "half acquisition").
+  out.half_acquisition = half_acquisition && std::fabs(out.offset_px) >= inner;
   return out;
 }
 
