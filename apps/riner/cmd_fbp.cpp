@@ -86,6 +86,16 @@ void note_short_scan(const Console& console, const FbpReport& report) {
   }
 }
 
+// Readings of +inf where the object stopped the beam: FBP fills them from their neighbours, so
+// metal does not show (training keeps them as bounds).
+void note_stopped_beam(const Console& console, std::size_t readings) {
+  if (readings == 0) return;
+  console.line("note: " + std::to_string(readings) +
+               " readings of +inf (no light) look like a beam the object stopped (metal?): FBP "
+               "fills them from their neighbours, so the image shows no metal there (--json: "
+               "stopped_beam_readings); riner reconstruct trains them as bounds");
+}
+
 int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions& options) {
   const ScanRows source(source_from(args));
   const std::vector<std::string> doubts = source.geometry_doubts();
@@ -137,6 +147,7 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
                  "dead row?)");
   }
   note_short_scan(console, report.fbp);
+  note_stopped_beam(console, report.fbp.stopped_beam_readings);
   note_half_acquisition(console, report.fbp.half_acquisition_overlap_mm);
   note_grid_beyond_rays(console, g);
   console.line("fbp (" + std::string(fbp_filter_name(options.filter)) + ", " +
@@ -158,6 +169,7 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
        {"memory_limit_bytes", limit},
        {"slab_bytes_estimated", fbp_slab_bytes(g, report.slices_per_slab)},
        {"non_finite_replaced", report.fbp.non_finite_replaced},
+       {"stopped_beam_readings", report.fbp.stopped_beam_readings},
        {"short_scan", report.fbp.short_scan},
        {"parker_weighted", report.fbp.parker_weighted},
        {"half_acquisition_overlap_mm", report.fbp.half_acquisition_overlap_mm},
@@ -249,6 +261,7 @@ int run_fbp(int argc, char** argv, int first) {
     write_png(png, image);
   }
   note_short_scan(console, report);
+  note_stopped_beam(console, report.stopped_beam_readings);
   note_half_acquisition(console, report.half_acquisition_overlap_mm);
   note_grid_beyond_rays(console, scan.geometry);
   note_object_beyond_detector(console, scan);
@@ -265,6 +278,7 @@ int run_fbp(int argc, char** argv, int first) {
        {"engine", engine_name(options.engine)},
        {"seconds", seconds},
        {"non_finite_replaced", report.non_finite_replaced},
+       {"stopped_beam_readings", report.stopped_beam_readings},
        {"short_scan", report.short_scan},
        {"parker_weighted", report.parker_weighted},
        {"half_acquisition_overlap_mm", report.half_acquisition_overlap_mm},

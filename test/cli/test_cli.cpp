@@ -201,6 +201,12 @@ TEST_SUITE("cli") {
         CHECK((std::find(dead.begin(), dead.end(), e) != dead.end()) != shadowed);
       }
       CHECK(dead.size() <= simulation["dead_elements"].size());
+      // FBP fills them from their neighbours (the metal does not show) and says so.
+      const Run fbp =
+          riner_cli("fbp " + sim + "/sino.npy --json --out " + (dir / "fbp.npy").string(), dir);
+      REQUIRE(fbp.code == 0);
+      CHECK(nlohmann::json::parse(fbp.out)["stopped_beam_readings"] == summary["starved_readings"]);
+      CHECK(fbp.err.find("look like a beam the object stopped") != std::string::npos);
     }
   }
 

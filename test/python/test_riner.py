@@ -481,6 +481,24 @@ def test_the_librarys_warnings_and_the_centre_check_reach_python():
     assert r.summary["centre_check"]["offset_px"] == pytest.approx(g["detector"]["offset_px"], abs=0.5)
 
 
+def test_fbp_says_when_it_fills_a_beam_the_metal_stopped():
+    # A 3/mm disc on the axis of a water disc stops the beam: FBP fills those readings from
+    # their neighbours (the metal does not show), and says so; without metal it says nothing.
+    g = riner.parallel_beam(np.linspace(0, np.pi, 90, endpoint=False), columns=70,
+                            image_shape=(64, 64))
+    y, x = np.mgrid[:64, :64] - 31.5
+    body = np.where(x * x + y * y < 28 * 28, 0.02, 0.0).astype(np.float32)
+    metal = np.where(x * x + y * y < 4.5 * 4.5, 3.0, body).astype(np.float32)
+    with pytest.warns(UserWarning, match="fewer than 10 photons"):
+        sino = riner.simulate(metal, g, seed=3)["sino"]
+    with pytest.warns(UserWarning, match="look like a beam the object stopped"):
+        riner.fbp(sino, g)
+    plain = riner.simulate(body, g, seed=3)["sino"]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        riner.fbp(plain, g)
+
+
 def test_a_360_degree_scan_under_180_degrees_of_angles_is_doubted_in_python():
     # The same lines as the command line's: fbp and reconstruct warn and keep them, center
     # raises; under the scan's own angles nothing is said.

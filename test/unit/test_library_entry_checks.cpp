@@ -114,7 +114,9 @@ TEST_SUITE("library_entry_checks") {
       riner::SlabOptions options;
       set(options);
       return error_of([&] {
-        riner::SlabRun run(riner::ScanRows({(dir / "stack.npy").string()}), config, out, options);
+        riner::SlabRun run(
+            riner::ScanRows({(dir / "stack.npy").string(), "", "", "", std::nullopt, "", ""}),
+            config, out, options);
       });
     };
     const std::filesystem::path out = dir / "run";

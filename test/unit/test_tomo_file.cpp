@@ -182,7 +182,8 @@ TEST_SUITE("tomo_file") {
     const riner::Geometry g = riner::test::make_geometry(riner::GeometryType::kParallel3d, 6, kCols,
                                                          kRows, {kRows, 24, 24}, 1.0, 1.0, M_PI);
     riner::write_text(dir / "geometry.json", g.to_json());
-    const riner::LoadedScan loaded = riner::load_scan_source({(dir / "scan.h5").string()});
+    const riner::LoadedScan loaded =
+        riner::load_scan_source({(dir / "scan.h5").string(), "", "", "", std::nullopt, "", ""});
     REQUIRE(loaded.flat_field);
     CHECK(loaded.flat_field->saturated_readings == 1);
     CHECK(std::isnan(loaded.scan.measurement.data[2 * kFrame + 7]));

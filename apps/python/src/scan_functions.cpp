@@ -50,10 +50,17 @@ py::array fbp_of(const py::handle& measurement, const std::string& geometry_json
   options.filter = parse_fbp_filter(filter);
   options.engine = parse_engine(engine);
   Array image;
+  FbpReport report;
   {
     py::gil_scoped_release release;
     options.device = device_for(options.engine, device);
-    image = fbp(scan, options);
+    image = fbp(scan, options, &report);
+  }
+  if (report.stopped_beam_readings > 0) {
+    warn(std::to_string(report.stopped_beam_readings) +
+         " readings of +inf (no light) look like a beam the object stopped (metal?): FBP fills "
+         "them from their neighbours, so the image shows no metal there; riner.reconstruct "
+         "trains them as bounds");
   }
   return to_numpy(std::move(image));
 }

@@ -44,6 +44,9 @@ struct FbpOptions {
 
 struct FbpReport {
   std::size_t non_finite_replaced = 0;  // NaN/inf measurements interpolated from neighbours
+  // Of them, readings of +inf where the object stopped the beam (metal: training keeps them as
+  // bounds, model/starved_readings.hpp): interpolated too, so the image shows no metal there.
+  std::size_t stopped_beam_readings = 0;
   bool short_scan = false;  // views miss part of the circle (half-circle for parallel beams)
   // A fan or cone beam's short scan (half a turn plus the fan, or more) weighted by Parker's
   // weights, each line counted once; a short scan without it misses lines: expect streaks.

@@ -3,6 +3,7 @@
 #include "analytic/fbp_setup.hpp"
 #include "cl/context.hpp"
 #include "cl/device_access.hpp"
+#include "model/starved_readings.hpp"
 #include "ops/fbp.hpp"
 #include "reference/fbp_ref.hpp"
 #include "riner/error.hpp"
@@ -59,6 +60,10 @@ Array fbp(const Scan& scan, const FbpOptions& options, FbpReport* report) {
   Geometry g = scan.geometry;  // a half acquisition's detector widens below
   Array weighted = scan.measurement;
   FbpReport local;
+  local.stopped_beam_readings =
+      model::mark_starved_readings(weighted, g.n_views(),
+                                   0.5 * (static_cast<double>(g.n_u) - 1.0) - g.offset_u)
+          .count;
   local.non_finite_replaced = analytic::repair_non_finite(weighted, g.n_u, g.is_3d() ? g.n_v : 1);
   analytic::cosine_weight(weighted, g);
   std::vector<double> view_weights = analytic::view_weights(g, &local.short_scan);

@@ -188,6 +188,8 @@ SlabFbpReport fbp_by_slabs(const ScanRows& source, const FbpOptions& options, Vo
       slab.slices = {first, 1, count};
       FbpReport part;
       slices = fbp(scan, slab, &part);
+      // Rows two cone slabs share count in each.
+      report.fbp.stopped_beam_readings += part.stopped_beam_readings;
       report.fbp.short_scan = report.fbp.short_scan || part.short_scan;
       report.fbp.parker_weighted = report.fbp.parker_weighted || part.parker_weighted;
       report.fbp.half_acquisition_overlap_mm = part.half_acquisition_overlap_mm;
