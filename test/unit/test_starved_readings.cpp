@@ -68,6 +68,18 @@ TEST_SUITE("starved_readings") {
       for (std::size_t e = 6; e < 10; ++e) CHECK(riner::model::is_starved(a(v, e)));
     }
     CHECK(s.count == 24 * 4 + 8 + 8);  // the edges' dark readings join the run: wide
+    // A spike above the largest (22, below the corrupt limit), or an element of the run unread
+    // (NaN) throughout: metal still (a review's: 611 bounds fell to 161).
+    riner::Array spiked = pin_on_axis_scan();
+    spiked(2, 0) = 22.0f;
+    riner::model::mark_starved_readings(spiked, 24, 7.5);
+    CHECK(riner::model::is_starved(spiked(1, 7)));
+    riner::Array masked = pin_on_axis_scan();
+    for (std::size_t v = 0; v < 24; ++v) masked(v, 7) = NAN;
+    riner::model::mark_starved_readings(masked, 24, 7.5);
+    CHECK(riner::model::is_starved(masked(1, 6)));
+    CHECK(riner::model::is_starved(masked(1, 8)));
+    CHECK(std::isnan(masked(1, 7)));
     // The axis a pixel and a half off the run's centre, or unknown: dead, as before.
     for (const double axis : {6.0, 9.0, std::numeric_limits<double>::quiet_NaN()}) {
       CAPTURE(axis);
@@ -103,6 +115,16 @@ TEST_SUITE("starved_readings") {
     for (std::size_t v = 0; v < 24; ++v) {
       for (std::size_t e = 6; e < 10; ++e) CHECK(std::isnan(thick(v, e)));
     }
+    // Beside elements dying part-way (dark from views 4 and 6 to the end), which read as the
+    // body before: dead (a review's: the module's middle 3.67/mm for 0.05).
+    riner::Array dying = pin_on_axis_scan();
+    for (std::size_t v = 0; v < 24; ++v) {
+      dying(v, 5) = v >= 4 ? INFINITY : 1.0f;
+      dying(v, 10) = v >= 6 ? INFINITY : 1.0f;
+    }
+    dying(0, 0) = 16.0f;
+    riner::model::mark_starved_readings(dying, 24, 7.5);
+    for (std::size_t v = 0; v < 24; ++v) CHECK(std::isnan(dying(v, 7)));
     // A module in a body whose rays beside it read as those beyond, and a blank frame (a lost
     // view): dead (a first version counted the frame as the edges' darkness, and took the
     // module for metal).

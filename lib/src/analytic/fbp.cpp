@@ -60,6 +60,9 @@ Array fbp(const Scan& scan, const FbpOptions& options, FbpReport* report) {
   Geometry g = scan.geometry;  // a half acquisition's detector widens below
   Array weighted = scan.measurement;
   FbpReport local;
+  // The readings training keeps as bounds, counted as it counts them (corrupt spikes first);
+  // all are interpolated below, as they were.
+  mark_corrupt_readings(weighted, g.n_views());
   local.stopped_beam_readings =
       model::mark_starved_readings(weighted, g.n_views(),
                                    0.5 * (static_cast<double>(g.n_u) - 1.0) - g.offset_u)

@@ -51,40 +51,59 @@ std::optional<std::pair<std::size_t, std::size_t>> dark_run_at(const DarkRuns& r
   return std::nullopt;
 }
 
-// Elements dark (+inf) in every view they read, a run wider than kWidestDeadRun centred on the
-// rotation axis (within kAxisRunTolerance of `axis_column`), beside which, in kAxisEdgeShare
-// of the views with light or more, the element on either side is dark, or reads `bar` or more
-// and a step of kAxisEdgeStep of the largest above the median of the kAxisBeyond readings
-// beyond it: the beam stopped on the axis in every view by something far denser than what
-// lies around it (a metal pin there, its edges' elements lit by a few photons, or dark, view
-// by view). A dead element or module off the axis leaves its conjugate rays, across the axis,
-// lit; a lone dead element on the axis stays dead (a bound there would draw a dense dot), and
-// so do dead elements on the axis of a thick body, whose rays beside them read as much as
-// those beyond (a review's disc of 0.14/mm at 10^4 photons, its rays beside them dark now and
-// then: bounds at the largest, a noisy reading above its middle's, made that 0.46).
+// Elements that read nothing finite in any view, a run of which more than kWidestDeadRun are
+// dark (+inf), centred on the rotation axis (within kAxisRunTolerance of `axis_column`),
+// beside which, in kAxisEdgeShare of the views with light or more, the element on either side
+// is dark (where it is a dense edge, as below, in most of its other views: not an element
+// dying part-way, or starved now and then at a thick body's middle), or reads `bar` or more
+// and a step of kAxisEdgeStep above the median of the kAxisBeyond readings beyond it: the beam
+// stopped on the axis in every view by something far denser than what lies around it (a metal
+// pin there, its edges' elements lit by a few photons, or dark, view by view). `bar` and the
+// step are shares of the views' typical largest reading (the median over views of each one's
+// largest: one spike moved the scan's largest and lost a pin). A dead element or module off
+// the axis leaves its conjugate rays, across the axis, lit; a lone dead element on the axis
+// stays dead (a bound there would draw a dense dot), and so do dead elements on the axis of a
+// thick body, whose rays beside them read as much as those beyond (a review's disc of
+// 0.14/mm at 10^4 photons, its rays beside them dark now and then: bounds at the largest, a
+// noisy reading above its middle's, made that 0.46), or beside elements dying part-way (a
+// review's: 3.67/mm for 0.05). Not told apart: a hollow capillary on the axis whose lumen a
+// dead module covers exactly, and metal whose edges read as the body beside it in a quarter
+// of the views (photon-starved scans: at 10^4 photons a pin's edges are dark or the body's).
 constexpr double kAxisRunTolerance = 1.0;
 constexpr double kAxisEdgeShare = 0.75;
 constexpr double kAxisEdgeStep = 0.25;
 constexpr long kAxisBeyond = 3;
 std::vector<char> stopped_on_axis(const Array& m, std::size_t views, double axis_column,
-                                  float largest) {
+                                  float limit) {
   const std::size_t per_view = m.size() / views;
   std::vector<char> out(per_view, 0);
-  if (!std::isfinite(axis_column) || !(largest > 0.0f)) return out;
+  if (!std::isfinite(axis_column)) return out;
   const auto n = static_cast<long>(m.shape.back());
   const std::size_t rows = per_view / static_cast<std::size_t>(n);
-  // Dark in every view it reads: +inf somewhere, finite nowhere (NaN, unread, is no darkness).
-  std::vector<char> dark(per_view, 1), seen(per_view, 0);
-  for (std::size_t i = 0; i < m.size(); ++i) {
-    if (std::isfinite(m.data[i])) dark[i % per_view] = 0;
-    if (is_starved(m.data[i])) seen[i % per_view] = 1;
+  // Unread in every view (NaN or +inf), and dark (+inf) in some.
+  std::vector<char> unread(per_view, 1), dark(per_view, 0);
+  std::vector<float> view_largest;
+  for (std::size_t v = 0; v < views; ++v) {
+    float top = -1.0f;
+    for (std::size_t e = 0; e < per_view; ++e) {
+      const float x = m.data[v * per_view + e];
+      if (std::isfinite(x)) {
+        unread[e] = 0;
+        if (std::fabs(x) <= limit) top = std::max(top, x);
+      }
+      if (is_starved(x)) dark[e] = 1;
+    }
+    if (top > 0.0f) view_largest.push_back(top);
   }
-  for (std::size_t e = 0; e < per_view; ++e) dark[e] = dark[e] && seen[e];
-  const float bar = static_cast<float>(kStarvedNeighbourShare) * largest;
-  const float step = static_cast<float>(kAxisEdgeStep) * largest;
-  // The element beside the run at `at`, the readings beyond it stepping by `dir`.
-  const auto edge = [&](const float* line, long at, long dir) {
-    if (is_starved(line[at])) return true;
+  if (view_largest.empty()) return out;
+  std::nth_element(view_largest.begin(), view_largest.begin() + view_largest.size() / 2,
+                   view_largest.end());
+  const float typical = view_largest[view_largest.size() / 2];
+  const float bar = static_cast<float>(kStarvedNeighbourShare) * typical;
+  const float step = static_cast<float>(kAxisEdgeStep) * typical;
+  // The element beside the run at `at` in a view's line, lit: a reading of `bar` or more, a
+  // step above the readings beyond it (stepping by `dir`).
+  const auto lit_edge = [&](const float* line, long at, long dir) {
     if (!(line[at] >= bar)) return false;
     std::vector<float> beyond;
     for (long j = at + dir; j >= 0 && j < n && beyond.size() < kAxisBeyond; j += dir) {
@@ -94,26 +113,47 @@ std::vector<char> stopped_on_axis(const Array& m, std::size_t views, double axis
     std::nth_element(beyond.begin(), beyond.begin() + beyond.size() / 2, beyond.end());
     return line[at] - beyond[beyond.size() / 2] >= step;
   };
+  // Whether the element at `at` of row `first` is a dense edge in most views where it is lit
+  // (a metal's edge lit by a few photons now and then; one dying part-way, or starved now and
+  // then at a thick body's middle, read as what lies beyond it before): its dark views count.
+  const auto dark_counts = [&](std::size_t first, long at, long dir) {
+    std::size_t lit = 0, dense = 0;
+    for (std::size_t v = 0; v < views; ++v) {
+      const float* line = m.ptr() + v * per_view + first;
+      if (!std::isfinite(line[at])) continue;
+      ++lit;
+      dense += lit_edge(line, at, dir);
+    }
+    return 2 * dense >= lit;
+  };
+  const auto edge = [&](const float* line, long at, long dir, bool dark_dense) {
+    return is_starved(line[at]) ? dark_dense : lit_edge(line, at, dir);
+  };
   for (std::size_t r = 0; r < rows; ++r) {
     const std::size_t first = r * static_cast<std::size_t>(n);
     for (long k = 0; k < n;) {
-      if (!dark[first + static_cast<std::size_t>(k)]) {
+      if (!unread[first + static_cast<std::size_t>(k)]) {
         ++k;
         continue;
       }
       long end = k;
-      while (end < n && dark[first + static_cast<std::size_t>(end)]) ++end;
+      std::size_t darks = 0;
+      for (; end < n && unread[first + static_cast<std::size_t>(end)]; ++end) {
+        darks += dark[first + static_cast<std::size_t>(end)];
+      }
       const double centre = 0.5 * static_cast<double>(k + end - 1);
-      const bool wide = static_cast<std::size_t>(end - k) > kWidestDeadRun;
-      if (wide && k > 0 && end < n && std::fabs(centre - axis_column) <= kAxisRunTolerance) {
+      if (darks > kWidestDeadRun && k > 0 && end < n &&
+          std::fabs(centre - axis_column) <= kAxisRunTolerance) {
+        const bool left_dense = dark_counts(first, k - 1, -1);
+        const bool right_dense = dark_counts(first, end, 1);
         std::size_t lit = 0, dense = 0;
         for (std::size_t v = 0; v < views; ++v) {
           const float* line = m.ptr() + v * per_view + first;
           if (std::none_of(line, line + n, [](float x) { return std::isfinite(x); })) continue;
           ++lit;  // a blank frame says nothing
-          dense += edge(line, k - 1, -1) && edge(line, end, 1);
+          dense += edge(line, k - 1, -1, left_dense) && edge(line, end, 1, right_dense);
         }
-        if (lit > 0 && static_cast<double>(dense) >= kAxisEdgeShare * static_cast<double>(lit)) {
+        if (static_cast<double>(dense) >= kAxisEdgeShare * static_cast<double>(lit)) {
           std::fill(out.begin() + static_cast<std::ptrdiff_t>(first) + k,
                     out.begin() + static_cast<std::ptrdiff_t>(first) + end, 1);
         }
@@ -129,6 +169,9 @@ std::vector<char> stopped_on_axis(const Array& m, std::size_t views, double axis
 StarvedReadings mark_starved_readings(Array& measurement, std::size_t views, double axis_column) {
   StarvedReadings out;
   if (measurement.size() == 0 || views == 0 || measurement.rank() < 2) return out;
+  // Most scans have no reading of +inf: nothing to tell apart (FBP of a large stack paid for
+  // the runs below on every slab).
+  if (std::none_of(measurement.data.begin(), measurement.data.end(), is_starved)) return out;
   const float limit = largest_reading(measurement, views);
   float largest = 0.0f;
   for (float x : measurement.data) {
@@ -144,7 +187,7 @@ StarvedReadings mark_starved_readings(Array& measurement, std::size_t views, dou
   }
   const DarkRuns dark = long_dark_runs(measurement, views, response_change_min_views(views));
   const float bar = static_cast<float>(kStarvedNeighbourShare) * largest;
-  const std::vector<char> on_axis = stopped_on_axis(measurement, views, axis_column, largest);
+  const std::vector<char> on_axis = stopped_on_axis(measurement, views, axis_column, limit);
   for (std::size_t l = 0; l < lines; ++l) {
     const std::size_t at = l * static_cast<std::size_t>(n);
     float* line = measurement.ptr() + at;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "model/starved_readings.hpp"
 #include "riner/error.hpp"
 #include "riner/slab_plan.hpp"
 
@@ -186,10 +187,21 @@ SlabFbpReport fbp_by_slabs(const ScanRows& source, const FbpOptions& options, Vo
       if (prepare) prepare(scan);
       FbpOptions slab = options;
       slab.slices = {first, 1, count};
+      // The stopped beam's readings on the rows no slab before read (a cone's slabs share rows).
+      if (new_rows > 0) {
+        Array fresh({g.n_views(), new_rows, g.n_u});
+        for (std::size_t v = 0; v < g.n_views(); ++v) {
+          std::copy_n(scan.measurement.ptr() + (v * rows.count + (new_first - rows.first)) * g.n_u,
+                      new_rows * g.n_u, fresh.ptr() + v * new_rows * g.n_u);
+        }
+        mark_corrupt_readings(fresh, g.n_views());
+        report.fbp.stopped_beam_readings +=
+            model::mark_starved_readings(fresh, g.n_views(),
+                                         0.5 * (static_cast<double>(g.n_u) - 1.0) - g.offset_u)
+                .count;
+      }
       FbpReport part;
       slices = fbp(scan, slab, &part);
-      // Rows two cone slabs share count in each.
-      report.fbp.stopped_beam_readings += part.stopped_beam_readings;
       report.fbp.short_scan = report.fbp.short_scan || part.short_scan;
       report.fbp.parker_weighted = report.fbp.parker_weighted || part.parker_weighted;
       report.fbp.half_acquisition_overlap_mm = part.half_acquisition_overlap_mm;
