@@ -68,10 +68,10 @@ TEST_SUITE("starved_readings") {
       for (std::size_t e = 6; e < 10; ++e) CHECK(riner::model::is_starved(a(v, e)));
     }
     CHECK(s.count == 24 * 4 + 8 + 8);  // the edges' dark readings join the run: wide
-    // A spike above the largest (22, below the corrupt limit), or an element of the run unread
+    // A spike above the largest (19, below the corrupt limit), or an element of the run unread
     // (NaN) throughout: metal still (a review's: 611 bounds fell to 161).
     riner::Array spiked = pin_on_axis_scan();
-    spiked(2, 0) = 22.0f;
+    spiked(2, 0) = 19.0f;
     riner::model::mark_starved_readings(spiked, 24, 7.5);
     CHECK(riner::model::is_starved(spiked(1, 7)));
     riner::Array masked = pin_on_axis_scan();
@@ -115,6 +115,17 @@ TEST_SUITE("starved_readings") {
     for (std::size_t v = 0; v < 24; ++v) {
       for (std::size_t e = 6; e < 10; ++e) CHECK(std::isnan(thick(v, e)));
     }
+    // A bone rod on the axis under a dead module: its edges step above what lies beyond them,
+    // but read far below the scan's largest (a plate's edge-on rays in one view), where the
+    // bounds would go: dead (a review's: 1.36/mm for 0.18).
+    riner::Array rod({24, 16}, 1.7f);
+    for (std::size_t v = 0; v < 24; ++v) {
+      for (std::size_t e = 6; e < 10; ++e) rod(v, e) = INFINITY;
+      rod(v, 5) = rod(v, 10) = 2.8f;
+    }
+    rod(3, 2) = 7.14f;
+    riner::model::mark_starved_readings(rod, 24, 7.5);
+    for (std::size_t v = 0; v < 24; ++v) CHECK(std::isnan(rod(v, 7)));
     // Beside elements dying part-way (dark from views 4 and 6 to the end), which read as the
     // body before: dead (a review's: the module's middle 3.67/mm for 0.05).
     riner::Array dying = pin_on_axis_scan();

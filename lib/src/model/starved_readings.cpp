@@ -74,7 +74,7 @@ constexpr double kAxisEdgeShare = 0.75;
 constexpr double kAxisEdgeStep = 0.25;
 constexpr long kAxisBeyond = 3;
 std::vector<char> stopped_on_axis(const Array& m, std::size_t views, double axis_column,
-                                  float limit) {
+                                  float limit, float floor) {
   const std::size_t per_view = m.size() / views;
   std::vector<char> out(per_view, 0);
   if (!std::isfinite(axis_column)) return out;
@@ -129,6 +129,23 @@ std::vector<char> stopped_on_axis(const Array& m, std::size_t views, double axis
   const auto edge = [&](const float* line, long at, long dir, bool dark_dense) {
     return is_starved(line[at]) ? dark_dense : lit_edge(line, at, dir);
   };
+  // The median of the element's finite readings; NaN where it has none.
+  const auto lit_median = [&](std::size_t e) {
+    std::vector<float> lit;
+    for (std::size_t v = 0; v < views; ++v) {
+      const float x = m.data[v * per_view + e];
+      if (std::isfinite(x)) lit.push_back(x);
+    }
+    if (lit.empty()) return NAN;
+    std::nth_element(lit.begin(), lit.begin() + lit.size() / 2, lit.end());
+    return lit[lit.size() / 2];
+  };
+  // The bounds go at the scan's largest reading: the edges, lit, must read near it, as a
+  // metal's do (a count-limited beam), not a bone rod's far below a plate's edge-on rays (a
+  // review's: its dead module's bounds at 7.14 drew 1.36/mm for 0.18).
+  const auto near_floor = [&](std::size_t e) {
+    return lit_median(e) >= static_cast<float>(kStarvedNeighbourShare) * floor;
+  };
   for (std::size_t r = 0; r < rows; ++r) {
     const std::size_t first = r * static_cast<std::size_t>(n);
     for (long k = 0; k < n;) {
@@ -143,7 +160,9 @@ std::vector<char> stopped_on_axis(const Array& m, std::size_t views, double axis
       }
       const double centre = 0.5 * static_cast<double>(k + end - 1);
       if (darks > kWidestDeadRun && k > 0 && end < n &&
-          std::fabs(centre - axis_column) <= kAxisRunTolerance) {
+          std::fabs(centre - axis_column) <= kAxisRunTolerance &&
+          near_floor(first + static_cast<std::size_t>(k - 1)) &&
+          near_floor(first + static_cast<std::size_t>(end))) {
         const bool left_dense = dark_counts(first, k - 1, -1);
         const bool right_dense = dark_counts(first, end, 1);
         std::size_t lit = 0, dense = 0;
@@ -187,7 +206,8 @@ StarvedReadings mark_starved_readings(Array& measurement, std::size_t views, dou
   }
   const DarkRuns dark = long_dark_runs(measurement, views, response_change_min_views(views));
   const float bar = static_cast<float>(kStarvedNeighbourShare) * largest;
-  const std::vector<char> on_axis = stopped_on_axis(measurement, views, axis_column, limit);
+  const std::vector<char> on_axis =
+      stopped_on_axis(measurement, views, axis_column, limit, largest);
   for (std::size_t l = 0; l < lines; ++l) {
     const std::size_t at = l * static_cast<std::size_t>(n);
     float* line = measurement.ptr() + at;
