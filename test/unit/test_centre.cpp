@@ -353,17 +353,12 @@ TEST_SUITE("centre") {
     const riner::Geometry closed = with_angles(riner::test::small_fan2d(), 91, 2.0 * M_PI, true);
     CHECK(std::fabs(riner::estimate_centre(scan_with_offset(closed, 1.6)).offset_px - 1.6) < 0.15);
     // The views in shuffled order, each with its angle (an interleaved acquisition): the same.
-    riner::Scan ordered = scan_with_offset(riner::test::small_fan2d(), 2.7);
-    riner::Scan shuffled = ordered;
-    shuffled.geometry.uniform_angles.reset();
-    const std::size_t views = ordered.geometry.n_views(), n_u = ordered.geometry.n_u;
-    for (std::size_t i = 0; i < views; ++i) {
-      const std::size_t from = (i * 7) % views;  // 7 is prime to the view count
-      REQUIRE(std::gcd(views, std::size_t{7}) == 1);
-      shuffled.geometry.angles[i] = ordered.geometry.angles[from];
-      std::copy_n(ordered.measurement.ptr() + from * n_u, n_u,
-                  shuffled.measurement.ptr() + i * n_u);
-    }
+    const riner::Scan ordered = scan_with_offset(riner::test::small_fan2d(), 2.7);
+    const std::size_t views = ordered.geometry.n_views();
+    REQUIRE(std::gcd(views, std::size_t{7}) == 1);
+    std::vector<std::size_t> from;
+    for (std::size_t i = 0; i < views; ++i) from.push_back((i * 7) % views);  // 7: prime to it
+    const riner::Scan shuffled = reordered(ordered, from);
     CHECK(riner::estimate_centre(shuffled).offset_px ==
           doctest::Approx(riner::estimate_centre(ordered).offset_px).epsilon(1e-9));
   }

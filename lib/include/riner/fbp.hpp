@@ -40,6 +40,9 @@ struct FbpOptions {
   SliceSelection slices;
   Engine engine = Engine::kOpenCL;
   std::optional<Device> device;  // OpenCL engine; default Device::open()
+  // With a report: count FbpReport::stopped_beam_readings (a pass over the readings where any
+  // is +inf; a slab run counts each row once itself).
+  bool count_stopped_beam = true;
 };
 
 struct FbpReport {

@@ -60,13 +60,11 @@ Array fbp(const Scan& scan, const FbpOptions& options, FbpReport* report) {
   Geometry g = scan.geometry;  // a half acquisition's detector widens below
   Array weighted = scan.measurement;
   FbpReport local;
-  // The readings training keeps as bounds, counted as it counts them (corrupt spikes first);
+  // The readings training keeps as bounds, counted as it counts them, for a caller that asks;
   // all are interpolated below, as they were.
-  mark_corrupt_readings(weighted, g.n_views());
-  local.stopped_beam_readings =
-      model::mark_starved_readings(weighted, g.n_views(),
-                                   0.5 * (static_cast<double>(g.n_u) - 1.0) - g.offset_u)
-          .count;
+  if (report != nullptr && options.count_stopped_beam) {
+    local.stopped_beam_readings = model::mark_starved_readings(weighted, g).count;
+  }
   local.non_finite_replaced = analytic::repair_non_finite(weighted, g.n_u, g.is_3d() ? g.n_v : 1);
   analytic::cosine_weight(weighted, g);
   std::vector<double> view_weights = analytic::view_weights(g, &local.short_scan);

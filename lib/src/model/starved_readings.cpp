@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "model/response_changes.hpp"
+#include "riner/rays.hpp"
 #include "riner/scan.hpp"
 
 namespace riner::model {
@@ -269,6 +270,12 @@ StarvedReadings mark_starved_readings(Array& measurement, std::size_t views, dou
   }
   if (out.count > 0) out.floor = largest;
   return out;
+}
+
+StarvedReadings mark_starved_readings(Array& measurement, const Geometry& g) {
+  mark_corrupt_readings(measurement, g.n_views());
+  return mark_starved_readings(measurement, g.n_views(),
+                               project_to_detector(g, 0, Vec3{0.0, 0.0, 0.0}).u);
 }
 
 }  // namespace riner::model

@@ -30,6 +30,7 @@
 #include <limits>
 
 #include "riner/array.hpp"
+#include "riner/geometry.hpp"
 
 namespace riner::model {
 
@@ -48,6 +49,10 @@ struct StarvedReadings {
 StarvedReadings mark_starved_readings(
     Array& measurement, std::size_t views,
     double axis_column = std::numeric_limits<double>::quiet_NaN());
+// The same for a scan's readings under `g`: corrupt spikes first set NaN (as training reads
+// them, riner/scan.hpp's mark_corrupt_readings), then the bounds about the column the rotation
+// axis projects onto.
+StarvedReadings mark_starved_readings(Array& measurement, const Geometry& g);
 
 // A kept bound: +inf after mark_starved_readings.
 inline bool is_starved(float reading) { return reading == std::numeric_limits<float>::infinity(); }

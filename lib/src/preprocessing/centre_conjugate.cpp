@@ -220,9 +220,8 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, const Scan& fine_s
   };
   // The whole central half in at most 129 steps (a wide detector's basin is as wide), which
   // the half-pixel search below moves on from.
-  const auto search_central = [&]() {
-    return search_around(0.0, inner, false, std::max(kCoarseStep, inner / 64.0));
-  };
+  const double central_step = std::max(kCoarseStep, inner / 64.0);
+  const auto search_central = [&]() { return search_around(0.0, inner, false, central_step); };
   const auto relative_at = [&](double offset) {
     return conjugate_cost(fine_scan, *turn, offset, kOuter).relative;
   };
@@ -274,11 +273,10 @@ std::optional<ConjugateAxis> conjugate_axis(const Scan& scan, const Scan& fine_s
     // far from the geometry's went to a spurious basin near it (250 px given as 0 on 2000
     // elements read 84.50; 400 px, 7.50; 120 px on 500, -124.71).
     {
-      const double step = std::max(kCoarseStep, inner / 64.0);
-      const auto steps = static_cast<long>(std::floor(inner / step));
+      const auto steps = static_cast<long>(std::floor(inner / central_step));
       Coarse relative;
       for (long k = -steps; k <= steps; ++k) {
-        const double offset = static_cast<double>(k) * step;
+        const double offset = static_cast<double>(k) * central_step;
         const double cost = relative_at(offset);
         if (cost < relative.least) {
           relative.least = cost;

@@ -194,12 +194,9 @@ SlabFbpReport fbp_by_slabs(const ScanRows& source, const FbpOptions& options, Vo
           std::copy_n(scan.measurement.ptr() + (v * rows.count + (new_first - rows.first)) * g.n_u,
                       new_rows * g.n_u, fresh.ptr() + v * new_rows * g.n_u);
         }
-        mark_corrupt_readings(fresh, g.n_views());
-        report.fbp.stopped_beam_readings +=
-            model::mark_starved_readings(fresh, g.n_views(),
-                                         0.5 * (static_cast<double>(g.n_u) - 1.0) - g.offset_u)
-                .count;
+        report.fbp.stopped_beam_readings += model::mark_starved_readings(fresh, g).count;
       }
+      slab.count_stopped_beam = false;  // counted above, once per row
       FbpReport part;
       slices = fbp(scan, slab, &part);
       report.fbp.short_scan = report.fbp.short_scan || part.short_scan;
