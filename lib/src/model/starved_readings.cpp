@@ -272,10 +272,11 @@ StarvedReadings mark_starved_readings(Array& measurement, std::size_t views, dou
   return out;
 }
 
+double axis_column(const Geometry& g) { return project_to_detector(g, 0, Vec3{0.0, 0.0, 0.0}).u; }
+
 StarvedReadings mark_starved_readings(Array& measurement, const Geometry& g) {
   mark_corrupt_readings(measurement, g.n_views());
-  return mark_starved_readings(measurement, g.n_views(),
-                               project_to_detector(g, 0, Vec3{0.0, 0.0, 0.0}).u);
+  return mark_starved_readings(measurement, g.n_views(), axis_column(g));
 }
 
 }  // namespace riner::model

@@ -49,9 +49,10 @@ struct StarvedReadings {
 StarvedReadings mark_starved_readings(
     Array& measurement, std::size_t views,
     double axis_column = std::numeric_limits<double>::quiet_NaN());
+// The detector column the rotation axis projects onto (riner/rays.hpp).
+double axis_column(const Geometry& g);
 // The same for a scan's readings under `g`: corrupt spikes first set NaN (as training reads
-// them, riner/scan.hpp's mark_corrupt_readings), then the bounds about the column the rotation
-// axis projects onto.
+// them, riner/scan.hpp's mark_corrupt_readings), then the bounds about axis_column(g).
 StarvedReadings mark_starved_readings(Array& measurement, const Geometry& g);
 
 // A kept bound: +inf after mark_starved_readings.
