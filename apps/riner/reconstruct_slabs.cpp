@@ -517,6 +517,9 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       flat->air_drift_sigmas = -1.0;
     }
     flat->invalid_readings += f["invalid_readings"].get<std::size_t>();
+    // The slabs' rows' noise: the largest of their medians (older records: none).
+    flat->dark_noise = std::max(flat->dark_noise, f.value("dark_noise", 0.0));
+    flat->readings_in_dark_noise += f.value("readings_in_dark_noise", std::size_t{0});
     flat->saturated_readings +=
         f.value("saturated_readings", std::size_t{0});  // older records: none
     flat->pixels_without_beam += f["pixels_without_beam"].get<std::size_t>();

@@ -316,6 +316,8 @@ nlohmann::json flat_field_json(const FlatFieldReport& r) {
   return {{"flat_frames", r.flat_frames},
           {"dark_frames", r.dark_frames},
           {"invalid_readings", r.invalid_readings},
+          {"dark_noise", r.dark_noise},
+          {"readings_in_dark_noise", r.readings_in_dark_noise},
           {"saturated_readings", r.saturated_readings},
           {"pixels_without_beam", r.pixels_without_beam},
           {"flat_series", r.flat_series},

@@ -87,6 +87,57 @@ TEST_SUITE("flat_field") {
     CHECK(report.pixels == 3);
   }
 
+  TEST_CASE("light within the dark's noise is no light; the noise from each row of dark frames") {
+    // Two rows of 40 pixels; 4 dark frames about 100, row 0 with a noise of 5 counts (plus one
+    // hot pixel of 200), row 1 with none. The threshold, 3 sigma sqrt(1 + 1/4), is 16.8 counts on
+    // row 0: light of 10 over the dark there is no light (+inf, a metal's rays), light of 25 a
+    // reading; on row 1 light of 2 is a reading.
+    const std::size_t columns = 40, pixels = 2 * columns;
+    const float noise[4] = {-5.0f, 5.0f, -5.0f, 5.0f};  // times sqrt(3/4): a variance of 25
+    Array darks({4, 2, columns});
+    for (std::size_t f = 0; f < 4; ++f) {
+      for (std::size_t c = 0; c < columns; ++c) {
+        darks.data[f * pixels + c] = 100.0f + noise[f] * std::sqrt(0.75f) * (c == 7 ? 40.0f : 1.0f);
+        darks.data[f * pixels + columns + c] = 100.0f;
+      }
+    }
+    Array flat({2, columns}, 1100.0f);
+    flat.data[9] = 300.0f;  // a weak beam (the edge of a beam's profile): the dark alone is none
+    Array raw({1, 2, columns}, 600.0f);
+    raw.data[3] = 110.0f;            // row 0: 10 over the dark
+    raw.data[4] = 125.0f;            // row 0: 25 over it
+    raw.data[9] = 110.0f;            // 10 over it under the weak beam
+    raw.data[columns + 3] = 102.0f;  // row 1: 2 over it
+    FlatFieldReport report;
+    const Array rho = riner::flat_field_normalise(raw, flat, darks, &report);
+    CHECK(rho.data[3] == std::numeric_limits<float>::infinity());
+    CHECK(rho.data[4] == doctest::Approx(-std::log(25.0 / 1000.0)).epsilon(1e-5));
+    CHECK(rho.data[columns + 3] == doctest::Approx(-std::log(2.0 / 1000.0)).epsilon(1e-5));
+    CHECK(rho.data[9] == doctest::Approx(-std::log(10.0 / 200.0)).epsilon(1e-5));
+    CHECK(report.invalid_readings == 1);
+    CHECK(report.readings_in_dark_noise == 1);
+    // The median over the rows of 5 (the hot pixel left out) and 0.
+    CHECK(report.dark_noise == doctest::Approx(5.0).epsilon(1e-4));
+    // One row alone (a slab, or --row) is read as in the whole stack.
+    Array raw_row({1, 1, columns}), flat_row({1, columns}, 1100.0f), darks_row({4, 1, columns});
+    flat_row.data[9] = 300.0f;
+    std::copy(raw.data.begin(), raw.data.begin() + columns, raw_row.data.begin());
+    for (std::size_t f = 0; f < 4; ++f) {
+      std::copy(darks.data.begin() + f * pixels, darks.data.begin() + f * pixels + columns,
+                darks_row.data.begin() + f * columns);
+    }
+    const Array rho_row = riner::flat_field_normalise(raw_row, flat_row, darks_row);
+    for (std::size_t c = 0; c < columns; ++c) CHECK(rho_row.data[c] == rho.data[c]);
+    // A single dark frame (or frames averaged before saving) says nothing of the noise: only
+    // light at or below the dark is none, as before.
+    Array one_dark({2, columns}, 100.0f);
+    FlatFieldReport single;
+    const Array rho_single = riner::flat_field_normalise(raw, flat, one_dark, &single);
+    CHECK(rho_single.data[3] == doctest::Approx(-std::log(10.0 / 1000.0)).epsilon(1e-5));
+    CHECK(single.dark_noise == 0.0);
+    CHECK(single.invalid_readings == 0);
+  }
+
   TEST_CASE("a flat field with beam on few of the pixels is named; one dead pixel is not") {
     // 40 pixels; the flat's beam on the first 20 only (a flat of another region, say).
     Array raw({2, 40});

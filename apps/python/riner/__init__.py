@@ -153,7 +153,10 @@ def _device(device):
 
 def flat_field(projections, flat, dark=None, flat_after=None):
     """rho = -ln((I - D) / (F - D)) with F and D the per-pixel means of the flat and dark frames
-    (one frame or a stack); invalid readings become NaN. flat_after: flats taken after the scan
+    (one frame or a stack). A reading with no light (at or below the dark, or, given two or more
+    dark frames, less than 3 times their noise above it: report's dark_noise and
+    readings_in_dark_noise) becomes +inf, which reconstruct keeps as a bound where an object
+    stopped the beam; other invalid readings become NaN. flat_after: flats taken after the scan
     (a drifting beam): each view's F is interpolated between the two series by its place in the
     scan. Returns (rho, report dict)."""
     rho, report = _riner.flat_field(_array(projections), _array(flat),

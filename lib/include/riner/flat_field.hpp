@@ -22,6 +22,11 @@ struct FlatFieldReport {
   // under a beam (no light left: metal, or a dead pixel; training keeps the first as a bound,
   // the library's model/starved_readings.hpp), NaN for a non-finite I (beta switches those off).
   std::size_t invalid_readings = 0;
+  // The dark field's noise (the median over detector rows of its standard deviation from frame to
+  // frame; 0 with fewer than two dark frames), and the invalid readings whose light was above
+  // the dark but within kDarkNoiseSigmas of that noise (taken as no light).
+  double dark_noise = 0.0;
+  std::size_t readings_in_dark_noise = 0;
   // Detector pixels with F - D <= 0 or no finite flat or dark frame: all their readings are NaN.
   std::size_t pixels_without_beam = 0;
   std::size_t pixels = 0;  // of one view
@@ -67,6 +72,12 @@ std::string saturation_line(const FlatFieldReport& report);
 // Readings of `dtype` (the file's) at its largest count set to NaN, and counted: uint16 and
 // uint8 only (a 12-bit camera's 4095 in uint16 is not known from the file).
 std::size_t mark_saturated(Array& projections, const std::string& dtype);
+
+// Light less than this many times the dark's noise above the dark is no light (+inf): the
+// chance that a pixel that saw none reads more is about 1 in 700.
+constexpr double kDarkNoiseSigmas = 3.0;
+// ... where a pixel's beam (F - D) is at least this share of the detector's median.
+constexpr double kDarkNoiseLeastBeam = 0.5;
 
 // A real detector has a few dead pixels; past this share of pixels without beam the flat field
 // is more likely of another detector region, binning or exposure than the projections'.

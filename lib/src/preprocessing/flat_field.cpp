@@ -88,6 +88,53 @@ double median_of(std::vector<double> values) {
   return *mid;
 }
 
+// The dark field's noise from frame to frame, one figure per detector row (a slab's rows get
+// the figures a whole stack's would: the estimate does not depend on how a scan is cut): each
+// pixel's variance over its finite frames, averaged over the row's pixels but those above
+// kHotPixelVariance times the row's median (hot or flickering pixels). Zeros with fewer than two
+// frames: one frame, or frames averaged before they were saved, say nothing of the noise.
+constexpr double kHotPixelVariance = 25.0;
+std::vector<double> dark_noise_by_row(const Array& darks,
+                                      const std::vector<std::size_t>& view_shape,
+                                      const std::vector<double>& dark) {
+  const std::size_t pixels = shape_size(view_shape);
+  const std::size_t columns = view_shape.back();
+  const std::size_t rows = pixels / columns;
+  std::vector<double> sigma(rows, 0.0);
+  if (darks.rank() != view_shape.size() + 1 || darks.shape[0] < 2) return sigma;
+  const std::size_t frames = darks.shape[0];
+  std::vector<double> variance(columns);
+  for (std::size_t row = 0; row < rows; ++row) {
+    std::size_t n_pixels = 0;
+    for (std::size_t c = 0; c < columns; ++c) {
+      const std::size_t p = row * columns + c;
+      double sum = 0.0;
+      std::size_t n = 0;
+      for (std::size_t f = 0; f < frames; ++f) {
+        const float x = darks.data[f * pixels + p];
+        if (std::isfinite(x)) {
+          sum += (x - dark[p]) * (x - dark[p]);
+          ++n;
+        }
+      }
+      if (n >= 2) variance[n_pixels++] = sum / static_cast<double>(n - 1);
+    }
+    if (n_pixels == 0) continue;
+    const double typical = median_of(std::vector<double>(
+        variance.begin(), variance.begin() + static_cast<std::ptrdiff_t>(n_pixels)));
+    double sum = 0.0;
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < n_pixels; ++i) {
+      if (variance[i] <= kHotPixelVariance * typical) {
+        sum += variance[i];
+        ++n;
+      }
+    }
+    sigma[row] = n ? std::sqrt(sum / static_cast<double>(n)) : 0.0;
+  }
+  return sigma;
+}
+
 }  // namespace
 
 bool air_drifts(const FlatFieldReport& r) {
@@ -244,7 +291,17 @@ Array flat_field_normalise(const Array& projections, const Array& flats, const A
   const std::size_t pixels = shape_size(view_shape);
   FlatFieldReport r;
   std::vector<double> dark(pixels, 0.0);
-  if (!darks.shape.empty()) dark = frame_mean(darks, view_shape, "the dark field", &r.dark_frames);
+  std::vector<double> no_light(pixels, 0.0);  // light at or below this is none
+  if (!darks.shape.empty()) {
+    dark = frame_mean(darks, view_shape, "the dark field", &r.dark_frames);
+    const std::vector<double> sigma = dark_noise_by_row(darks, view_shape, dark);
+    const std::size_t columns = view_shape.back();
+    const double mean_error = std::sqrt(1.0 + 1.0 / static_cast<double>(r.dark_frames));
+    for (std::size_t p = 0; p < pixels; ++p) {
+      no_light[p] = kDarkNoiseSigmas * sigma[p / columns] * mean_error;
+    }
+    r.dark_noise = median_of(sigma);
+  }
   // Each series' beam F - D per pixel, NaN where there is none (in any series).
   const std::vector<FlatSeries> series = flat_series(flats, flat_positions, view_shape);
   std::vector<std::vector<double>> beams;
@@ -262,6 +319,19 @@ Array flat_field_normalise(const Array& projections, const Array& flats, const A
   }
   r.flat_series = series.size();
   for (std::size_t p = 0; p < pixels; ++p) r.pixels_without_beam += no_beam[p];
+  // A pixel under a weak beam (the edge of a synchrotron's beam profile) keeps light at or
+  // below the dark alone as none: its own readings' limit, ln(beam / noise), lies below what
+  // the strong pixels read, and a ray without light is bounded by the scan's largest reading.
+  {
+    std::vector<double> lit;
+    for (std::size_t p = 0; p < pixels; ++p) {
+      if (!no_beam[p]) lit.push_back(beams.front()[p]);
+    }
+    const double typical = median_of(lit);
+    for (std::size_t p = 0; p < pixels; ++p) {
+      if (!(beams.front()[p] >= kDarkNoiseLeastBeam * typical)) no_light[p] = 0.0;
+    }
+  }
   r.pixels = pixels;
   if (beams.size() > 1) {
     std::vector<double> change;
@@ -284,10 +354,14 @@ Array flat_field_normalise(const Array& projections, const Array& flats, const A
     for (std::size_t p = 0; p < pixels; ++p) {
       const std::size_t i = v * pixels + p;
       const double light = static_cast<double>(projections.data[i]) - dark[p];
-      if (!(light > 0.0) || no_beam[p]) {
-        // No light left (at or below the dark) under a beam: -ln 0, a beam the object stopped
-        // or a dead pixel, which model/starved_readings.hpp tells apart.
+      if (!(light > no_light[p]) || no_beam[p]) {
+        // No light left (within the dark's noise) under a beam: -ln 0, a beam the object stopped
+        // or a dead pixel, which model/starved_readings.hpp tells apart. Light within the noise
+        // says only that the ray's line integral is large: its logarithm would be noise (a
+        // count over the dark reads 9 where the next reads 7) and break a metal's trace into
+        // pieces read as dead elements.
         const bool dark_only = !no_beam[p] && !std::isnan(light);
+        if (dark_only && light > 0.0) ++r.readings_in_dark_noise;
         rho.data[i] = dark_only ? std::numeric_limits<float>::infinity()
                                 : std::numeric_limits<float>::quiet_NaN();
         ++r.invalid_readings;

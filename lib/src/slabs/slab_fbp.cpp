@@ -119,12 +119,15 @@ void merge_flat_report(SlabFbpReport& report, const FlatFieldReport& slab, std::
     report.flat_field = slab;
     report.flat_field->invalid_readings = 0;
     report.flat_field->saturated_readings = 0;
+    report.flat_field->readings_in_dark_noise = 0;
     report.flat_field->pixels_without_beam = 0;
     report.flat_field->pixels = 0;
   }
   FlatFieldReport& all = *report.flat_field;
   all.invalid_readings += non_finite;
   all.saturated_readings += scaled(slab.saturated_readings);
+  all.readings_in_dark_noise += scaled(slab.readings_in_dark_noise);
+  all.dark_noise = std::max(all.dark_noise, slab.dark_noise);
   all.pixels_without_beam += scaled(slab.pixels_without_beam);
   all.pixels += scaled(slab.pixels);
   if (std::isfinite(slab.air_first) && std::isfinite(slab.air_last) &&

@@ -79,6 +79,8 @@ nlohmann::json readings_record(const Scan& scan, const Slab& slab, const FlatFie
   out["flat_field"] = {{"flat_frames", flat.flat_frames},
                        {"dark_frames", flat.dark_frames},
                        {"invalid_readings", scaled(flat.invalid_readings)},
+                       {"dark_noise", flat.dark_noise},
+                       {"readings_in_dark_noise", scaled(flat.readings_in_dark_noise)},
                        {"saturated_readings", scaled(flat.saturated_readings)},
                        {"pixels_without_beam", scaled(flat.pixels_without_beam)},
                        {"pixels", scaled(flat.pixels)},

@@ -438,13 +438,19 @@ std::string flat_field_line(const FlatFieldReport& r) {
                   " in %zu series interpolated by view (the beam %+.2f%% from first to last)",
                   r.flat_series, 100.0 * r.flat_change);
   }
-  return "raw projections: flat field of " + std::to_string(r.flat_frames) + " frame(s)" +
-         series + ", " +
+  char below[160] = "at or below the dark";
+  if (r.dark_noise > 0.0) {
+    std::snprintf(below, sizeof(below),
+                  "no more light than %.0f times the dark's noise, %.3g, of which %zu above the "
+                  "dark",
+                  kDarkNoiseSigmas, r.dark_noise, r.readings_in_dark_noise);
+  }
+  return "raw projections: flat field of " + std::to_string(r.flat_frames) + " frame(s)" + series +
+         ", " +
          (r.dark_frames ? "dark field of " + std::to_string(r.dark_frames) + " frame(s)"
                         : std::string("no dark field")) +
-         "; " + std::to_string(r.invalid_readings) +
-         " readings invalid (at or below the dark, or on " + std::to_string(r.pixels_without_beam) +
-         " pixels without beam)";
+         "; " + std::to_string(r.invalid_readings) + " readings invalid (" + below + "; or on " +
+         std::to_string(r.pixels_without_beam) + " pixels without beam)";
 }
 
 std::string centre_line(const CentreEstimate& e) {
