@@ -349,13 +349,15 @@ def test_flat_field_and_center_on_raw_parallel_projections():
 
 def test_flat_field_takes_light_within_the_dark_noise_for_none():
     # Two dark frames 100 +- 4 (a noise of 4 * sqrt(2) = 5.66 counts): light of 10 over the dark is
-    # within 3 sigma sqrt(1 + 1/2) = 20.8 of it, light of 30 is not.
+    # within 3 sigma sqrt(1 + 1/2) = 20.8 of it, light of 30 is not, under a beam of 10^4 (over
+    # e^4 times 20.8: a beam a metal stops).
     dark = np.stack([np.full(50, 96.0), np.full(50, 104.0)])
-    flat = np.full(50, 1100.0)
+    dark[:, ::2] = dark[::-1, ::2]  # the noise differs between pixels: no frame-wide offset
+    flat = np.full(50, 10100.0)
     raw = np.full((2, 50), 600.0)
     raw[0, 5], raw[1, 5] = 110.0, 130.0
     rho, report = riner.flat_field(raw, flat, dark)
-    assert rho[0, 5] == np.inf and rho[1, 5] == pytest.approx(-np.log(0.03), rel=1e-5)
+    assert rho[0, 5] == np.inf and rho[1, 5] == pytest.approx(-np.log(0.003), rel=1e-5)
     assert report["dark_noise"] == pytest.approx(4 * np.sqrt(2), rel=1e-5)
     assert report["readings_in_dark_noise"] == 1 and report["invalid_readings"] == 1
     # One dark frame says nothing of its noise: the light of 10 is a reading.

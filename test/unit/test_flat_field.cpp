@@ -89,20 +89,26 @@ TEST_SUITE("flat_field") {
 
   TEST_CASE("light within the dark's noise is no light; the noise from each row of dark frames") {
     // Two rows of 40 pixels; 4 dark frames about 100, row 0 with a noise of 5 counts (plus one
-    // hot pixel of 200), row 1 with none. The threshold, 3 sigma sqrt(1 + 1/4), is 16.8 counts on
-    // row 0: light of 10 over the dark there is no light (+inf, a metal's rays), light of 25 a
-    // reading; on row 1 light of 2 is a reading.
+    // hot pixel of 200) and a level that drifts from frame to frame by 20 (no noise of a
+    // reading), row 1 with none. The threshold, 3 sigma sqrt(1 + 1/4), is 16.8 counts on row 0:
+    // light of 10 over the dark there is no light (+inf, a metal's rays), light of 25 a reading;
+    // on row 1 light of 2 is a reading.
     const std::size_t columns = 40, pixels = 2 * columns;
-    const float noise[4] = {-5.0f, 5.0f, -5.0f, 5.0f};  // times sqrt(3/4): a variance of 25
+    const float b = std::sqrt(37.5f);  // -b, 0, b, 0: a variance of 25
+    const float noise[4] = {-b, 0.0f, b, 0.0f};
+    const float drift[4] = {-30.0f, -10.0f, 10.0f, 30.0f};
     Array darks({4, 2, columns});
     for (std::size_t f = 0; f < 4; ++f) {
       for (std::size_t c = 0; c < columns; ++c) {
-        darks.data[f * pixels + c] = 100.0f + noise[f] * std::sqrt(0.75f) * (c == 7 ? 40.0f : 1.0f);
+        darks.data[f * pixels + c] =
+            100.0f + drift[f] + noise[(f + c) % 4] * (c == 7 ? 40.0f : 1.0f);
         darks.data[f * pixels + columns + c] = 100.0f;
       }
     }
     Array flat({2, columns}, 1100.0f);
-    flat.data[9] = 300.0f;  // a weak beam (the edge of a beam's profile): the dark alone is none
+    // A dim beam, 200 over the dark (under e^4 times the threshold: a thick body's light, not a
+    // metal's, lies within the noise there): only light at or below the dark is none.
+    flat.data[9] = 300.0f;
     Array raw({1, 2, columns}, 600.0f);
     raw.data[3] = 110.0f;            // row 0: 10 over the dark
     raw.data[4] = 125.0f;            // row 0: 25 over it
@@ -116,7 +122,7 @@ TEST_SUITE("flat_field") {
     CHECK(rho.data[9] == doctest::Approx(-std::log(10.0 / 200.0)).epsilon(1e-5));
     CHECK(report.invalid_readings == 1);
     CHECK(report.readings_in_dark_noise == 1);
-    // The median over the rows of 5 (the hot pixel left out) and 0.
+    // The median over the rows of 5 (the hot pixel and the drift left out) and 0.
     CHECK(report.dark_noise == doctest::Approx(5.0).epsilon(1e-4));
     // One row alone (a slab, or --row) is read as in the whole stack.
     Array raw_row({1, 1, columns}), flat_row({1, columns}, 1100.0f), darks_row({4, 1, columns});

@@ -76,8 +76,11 @@ std::size_t mark_saturated(Array& projections, const std::string& dtype);
 // Light less than this many times the dark's noise above the dark is no light (+inf): the
 // chance that a pixel that saw none reads more is about 1 in 700.
 constexpr double kDarkNoiseSigmas = 3.0;
-// ... where a pixel's beam (F - D) is at least this share of the detector's median.
-constexpr double kDarkNoiseLeastBeam = 0.5;
+// ... where the pixel's beam (F - D) is at least e^this times that light: a detector that reads
+// through 98% attenuation, where light within the noise is a beam an object (metal) stopped.
+// Under a dimmer beam (flats of 100-300 counts over a dark noise of 5-10) half the body's
+// readings lie within the noise, and as bounds they left FBP's centre at half its level.
+constexpr double kDarkNoiseLeastDepth = 4.0;
 
 // A real detector has a few dead pixels; past this share of pixels without beam the flat field
 // is more likely of another detector region, binning or exposure than the projections'.

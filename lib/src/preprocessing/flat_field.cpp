@@ -91,8 +91,10 @@ double median_of(std::vector<double> values) {
 // The dark field's noise from frame to frame, one figure per detector row (a slab's rows get
 // the figures a whole stack's would: the estimate does not depend on how a scan is cut): each
 // pixel's variance over its finite frames, averaged over the row's pixels but those above
-// kHotPixelVariance times the row's median (hot or flickering pixels). Zeros with fewer than two
-// frames: one frame, or frames averaged before they were saved, say nothing of the noise.
+// kHotPixelVariance times the row's median (hot or flickering pixels). Each frame's offset
+// along the row (its median departure from the mean dark) is taken out first: a dark level that
+// drifts from frame to frame is no noise of a reading. Zeros with fewer than two frames: one
+// frame, or frames averaged before they were saved, say nothing of the noise.
 constexpr double kHotPixelVariance = 25.0;
 std::vector<double> dark_noise_by_row(const Array& darks,
                                       const std::vector<std::size_t>& view_shape,
@@ -104,18 +106,33 @@ std::vector<double> dark_noise_by_row(const Array& darks,
   if (darks.rank() != view_shape.size() + 1 || darks.shape[0] < 2) return sigma;
   const std::size_t frames = darks.shape[0];
   std::vector<double> variance(columns);
+  std::vector<double> offset(frames);
   for (std::size_t row = 0; row < rows; ++row) {
+    for (std::size_t f = 0; f < frames; ++f) {
+      std::vector<double> departures;
+      for (std::size_t c = 0; c < columns; ++c) {
+        const float x = darks.data[f * pixels + row * columns + c];
+        if (std::isfinite(x)) departures.push_back(x - dark[row * columns + c]);
+      }
+      offset[f] = departures.empty() ? 0.0 : median_of(std::move(departures));
+    }
     std::size_t n_pixels = 0;
     for (std::size_t c = 0; c < columns; ++c) {
       const std::size_t p = row * columns + c;
-      double sum = 0.0;
+      double mean = 0.0;
       std::size_t n = 0;
       for (std::size_t f = 0; f < frames; ++f) {
         const float x = darks.data[f * pixels + p];
         if (std::isfinite(x)) {
-          sum += (x - dark[p]) * (x - dark[p]);
+          mean += x - offset[f];
           ++n;
         }
+      }
+      if (n >= 2) mean /= static_cast<double>(n);
+      double sum = 0.0;
+      for (std::size_t f = 0; f < frames; ++f) {
+        const float x = darks.data[f * pixels + p];
+        if (std::isfinite(x)) sum += (x - offset[f] - mean) * (x - offset[f] - mean);
       }
       if (n >= 2) variance[n_pixels++] = sum / static_cast<double>(n - 1);
     }
@@ -319,18 +336,11 @@ Array flat_field_normalise(const Array& projections, const Array& flats, const A
   }
   r.flat_series = series.size();
   for (std::size_t p = 0; p < pixels; ++p) r.pixels_without_beam += no_beam[p];
-  // A pixel under a weak beam (the edge of a synchrotron's beam profile) keeps light at or
-  // below the dark alone as none: its own readings' limit, ln(beam / noise), lies below what
-  // the strong pixels read, and a ray without light is bounded by the scan's largest reading.
-  {
-    std::vector<double> lit;
-    for (std::size_t p = 0; p < pixels; ++p) {
-      if (!no_beam[p]) lit.push_back(beams.front()[p]);
-    }
-    const double typical = median_of(lit);
-    for (std::size_t p = 0; p < pixels; ++p) {
-      if (!(beams.front()[p] >= kDarkNoiseLeastBeam * typical)) no_light[p] = 0.0;
-    }
+  // Where the beam stands less than kDarkNoiseLeastDepth above the noise (a dim beam, a low-flux
+  // neutron or lab scan, the edge of a beam's profile), light within the noise is a thick
+  // body's, which its readings still tell on average: only light at or below the dark is none.
+  for (std::size_t p = 0; p < pixels; ++p) {
+    if (!(beams.front()[p] >= std::exp(kDarkNoiseLeastDepth) * no_light[p])) no_light[p] = 0.0;
   }
   r.pixels = pixels;
   if (beams.size() > 1) {
