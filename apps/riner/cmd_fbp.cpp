@@ -86,14 +86,25 @@ void note_short_scan(const Console& console, const FbpReport& report) {
   }
 }
 
-// Readings of +inf where the object stopped the beam: FBP fills them from their neighbours, so
-// metal does not show (training keeps them as bounds).
-void note_stopped_beam(const Console& console, std::size_t readings) {
+// Readings of +inf where the object stopped the beam: FBP reads them at the floor (the metal
+// shows, lighter than it is) or fills them from their neighbours (no metal shows).
+void note_stopped_beam(const Console& console, std::size_t readings, float floor) {
   if (readings == 0) return;
+  char read_as[240];
+  if (floor > 0.0f) {
+    std::snprintf(read_as, sizeof(read_as),
+                  "FBP reads them as the largest finite reading (of their detector row in a "
+                  "stack), %.3g, so the metal shows, "
+                  "lighter than it is and with streaks (--fill-stopped-beam interpolates them)",
+                  floor);
+  } else {
+    std::snprintf(read_as, sizeof(read_as),
+                  "FBP fills them from their neighbours, so the image shows no metal there");
+  }
   console.line("note: " + std::to_string(readings) +
-               " readings of +inf (no light) look like a beam the object stopped (metal?): FBP "
-               "fills them from their neighbours, so the image shows no metal there (--json: "
-               "stopped_beam_readings); riner reconstruct trains them as bounds");
+               " readings of +inf (no light) look like a beam the object stopped (metal?; --json: "
+               "stopped_beam_readings): " +
+               read_as + "; riner reconstruct trains them as bounds");
 }
 
 int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions& options) {
@@ -147,7 +158,7 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
                  "dead row?)");
   }
   note_short_scan(console, report.fbp);
-  note_stopped_beam(console, report.fbp.stopped_beam_readings);
+  note_stopped_beam(console, report.fbp.stopped_beam_readings, report.fbp.stopped_beam_floor);
   note_half_acquisition(console, report.fbp.half_acquisition_overlap_mm);
   note_grid_beyond_rays(console, g);
   console.line("fbp (" + std::string(fbp_filter_name(options.filter)) + ", " +
@@ -170,6 +181,7 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
        {"slab_bytes_estimated", fbp_slab_bytes(g, report.slices_per_slab)},
        {"non_finite_replaced", report.fbp.non_finite_replaced},
        {"stopped_beam_readings", report.fbp.stopped_beam_readings},
+       {"stopped_beam_floor", report.fbp.stopped_beam_floor},
        {"short_scan", report.fbp.short_scan},
        {"parker_weighted", report.fbp.parker_weighted},
        {"half_acquisition_overlap_mm", report.fbp.half_acquisition_overlap_mm},
@@ -188,13 +200,19 @@ int run_fbp(int argc, char** argv, int first) {
   Args args("fbp",
             "Filtered backprojection of a scan: FBP for parallel and fan beam, FDK for cone "
             "beam. NaN/inf measurements (dead elements) are interpolated from their neighbours "
-            "first. The image is written in the format of --out's extension.");
+            "first; +inf where the object stopped the beam (metal) reads as the largest finite "
+            "reading of its detector row. The image is written in the format of --out's "
+            "extension.");
   add_scan_options(args);
   args.option("out", "IMAGE",
               "output image/volume (.nii, .npy, .tif, .raw), a volume as FILE.h5[:/dataset] "
               "(default dataset /volume), or a folder (no extension) of one TIFF per slice")
       .option("filter", "NAME", "ram-lak, shepp-logan or hann", "ram-lak")
       .flag("png", "also write a PNG preview beside the output")
+      .flag("fill-stopped-beam",
+            "readings of +inf where the object stopped the beam (metal) interpolated from their "
+            "neighbours, as other invalid readings are, not read as their row's largest finite "
+            "reading: no metal (and no metal streaks) in the image")
       .option("slab-slices", "N",
               "a projection stack (parallel or cone beam) in slabs of up to N axial slices (evened "
               "out: 16 slices at N=5 are 4 slabs of 4), each read, "
@@ -226,6 +244,7 @@ int run_fbp(int argc, char** argv, int first) {
     if (!made) {
       FbpOptions options;
       options.filter = parse_fbp_filter(args.get("filter"));
+      options.stopped_beam_at_floor = !args.is_set("fill-stopped-beam");
       options.engine = engine_from(args);
       options.device = device_from(args, options.engine);
       made = std::move(options);
@@ -261,7 +280,7 @@ int run_fbp(int argc, char** argv, int first) {
     write_png(png, image);
   }
   note_short_scan(console, report);
-  note_stopped_beam(console, report.stopped_beam_readings);
+  note_stopped_beam(console, report.stopped_beam_readings, report.stopped_beam_floor);
   note_half_acquisition(console, report.half_acquisition_overlap_mm);
   note_grid_beyond_rays(console, scan.geometry);
   note_object_beyond_detector(console, scan);
@@ -279,6 +298,7 @@ int run_fbp(int argc, char** argv, int first) {
        {"seconds", seconds},
        {"non_finite_replaced", report.non_finite_replaced},
        {"stopped_beam_readings", report.stopped_beam_readings},
+       {"stopped_beam_floor", report.stopped_beam_floor},
        {"short_scan", report.short_scan},
        {"parker_weighted", report.parker_weighted},
        {"half_acquisition_overlap_mm", report.half_acquisition_overlap_mm},

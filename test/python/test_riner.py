@@ -499,9 +499,10 @@ def test_the_librarys_warnings_and_the_centre_check_reach_python():
     assert r.summary["centre_check"]["offset_px"] == pytest.approx(g["detector"]["offset_px"], abs=0.5)
 
 
-def test_fbp_says_when_it_fills_a_beam_the_metal_stopped():
-    # A 3/mm disc on the axis of a water disc stops the beam: FBP fills those readings from
-    # their neighbours (the metal does not show), and says so; without metal it says nothing.
+def test_fbp_shows_a_beam_the_metal_stopped_and_says_so():
+    # A 3/mm disc on the axis of a water disc stops the beam: FBP reads those readings as the
+    # scan's largest finite reading (the metal shows), and says so; fill_stopped_beam=True
+    # interpolates them from their neighbours (it hardly shows); without metal nothing is said.
     g = riner.parallel_beam(np.linspace(0, np.pi, 90, endpoint=False), columns=70,
                             image_shape=(64, 64))
     y, x = np.mgrid[:64, :64] - 31.5
@@ -509,8 +510,13 @@ def test_fbp_says_when_it_fills_a_beam_the_metal_stopped():
     metal = np.where(x * x + y * y < 4.5 * 4.5, 3.0, body).astype(np.float32)
     with pytest.warns(UserWarning, match="fewer than 10 photons"):
         sino = riner.simulate(metal, g, seed=3)["sino"]
-    with pytest.warns(UserWarning, match="look like a beam the object stopped"):
-        riner.fbp(sino, g)
+    with pytest.warns(UserWarning, match="look like a beam the object stopped.*reads them as"):
+        shown = riner.fbp(sino, g)
+    with pytest.warns(UserWarning, match="fills them from their neighbours"):
+        filled = riner.fbp(sino, g, fill_stopped_beam=True)
+    inside = metal > 1
+    # 1.86 and 1.04 (the truth 3.0)
+    assert shown[inside].mean() > 1.5 and shown[inside].mean() > 1.5 * filled[inside].mean()
     plain = riner.simulate(body, g, seed=3)["sino"]
     with warnings.catch_warnings():
         warnings.simplefilter("error")

@@ -43,11 +43,13 @@ void warn_geometry_doubts(const Scan& scan) {
 }
 
 py::array fbp_of(const py::handle& measurement, const std::string& geometry_json,
-                 const std::string& filter, const std::string& engine, const std::string& device) {
+                 const std::string& filter, const std::string& engine, const std::string& device,
+                 bool fill_stopped_beam) {
   const Scan scan = scan_from(measurement, geometry_json);
   warn_geometry_doubts(scan);
   FbpOptions options;
   options.filter = parse_fbp_filter(filter);
+  options.stopped_beam_at_floor = !fill_stopped_beam;
   options.engine = parse_engine(engine);
   Array image;
   FbpReport report;
@@ -57,10 +59,21 @@ py::array fbp_of(const py::handle& measurement, const std::string& geometry_json
     image = fbp(scan, options, &report);
   }
   if (report.stopped_beam_readings > 0) {
+    char read_as[200];
+    if (report.stopped_beam_floor > 0.0f) {
+      std::snprintf(read_as, sizeof(read_as),
+                    "FBP reads them as the largest finite reading (of their detector row in a "
+                    "stack), %.3g, so the metal "
+                    "shows, lighter than it is and with streaks (fill_stopped_beam=True: "
+                    "interpolated)",
+                    report.stopped_beam_floor);
+    } else {
+      std::snprintf(read_as, sizeof(read_as),
+                    "FBP fills them from their neighbours, so the image shows no metal there");
+    }
     warn(std::to_string(report.stopped_beam_readings) +
-         " readings of +inf (no light) look like a beam the object stopped (metal?): FBP fills "
-         "them from their neighbours, so the image shows no metal there; riner.reconstruct "
-         "trains them as bounds");
+         " readings of +inf (no light) look like a beam the object stopped (metal?): " + read_as +
+         "; riner.reconstruct trains them as bounds");
   }
   return to_numpy(std::move(image));
 }

@@ -43,13 +43,21 @@ struct FbpOptions {
   // With a report: count FbpReport::stopped_beam_readings (a pass over the readings where any
   // is +inf; a slab run counts each row once itself).
   bool count_stopped_beam = true;
+  // Readings of +inf where the object stopped the beam (model/starved_readings.hpp: metal) read
+  // as the largest finite reading of their detector row (a 2D scan's: the bound training
+  // keeps): the metal shows, lighter than it is, with its streaks. false: interpolated from their
+  // neighbours like every other invalid reading, so the image shows no metal there (a reference
+  // that must not streak).
+  bool stopped_beam_at_floor = true;
 };
 
 struct FbpReport {
   std::size_t non_finite_replaced = 0;  // NaN/inf measurements interpolated from neighbours
-  // Of them, readings of +inf where the object stopped the beam (metal: training keeps them as
-  // bounds, model/starved_readings.hpp): interpolated too, so the image shows no metal there.
+  // Readings of +inf where the object stopped the beam (metal: training keeps them as bounds,
+  // model/starved_readings.hpp), and the largest reading they took (their rows' largest finite
+  // reading, FbpOptions::stopped_beam_at_floor; 0 when interpolated with the non-finite ones).
   std::size_t stopped_beam_readings = 0;
+  float stopped_beam_floor = 0.0f;
   bool short_scan = false;  // views miss part of the circle (half-circle for parallel beams)
   // A fan or cone beam's short scan (half a turn plus the fan, or more) weighted by Parker's
   // weights, each line counted once; a short scan without it misses lines: expect streaks.

@@ -1,9 +1,12 @@
 #include "riner/fbp.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 #include "analytic/fbp_setup.hpp"
+#include "analytic/stopped_beam_rows.hpp"
 #include "cl/context.hpp"
 #include "cl/device_access.hpp"
-#include "model/starved_readings.hpp"
 #include "ops/fbp.hpp"
 #include "reference/fbp_ref.hpp"
 #include "riner/error.hpp"
@@ -60,10 +63,13 @@ Array fbp(const Scan& scan, const FbpOptions& options, FbpReport* report) {
   Geometry g = scan.geometry;  // a half acquisition's detector widens below
   Array weighted = scan.measurement;
   FbpReport local;
-  // The readings training keeps as bounds, counted as it counts them, for a caller that asks;
-  // all are interpolated below, as they were.
-  if (report != nullptr && options.count_stopped_beam) {
-    local.stopped_beam_readings = model::mark_starved_readings(weighted, g).count;
+  // The readings training keeps as bounds, found as it finds them (a pass only where a reading
+  // is +inf), at their row's floor or left to the interpolation below.
+  if (options.stopped_beam_at_floor || (report != nullptr && options.count_stopped_beam)) {
+    const analytic::StoppedBeamRows stopped =
+        analytic::stopped_beam_rows(weighted, g, options.stopped_beam_at_floor);
+    if (options.count_stopped_beam) local.stopped_beam_readings = stopped.count;
+    local.stopped_beam_floor = stopped.largest_floor;
   }
   local.non_finite_replaced = analytic::repair_non_finite(weighted, g.n_u, g.is_3d() ? g.n_v : 1);
   analytic::cosine_weight(weighted, g);

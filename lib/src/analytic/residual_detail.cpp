@@ -170,6 +170,7 @@ ResidualDetailResult detail_of(Array image, const Array& field, const Scan& scan
       residual_readings(scan, Projector(g, engine, device).project(field), log_alpha, dead, used);
   const std::vector<double> means = element_means(misfit, used, n);
   FbpOptions options;
+  options.stopped_beam_at_floor = false;  // no metal streaks in what training reads
   options.engine = engine;
   options.device = device;
   // The whole scan's FBP is the halves' mean (each half's views weigh twice the angle): two

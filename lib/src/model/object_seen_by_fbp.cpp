@@ -215,6 +215,7 @@ ObjectSeenByFbp object_seen_by_fbp(const Scan& scan, const std::vector<std::uint
   const Scan binned = binned_scan(scan, f);
   const Geometry& b = binned.geometry;
   FbpOptions options;
+  options.stopped_beam_at_floor = false;  // no metal streaks in what training reads
   options.filter = FbpFilter::kHann;
   options.engine = settings.engine;
   options.device = settings.device;

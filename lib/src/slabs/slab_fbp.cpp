@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "model/starved_readings.hpp"
+#include "analytic/stopped_beam_rows.hpp"
 #include "riner/error.hpp"
 #include "riner/slab_plan.hpp"
 
@@ -184,7 +184,6 @@ SlabFbpReport fbp_by_slabs(const ScanRows& source, const FbpOptions& options, Vo
           non_finite += std::fabs(line[k]) <= kLargestReading ? 0 : 1;
         }
       }
-      report.fbp.non_finite_replaced += non_finite;
       if (flat.flat_frames > 0) merge_flat_report(report, flat, new_rows, rows.count, non_finite);
       scan.geometry = detector_rows_geometry(g, rows.first, rows.count);
       if (prepare) prepare(scan);
@@ -197,14 +196,20 @@ SlabFbpReport fbp_by_slabs(const ScanRows& source, const FbpOptions& options, Vo
           std::copy_n(scan.measurement.ptr() + (v * rows.count + (new_first - rows.first)) * g.n_u,
                       new_rows * g.n_u, fresh.ptr() + v * new_rows * g.n_u);
         }
-        report.fbp.stopped_beam_readings += model::mark_starved_readings(fresh, g).count;
+        const std::size_t stopped = analytic::stopped_beam_rows(fresh, g, false).count;
+        report.fbp.stopped_beam_readings += stopped;
+        // Read at the floor, not interpolated.
+        if (options.stopped_beam_at_floor) non_finite -= std::min(non_finite, stopped);
       }
+      report.fbp.non_finite_replaced += non_finite;
       slab.count_stopped_beam = false;  // counted above, once per row
       FbpReport part;
       slices = fbp(scan, slab, &part);
       report.fbp.short_scan = report.fbp.short_scan || part.short_scan;
       report.fbp.parker_weighted = report.fbp.parker_weighted || part.parker_weighted;
       report.fbp.half_acquisition_overlap_mm = part.half_acquisition_overlap_mm;
+      report.fbp.stopped_beam_floor =
+          std::max(report.fbp.stopped_beam_floor, part.stopped_beam_floor);
     }
     out.write(first, slices);
     if (written) written(first, slices);

@@ -36,6 +36,7 @@ ClassicalAnswer classical_answer(const TrainingSetup& setup, std::optional<Devic
   Scan destriped{destripe(setup.scan.measurement, setup.scan.geometry, filter, &report),
                  setup.scan.geometry, 0};
   FbpOptions fbp_options;
+  fbp_options.stopped_beam_at_floor = false;  // no metal streaks in what training reads
   fbp_options.engine = setup.config.engine;
   fbp_options.device = std::move(device);
   return {fbp(destriped, fbp_options), std::move(report.removed)};
