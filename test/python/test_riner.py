@@ -513,7 +513,10 @@ def test_fbp_shows_a_beam_the_metal_stopped_and_says_so():
     with pytest.warns(UserWarning, match="look like a beam the object stopped.*reads them as"):
         shown = riner.fbp(sino, g)
     with pytest.warns(UserWarning, match="fills them from their neighbours"):
-        filled = riner.fbp(sino, g, fill_stopped_beam=True)
+        filled, report = riner.fbp(sino, g, fill_stopped_beam=True, return_report=True)
+    assert report["stopped_beam_readings"] > 100 and report["stopped_beam_floor"] == 0
+    assert report["non_finite_replaced"] >= report["stopped_beam_readings"]
+    assert report["flat_field"] is None and report["centre"] is None
     inside = metal > 1
     # 1.86 and 1.04 (the truth 3.0)
     assert shown[inside].mean() > 1.5 and shown[inside].mean() > 1.5 * filled[inside].mean()

@@ -198,16 +198,24 @@ def center(sino, geometry, flat=None, dark=None, flat_after=None):
 
 
 def fbp(sino, geometry, flat=None, dark=None, center=None, filter="ram-lak", device=None,
-        engine="opencl", flat_after=None, fill_stopped_beam=False):
+        engine="opencl", flat_after=None, fill_stopped_beam=False, return_report=False):
     """FBP (parallel, fan), FDK (cone) or slice-wise FBP (parallel 3D) of a scan, mu in 1/mm.
     center: the axis column, or "auto" to estimate it (parallel beam); flat_after: as
     flat_field's. Invalid readings are interpolated from their neighbours, but readings of +inf
     where the object stopped the beam (metal) read as the largest finite reading of their
     detector row, so the metal shows (a UserWarning says so); fill_stopped_beam=True
-    interpolates them too."""
-    sino, geometry_json, _ = _scan(sino, geometry, flat, dark, center, flat_after)
-    return _riner.fbp(sino, geometry_json, filter, engine, _device(device),
-                      bool(fill_stopped_beam))
+    interpolates them too. return_report=True returns (image, report): the dict `riner fbp
+    --json` gives (non_finite_replaced, stopped_beam_readings, stopped_beam_floor, short_scan,
+    parker_weighted, half_acquisition_overlap_mm, and flat_field and centre as reconstruct's
+    summary has them)."""
+    sino, geometry_json, notes = _scan(sino, geometry, flat, dark, center, flat_after)
+    image, report = _riner.fbp(sino, geometry_json, filter, engine, _device(device),
+                               bool(fill_stopped_beam))
+    if not return_report:
+        return image
+    report = json.loads(report)
+    report.update(notes)
+    return image, report
 
 
 def destripe(sino, geometry, flat=None, dark=None, center=None, method="all", size=0,

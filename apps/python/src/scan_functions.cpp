@@ -42,7 +42,8 @@ void warn_geometry_doubts(const Scan& scan) {
   for (const std::string& doubt : doubts) warn(doubt);  // the module's handler: UserWarning
 }
 
-py::array fbp_of(const py::handle& measurement, const std::string& geometry_json,
+// The image and what FBP did (the keys of `riner fbp --json`'s), as JSON.
+py::tuple fbp_of(const py::handle& measurement, const std::string& geometry_json,
                  const std::string& filter, const std::string& engine, const std::string& device,
                  bool fill_stopped_beam) {
   const Scan scan = scan_from(measurement, geometry_json);
@@ -75,7 +76,14 @@ py::array fbp_of(const py::handle& measurement, const std::string& geometry_json
          " readings of +inf (no light) look like a beam the object stopped (metal?): " + read_as +
          "; riner.reconstruct trains them as bounds");
   }
-  return to_numpy(std::move(image));
+  const nlohmann::json done = {{"filter", fbp_filter_name(options.filter)},
+                               {"non_finite_replaced", report.non_finite_replaced},
+                               {"stopped_beam_readings", report.stopped_beam_readings},
+                               {"stopped_beam_floor", report.stopped_beam_floor},
+                               {"short_scan", report.short_scan},
+                               {"parker_weighted", report.parker_weighted},
+                               {"half_acquisition_overlap_mm", report.half_acquisition_overlap_mm}};
+  return py::make_tuple(to_numpy(std::move(image)), done.dump());
 }
 
 // Classical stripe removal (riner/destripe.hpp): the destriped measurement and a report.
