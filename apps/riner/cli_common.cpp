@@ -221,7 +221,8 @@ void note_starved_readings(const Console& console, std::size_t count, float floo
   char line[320];
   std::snprintf(line, sizeof(line),
                 "of the readings not finite, %zu of +inf (no light) are a beam the object stopped "
-                "(metal?): trained as at least %.4g, the largest finite reading, not as 0 "
+                "(metal?): trained as at least %.4g, the largest finite reading of nine views in "
+                "ten, not as 0 "
                 "(summary.json starved_readings)",
                 count, static_cast<double>(floor));
   console.line(line);

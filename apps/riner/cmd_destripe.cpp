@@ -165,7 +165,9 @@ int run_destripe(int argc, char** argv, int first) {
     // What the filter did to the image, against the FBP of the scan as it came: a median
     // across columns can take an object's detail for stripes (docs/guide/destripe.md).
     QualityCheck check;
-    check.image = quality_against_fbp(image, fbp(scan, fbp_options), field_radius_px(scan.geometry));
+    FbpOptions reference = fbp_options;
+    reference.stopped_beam_at_floor = false;  // as reconstruct's quality reference
+    check.image = quality_against_fbp(image, fbp(scan, reference), field_radius_px(scan.geometry));
     summary["quality"] = quality_summary(check);
     const QualityReport& q = check.image;
     std::snprintf(line, sizeof(line),

@@ -90,11 +90,11 @@ void note_short_scan(const Console& console, const FbpReport& report) {
 // shows, lighter than it is) or fills them from their neighbours (no metal shows).
 void note_stopped_beam(const Console& console, std::size_t readings, float floor) {
   if (readings == 0) return;
-  char read_as[240];
+  char read_as[320];
   if (floor > 0.0f) {
     std::snprintf(read_as, sizeof(read_as),
-                  "FBP reads them as the largest finite reading (of their detector row in a "
-                  "stack), %.3g, so the metal shows, "
+                  "FBP reads them, beside a metal's edge, as the largest finite reading of nine "
+                  "views in ten (of their detector row in a stack), %.3g, so the metal shows, "
                   "lighter than it is and with streaks (--fill-stopped-beam interpolates them)",
                   floor);
   } else {
@@ -200,9 +200,9 @@ int run_fbp(int argc, char** argv, int first) {
   Args args("fbp",
             "Filtered backprojection of a scan: FBP for parallel and fan beam, FDK for cone "
             "beam. NaN/inf measurements (dead elements) are interpolated from their neighbours "
-            "first; +inf where the object stopped the beam (metal) reads as the largest finite "
-            "reading of its detector row. The image is written in the format of --out's "
-            "extension.");
+            "first; +inf where the object stopped the beam (metal), beside its edge, reads as "
+            "the largest finite reading of nine views in ten (of its detector row). The image is "
+            "written in the format of --out's extension.");
   add_scan_options(args);
   args.option("out", "IMAGE",
               "output image/volume (.nii, .npy, .tif, .raw), a volume as FILE.h5[:/dataset] "
@@ -211,8 +211,8 @@ int run_fbp(int argc, char** argv, int first) {
       .flag("png", "also write a PNG preview beside the output")
       .flag("fill-stopped-beam",
             "readings of +inf where the object stopped the beam (metal) interpolated from their "
-            "neighbours, as other invalid readings are, not read as their row's largest finite "
-            "reading: no metal (and no metal streaks) in the image")
+            "neighbours, as other invalid readings are, not read as their row's floor: no metal "
+            "(and no metal streaks) in the image")
       .option("slab-slices", "N",
               "a projection stack (parallel or cone beam) in slabs of up to N axial slices (evened "
               "out: 16 slices at N=5 are 4 slabs of 4), each read, "

@@ -153,6 +153,9 @@ void require_training(const RinerConfig& c) {
 QualityCheck check_quality(const Reconstructor& r, const ReconstructionResult& result,
                            const std::optional<Device>& device) {
   FbpOptions options;
+  // A metal's edges read at the floor outweigh the image's own in the edge measure: a review's
+  // fan beam with two pins was called blurred (15% of FBP's edges, where it had 200%).
+  options.stopped_beam_at_floor = false;
   options.engine = r.config().engine;
   options.device = device;
   const Geometry& g = r.scan().geometry;

@@ -202,8 +202,9 @@ def fbp(sino, geometry, flat=None, dark=None, center=None, filter="ram-lak", dev
     """FBP (parallel, fan), FDK (cone) or slice-wise FBP (parallel 3D) of a scan, mu in 1/mm.
     center: the axis column, or "auto" to estimate it (parallel beam); flat_after: as
     flat_field's. Invalid readings are interpolated from their neighbours, but readings of +inf
-    where the object stopped the beam (metal) read as the largest finite reading of their
-    detector row, so the metal shows (a UserWarning says so); fill_stopped_beam=True
+    where the object stopped the beam (metal) read, beside a metal's edge, as the largest finite
+    reading of nine views in ten (of their detector row), so the metal shows (a UserWarning says
+    so); fill_stopped_beam=True
     interpolates them too. return_report=True returns (image, report): the dict `riner fbp
     --json` gives (non_finite_replaced, stopped_beam_readings, stopped_beam_floor, short_scan,
     parker_weighted, half_acquisition_overlap_mm, and flat_field and centre as reconstruct's

@@ -60,13 +60,12 @@ py::tuple fbp_of(const py::handle& measurement, const std::string& geometry_json
     image = fbp(scan, options, &report);
   }
   if (report.stopped_beam_readings > 0) {
-    char read_as[200];
+    char read_as[320];
     if (report.stopped_beam_floor > 0.0f) {
       std::snprintf(read_as, sizeof(read_as),
-                    "FBP reads them as the largest finite reading (of their detector row in a "
-                    "stack), %.3g, so the metal "
-                    "shows, lighter than it is and with streaks (fill_stopped_beam=True: "
-                    "interpolated)",
+                    "FBP reads them, beside a metal's edge, as the largest finite reading of nine "
+                    "views in ten (of their detector row in a stack), %.3g, so the metal shows, "
+                    "lighter than it is and with streaks (fill_stopped_beam=True: interpolated)",
                     report.stopped_beam_floor);
     } else {
       std::snprintf(read_as, sizeof(read_as),

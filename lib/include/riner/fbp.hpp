@@ -43,11 +43,12 @@ struct FbpOptions {
   // With a report: count FbpReport::stopped_beam_readings (a pass over the readings where any
   // is +inf; a slab run counts each row once itself).
   bool count_stopped_beam = true;
-  // Readings of +inf where the object stopped the beam (model/starved_readings.hpp: metal) read
-  // as the largest finite reading of their detector row (a 2D scan's: the bound training
-  // keeps): the metal shows, lighter than it is, with its streaks. false: interpolated from their
-  // neighbours like every other invalid reading, so the image shows no metal there (a reference
-  // that must not streak).
+  // Readings of +inf where the object stopped the beam (model/starved_readings.hpp: metal) read,
+  // beside a metal's edge or on the axis, as their detector row's floor (the largest finite
+  // reading of nine views in ten; a 2D scan's: the bound training keeps): the metal shows,
+  // lighter than it is, with its streaks. false: interpolated from their neighbours like every
+  // other invalid reading, so the image shows no metal there (a reference that must not streak,
+  // and whose edges are the object's: the quality report's).
   bool stopped_beam_at_floor = true;
 };
 

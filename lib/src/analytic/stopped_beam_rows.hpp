@@ -17,7 +17,8 @@ struct StoppedBeamRows {
 
 // `readings` [views, elements] or [views, rows, elements] under `g` (its rows: readings' own).
 // Each row's corrupt spikes and +inf that are no stopped beam become NaN; with `at_floor` the
-// stopped beam's readings become the row's largest finite reading, else they stay +inf.
+// stopped beam's readings beside a reading near the row's floor (a metal's edge) become the
+// floor (model/starved_readings.hpp's, of the row alone), the others NaN; else they stay +inf.
 StoppedBeamRows stopped_beam_rows(Array& readings, const Geometry& g, bool at_floor);
 
 }  // namespace riner::analytic

@@ -1,8 +1,9 @@
 // Readings of +inf (no light reached the element: -ln 0) mean one of two things. Where the object
 // stopped the beam (metal, photon starvation) the ray's line integral is at least about the
-// scan's largest finite reading: a bound training keeps (a censored reading; kernels/ray_sum.cl,
-// ray_loss). Where an element read nothing while the rays beside it saw light, it is dead or
-// dying: unread, as NaN is, which beta switches off.
+// largest finite reading of nine views in ten (one bad reading does not set it): a bound
+// training keeps (a censored reading; kernels/ray_sum.cl, ray_loss). Where an element read
+// nothing while the rays beside it saw light, it is dead or dying: unread, as NaN is, which
+// beta switches off.
 //
 // Along each detector line, a run of +inf is a stopped beam when it is wider than
 // kWidestDeadRun elements (a 9-pixel metal disc: runs of 7-9; a dead element: 1), or when a
@@ -36,10 +37,13 @@ namespace riner::model {
 
 constexpr std::size_t kWidestDeadRun = 2;
 constexpr double kStarvedNeighbourShare = 0.75;
+// The bounds' floor: this quantile over the views of each view's largest finite reading.
+constexpr double kFloorViewQuantile = 0.9;
 
 struct StarvedReadings {
   std::size_t count = 0;  // +inf readings kept as bounds
-  float floor = 0.0f;     // the bound: the largest finite reading (0 when none is kept)
+  float floor =
+      0.0f;  // the bound: the views' largest finite readings' kFloorViewQuantile (0: none)
 };
 
 // `measurement` is [views, elements] or [views, rows, columns]. Sets the +inf readings that are
