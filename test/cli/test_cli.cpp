@@ -227,6 +227,16 @@ TEST_SUITE("cli") {
       CAPTURE(interpolated);
       CHECK(at_floor > 1.5);                 // 1.73 off the axis, 1.86 on it (the truth 3.0)
       CHECK(at_floor > 1.5 * interpolated);  // 1.08 and 1.04
+      // Through the stripe filter too (it fills every invalid reading; before, 1.14).
+      const Run destriped = riner_cli("fbp " + sim + "/sino.npy --destripe all --json --out " +
+                                          (dir / "destriped.npy").string(),
+                                      dir);
+      REQUIRE(destriped.code == 0);
+      CHECK(nlohmann::json::parse(destriped.out)["stopped_beam_readings"] ==
+            summary["starved_readings"]);
+      const double through_filter = metal_mean(riner::read_array(dir / "destriped.npy").array);
+      CAPTURE(through_filter);
+      CHECK(through_filter > 1.5);
       // A lost tile, 16 elements in two views away from the metal, is no metal's edge: FBP
       // interpolates it (at the floor it drew a streak across the image).
       riner::Array sino = riner::read_array(sim + "/sino.npy").array;
