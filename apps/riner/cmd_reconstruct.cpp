@@ -349,6 +349,15 @@ int run_reconstruct(int argc, char** argv, int first) {
                " (training " + format_duration(stats.seconds) + "; " + std::to_string(stats.steps) +
                " steps, " + std::to_string(dead.size()) + " elements flagged dead) -> " +
                out.string());
+  if (result.stopped_hull_voxels > 0) {
+    char line[320];
+    std::snprintf(line, sizeof(line),
+                  "metal: %zu voxels whose rays read no light in nearly every view (its shadow "
+                  "hull) shown at least at %.3g, the hull's upper level: the readings say no "
+                  "more of them (summary.json stopped_hull)",
+                  result.stopped_hull_voxels, static_cast<double>(result.stopped_hull_level));
+    console.line(line);
+  }
   print_quality_doubts(console, quality.image);
   console.summary(summary);
   return 0;

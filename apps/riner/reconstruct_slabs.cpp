@@ -491,12 +491,14 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   std::size_t non_finite = 0;
   std::size_t starved = 0;
   float starved_floor = 0.0f;  // the largest of the slabs' floors
+  std::size_t hull = 0;        // the metal's shadow hull's voxels raised (model/stopped_hull.hpp)
   // The field's unit (model/field_scale.hpp): the slabs' distinct factors.
   std::vector<double> field_per_mu;
   std::optional<FlatFieldReport> flat;
   for (const nlohmann::json& entry : run.manifest()["slabs"]) {
     starved += entry.value("starved_readings", std::size_t{0});
     starved_floor = std::max(starved_floor, entry.value("starved_floor", 0.0f));
+    hull += entry.value("stopped_hull_voxels", std::size_t{0});
     if (entry.contains("summary") && entry["summary"].is_object()) {
       const double f = entry["summary"].value("field_per_mu", 1.0);
       if (std::find(field_per_mu.begin(), field_per_mu.end(), f) == field_per_mu.end()) {
@@ -631,6 +633,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
       {"slabs_without_readings", without_readings},
       {"non_finite_measurements", non_finite},
       {"starved_readings", starved},
+      {"stopped_hull_voxels", hull},
       {"field_per_mu", field_per_mu},
       {"inputs", inputs_json(args)},
       {"flat_field", flat ? flat_field_json(*flat) : nlohmann::json(nullptr)},

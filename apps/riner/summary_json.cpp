@@ -275,6 +275,8 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
         {"held_out_views", result.residual_detail.held_out_views},
         {"seconds", result.residual_detail.seconds},
         {"note", result.residual_detail.note}}},
+      {"stopped_hull",
+       {{"voxels", result.stopped_hull_voxels}, {"level", result.stopped_hull_level}}},
       {"final_loss", history.empty() ? 0.0 : history.back().data_loss}};
 }
 

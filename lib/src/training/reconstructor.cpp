@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "cl/buffer.hpp"
+#include "model/stopped_hull.hpp"
 #include "riner/error.hpp"
 #include "riner/ring_chain.hpp"
 #include "riner/ring_correction.hpp"
@@ -349,6 +350,11 @@ ReconstructionResult Reconstructor::evaluate_result() const {
   evaluate_rings(r);
   evaluate_residual_detail(r, p, trained);
   evaluate_rings_after_detail(r);
+  const model::StoppedHull hull =
+      model::raise_stopped_hull(r.image, impl_->setup.scan.measurement, impl_->setup.scan.geometry,
+                                impl_->setup.starved.floor);
+  r.stopped_hull_voxels = hull.voxels;
+  r.stopped_hull_level = hull.level;
   r.alpha_by_view = responses_by_view(impl_->setup, p, trained, r.alpha);
   return r;
 }
