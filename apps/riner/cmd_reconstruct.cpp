@@ -350,12 +350,14 @@ int run_reconstruct(int argc, char** argv, int first) {
                " steps, " + std::to_string(dead.size()) + " elements flagged dead) -> " +
                out.string());
   if (result.stopped_hull_voxels > 0) {
-    char line[320];
+    char line[400];
     std::snprintf(line, sizeof(line),
-                  "metal: %zu voxels whose rays read no light in nearly every view (its shadow "
-                  "hull) shown at least at %.3g, the hull's upper level: the readings say no "
-                  "more of them (summary.json stopped_hull)",
-                  result.stopped_hull_voxels, static_cast<double>(result.stopped_hull_level));
+                  "note: %zu voxels lie in the full shadow of what stopped the beam (their rays "
+                  "read no light in nearly every view): the readings say only that their rays "
+                  "are dense, not whether they hold a solid metal's middle or a hollow one's "
+                  "contents; the image shows what training left there, %.3g on average "
+                  "(summary.json stopped_hull)",
+                  result.stopped_hull_voxels, result.stopped_hull_mean);
     console.line(line);
   }
   print_quality_doubts(console, quality.image);

@@ -542,6 +542,13 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   }
   note_non_finite(console, non_finite);
   note_starved_readings(console, starved, starved_floor);
+  if (hull > 0) {
+    console.line("note: " + std::to_string(hull) +
+                 " voxels lie in the full shadow of what stopped the beam (their rays read no "
+                 "light in nearly every view): the readings say only that their rays are dense, "
+                 "not whether they hold a solid metal's middle or a hollow one's contents "
+                 "(summary.json stopped_hull_voxels)");
+  }
   // Rows a slab's training filled from the rows beside them, by the detector's numbering.
   std::vector<std::size_t> filled_rows;
   for (const Slab& s : run.slabs()) {

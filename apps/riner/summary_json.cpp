@@ -276,7 +276,7 @@ nlohmann::json run_summary(const Reconstructor& r, const ReconstructionResult& r
         {"seconds", result.residual_detail.seconds},
         {"note", result.residual_detail.note}}},
       {"stopped_hull",
-       {{"voxels", result.stopped_hull_voxels}, {"level", result.stopped_hull_level}}},
+       {{"voxels", result.stopped_hull_voxels}, {"mean", result.stopped_hull_mean}}},
       {"final_loss", history.empty() ? 0.0 : history.back().data_loss}};
 }
 

@@ -67,10 +67,10 @@ struct ReconstructionResult {
   std::optional<VolumeRingCorrection> volume_rings;
   // The readings' detail given back after the corrections (riner/residual_detail.hpp).
   ResidualDetail residual_detail;
-  // Voxels whose rays read no light in nearly every view (a metal's shadow hull), which the
-  // readings leave free inside the metal, raised to the hull's upper level (0 voxels: none).
+  // Voxels whose rays read no light in nearly every view (a metal's full shadow), whose values
+  // the readings do not hold (model/stopped_hull.hpp), and the image's mean there.
   std::size_t stopped_hull_voxels = 0;
-  float stopped_hull_level = 0.0f;
+  double stopped_hull_mean = 0.0;
 };
 
 // An element taken for dead, and why: its readings are all non-finite, they stay steady while

@@ -9,8 +9,8 @@
 
 namespace riner::model {
 
-StoppedHull raise_stopped_hull(Array& image, const Array& readings, const Geometry& g,
-                               float floor) {
+StoppedHull find_stopped_hull(const Array& image, const Array& readings, const Geometry& g,
+                              float floor) {
   StoppedHull out;
   if (!(floor > 0.0f) || std::none_of(readings.data.begin(), readings.data.end(), is_starved)) {
     return out;
@@ -57,15 +57,10 @@ StoppedHull raise_stopped_hull(Array& image, const Array& readings, const Geomet
     }
   }
   if (hull.empty()) return out;
-  std::vector<float> values;
-  values.reserve(hull.size());
-  for (std::size_t i : hull) values.push_back(image.data[i]);
-  const auto at = values.begin() + static_cast<std::ptrdiff_t>(
-                                       kHullLevelQuantile * static_cast<double>(values.size() - 1));
-  std::nth_element(values.begin(), at, values.end());
-  out.level = *at;
+  double sum = 0.0;
+  for (std::size_t i : hull) sum += image.data[i];
   out.voxels = hull.size();
-  for (std::size_t i : hull) image.data[i] = std::max(image.data[i], out.level);
+  out.mean = sum / static_cast<double>(hull.size());
   return out;
 }
 

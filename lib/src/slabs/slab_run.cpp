@@ -477,7 +477,7 @@ void SlabRun::write_slab(const Slab& slab, const Reconstructor& r, const Summari
   entry["starved_readings"] =
       stats.starved_readings;  // +inf kept as bounds (model/starved_readings.hpp)
   entry["starved_floor"] = stats.starved_floor;
-  entry["stopped_hull_voxels"] = result.stopped_hull_voxels;  // model/stopped_hull.hpp
+  entry["stopped_hull_voxels"] = result.stopped_hull_voxels;  // model/stopped_hull.hpp: unknown
   // A slice trained in 2D names its dead elements by column, for every row of the slab.
   entry["trained_as"] = slices_2d_ ? "slice_2d" : "field_3d";
   entry["summary"] = summarise ? summarise(r, result, device) : nlohmann::json(nullptr);

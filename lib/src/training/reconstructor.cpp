@@ -351,10 +351,10 @@ ReconstructionResult Reconstructor::evaluate_result() const {
   evaluate_residual_detail(r, p, trained);
   evaluate_rings_after_detail(r);
   const model::StoppedHull hull =
-      model::raise_stopped_hull(r.image, impl_->setup.scan.measurement, impl_->setup.scan.geometry,
-                                impl_->setup.starved.floor);
+      model::find_stopped_hull(r.image, impl_->setup.scan.measurement, impl_->setup.scan.geometry,
+                               impl_->setup.starved.floor);
   r.stopped_hull_voxels = hull.voxels;
-  r.stopped_hull_level = hull.level;
+  r.stopped_hull_mean = hull.mean;
   r.alpha_by_view = responses_by_view(impl_->setup, p, trained, r.alpha);
   return r;
 }
