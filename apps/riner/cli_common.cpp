@@ -228,6 +228,22 @@ void note_starved_readings(const Console& console, std::size_t count, float floo
   console.line(line);
 }
 
+void note_stopped_hull(const Console& console, std::size_t voxels, std::optional<double> mean) {
+  if (voxels == 0) return;
+  char left[160] = " (summary.json stopped_hull_voxels)";
+  if (mean) {
+    std::snprintf(left, sizeof(left),
+                  "; the image shows what training left there, %.3g on average (summary.json "
+                  "stopped_hull)",
+                  *mean);
+  }
+  console.line("note: " + std::to_string(voxels) +
+               " voxels lie in the full shadow of what stopped the beam (their rays read no "
+               "light in nearly every view): the readings say only that their rays are dense, "
+               "not whether they hold a solid metal's middle or a hollow one's contents" +
+               left);
+}
+
 void note_non_finite(const Console& console, std::size_t non_finite) {
   if (non_finite == 0) return;
   console.line(std::to_string(non_finite) +

@@ -78,6 +78,9 @@ void note_large_stripes(Console& console, const DestripeReport& report);
 void note_non_finite(const Console& console, std::size_t non_finite);
 // The +inf readings training keeps as bounds (TrainingStats::starved_readings).
 void note_starved_readings(const Console& console, std::size_t count, float floor);
+// The voxels in the full shadow of what stopped the beam (model/stopped_hull.hpp), whose
+// contents the readings do not say; `mean` the image's there (a slab run's summary has none).
+void note_stopped_hull(const Console& console, std::size_t voxels, std::optional<double> mean);
 // The detector rows training filled from the rows beside them (TrainingStats::filled_rows).
 void note_filled_rows(const Console& console, const std::vector<std::size_t>& rows);
 // Before training: a warning when the views leave lines never measured (views_miss_lines), as

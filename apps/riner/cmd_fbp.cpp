@@ -185,7 +185,8 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
                " non-finite or absurd (spikes far beyond the other views' readings) measurements "
                "interpolated -> " +
                out);
-  console.summary(
+  nlohmann::json summary = fbp_report_json(report.fbp);
+  summary.update(
       {{"out", out},
        {"shape", g.volume_shape},
        {"filter", fbp_filter_name(options.filter)},
@@ -195,18 +196,13 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
        {"slices_per_slab", report.slices_per_slab},
        {"memory_limit_bytes", limit},
        {"slab_bytes_estimated", fbp_slab_bytes(g, report.slices_per_slab)},
-       {"non_finite_replaced", report.fbp.non_finite_replaced},
-       {"stopped_beam_readings", report.fbp.stopped_beam_readings},
-       {"stopped_beam_floor", report.fbp.stopped_beam_floor},
-       {"short_scan", report.fbp.short_scan},
-       {"parker_weighted", report.fbp.parker_weighted},
-       {"half_acquisition_overlap_mm", report.fbp.half_acquisition_overlap_mm},
        {"geometry_doubts", doubts},
        {"inputs", inputs_json(args)},
        {"flat_field",
         report.flat_field ? flat_field_json(*report.flat_field) : nlohmann::json(nullptr)},
        {"slices_without_readings", report.slices_without_readings},
        {"centre", source.centre() ? centre_json(*source.centre()) : nlohmann::json(nullptr)}});
+  console.summary(summary);
   return 0;
 }
 
@@ -307,18 +303,13 @@ int run_fbp(int argc, char** argv, int first) {
                " non-finite or absurd (spikes far beyond the other views' readings) measurements "
                "interpolated -> " +
                out.string());
-  console.summary(
+  nlohmann::json summary = fbp_report_json(report);
+  summary.update(
       {{"out", out.string()},
        {"shape", image.shape},
        {"filter", fbp_filter_name(options.filter)},
        {"engine", engine_name(options.engine)},
        {"seconds", seconds},
-       {"non_finite_replaced", report.non_finite_replaced},
-       {"stopped_beam_readings", report.stopped_beam_readings},
-       {"stopped_beam_floor", report.stopped_beam_floor},
-       {"short_scan", report.short_scan},
-       {"parker_weighted", report.parker_weighted},
-       {"half_acquisition_overlap_mm", report.half_acquisition_overlap_mm},
        {"destripe",
         stripes ? nlohmann::json(destripe_method_name(stripes->method)) : nlohmann::json(nullptr)},
        {"geometry_doubts", loaded.geometry_doubts},
@@ -326,6 +317,7 @@ int run_fbp(int argc, char** argv, int first) {
        {"flat_field",
         loaded.flat_field ? flat_field_json(*loaded.flat_field) : nlohmann::json(nullptr)},
        {"centre", loaded.centre ? centre_json(*loaded.centre) : nlohmann::json(nullptr)}});
+  console.summary(summary);
   return 0;
 }
 

@@ -349,17 +349,7 @@ int run_reconstruct(int argc, char** argv, int first) {
                " (training " + format_duration(stats.seconds) + "; " + std::to_string(stats.steps) +
                " steps, " + std::to_string(dead.size()) + " elements flagged dead) -> " +
                out.string());
-  if (result.stopped_hull_voxels > 0) {
-    char line[400];
-    std::snprintf(line, sizeof(line),
-                  "note: %zu voxels lie in the full shadow of what stopped the beam (their rays "
-                  "read no light in nearly every view): the readings say only that their rays "
-                  "are dense, not whether they hold a solid metal's middle or a hollow one's "
-                  "contents; the image shows what training left there, %.3g on average "
-                  "(summary.json stopped_hull)",
-                  result.stopped_hull_voxels, result.stopped_hull_mean);
-    console.line(line);
-  }
+  note_stopped_hull(console, result.stopped_hull_voxels, result.stopped_hull_mean);
   print_quality_doubts(console, quality.image);
   console.summary(summary);
   return 0;

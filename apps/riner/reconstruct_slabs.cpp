@@ -491,7 +491,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   std::size_t non_finite = 0;
   std::size_t starved = 0;
   float starved_floor = 0.0f;  // the largest of the slabs' floors
-  std::size_t hull = 0;        // the metal's shadow hull's voxels raised (model/stopped_hull.hpp)
+  std::size_t hull = 0;        // voxels in the full shadow (model/stopped_hull.hpp)
   // The field's unit (model/field_scale.hpp): the slabs' distinct factors.
   std::vector<double> field_per_mu;
   std::optional<FlatFieldReport> flat;
@@ -542,13 +542,7 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   }
   note_non_finite(console, non_finite);
   note_starved_readings(console, starved, starved_floor);
-  if (hull > 0) {
-    console.line("note: " + std::to_string(hull) +
-                 " voxels lie in the full shadow of what stopped the beam (their rays read no "
-                 "light in nearly every view): the readings say only that their rays are dense, "
-                 "not whether they hold a solid metal's middle or a hollow one's contents "
-                 "(summary.json stopped_hull_voxels)");
-  }
+  note_stopped_hull(console, hull, std::nullopt);
   // Rows a slab's training filled from the rows beside them, by the detector's numbering.
   std::vector<std::size_t> filled_rows;
   for (const Slab& s : run.slabs()) {

@@ -317,6 +317,15 @@ nlohmann::json centre_json(const CentreEstimate& e) {
           {"rows", e.rows}};
 }
 
+nlohmann::json fbp_report_json(const FbpReport& r) {
+  return {{"non_finite_replaced", r.non_finite_replaced},
+          {"stopped_beam_readings", r.stopped_beam_readings},
+          {"stopped_beam_floor", r.stopped_beam_floor},
+          {"short_scan", r.short_scan},
+          {"parker_weighted", r.parker_weighted},
+          {"half_acquisition_overlap_mm", r.half_acquisition_overlap_mm}};
+}
+
 nlohmann::json flat_field_json(const FlatFieldReport& r) {
   return {{"flat_frames", r.flat_frames},
           {"dark_frames", r.dark_frames},

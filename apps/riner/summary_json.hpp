@@ -10,6 +10,7 @@
 
 #include "riner/centre.hpp"
 #include "riner/device.hpp"
+#include "riner/fbp.hpp"
 #include "riner/flat_field.hpp"
 #include "riner/quality.hpp"
 #include "riner/reconstructor.hpp"
@@ -54,6 +55,9 @@ nlohmann::json dead_elements_json(const std::vector<DeadElement>& dead);
 nlohmann::json changing_elements_json(const std::vector<ChangingElement>& changing);
 nlohmann::json flat_field_json(const FlatFieldReport& report);
 nlohmann::json centre_json(const CentreEstimate& estimate);
+// What FBP did (`riner fbp --json`, Python's riner.fbp report): the readings it interpolated, the
+// stopped beam's count and floor, a short scan, Parker's weights, a half acquisition's overlap.
+nlohmann::json fbp_report_json(const FbpReport& report);
 
 // Further from the scan's own estimate of its axis (`riner center`) than this, the geometry's
 // offset is doubted aloud: half a pixel blurs little, a few pixels double edges.

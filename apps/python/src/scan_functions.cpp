@@ -75,13 +75,8 @@ py::tuple fbp_of(const py::handle& measurement, const std::string& geometry_json
          " readings of +inf (no light) look like a beam the object stopped (metal?): " + read_as +
          "; riner.reconstruct trains them as bounds");
   }
-  const nlohmann::json done = {{"filter", fbp_filter_name(options.filter)},
-                               {"non_finite_replaced", report.non_finite_replaced},
-                               {"stopped_beam_readings", report.stopped_beam_readings},
-                               {"stopped_beam_floor", report.stopped_beam_floor},
-                               {"short_scan", report.short_scan},
-                               {"parker_weighted", report.parker_weighted},
-                               {"half_acquisition_overlap_mm", report.half_acquisition_overlap_mm}};
+  nlohmann::json done = app::fbp_report_json(report);
+  done["filter"] = fbp_filter_name(options.filter);
   return py::make_tuple(to_numpy(std::move(image)), done.dump());
 }
 

@@ -55,8 +55,8 @@ struct FbpOptions {
 struct FbpReport {
   std::size_t non_finite_replaced = 0;  // NaN/inf measurements interpolated from neighbours
   // Readings of +inf where the object stopped the beam (metal: training keeps them as bounds,
-  // model/starved_readings.hpp), and the largest reading they took (their rows' largest finite
-  // reading, FbpOptions::stopped_beam_at_floor; 0 when interpolated with the non-finite ones).
+  // model/starved_readings.hpp), and the largest reading they took (their rows' floors,
+  // FbpOptions::stopped_beam_at_floor; 0 when interpolated with the non-finite ones).
   std::size_t stopped_beam_readings = 0;
   float stopped_beam_floor = 0.0f;
   bool short_scan = false;  // views miss part of the circle (half-circle for parallel beams)

@@ -1,8 +1,5 @@
 #include "riner/fbp.hpp"
 
-#include <algorithm>
-#include <cmath>
-
 #include "analytic/fbp_setup.hpp"
 #include "analytic/stopped_beam_rows.hpp"
 #include "cl/context.hpp"

@@ -29,23 +29,12 @@ void set_runs_at_floor(float* line, std::size_t n, float floor, double axis) {
     }
     std::size_t end = k;
     while (end < n && model::is_starved(line[end])) ++end;
-    // The nearest finite reading on either side.
-    float beside = -std::numeric_limits<float>::infinity();
-    for (std::size_t j = k; j-- > 0;) {
-      if (std::isfinite(line[j])) {
-        beside = line[j];
-        break;
-      }
-    }
-    for (std::size_t j = end; j < n; ++j) {
-      if (std::isfinite(line[j])) {
-        beside = std::max(beside, line[j]);
-        break;
-      }
-    }
+    // The nearest finite reading on either side (NaN where none: no edge).
+    const auto length = static_cast<long>(n);
+    const bool edge = model::nearest_finite(line, static_cast<long>(k) - 1, -1, length) >= dense ||
+                      model::nearest_finite(line, static_cast<long>(end), 1, length) >= dense;
     const bool on_axis = static_cast<double>(k) - 1.0 <= axis && axis <= static_cast<double>(end);
-    const float value =
-        beside >= dense || on_axis ? floor : std::numeric_limits<float>::quiet_NaN();
+    const float value = edge || on_axis ? floor : std::numeric_limits<float>::quiet_NaN();
     for (std::size_t j = k; j < end; ++j) line[j] = value;
     k = end;
   }

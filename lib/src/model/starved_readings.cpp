@@ -15,14 +15,6 @@ namespace riner::model {
 
 namespace {
 
-// The first finite reading from `from` on, stepping by `step` (-1: leftwards); NaN where none.
-float nearest_finite(const float* line, long from, long step, long n) {
-  for (long k = from; k >= 0 && k < n; k += step) {
-    if (std::isfinite(line[k])) return line[k];
-  }
-  return NAN;
-}
-
 // Each element's runs of at least `views_needed` consecutive views reading +inf, [first, end).
 using DarkRuns = std::vector<std::vector<std::pair<std::size_t, std::size_t>>>;
 DarkRuns long_dark_runs(const Array& m, std::size_t views, std::size_t views_needed) {
@@ -75,31 +67,18 @@ constexpr double kAxisEdgeShare = 0.75;
 constexpr double kAxisEdgeStep = 0.25;
 constexpr long kAxisBeyond = 3;
 std::vector<char> stopped_on_axis(const Array& m, std::size_t views, double axis_column,
-                                  float limit, float floor) {
+                                  float typical, float floor) {
   const std::size_t per_view = m.size() / views;
   std::vector<char> out(per_view, 0);
-  if (!std::isfinite(axis_column)) return out;
+  if (!std::isfinite(axis_column) || !(typical > 0.0f)) return out;
   const auto n = static_cast<long>(m.shape.back());
   const std::size_t rows = per_view / static_cast<std::size_t>(n);
   // Unread in every view (NaN or +inf), and dark (+inf) in some.
   std::vector<char> unread(per_view, 1), dark(per_view, 0);
-  std::vector<float> view_largest;
-  for (std::size_t v = 0; v < views; ++v) {
-    float top = -1.0f;
-    for (std::size_t e = 0; e < per_view; ++e) {
-      const float x = m.data[v * per_view + e];
-      if (std::isfinite(x)) {
-        unread[e] = 0;
-        if (std::fabs(x) <= limit) top = std::max(top, x);
-      }
-      if (is_starved(x)) dark[e] = 1;
-    }
-    if (top > 0.0f) view_largest.push_back(top);
+  for (std::size_t i = 0; i < m.size(); ++i) {
+    if (std::isfinite(m.data[i])) unread[i % per_view] = 0;
+    if (is_starved(m.data[i])) dark[i % per_view] = 1;
   }
-  if (view_largest.empty()) return out;
-  std::nth_element(view_largest.begin(), view_largest.begin() + view_largest.size() / 2,
-                   view_largest.end());
-  const float typical = view_largest[view_largest.size() / 2];
   const float bar = static_cast<float>(kStarvedNeighbourShare) * typical;
   const float step = static_cast<float>(kAxisEdgeStep) * typical;
   // The element beside the run at `at` in a view's line, lit: a reading of `bar` or more, a
@@ -186,6 +165,13 @@ std::vector<char> stopped_on_axis(const Array& m, std::size_t views, double axis
 
 }  // namespace
 
+float nearest_finite(const float* line, long from, long step, long n) {
+  for (long k = from; k >= 0 && k < n; k += step) {
+    if (std::isfinite(line[k])) return line[k];
+  }
+  return NAN;
+}
+
 StarvedReadings mark_starved_readings(Array& measurement, std::size_t views, double axis_column) {
   StarvedReadings out;
   if (measurement.size() == 0 || views == 0 || measurement.rank() < 2) return out;
@@ -198,6 +184,8 @@ StarvedReadings mark_starved_readings(Array& measurement, std::size_t views, dou
   // largest finite reading, high among the views but not the highest (kFloorViewQuantile): one
   // bad reading under the corrupt limit set the floor of every bound (a review's 100 made a
   // 3/mm disc read 23.6 and FBP's 11.4), where a metal's edges read near it in most views.
+  // Each view's largest finite reading (of the views with one above 0): their largest, the
+  // median (the axis rule's typical) and the floor's quantile, from one pass.
   const std::size_t per_view_all = measurement.size() / views;
   std::vector<float> view_largest;
   float largest = 0.0f;
@@ -211,7 +199,11 @@ StarvedReadings mark_starved_readings(Array& measurement, std::size_t views, dou
     largest = std::max(largest, top);
   }
   float floor = largest;
+  float typical = 0.0f;
   if (!view_largest.empty()) {
+    const auto middle = view_largest.begin() + static_cast<std::ptrdiff_t>(view_largest.size() / 2);
+    std::nth_element(view_largest.begin(), middle, view_largest.end());
+    typical = *middle;
     const auto at = view_largest.begin() +
                     static_cast<std::ptrdiff_t>(kFloorViewQuantile *
                                                 static_cast<double>(view_largest.size() - 1));
@@ -229,7 +221,7 @@ StarvedReadings mark_starved_readings(Array& measurement, std::size_t views, dou
   const DarkRuns dark = long_dark_runs(measurement, views, response_change_min_views(views));
   const float bar = static_cast<float>(kStarvedNeighbourShare) * largest;
   const std::vector<char> on_axis =
-      stopped_on_axis(measurement, views, axis_column, limit, largest);
+      stopped_on_axis(measurement, views, axis_column, typical, largest);
   for (std::size_t l = 0; l < lines; ++l) {
     const std::size_t at = l * static_cast<std::size_t>(n);
     float* line = measurement.ptr() + at;

@@ -59,6 +59,10 @@ double axis_column(const Geometry& g);
 // them, riner/scan.hpp's mark_corrupt_readings), then the bounds about axis_column(g).
 StarvedReadings mark_starved_readings(Array& measurement, const Geometry& g);
 
+// The first finite reading of a detector line of n from `from` on, stepping by `step` (-1:
+// leftwards); NaN where none.
+float nearest_finite(const float* line, long from, long step, long n);
+
 // A kept bound: +inf after mark_starved_readings.
 inline bool is_starved(float reading) { return reading == std::numeric_limits<float>::infinity(); }
 // An unread reading (NaN, -inf): not finite, and no bound.
