@@ -204,6 +204,32 @@ TEST_SUITE("starved_readings") {
     CHECK(riner::model::is_starved(a(31, 6)));
   }
 
+  TEST_CASE(
+      "a thin trace that moves with the views is a stopped beam, its neighbours however low") {
+    // 48 views of 24 elements reading 1, element 22 reading 16 (the largest, a dense edge); a
+    // wire's trace two elements wide moves from element 4 to 16, its neighbours, partly covered,
+    // reading 3, far below 0.75 of 16: before, all 96 of its readings were dead elements'. Not
+    // moving: element 2 dead throughout, a glitch of elements 18-19 in views 8-10 and element 20
+    // dying from view 30 on (both among readings of 1).
+    riner::Array a({48, 24}, 1.0f);
+    for (std::size_t v = 0; v < 48; ++v) {
+      const std::size_t m = 4 + v / 4;
+      a(v, m - 1) = a(v, m + 2) = 3.0f;
+      a(v, m) = a(v, m + 1) = INFINITY;
+      a(v, 22) = 16.0f;
+      a(v, 2) = INFINITY;
+      if (v >= 8 && v < 11) a(v, 18) = a(v, 19) = INFINITY;
+      if (v >= 30) a(v, 20) = INFINITY;
+    }
+    const riner::model::StarvedReadings s = riner::model::mark_starved_readings(a, 48);
+    CHECK(s.count == 96);
+    CHECK(riner::model::is_starved(a(10, 6)));
+    CHECK(riner::model::is_starved(a(47, 16)));
+    CHECK(std::isnan(a(0, 2)));
+    CHECK(std::isnan(a(9, 18)));
+    CHECK(std::isnan(a(40, 20)));
+  }
+
   TEST_CASE("a module failing part-way, a blank frame: unread, not metal") {
     // failing_module_scan's module; view 10 reads nothing at all (a blank frame).
     riner::Array a = failing_module_scan();

@@ -11,7 +11,8 @@
 // largest (the few photons at a dense edge) and its element is not dark for a run of
 // response_change_min_views views or more there (an element dying part-way in the middle of a
 // body, whose rays read near the largest; the dead columns of the shared neutron scan sit among
-// rays at 0.36 of it). But kWidestDeadRun + 1 or more elements of a run dark together from
+// rays at 0.36 of it), or when it is part of a trace that moves across the detector with the
+// views (a thin wire's, its partly covered neighbours far below the largest). But kWidestDeadRun + 1 or more elements of a run dark together from
 // one view to the scan's end (or from its start to one view), for that many views, are a
 // module failing, and a run filling a whole line (a blank frame) says nothing: both unread. An
 // element that reads nothing in any view is dead whatever its neighbours read (a rule that
