@@ -168,15 +168,24 @@ std::vector<char> stopped_on_axis(const Array& m, std::size_t views, double axis
 // The +inf readings of traces that move across the detector with the views, as the beam a
 // dense object off the axis stops does, view after view: within each detector row, runs of +inf
 // joined across neighbouring views (touching diagonally too) that span kLeastTraceViews views or
-// more and whose elements shift by kLeastTraceShift or more beyond the widest run's width. A
-// thin wire's trace is a run of one or two elements whose neighbours, partly covered, read far
-// below the largest (a 2.6-px wire of 10/mm at 10^6 photons: beside it 0.8-5 for a largest of
-// 13.8, its 142 readings taken for dead elements, 27 live elements flagged dead and the wire
-// read as air). A dead element, a module, a glitch of a few views or a blank frame does not
-// move. Left out: elements that read nothing, lines with no light, and an element's long dark
-// run from the scan's start or to its end (an element dying beside a trace would join it).
+// more (and a kTraceViewShare-th of the views), about one run a view, and whose elements shift by
+// kLeastTraceShift or more beyond the widest run's width. A thin wire's trace is a run of one or
+// two elements whose neighbours, partly covered, read far below the largest (a 2.6-px wire of 10/mm
+// at 10^6 photons: beside it 0.8-5 for a largest of 13.8, its 142 readings taken for dead elements,
+// 27 live elements flagged dead and the wire read as air). A dead element, a module, a glitch of a
+// few views or a blank frame does not move. Left out: elements that read nothing, lines with no
+// light, and an element's long dark run from the scan's start or to its end (an element dying
+// beside a trace would join it). A trace broken into several runs in a view, on average, is light
+// and noise alternating along a wide metal's trace under a dim beam (flats of 300 counts over a
+// dark noise of 8): its pieces as bounds beside readings of noise drew streaks (the body's error
+// 0.048 -> 0.071). A trace spans a quarter of the scan's views or more: a wire stops the beam in
+// every view, where photon starvation's noise under a dim beam (no light by chance in a thick
+// body's rays) chains its dark readings over 11-21 views of 90 (bounds far above those rays'
+// integrals).
 constexpr std::size_t kLeastTraceViews = 8;
+constexpr std::size_t kTraceViewShare = 4;
 constexpr long kLeastTraceShift = 2;
+constexpr double kMostRunsPerTraceView = 1.25;
 std::vector<char> moving_traces(const Array& m, std::size_t views, const std::vector<char>& reads,
                                 const DarkRuns& dark) {
   const std::size_t per_view = m.size() / views;
@@ -229,7 +238,7 @@ std::vector<char> moving_traces(const Array& m, std::size_t views, const std::ve
       }
     }
     struct Extent {
-      std::size_t first_view = SIZE_MAX, last_view = 0;
+      std::size_t first_view = SIZE_MAX, last_view = 0, runs = 0;
       long first = LONG_MAX, end = LONG_MIN, widest = 0;
     };
     std::map<std::size_t, Extent> extent;
@@ -240,11 +249,16 @@ std::vector<char> moving_traces(const Array& m, std::size_t views, const std::ve
       x.first = std::min(x.first, found[i].first);
       x.end = std::max(x.end, found[i].end);
       x.widest = std::max(x.widest, found[i].end - found[i].first);
+      ++x.runs;
     }
     for (std::size_t i = 0; i < found.size(); ++i) {
       const Extent& x = extent[root(i)];
-      if (x.last_view - x.first_view + 1 < kLeastTraceViews) continue;
+      const std::size_t spanned = x.last_view - x.first_view + 1;
+      if (spanned < std::max(kLeastTraceViews, views / kTraceViewShare)) continue;
       if (x.end - x.first - x.widest < kLeastTraceShift) continue;
+      if (static_cast<double>(x.runs) > kMostRunsPerTraceView * static_cast<double>(spanned)) {
+        continue;
+      }
       const std::size_t at = found[i].view * per_view + row;
       std::fill(out.begin() + static_cast<std::ptrdiff_t>(at) + found[i].first,
                 out.begin() + static_cast<std::ptrdiff_t>(at) + found[i].end, 1);
