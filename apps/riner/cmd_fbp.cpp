@@ -19,6 +19,7 @@
 #include "riner/slab_plan.hpp"
 #include "riner/tomo_file.hpp"
 #include "scan_options.hpp"
+#include "stopped_beam_note.hpp"
 #include "summary_json.hpp"
 
 namespace riner::app {
@@ -103,22 +104,7 @@ void note_short_scan(const Console& console, const FbpReport& report) {
 // Readings of +inf where the object stopped the beam: FBP reads them at the floor (the metal
 // shows, lighter than it is) or fills them from their neighbours (no metal shows).
 void note_stopped_beam(const Console& console, std::size_t readings, float floor) {
-  if (readings == 0) return;
-  char read_as[320];
-  if (floor > 0.0f) {
-    std::snprintf(read_as, sizeof(read_as),
-                  "FBP reads them, beside a metal's edge, as the largest finite reading of nine "
-                  "views in ten (of their detector row in a stack), %.3g, so the metal shows, "
-                  "lighter than it is and with streaks (--fill-stopped-beam interpolates them)",
-                  floor);
-  } else {
-    std::snprintf(read_as, sizeof(read_as),
-                  "FBP fills them from their neighbours, so the image shows no metal there");
-  }
-  console.line("note: " + std::to_string(readings) +
-               " readings of +inf (no light) look like a beam the object stopped (metal?; --json: "
-               "stopped_beam_readings): " +
-               read_as + "; riner reconstruct trains them as bounds");
+  if (readings > 0) console.line("note: " + stopped_beam_note(readings, floor));
 }
 
 int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions& options) {

@@ -510,7 +510,9 @@ def test_fbp_shows_a_beam_the_metal_stopped_and_says_so():
     metal = np.where(x * x + y * y < 4.5 * 4.5, 3.0, body).astype(np.float32)
     with pytest.warns(UserWarning, match="fewer than 10 photons"):
         sino = riner.simulate(metal, g, seed=3)["sino"]
-    with pytest.warns(UserWarning, match="look like a beam the object stopped.*reads them"):
+    # In Python's words: the keyword, not the command line's option.
+    with pytest.warns(UserWarning, match=r"look like a beam the object stopped.*reads them.*"
+                      r"fill_stopped_beam=True interpolates them.*riner\.reconstruct trains"):
         shown = riner.fbp(sino, g)
     with pytest.warns(UserWarning, match="fills them from their neighbours"):
         filled, report = riner.fbp(sino, g, fill_stopped_beam=True, return_report=True)

@@ -10,7 +10,10 @@ namespace {
 
 // Phrases first (an offset in pixels becomes the axis's column), then single options; an
 // option matches only whole (--flat is not the start of --flat-after).
-constexpr std::array<std::pair<std::string_view, std::string_view>, 11> kWording{{
+constexpr std::array<std::pair<std::string_view, std::string_view>, 14> kWording{{
+    {"(--fill-stopped-beam interpolates them)", "(fill_stopped_beam=True interpolates them)"},
+    {"--json: stopped_beam_readings", "return_report=True: stopped_beam_readings"},
+    {"riner reconstruct trains", "riner.reconstruct trains"},
     {"pass the offset with --offset-px", "pass the axis's column with center="},
     {"pass --offset-px auto", "pass center=\"auto\""},
     {"--mu-unit cm", "mu_unit=\"cm\""},

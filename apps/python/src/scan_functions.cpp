@@ -17,6 +17,7 @@
 #include "riner/phantom.hpp"
 #include "riner/scan_source.hpp"
 #include "riner/simulate.hpp"
+#include "stopped_beam_note.hpp"
 #include "summary_json.hpp"
 
 namespace riner::python {
@@ -60,20 +61,8 @@ py::tuple fbp_of(const py::handle& measurement, const std::string& geometry_json
     image = fbp(scan, options, &report);
   }
   if (report.stopped_beam_readings > 0) {
-    char read_as[320];
-    if (report.stopped_beam_floor > 0.0f) {
-      std::snprintf(read_as, sizeof(read_as),
-                    "FBP reads them, beside a metal's edge, as the largest finite reading of nine "
-                    "views in ten (of their detector row in a stack), %.3g, so the metal shows, "
-                    "lighter than it is and with streaks (fill_stopped_beam=True: interpolated)",
-                    report.stopped_beam_floor);
-    } else {
-      std::snprintf(read_as, sizeof(read_as),
-                    "FBP fills them from their neighbours, so the image shows no metal there");
-    }
-    warn(std::to_string(report.stopped_beam_readings) +
-         " readings of +inf (no light) look like a beam the object stopped (metal?): " + read_as +
-         "; riner.reconstruct trains them as bounds");
+    warn(python_wording(
+        app::stopped_beam_note(report.stopped_beam_readings, report.stopped_beam_floor)));
   }
   nlohmann::json done = app::fbp_report_json(report);
   done["filter"] = fbp_filter_name(options.filter);
