@@ -134,7 +134,7 @@ TEST_SUITE("cli") {
         "reconstruct " + scan + " --slab-slices 10 --steps 20 --quiet --out " + nii.string(), dir);
     CHECK(again.code != 0);
     CHECK(again.err.find("holds a finished slabbed run (manifest.json): choose another output "
-                         "folder") != std::string::npos);
+                         "folder, or remove that folder to run again") != std::string::npos);
 
     // The same run, killed as soon as its first slab is written.
     riner::test::run_until({"reconstruct", scan, "--slab-slices", "4", "--steps", "600", "--quiet",
@@ -191,6 +191,27 @@ TEST_SUITE("cli") {
     CHECK(files == 20);
     const riner::Array alpha = riner::read_array(whole / "alpha.npy").array;
     CHECK(alpha.shape == std::vector<std::size_t>{20, 30});
+
+    // A done slab's slice truncated since: --resume trains that slab again, and says so (its
+    // record was trusted: the damaged file stayed, or every gather failed).
+    const std::filesystem::path slice = killed / "volume" / "slice_00005.tif";
+    std::filesystem::resize_file(slice, std::filesystem::file_size(slice) / 2);
+    const Run mended = riner_cli(common + " --resume --out " + killed.string(), dir);
+    REQUIRE(mended.code == 0);
+    CHECK(mended.err.find("volume/slice_00005.tif is not the size slab 1's record gives") !=
+          std::string::npos);
+    check_same_volume(whole, killed, 20);
+    // The manifest removed ("remove it to run again" read so): its slabs are not taken for a new
+    // run's, whatever its settings (they were, a volume of other steps under this run's name).
+    std::filesystem::remove(killed / "manifest.json");
+    for (const char* resume : {"", " --resume"}) {
+      const Run stale = riner_cli("reconstruct " + scan + " --slab-slices 4 --steps 300 --quiet" +
+                                      resume + " --out " + killed.string(),
+                                  dir);
+      CHECK(stale.code != 0);
+      CHECK(stale.err.find("holds a slabbed run's slabs (slabs/) but no manifest.json") !=
+            std::string::npos);
+    }
   }
 
   TEST_CASE("two and three MPI ranks share a slabbed run and give the volume of one") {

@@ -130,7 +130,12 @@ class SlabRun {
 
  private:
   std::filesystem::path slab_file(const Slab& slab, const std::string& what) const;
+  // Every file a done slab leaves (its slices, detector maps and preview planes).
+  std::vector<std::filesystem::path> slab_outputs(const Slab& slab) const;
   bool is_done(const Slab& slab) const;
+  // Drops the record of each done slab a file of which is not the size the record gives (a
+  // file truncated or replaced since): the slab trains again. Returns how many.
+  std::size_t forget_damaged_slabs() const;
   bool stopping() const;  // SlabOptions::stop
   // Its training's checkpoint (SlabOptions::checkpoint_seconds), and going on from it.
   std::filesystem::path slab_checkpoint(const Slab& slab) const;

@@ -59,7 +59,7 @@ StoppedBeamRows stopped_beam_rows(Array& readings, const Geometry& g, bool at_fl
     }
     if (!any) continue;
     mark_corrupt_readings(row, views);
-    const model::StarvedReadings stopped = model::mark_starved_readings(row, views, axis);
+    const model::StarvedReadings stopped = model::mark_starved_readings(row, views, axis, &g);
     out.count += stopped.count;
     if (at_floor && stopped.count > 0) {
       for (std::size_t v = 0; v < views; ++v) {

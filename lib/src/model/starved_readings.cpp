@@ -173,21 +173,74 @@ std::vector<char> stopped_on_axis(const Array& m, std::size_t views, double axis
 // two elements whose neighbours, partly covered, read far below the largest (a 2.6-px wire of 10/mm
 // at 10^6 photons: beside it 0.8-5 for a largest of 13.8, its 142 readings taken for dead elements,
 // 27 live elements flagged dead and the wire read as air). A dead element, a module, a glitch of a
-// few views or a blank frame does not move. Left out: elements that read nothing, lines with no
-// light, and an element's long dark run from the scan's start or to its end (an element dying
-// beside a trace would join it). A trace broken into several runs in a view, on average, is light
-// and noise alternating along a wide metal's trace under a dim beam (flats of 300 counts over a
-// dark noise of 8): its pieces as bounds beside readings of noise drew streaks (the body's error
-// 0.048 -> 0.071). A trace spans a quarter of the scan's views or more: a wire stops the beam in
-// every view, where photon starvation's noise under a dim beam (no light by chance in a thick
-// body's rays) chains its dark readings over 11-21 views of 90 (bounds far above those rays'
+// few views or a blank frame does not move, and the runs kept follow one point's projection in
+// kTraceOnPathShare of the views the trace spans (fit_trace_point). Left out: elements that read
+// nothing, lines with no light, and an element's long dark run from the scan's start or to its end
+// (an element dying beside a trace would join it). A trace broken into several runs in a view, on
+// average, is light and noise alternating along a wide metal's trace under a dim beam (flats of 300
+// counts over a dark noise of 8): its pieces as bounds beside readings of noise drew streaks (the
+// body's error 0.048 -> 0.071). A trace spans a quarter of the scan's views or more: a wire stops
+// the beam in every view, where photon starvation's noise under a dim beam (no light by chance in a
+// thick body's rays) chains its dark readings over 11-21 views of 90 (bounds far above those rays'
 // integrals).
 constexpr std::size_t kLeastTraceViews = 8;
 constexpr std::size_t kTraceViewShare = 4;
 constexpr long kLeastTraceShift = 2;
 constexpr double kMostRunsPerTraceView = 1.25;
+// The share of the views a trace spans in which a run lies on one point's path.
+constexpr double kTraceOnPathShare = 0.9;
+// The point in the volume's plane whose projection best follows `centres` (a run's middle
+// column in each of `at` views): a coarse grid over 1.5 times the volume's extent scored by the
+// median miss, then Gauss-Newton on the runs within kTraceFitTolerance * 3 of it. u does not
+// depend on z in the geometries riner reads (parallel, fan, cone with a flat detector).
+struct TraceFit {
+  double x = 0.0, y = 0.0;
+};
+constexpr double kTraceFitTolerance = 1.0;  // elements between a run's middle and the point's
+constexpr int kTraceGrid = 64;
+constexpr std::size_t kTraceCoarseRuns = 48;
+TraceFit fit_trace_point(const Geometry& g, const std::vector<std::size_t>& at,
+                         const std::vector<double>& centres) {
+  const auto miss = [&](std::size_t i, double x, double y) {
+    return centres[i] - project_to_detector(g, at[i], Vec3{x, y, 0.0}).u;
+  };
+  const std::size_t ny = g.volume_shape[g.volume_shape.size() - 2], nx = g.volume_shape.back();
+  const double half = 0.75 * g.voxel_mm * static_cast<double>(std::max(nx, ny));
+  const std::size_t stride = std::max<std::size_t>(1, at.size() / kTraceCoarseRuns);
+  TraceFit best;
+  double best_score = INFINITY;
+  std::vector<double> misses;
+  for (int j = 0; j <= kTraceGrid; ++j) {
+    for (int i = 0; i <= kTraceGrid; ++i) {
+      const double x = -half + 2.0 * half * i / kTraceGrid, y = -half + 2.0 * half * j / kTraceGrid;
+      misses.clear();
+      for (std::size_t k = 0; k < at.size(); k += stride)
+        misses.push_back(std::fabs(miss(k, x, y)));
+      std::nth_element(misses.begin(), misses.begin() + misses.size() / 2, misses.end());
+      if (misses[misses.size() / 2] < best_score)
+        best_score = misses[misses.size() / 2], best = {x, y};
+    }
+  }
+  const double h = 1e-3 * g.voxel_mm;
+  for (int round = 0; round < 10; ++round) {
+    double a11 = 0.0, a12 = 0.0, a22 = 0.0, b1 = 0.0, b2 = 0.0;
+    for (std::size_t k = 0; k < at.size(); ++k) {
+      const double r = miss(k, best.x, best.y);
+      if (std::fabs(r) > 3.0 * kTraceFitTolerance) continue;
+      const double dx = (miss(k, best.x + h, best.y) - r) / h;
+      const double dy = (miss(k, best.x, best.y + h) - r) / h;
+      a11 += dx * dx, a12 += dx * dy, a22 += dy * dy, b1 += dx * r, b2 += dy * r;
+    }
+    const double det = a11 * a22 - a12 * a12;
+    if (!(std::fabs(det) > 0.0)) break;
+    best.x -= (a22 * b1 - a12 * b2) / det;
+    best.y -= (a11 * b2 - a12 * b1) / det;
+  }
+  return best;
+}
+
 std::vector<char> moving_traces(const Array& m, std::size_t views, const std::vector<char>& reads,
-                                const DarkRuns& dark) {
+                                const DarkRuns& dark, const Geometry& g) {
   const std::size_t per_view = m.size() / views;
   const auto n = static_cast<long>(m.shape.back());
   const std::size_t rows = per_view / static_cast<std::size_t>(n);
@@ -251,17 +304,49 @@ std::vector<char> moving_traces(const Array& m, std::size_t views, const std::ve
       x.widest = std::max(x.widest, found[i].end - found[i].first);
       ++x.runs;
     }
+    const std::size_t least_views = std::max(kLeastTraceViews, views / kTraceViewShare);
+    std::map<std::size_t, std::vector<std::size_t>> members;
     for (std::size_t i = 0; i < found.size(); ++i) {
       const Extent& x = extent[root(i)];
       const std::size_t spanned = x.last_view - x.first_view + 1;
-      if (spanned < std::max(kLeastTraceViews, views / kTraceViewShare)) continue;
+      if (spanned < least_views) continue;
       if (x.end - x.first - x.widest < kLeastTraceShift) continue;
       if (static_cast<double>(x.runs) > kMostRunsPerTraceView * static_cast<double>(spanned)) {
         continue;
       }
-      const std::size_t at = found[i].view * per_view + row;
-      std::fill(out.begin() + static_cast<std::ptrdiff_t>(at) + found[i].first,
-                out.begin() + static_cast<std::ptrdiff_t>(at) + found[i].end, 1);
+      members[root(i)].push_back(i);
+    }
+    // A trace is a fixed object's: its runs follow one point's projection, view after view (a
+    // dead element that drifts across the detector, as in projections shifted to correct a
+    // drift, moved and joined too: the review's pin scene read 0.39/mm of error for 0.01).
+    // Only the runs on that path are kept (an element dark for some views beside it is not).
+    for (const auto& [component, runs] : members) {
+      std::vector<std::size_t> at;
+      std::vector<double> centres;
+      for (std::size_t i : runs) {
+        at.push_back(found[i].view);
+        centres.push_back(0.5 * static_cast<double>(found[i].first + found[i].end - 1));
+      }
+      const TraceFit point = fit_trace_point(g, at, centres);
+      std::vector<std::size_t> on_path;
+      std::vector<std::size_t> path_views;
+      for (std::size_t k = 0; k < runs.size(); ++k) {
+        const double miss =
+            centres[k] - project_to_detector(g, at[k], Vec3{point.x, point.y, 0.0}).u;
+        if (std::fabs(miss) > kTraceFitTolerance) continue;
+        on_path.push_back(runs[k]);
+        path_views.push_back(at[k]);
+      }
+      std::sort(path_views.begin(), path_views.end());
+      path_views.erase(std::unique(path_views.begin(), path_views.end()), path_views.end());
+      const Extent& x = extent[component];
+      const std::size_t spanned = x.last_view - x.first_view + 1;
+      if (path_views.size() < kTraceOnPathShare * static_cast<double>(spanned)) continue;
+      for (std::size_t i : on_path) {
+        const std::size_t at_line = found[i].view * per_view + row;
+        std::fill(out.begin() + static_cast<std::ptrdiff_t>(at_line) + found[i].first,
+                  out.begin() + static_cast<std::ptrdiff_t>(at_line) + found[i].end, 1);
+      }
     }
   }
   return out;
@@ -276,7 +361,8 @@ float nearest_finite(const float* line, long from, long step, long n) {
   return NAN;
 }
 
-StarvedReadings mark_starved_readings(Array& measurement, std::size_t views, double axis_column) {
+StarvedReadings mark_starved_readings(Array& measurement, std::size_t views, double axis_column,
+                                      const Geometry* geometry) {
   StarvedReadings out;
   if (measurement.size() == 0 || views == 0 || measurement.rank() < 2) return out;
   // Most scans have no reading of +inf: nothing to tell apart (FBP of a large stack paid for
@@ -326,7 +412,9 @@ StarvedReadings mark_starved_readings(Array& measurement, std::size_t views, dou
   const float bar = static_cast<float>(kStarvedNeighbourShare) * largest;
   const std::vector<char> on_axis =
       stopped_on_axis(measurement, views, axis_column, typical, largest);
-  const std::vector<char> moving = moving_traces(measurement, views, reads, dark);
+  const std::vector<char> moving = geometry
+                                       ? moving_traces(measurement, views, reads, dark, *geometry)
+                                       : std::vector<char>(measurement.size(), 0);
   for (std::size_t l = 0; l < lines; ++l) {
     const std::size_t at = l * static_cast<std::size_t>(n);
     float* line = measurement.ptr() + at;
@@ -395,7 +483,7 @@ double axis_column(const Geometry& g) { return project_to_detector(g, 0, Vec3{0.
 
 StarvedReadings mark_starved_readings(Array& measurement, const Geometry& g) {
   mark_corrupt_readings(measurement, g.n_views());
-  return mark_starved_readings(measurement, g.n_views(), axis_column(g));
+  return mark_starved_readings(measurement, g.n_views(), axis_column(g), &g);
 }
 
 }  // namespace riner::model

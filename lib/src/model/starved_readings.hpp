@@ -12,14 +12,15 @@
 // response_change_min_views views or more there (an element dying part-way in the middle of a
 // body, whose rays read near the largest; the dead columns of the shared neutron scan sit among
 // rays at 0.36 of it), or when it is part of a trace that moves across the detector with the
-// views (a thin wire's, its partly covered neighbours far below the largest). But kWidestDeadRun + 1 or more elements of a run dark together from
-// one view to the scan's end (or from its start to one view), for that many views, are a
-// module failing, and a run filling a whole line (a blank frame) says nothing: both unread. An
-// element that reads nothing in any view is dead whatever its neighbours read (a rule that
-// took a block whose neighbours were dark in half the views for metal made an audit's dead
-// modules beside a metal's trace, or beside a dying element, into bright bounds), except in a
-// run wider than kWidestDeadRun, dark in every view it reads, centred on the rotation axis
-// (within a pixel), whose elements on both sides, in three quarters of the views with light,
+// views and follows one point's projection (a thin wire's, its partly covered neighbours far
+// below the largest; a dead element that drifts follows none). But kWidestDeadRun + 1 or more
+// elements of a run dark together from one view to the scan's end (or from its start to one view),
+// for that many views, are a module failing, and a run filling a whole line (a blank frame) says
+// nothing: both unread. An element that reads nothing in any view is dead whatever its neighbours
+// read (a rule that took a block whose neighbours were dark in half the views for metal made an
+// audit's dead modules beside a metal's trace, or beside a dying element, into bright bounds),
+// except in a run wider than kWidestDeadRun, dark in every view it reads, centred on the rotation
+// axis (within a pixel), whose elements on both sides, in three quarters of the views with light,
 // are dark or read kStarvedNeighbourShare of the largest and a step above the readings beyond
 // them: metal on the axis stops those rays in every view (a 3/mm pin there read 0.62 for 3.0
 // as dead elements), where a dead element or module off the axis leaves its conjugate rays
@@ -51,9 +52,11 @@ struct StarvedReadings {
 // no bound to NaN. Finite readings beyond riner::largest_reading are left out of the largest.
 // `axis_column`: the column the rotation axis projects onto (NaN: unknown, no run is read as
 // stopped on the axis).
-StarvedReadings mark_starved_readings(
-    Array& measurement, std::size_t views,
-    double axis_column = std::numeric_limits<double>::quiet_NaN());
+// `geometry`: the scan's (its views' projections), for traces that move across the detector
+// with the views; none: no run is read as one.
+StarvedReadings mark_starved_readings(Array& measurement, std::size_t views,
+                                      double axis_column = std::numeric_limits<double>::quiet_NaN(),
+                                      const Geometry* geometry = nullptr);
 // The detector column the rotation axis projects onto (riner/rays.hpp).
 double axis_column(const Geometry& g);
 // The same for a scan's readings under `g`: corrupt spikes first set NaN (as training reads

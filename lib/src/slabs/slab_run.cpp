@@ -187,6 +187,20 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
   if (join_ && !held_run) {
     throw InputError(path.string() + ": no run to join (the leader writes it first)");
   }
+  // Slabs with no manifest to check them against (the manifest removed, as "remove it to run
+  // again" was read): their records were trusted, a volume of other settings, or two, taken
+  // for this run's (a fuzz audit's).
+  if (!held_run && !join_) {
+    std::error_code error;
+    for (const auto& entry : std::filesystem::directory_iterator(out_ / "slabs", error)) {
+      if (entry.path().filename().string().rfind("slab_", 0) == 0) {
+        throw InputError(out_.string() +
+                         " holds a slabbed run's slabs (slabs/) but no manifest.json to check "
+                         "them against: choose another output folder, or remove that folder to "
+                         "run again");
+      }
+    }
+  }
   // A mistyped folder would otherwise start the whole scan again without a word.
   if (options.resume && !held_run && !join_) {
     warn("--resume: " + out_.string() + " holds no slabbed run (manifest.json): starting one");
@@ -207,7 +221,7 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
       }
       throw InputError(out_.string() +
                        (finished ? " holds a finished slabbed run (manifest.json): choose another "
-                                   "output folder, or remove it to run again"
+                                   "output folder, or remove that folder to run again"
                                  : " holds a slabbed run (manifest.json): pass --resume to finish "
                                    "it, or choose another output folder"));
     }
@@ -282,6 +296,7 @@ SlabRun::SlabRun(ScanRows source, RinerConfig config, std::filesystem::path out,
   }
   std::filesystem::create_directories(volume_dir());
   std::filesystem::create_directories(out_ / "slabs");
+  if (held_run && !join_) forget_damaged_slabs();
   if (!join_) write_manifest();
 }
 
@@ -315,16 +330,68 @@ std::filesystem::path SlabRun::slab_record(const Slab& slab) const {
   return out_ / "slabs" / numbered("slab_%04zu.json", slab.index);
 }
 
+std::vector<std::filesystem::path> SlabRun::slab_outputs(const Slab& slab) const {
+  std::vector<std::filesystem::path> files;
+  for (std::size_t k = 0; k < slab.slices; ++k) files.push_back(slice_path(slab.first_slice + k));
+  for (const char* what : {"alpha", "beta", "coronal", "sagittal"}) {
+    files.push_back(slab_file(slab, what));
+  }
+  return files;
+}
+
 bool SlabRun::is_done(const Slab& slab) const {
   if (!std::filesystem::exists(slab_record(slab))) return false;
   // The record is written last; the files are there unless someone removed them since.
-  for (std::size_t k = 0; k < slab.slices; ++k) {
-    if (!std::filesystem::exists(slice_path(slab.first_slice + k))) return false;
+  const std::vector<std::filesystem::path> files = slab_outputs(slab);
+  return std::all_of(files.begin(), files.end(),
+                     [](const std::filesystem::path& f) { return std::filesystem::exists(f); });
+}
+
+namespace {
+
+// The size of each of `files` by its path relative to `out`, as a record keeps them.
+nlohmann::json file_sizes(const std::vector<std::filesystem::path>& files,
+                          const std::filesystem::path& out) {
+  nlohmann::json sizes = nlohmann::json::object();
+  for (const std::filesystem::path& f : files) {
+    sizes[f.lexically_relative(out).generic_string()] = std::filesystem::file_size(f);
   }
-  for (const char* what : {"alpha", "beta", "coronal", "sagittal"}) {
-    if (!std::filesystem::exists(slab_file(slab, what))) return false;
+  return sizes;
+}
+
+}  // namespace
+
+std::size_t SlabRun::forget_damaged_slabs() const {
+  std::size_t forgotten = 0;
+  for (const Slab& slab : slabs_) {
+    if (!is_done(slab)) continue;
+    nlohmann::json record;
+    try {
+      std::ifstream in(slab_record(slab));
+      record = nlohmann::json::parse(in);
+    } catch (const nlohmann::json::exception&) {
+      continue;  // finish() names an unreadable record
+    }
+    // Records of before the sizes were kept have none to check.
+    if (!record.is_object() || !record.contains("file_sizes")) continue;
+    const nlohmann::json& held = record["file_sizes"];
+    std::string damaged;
+    for (const std::filesystem::path& f : slab_outputs(slab)) {
+      const std::string name = f.lexically_relative(out_).generic_string();
+      std::error_code error;
+      const std::uintmax_t size = std::filesystem::file_size(f, error);
+      if (!held.contains(name) || error || held[name] != size) {
+        damaged = name;
+        break;
+      }
+    }
+    if (damaged.empty()) continue;
+    warn(out_.string() + ": " + damaged + " is not the size slab " + std::to_string(slab.index) +
+         "'s record gives (truncated or replaced since it was written): the slab trains again");
+    std::filesystem::remove(slab_record(slab));
+    ++forgotten;
   }
-  return true;
+  return forgotten;
 }
 
 double SlabRun::slices_recorded(std::size_t* slabs) const {
@@ -482,6 +549,7 @@ void SlabRun::write_slab(const Slab& slab, const Reconstructor& r, const Summari
   entry["trained_as"] = slices_2d_ ? "slice_2d" : "field_3d";
   entry["summary"] = summarise ? summarise(r, result, device) : nlohmann::json(nullptr);
   entry["readings"] = readings;
+  entry["file_sizes"] = file_sizes(slab_outputs(slab), out_);  // checked on --resume
   write_text(slab_record(slab), entry.dump(1) + "\n");  // last: the slab is done
 }
 
@@ -503,6 +571,7 @@ void SlabRun::write_empty_slab(const Slab& slab, const std::string& why) const {
   entry["finished_unix"] = unix_seconds();
   entry["no_readings"] = why;
   entry["summary"] = nullptr;
+  entry["file_sizes"] = file_sizes(slab_outputs(slab), out_);
   write_text(slab_record(slab), entry.dump(1) + "\n");
 }
 

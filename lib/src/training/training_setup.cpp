@@ -97,7 +97,7 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
   // A beam the object stopped (+inf beside rays near the largest reading) is a bound, not a
   // dead element's 0: metal read as air where it was taken as one.
   starved = model::mark_starved_readings(scan.measurement, scan.geometry.n_views(),
-                                         model::axis_column(scan.geometry));
+                                         model::axis_column(scan.geometry), &scan.geometry);
   filled_rows = model::fill_dead_rows(scan.measurement, scan.geometry);
   const Geometry& g = scan.geometry;
   elements_per_view = g.n_u * (g.is_3d() ? g.n_v : 1);
