@@ -174,25 +174,29 @@ std::vector<char> stopped_on_axis(const Array& m, std::size_t views, double axis
 // at 10^6 photons: beside it 0.8-5 for a largest of 13.8, its 142 readings taken for dead elements,
 // 27 live elements flagged dead and the wire read as air). A dead element, a module, a glitch of a
 // few views or a blank frame does not move, and the runs kept follow one point's projection in
-// kTraceOnPathShare of the views the trace spans (fit_trace_point). Left out: elements that read
-// nothing, lines with no light, and an element's long dark run from the scan's start or to its end
-// (an element dying beside a trace would join it). A trace broken into several runs in a view, on
-// average, is light and noise alternating along a wide metal's trace under a dim beam (flats of 300
-// counts over a dark noise of 8): its pieces as bounds beside readings of noise drew streaks (the
-// body's error 0.048 -> 0.071). A trace spans a quarter of the scan's views or more: a wire stops
-// the beam in every view, where photon starvation's noise under a dim beam (no light by chance in a
-// thick body's rays) chains its dark readings over 11-21 views of 90 (bounds far above those rays'
-// integrals).
+// kTraceOnPathShare of the views the trace spans (fit_trace_point), one point after another
+// (kMostTracePoints: two wires' traces cross in every half turn, and join). Left out: elements that
+// read nothing, lines with no light, and an element's long dark run from the scan's start or to its
+// end (an element dying beside a trace would join it). Light and noise alternating along a wide
+// metal's trace under a dim beam (flats of 300 counts over a dark noise of 8) break it into
+// pieces that follow no one path (as bounds beside readings of noise they drew streaks: the
+// body's error 0.048 -> 0.071), and more than kMostRunsPerTraceView runs a view per point are
+// not looked at. A trace spans a quarter of the scan's views or more: a wire
+// stops the beam in every view, where photon starvation's noise under a dim beam (no light by
+// chance in a thick body's rays) chains its dark readings over 11-21 views of 90 (bounds far above
+// those rays' integrals).
 constexpr std::size_t kLeastTraceViews = 8;
 constexpr std::size_t kTraceViewShare = 4;
 constexpr long kLeastTraceShift = 2;
 constexpr double kMostRunsPerTraceView = 1.25;
+// Traces told apart in one component, one point's path at a time.
+constexpr std::size_t kMostTracePoints = 4;
 // The share of the views a trace spans in which a run lies on one point's path.
 constexpr double kTraceOnPathShare = 0.9;
 // The point in the volume's plane whose projection best follows `centres` (a run's middle
 // column in each of `at` views): a coarse grid over 1.5 times the volume's extent scored by the
-// median miss, then Gauss-Newton on the runs within kTraceFitTolerance * 3 of it. u does not
-// depend on z in the geometries riner reads (parallel, fan, cone with a flat detector).
+// lower quartile of the misses, then Gauss-Newton on the runs within kTraceFitTolerance * 3 of it.
+// u does not depend on z in the geometries riner reads (parallel, fan, cone with a flat detector).
 struct TraceFit {
   double x = 0.0, y = 0.0;
 };
@@ -216,9 +220,10 @@ TraceFit fit_trace_point(const Geometry& g, const std::vector<std::size_t>& at,
       misses.clear();
       for (std::size_t k = 0; k < at.size(); k += stride)
         misses.push_back(std::fabs(miss(k, x, y)));
-      std::nth_element(misses.begin(), misses.begin() + misses.size() / 2, misses.end());
-      if (misses[misses.size() / 2] < best_score)
-        best_score = misses[misses.size() / 2], best = {x, y};
+      // A low quantile: the runs of other points' traces in the component miss by far.
+      const auto quantile = misses.begin() + static_cast<std::ptrdiff_t>(misses.size() / 4);
+      std::nth_element(misses.begin(), quantile, misses.end());
+      if (*quantile < best_score) best_score = *quantile, best = {x, y};
     }
   }
   const double h = 1e-3 * g.voxel_mm;
@@ -311,7 +316,8 @@ std::vector<char> moving_traces(const Array& m, std::size_t views, const std::ve
       const std::size_t spanned = x.last_view - x.first_view + 1;
       if (spanned < least_views) continue;
       if (x.end - x.first - x.widest < kLeastTraceShift) continue;
-      if (static_cast<double>(x.runs) > kMostRunsPerTraceView * static_cast<double>(spanned)) {
+      if (static_cast<double>(x.runs) >
+          kMostRunsPerTraceView * static_cast<double>(kMostTracePoints * spanned)) {
         continue;
       }
       members[root(i)].push_back(i);
@@ -321,31 +327,41 @@ std::vector<char> moving_traces(const Array& m, std::size_t views, const std::ve
     // drift, moved and joined too: the review's pin scene read 0.39/mm of error for 0.01).
     // Only the runs on that path are kept (an element dark for some views beside it is not).
     for (const auto& [component, runs] : members) {
-      std::vector<std::size_t> at;
-      std::vector<double> centres;
-      for (std::size_t i : runs) {
-        at.push_back(found[i].view);
-        centres.push_back(0.5 * static_cast<double>(found[i].first + found[i].end - 1));
-      }
-      const TraceFit point = fit_trace_point(g, at, centres);
-      std::vector<std::size_t> on_path;
-      std::vector<std::size_t> path_views;
-      for (std::size_t k = 0; k < runs.size(); ++k) {
-        const double miss =
-            centres[k] - project_to_detector(g, at[k], Vec3{point.x, point.y, 0.0}).u;
-        if (std::fabs(miss) > kTraceFitTolerance) continue;
-        on_path.push_back(runs[k]);
-        path_views.push_back(at[k]);
-      }
-      std::sort(path_views.begin(), path_views.end());
-      path_views.erase(std::unique(path_views.begin(), path_views.end()), path_views.end());
       const Extent& x = extent[component];
       const std::size_t spanned = x.last_view - x.first_view + 1;
-      if (path_views.size() < kTraceOnPathShare * static_cast<double>(spanned)) continue;
-      for (std::size_t i : on_path) {
-        const std::size_t at_line = found[i].view * per_view + row;
-        std::fill(out.begin() + static_cast<std::ptrdiff_t>(at_line) + found[i].first,
-                  out.begin() + static_cast<std::ptrdiff_t>(at_line) + found[i].end, 1);
+      // Each point in turn: the traces of two wires in a slice cross (two sinusoids meet once
+      // in half a turn) and join into one component.
+      std::vector<char> taken(runs.size(), 0);
+      for (std::size_t point_index = 0; point_index < kMostTracePoints; ++point_index) {
+        std::vector<std::size_t> left, at;
+        std::vector<double> centres;
+        for (std::size_t k = 0; k < runs.size(); ++k) {
+          if (taken[k]) continue;
+          left.push_back(k);
+          at.push_back(found[runs[k]].view);
+          centres.push_back(0.5 *
+                            static_cast<double>(found[runs[k]].first + found[runs[k]].end - 1));
+        }
+        if (left.size() < least_views) break;
+        const TraceFit point = fit_trace_point(g, at, centres);
+        std::vector<std::size_t> on_path, path_views;
+        for (std::size_t k = 0; k < left.size(); ++k) {
+          const double miss =
+              centres[k] - project_to_detector(g, at[k], Vec3{point.x, point.y, 0.0}).u;
+          if (std::fabs(miss) > kTraceFitTolerance) continue;
+          on_path.push_back(left[k]);
+          path_views.push_back(at[k]);
+        }
+        std::sort(path_views.begin(), path_views.end());
+        path_views.erase(std::unique(path_views.begin(), path_views.end()), path_views.end());
+        if (path_views.size() < kTraceOnPathShare * static_cast<double>(spanned)) break;
+        for (std::size_t k : on_path) {
+          taken[k] = 1;
+          const Run& run = found[runs[k]];
+          const std::size_t at_line = run.view * per_view + row;
+          std::fill(out.begin() + static_cast<std::ptrdiff_t>(at_line) + run.first,
+                    out.begin() + static_cast<std::ptrdiff_t>(at_line) + run.end, 1);
+        }
       }
     }
   }
