@@ -262,6 +262,22 @@ TEST_SUITE("starved_readings") {
     CHECK(merged < 20);
   }
 
+  TEST_CASE("a dead element drifting a few pixels about the axis is no trace") {
+    // A point within a few pixels of the axis sweeps as little: a dead element shifted 4 px
+    // across the axis column over the scan (registration, a runout corrected) follows one as
+    // closely as a wire would (a review's: kept, a fake dot of 6-9 /mm at the centre).
+    const riner::Geometry g = riner::test::small_parallel2d();
+    const std::size_t views = g.n_views(), n = g.n_u;
+    const double axis = riner::model::axis_column(g);
+    riner::Array a({views, n}, 1.0f);
+    for (std::size_t v = 0; v < views; ++v) {
+      a(v, 90) = 16.0f;
+      const double drift = -2.0 + 4.0 * static_cast<double>(v) / static_cast<double>(views - 1);
+      a(v, static_cast<std::size_t>(std::lround(axis + drift))) = INFINITY;
+    }
+    CHECK(riner::model::mark_starved_readings(a, views, axis, &g).count == 0);
+  }
+
   TEST_CASE("a module failing part-way, a blank frame: unread, not metal") {
     // failing_module_scan's module; view 10 reads nothing at all (a blank frame).
     riner::Array a = failing_module_scan();
