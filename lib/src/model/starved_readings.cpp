@@ -350,11 +350,8 @@ std::vector<char> moving_traces(const Array& m, std::size_t views, const std::ve
         if (left.size() < least_views) break;
         const TraceFit point = fit_trace_point(g, at, centres);
         std::vector<std::size_t> on_path, path_views;
-        double nearest = INFINITY, farthest = -INFINITY;  // the point's path across the detector
         for (std::size_t k = 0; k < left.size(); ++k) {
           const double u = project_to_detector(g, at[k], Vec3{point.x, point.y, 0.0}).u;
-          nearest = std::min(nearest, u);
-          farthest = std::max(farthest, u);
           if (std::fabs(centres[k] - u) > kTraceFitTolerance) continue;
           on_path.push_back(left[k]);
           path_views.push_back(at[k]);
@@ -366,6 +363,13 @@ std::vector<char> moving_traces(const Array& m, std::size_t views, const std::ve
         // aside and the next point is looked for among the rest; a path that sweeps less than
         // kLeastTraceSweep elements is a point near the axis, which a dead element drifting a
         // few pixels about the axis, or corrected for a runout there, follows as well.
+        // The sweep over the whole scan: a trace cut by a dead element spans part of it.
+        double nearest = INFINITY, farthest = -INFINITY;
+        for (std::size_t v = 0; v < views; ++v) {
+          const double u = project_to_detector(g, v, Vec3{point.x, point.y, 0.0}).u;
+          nearest = std::min(nearest, u);
+          farthest = std::max(farthest, u);
+        }
         const bool trace = path_views.size() >= kTraceOnPathShare * static_cast<double>(spanned) &&
                            farthest - nearest >= kLeastTraceSweep;
         for (std::size_t k : on_path) taken[k] = 1;
