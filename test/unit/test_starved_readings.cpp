@@ -262,6 +262,32 @@ TEST_SUITE("starved_readings") {
     CHECK(merged < 20);
   }
 
+  TEST_CASE("a wire's trace cut by a dead element is kept, each part on the whole path") {
+    // The fan beam above, one wire, and element 48 (the axis column) dead throughout: the trace
+    // falls in parts, each spanning fewer views and sweeping less than the whole (a part of a
+    // real scan's swept 9.9 elements over its own views and was refused as a point near the
+    // axis; the sweep is the point's over the scan).
+    const riner::Geometry g = riner::test::small_fan2d();
+    const std::size_t views = g.n_views(), n = g.n_u;
+    riner::Array a({views, n}, 1.0f);
+    std::size_t wire = 0;
+    for (std::size_t v = 0; v < views; ++v) {
+      const double u = riner::project_to_detector(g, v, riner::Vec3{12.0, 5.0, 0.0}).u;
+      const auto m = static_cast<std::size_t>(std::lround(u - 0.5));
+      a(v, m - 1) = a(v, m + 2) = 3.0f;
+      a(v, m) = a(v, m + 1) = INFINITY;
+      wire += (m != 48) + (m + 1 != 48);
+      a(v, 90) = 16.0f;
+      a(v, 48) = INFINITY;
+    }
+    const riner::model::StarvedReadings s =
+        riner::model::mark_starved_readings(a, views, riner::model::axis_column(g), &g);
+    // A part spanning under a quarter of the views stays unread (here 31 of 176 readings).
+    CHECK(s.count > 8 * wire / 10);
+    CHECK(s.count <= wire);
+    for (std::size_t v = 0; v < views; ++v) CHECK(std::isnan(a(v, 48)));
+  }
+
   TEST_CASE("a dead element drifting a few pixels about the axis is no trace") {
     // A point within a few pixels of the axis sweeps as little: a dead element shifted 4 px
     // across the axis column over the scan (registration, a runout corrected) follows one as
