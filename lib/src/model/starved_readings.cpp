@@ -181,10 +181,10 @@ std::vector<char> stopped_on_axis(const Array& m, std::size_t views, double axis
 // metal's trace under a dim beam (flats of 300 counts over a dark noise of 8) break it into
 // pieces that follow no one path (as bounds beside readings of noise they drew streaks: the
 // body's error 0.048 -> 0.071), and more than kMostRunsPerTraceView runs a view per point are
-// not looked at. A trace spans a quarter of the scan's views or more: a wire
-// stops the beam in every view, where photon starvation's noise under a dim beam (no light by
-// chance in a thick body's rays) chains its dark readings over 11-21 views of 90 (bounds far above
-// those rays' integrals).
+// not looked at. A trace spans a quarter of the scan's views or more: a wire stops the beam in
+// every view, where photon starvation's noise under a dim beam (no light by chance in a thick
+// body's rays) chains its dark readings over 11-21 views of 90 (bounds far above those rays'
+// integrals).
 constexpr std::size_t kLeastTraceViews = 8;
 constexpr std::size_t kTraceViewShare = 4;
 constexpr long kLeastTraceShift = 2;
@@ -249,12 +249,15 @@ TraceFit fit_trace_point(const Geometry& g, const std::vector<std::size_t>& at,
   return best;
 }
 
-std::vector<char> moving_traces(const Array& m, std::size_t views, const std::vector<char>& reads,
-                                const DarkRuns& dark, const Geometry& g) {
+// Returns the indices of the readings kept, sorted: few, where a mask would take a quarter of
+// the readings' memory on every scan with a dead element.
+std::vector<std::size_t> moving_traces(const Array& m, std::size_t views,
+                                       const std::vector<char>& reads, const DarkRuns& dark,
+                                       const Geometry& g) {
   const std::size_t per_view = m.size() / views;
   const auto n = static_cast<long>(m.shape.back());
   const std::size_t rows = per_view / static_cast<std::size_t>(n);
-  std::vector<char> out(m.size(), 0);
+  std::vector<std::size_t> out;
   const auto counts = [&](std::size_t v, std::size_t e) {
     if (!is_starved(m.data[v * per_view + e]) || !reads[e]) return false;
     const auto run = dark_run_at(dark, e, v);
@@ -362,8 +365,8 @@ std::vector<char> moving_traces(const Array& m, std::size_t views, const std::ve
         // Runs that follow no trace (a dead element drifting beside it, picked first) are set
         // aside and the next point is looked for among the rest; a path that sweeps less than
         // kLeastTraceSweep elements is a point near the axis, which a dead element drifting a
-        // few pixels about the axis, or corrected for a runout there, follows as well.
-        // The sweep over the whole scan: a trace cut by a dead element spans part of it.
+        // few pixels about the axis, or corrected for a runout there, follows as well. The sweep
+        // is over the whole scan: a trace cut by a dead element spans part of it.
         double nearest = INFINITY, farthest = -INFINITY;
         for (std::size_t v = 0; v < views; ++v) {
           const double u = project_to_detector(g, v, Vec3{point.x, point.y, 0.0}).u;
@@ -377,12 +380,14 @@ std::vector<char> moving_traces(const Array& m, std::size_t views, const std::ve
         for (std::size_t k : on_path) {
           const Run& run = found[runs[k]];
           const std::size_t at_line = run.view * per_view + row;
-          std::fill(out.begin() + static_cast<std::ptrdiff_t>(at_line) + run.first,
-                    out.begin() + static_cast<std::ptrdiff_t>(at_line) + run.end, 1);
+          for (long e = run.first; e < run.end; ++e) {
+            out.push_back(at_line + static_cast<std::size_t>(e));
+          }
         }
       }
     }
   }
+  std::sort(out.begin(), out.end());
   return out;
 }
 
@@ -446,9 +451,9 @@ StarvedReadings mark_starved_readings(Array& measurement, std::size_t views, dou
   const float bar = static_cast<float>(kStarvedNeighbourShare) * largest;
   const std::vector<char> on_axis =
       stopped_on_axis(measurement, views, axis_column, typical, largest);
-  const std::vector<char> moving = geometry
-                                       ? moving_traces(measurement, views, reads, dark, *geometry)
-                                       : std::vector<char>(measurement.size(), 0);
+  const std::vector<std::size_t> moving =
+      geometry ? moving_traces(measurement, views, reads, dark, *geometry)
+               : std::vector<std::size_t>();
   for (std::size_t l = 0; l < lines; ++l) {
     const std::size_t at = l * static_cast<std::size_t>(n);
     float* line = measurement.ptr() + at;
@@ -499,7 +504,8 @@ StarvedReadings mark_starved_readings(Array& measurement, std::size_t views, dou
         const bool failing = run && of_module(*run);
         const bool axis = on_axis[i % per_view] != 0;
         const bool stopped =
-            !blank && (axis || (!failing && (wide || (dense_beside && !run) || moving[i])));
+            !blank && (axis || (!failing && (wide || (dense_beside && !run) ||
+                                             std::binary_search(moving.begin(), moving.end(), i))));
         if (largest > 0.0f && stopped && (reads[i % per_view] || axis)) {
           ++out.count;
         } else {

@@ -349,12 +349,16 @@ bool SlabRun::is_done(const Slab& slab) const {
 
 namespace {
 
-// The size of each of `files` by its path relative to `out`, as a record keeps them.
+// The size of each of `files` by its path relative to `out`, as a record keeps them (null for
+// one that is not there).
 nlohmann::json file_sizes(const std::vector<std::filesystem::path>& files,
                           const std::filesystem::path& out) {
   nlohmann::json sizes = nlohmann::json::object();
   for (const std::filesystem::path& f : files) {
-    sizes[f.lexically_relative(out).generic_string()] = std::filesystem::file_size(f);
+    std::error_code error;
+    const std::uintmax_t size = std::filesystem::file_size(f, error);
+    sizes[f.lexically_relative(out).generic_string()] =
+        error ? nlohmann::json(nullptr) : nlohmann::json(size);
   }
   return sizes;
 }
@@ -376,11 +380,9 @@ std::size_t SlabRun::forget_damaged_slabs() const {
     if (!record.is_object() || !record.contains("file_sizes")) continue;
     const nlohmann::json& held = record["file_sizes"];
     std::string damaged;
-    for (const std::filesystem::path& f : slab_outputs(slab)) {
-      const std::string name = f.lexically_relative(out_).generic_string();
-      std::error_code error;
-      const std::uintmax_t size = std::filesystem::file_size(f, error);
-      if (!held.contains(name) || error || held[name] != size) {
+    const nlohmann::json now = file_sizes(slab_outputs(slab), out_);
+    for (const auto& [name, size] : now.items()) {
+      if (size.is_null() || !held.contains(name) || held[name] != size) {
         damaged = name;
         break;
       }
