@@ -186,6 +186,18 @@ TEST_SUITE("cli") {
     REQUIRE(std::filesystem::exists(stopped / "training.checkpoint"));
     CHECK(!std::filesystem::exists(stopped / "image.nii"));
 
+    // A byte flipped in the checkpoint (a disk's damage): refused by name, not trained on.
+    const std::string saved = riner::test::read_bytes(stopped / "training.checkpoint");
+    std::string damaged = saved;
+    damaged[damaged.size() / 2] = static_cast<char>(~damaged[damaged.size() / 2]);
+    riner::test::write_bytes(stopped / "training.checkpoint", damaged);
+    const Run refused = riner_cli(common + " --resume --out " + stopped.string(), dir);
+    CHECK(refused.code != 0);
+    CHECK(refused.err.find("training.checkpoint: truncated or corrupt (its checksum does not "
+                           "match its bytes)") != std::string::npos);
+    CHECK(riner::test::read_bytes(stopped / "training.checkpoint") == damaged);
+    riner::test::write_bytes(stopped / "training.checkpoint", saved);
+
     const Run finished = riner_cli(common + " --resume --out " + stopped.string(), dir);
     REQUIRE(finished.code == 0);
     const nlohmann::json summary =

@@ -3,6 +3,8 @@
 // checkpoint of another run or a damaged file is refused with a clear error.
 #include <doctest/doctest.h>
 
+#include <cstdint>
+#include <cstring>
 #include <string>
 
 #include "riner/error.hpp"
@@ -98,6 +100,11 @@ TEST_SUITE("checkpoint") {
     CHECK(error_of(r, dir / "half").find("truncated or corrupt") != std::string::npos);
     riner::test::write_bytes(dir / "longer", bytes + "x");
     CHECK(error_of(r, dir / "longer").find("truncated or corrupt") != std::string::npos);
+    // Bytes flipped inside (a disk's or a copy's damage, which no kill can do): the checksum.
+    std::string flipped = bytes;
+    flipped[flipped.size() / 2] = static_cast<char>(~flipped[flipped.size() / 2]);
+    riner::test::write_bytes(dir / "flipped", flipped);
+    CHECK(error_of(r, dir / "flipped").find("checksum does not match") != std::string::npos);
     riner::test::write_bytes(dir / "text", "not a checkpoint at all");
     CHECK(error_of(r, dir / "text").find("not a riner training checkpoint") != std::string::npos);
     riner::test::write_bytes(dir / "empty", "");
@@ -107,5 +114,30 @@ TEST_SUITE("checkpoint") {
     CHECK(r.steps_done() == 0);
     r.resume_from(saved);
     CHECK(r.steps_done() == 5);
+  }
+
+  TEST_CASE("a checkpoint of format 1 (no checksum) still resumes") {
+    const riner::test::TinyProblem t = riner::test::tiny_problem(5);
+    const riner::RinerConfig c = checkpoint_config(riner::Engine::kOpenCL);
+    const riner::test::TempDir dir;
+    {
+      riner::Reconstructor r(t.scan, c, riner::test::device());
+      r.step(5);
+      r.save_checkpoint(dir / "v2");
+    }
+    // Format 1 is format 2 without the trailing 8-byte checksum, the version after the magic.
+    std::string bytes = riner::test::read_bytes(dir / "v2");
+    bytes.resize(bytes.size() - 8);
+    const std::uint32_t one = 1;
+    std::memcpy(bytes.data() + 8, &one, sizeof(one));
+    riner::test::write_bytes(dir / "v1", bytes);
+    riner::Reconstructor r(t.scan, c, riner::test::device());
+    r.resume_from(dir / "v1");
+    CHECK(r.steps_done() == 5);
+    const std::uint32_t three = 3;
+    std::memcpy(bytes.data() + 8, &three, sizeof(three));
+    riner::test::write_bytes(dir / "v3", bytes);
+    riner::Reconstructor other(t.scan, c, riner::test::device());
+    CHECK(error_of(other, dir / "v3").find("format 3") != std::string::npos);
   }
 }

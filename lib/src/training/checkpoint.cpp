@@ -1,5 +1,7 @@
 #include "training/checkpoint.hpp"
 
+#include <array>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <span>
@@ -15,8 +17,12 @@ namespace riner::detail {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'I', 'N', 'E', 'R', 'C', 'K', 'P'};
-// The format's version: a checkpoint of another one is refused rather than misread.
-constexpr std::uint32_t kVersion = 1;
+// The format's version: a checkpoint of another one is refused rather than misread. Version 2
+// ends with a checksum of the bytes before it (a kill mid-write cannot damage a checkpoint, its
+// writes being atomic, but a disk or a copy can, and a resumed training would go on from
+// garbage without a word); version 1, without it, is still read.
+constexpr std::uint32_t kVersion = 2;
+constexpr std::uint32_t kUnsummedVersion = 1;
 
 }  // namespace
 
@@ -42,6 +48,7 @@ void write_checkpoint(const std::filesystem::path& path, const TrainingCheckpoin
   out.put_array(std::span<const std::uint32_t>(c.element_rays));
   out.put_array(std::span<const LossRecord>(c.history));
   out.put_string(c.trainer_state);
+  out.put(fingerprint(out.bytes()));
   write_text(path, out.bytes());
 }
 
@@ -52,17 +59,33 @@ TrainingCheckpoint read_checkpoint(const std::filesystem::path& path) {
   if (!file) throw InputError(path.string() + ": cannot read the checkpoint");
   const std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
   const std::string what = path.string();
-  ByteReader in(bytes, what);
+  ByteReader header(bytes, what);
   for (const char m : kMagic) {
-    if (bytes.size() < sizeof(kMagic) || in.get<char>() != m) {
+    if (bytes.size() < sizeof(kMagic) || header.get<char>() != m) {
       throw InputError(what + ": not a riner training checkpoint");
     }
   }
-  const auto version = in.get<std::uint32_t>();
-  if (version != kVersion) {
+  const auto version = header.get<std::uint32_t>();
+  if (version != kVersion && version != kUnsummedVersion) {
     throw InputError(what + ": a checkpoint of format " + std::to_string(version) +
-                     ", this riner reads " + std::to_string(kVersion));
+                     ", this riner reads " + std::to_string(kUnsummedVersion) + " and " +
+                     std::to_string(kVersion));
   }
+  std::string_view body = bytes;
+  if (version == kVersion) {
+    std::uint64_t sum = 0;
+    if (body.size() < sizeof(kMagic) + sizeof(version) + sizeof(sum)) {
+      throw InputError(what + ": truncated or corrupt");
+    }
+    body.remove_suffix(sizeof(sum));
+    std::memcpy(&sum, bytes.data() + body.size(), sizeof(sum));
+    if (fingerprint(body) != sum) {
+      throw InputError(what + ": truncated or corrupt (its checksum does not match its bytes)");
+    }
+  }
+  ByteReader in(body, what);
+  in.get<std::array<char, sizeof(kMagic)>>();
+  in.get<std::uint32_t>();
   TrainingCheckpoint c;
   c.scan_fingerprint = in.get<std::uint64_t>();
   c.settings_fingerprint = in.get<std::uint64_t>();
