@@ -56,6 +56,7 @@ bool fbp_wants_slabs(const Args& args, const std::function<const FbpOptions&()>&
   const std::optional<Geometry> g = stack_geometry(args);
   return g && g->is_3d() &&
          (asked || folder || fbp_slab_bytes(*g, g->volume_shape[0]) > default_memory_limit() ||
+          fbp_slices_within_piece_size(*g) < g->volume_shape[0] ||
           fbp_device_slices(*g, SlabOptions{}, options()) < g->volume_shape[0]);
 }
 
@@ -120,7 +121,8 @@ int fbp_by_slabs_cli(const Args& args, const Console& console, const FbpOptions&
   const std::size_t per =
       asked.slices_per_slab
           ? asked.slices_per_slab
-          : std::min(fbp_slices_within(g, limit), fbp_device_slices(g, asked, options));
+          : std::min({fbp_slices_within(g, limit), fbp_device_slices(g, asked, options),
+                      fbp_slices_within_piece_size(g)});
   const std::string out = args.get("out");
   remove_stale_beside(out);
   VolumeWriter writer(out, g.volume_shape, g.voxel_mm);

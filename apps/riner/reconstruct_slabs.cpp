@@ -169,8 +169,8 @@ bool wants_slabs(const Args& args) {
   for (const char* name : {"slab-slices", "memory-limit", "workers", "processes", "join-run"}) {
     if (auto v = args.maybe(name); v && !v->empty()) return true;
   }
-  // Left to the scan: by slabs when a volume does not fit whole, or when a parallel beam's
-  // slices are large enough to train each alone.
+  // Left to the scan: by slabs when a volume does not fit whole (in memory, or in the kernels'
+  // 32-bit indices), or when a parallel beam's slices are large enough to train each alone.
   const std::optional<Geometry> g = stack_geometry(args);
   // --resume goes on with what the folder holds: a slabbed run (its manifest), or a volume or
   // slice trained whole (its training's checkpoint, cmd_reconstruct.cpp); a 3D volume killed
@@ -181,7 +181,8 @@ bool wants_slabs(const Args& args) {
     if (std::filesystem::exists(out / "training.checkpoint")) return false;
   }
   return g && g->is_3d() &&
-         (slices_2d_by_default(*g) || slab_bytes(*g, g->volume_shape[0]) > default_memory_limit());
+         (slices_2d_by_default(*g) || slab_bytes(*g, g->volume_shape[0]) > default_memory_limit() ||
+          slices_within_piece_size(*g) < g->volume_shape[0]);
 }
 
 namespace {

@@ -10,6 +10,7 @@
 #include "riner/geometry.hpp"
 #include "riner/projector.hpp"
 #include "riner/rays.hpp"
+#include "riner/slab_fbp.hpp"
 #include "riner/slab_plan.hpp"
 
 namespace {
@@ -222,7 +223,9 @@ TEST_CASE(
   flat.type = riner::GeometryType::kParallel3d;
   CHECK(riner::slab_bytes(g, 6) > riner::slab_bytes(flat, 6));
   CHECK(riner::slab_bytes(g, 6) < riner::slab_bytes(g, 24));
-  CHECK(riner::slab_bytes(g, 24) == riner::slab_bytes(flat, 24));
+  // Whole, the cone reads every row; a parallel beam only the rows its grid's height reaches.
+  CHECK(riner::slab_extent(flat, 0, 24).rows.count < g.n_v);
+  CHECK(riner::slab_bytes(g, 24) > riner::slab_bytes(flat, 24));
 }
 
 TEST_CASE("a cone-beam slab's field of view: the heights of its grid that every view sees") {
@@ -348,4 +351,79 @@ TEST_CASE("a GPU's own memory bounds the slabs trained on it at once") {
   const riner::SlabSizing tiny = riner::size_slabs(few, gpu, 8, 1);
   CHECK(tiny.slices_per_slab == 1);
   CHECK(tiny.workers == 6);
+}
+
+TEST_CASE("a slab never holds more readings or voxels than the kernels' 32-bit indices reach") {
+  // The synchrotron stack again (9.2e6 readings and 6.6e6 voxels a slice) on a 1 TB node: the
+  // memory alone would take slabs of 4.6e9 readings (an audit's plan, 2026-12-07).
+  riner::Geometry g = parallel3d(2000, 2000, 1.0, 0.0);
+  g.n_u = 2560;
+  g.angles.clear();
+  for (int i = 0; i < 3600; ++i) g.angles.push_back(M_PI * i / 3600.0);
+  g.volume_shape = {2000, 2560, 2560};
+  const std::size_t gib = std::size_t{1} << 30;
+  const std::size_t most = riner::slices_within_piece_size(g);
+  CHECK(most == 233);  // 2^31 / (3600 x 2560)
+  const riner::SlabSizing big = riner::size_slabs(g, {1024 * gib, 0, 0}, 1, 1);
+  CHECK(big.slices_per_slab == most);
+  CHECK(riner::slab_bytes(g, 500) < 1024 * gib);  // the memory would have allowed more
+  // Slabs of a size asked for beyond it are refused, naming the most.
+  CHECK_THROWS_WITH_AS(riner::size_slabs(g, {1024 * gib, 0, 0}, 1, 1, 500),
+                       doctest::Contains("at most 233 slices a slab"), riner::InputError);
+  CHECK(riner::size_slabs(g, {1024 * gib, 0, 0}, 1, 1, 233).slices_per_slab == 233);
+  // A slab's own geometry within it passes the training's and the kernels' check; the whole
+  // stack does not.
+  const std::vector<riner::Slab> slabs = riner::plan_slabs(g, most);
+  CHECK_NOTHROW(riner::check_piece_size(riner::slab_geometry(g, slabs[0]), "training"));
+  CHECK_THROWS_WITH_AS(riner::check_piece_size(g, "training"),
+                       doctest::Contains("training: 1.843e+10 readings, more than the 2^31 - 1"),
+                       riner::InputError);
+
+  // FBP's slabs likewise (the rows a slab reaches include one either side for its sampling).
+  const std::size_t fbp_most = riner::fbp_slices_within_piece_size(g);
+  CHECK(fbp_most == 231);
+  const double fbp_rows = static_cast<double>(riner::fbp_rows_reached(g, 0, fbp_most).count);
+  CHECK(fbp_rows * 3600.0 * 2560.0 <= riner::kMostElementsPerPiece);
+
+  // A cone beam: 2000 views of a 1280 x 1280 detector (3.3e9 readings), a 1280^3 volume. Each
+  // slab's rows and trained slices (its own and those its rows' rays cross) stay within it.
+  riner::Geometry cone;
+  cone.type = riner::GeometryType::kCone3d;
+  cone.n_u = cone.n_v = 1280;
+  cone.pitch_u = cone.pitch_v = 0.2;
+  cone.source_origin_mm = 500.0;
+  cone.origin_detector_mm = 500.0;
+  for (int i = 0; i < 2000; ++i) cone.angles.push_back(2.0 * M_PI * i / 2000.0);
+  cone.volume_shape = {1280, 1280, 1280};
+  cone.voxel_mm = 0.1;
+  const std::size_t cone_most = riner::slices_within_piece_size(cone);
+  const riner::SlabSizing cone_big = riner::size_slabs(cone, {1024 * gib, 0, 0}, 1, 1);
+  MESSAGE("cone: at most " << cone_most << " slices a slab");
+  CHECK(cone_big.slices_per_slab == cone_most);
+  CHECK(cone_most < 1280);
+  for (const riner::Slab& s : riner::plan_slabs(cone, cone_most)) {
+    CHECK_NOTHROW(riner::check_piece_size(riner::slab_geometry(cone, s), "training"));
+  }
+  // Twice the grid and the detector: the thinnest slab's rays cross 512 or more of the 2048
+  // slices (2^31 voxels and more), which no slab can hold: refused before anything is read.
+  cone.n_u = cone.n_v = 2048;
+  cone.volume_shape = {2048, 2048, 2048};
+  CHECK_THROWS_WITH_AS(riner::size_slabs(cone, {1024 * gib, 0, 0}, 1, 1),
+                       doctest::Contains("use larger voxels or a smaller volume"),
+                       riner::InputError);
+}
+
+TEST_CASE(
+    "a parallel slab's memory counts the rows its slices reach, not a share of the detector") {
+  // A grid of 17 slices on an 8000-row detector (a region of interest): a slab of 4 slices reads
+  // 4 rows, as on a detector of 17 rows (an audit's run: "need about 59.0 GiB", 350 MB measured).
+  const riner::Geometry roi = parallel3d(17, 8000, 1.0, 0.0);
+  const riner::Geometry matched = parallel3d(17, 17, 1.0, 0.0);
+  CHECK(riner::slab_extent(roi, 0, 4).rows.count == 4);
+  CHECK(riner::slab_bytes(roi, 4) == riner::slab_bytes(matched, 4));
+  CHECK(riner::slab_device_bytes(roi, 4) == riner::slab_device_bytes(matched, 4));
+  // Rows twice as fine as the voxels: twice the rows.
+  const riner::Geometry fine = parallel3d(17, 34, 0.5, 0.0);
+  CHECK(riner::slab_extent(fine, 0, 4).rows.count == 8);
+  CHECK(riner::slab_bytes(fine, 4) > riner::slab_bytes(matched, 4));
 }

@@ -73,6 +73,17 @@ struct Geometry {
   void save(const std::filesystem::path& path) const;
 };
 
+// The most readings, and the most voxels, that one piece of work may hold (a slab, or a scan
+// trained or filtered whole): the kernels index both with 32-bit signed integers. Slabs are cut
+// within it (slab_plan.hpp).
+inline constexpr double kMostElementsPerPiece = 2147483647.0;  // 2^31 - 1
+// The readings (views x rows x columns) and the voxels of g, in double (no overflow).
+double reading_count(const Geometry& g);
+double voxel_count(const Geometry& g);
+// InputError "<what>: N readings (or voxels), more than the 2^31 - 1 one piece of work may hold:
+// split it into slabs ..." where g's readings or voxels exceed kMostElementsPerPiece.
+void check_piece_size(const Geometry& g, const std::string& what);
+
 // Whether the views go all the way round: no gap between neighbouring angles (mod 2 pi) of more
 // than three mean steps.
 bool covers_full_turn(const Geometry& g);

@@ -38,6 +38,9 @@ RowRange fbp_rows_reached(const Geometry& g, std::size_t first, std::size_t coun
 std::size_t fbp_slab_bytes(const Geometry& g, std::size_t slices);
 // The most slices per slab within `limit` bytes (at least 1).
 std::size_t fbp_slices_within(const Geometry& g, std::size_t limit);
+// The most slices an FBP slab may hold within kMostElementsPerPiece readings and voxels
+// (riner/geometry.hpp; at least 1); fbp_by_slabs refuses thicker slabs.
+std::size_t fbp_slices_within_piece_size(const Geometry& g);
 // Memory FBP of a slab takes on a device with its own (a GPU): its readings in two copies
 // (weighted, filtered) and its voxels.
 std::size_t fbp_slab_device_bytes(const Geometry& g, std::size_t slices);

@@ -55,7 +55,11 @@ std::size_t slab_bytes(const Geometry& g, std::size_t slices);
 // docs/history/RESULTS.md "device memory"): the model and the training's per-sample caches, and per
 // slice the quality check's FBP (its readings in two copies) and the voxels it evaluates.
 std::size_t slab_device_bytes(const Geometry& g, std::size_t slices);
-// The largest single device buffer of such a slab: one copy of its readings.
+// The most slices a slab may hold within kMostElementsPerPiece readings and voxels (riner/
+// geometry.hpp; at least 1). size_slabs cuts within it and refuses a slices_per_slab above it.
+std::size_t slices_within_piece_size(const Geometry& g);
+// The largest single device buffer of such a slab: one copy of its readings, or of its voxels
+// (a cone-beam slab trains more slices than its rows).
 std::size_t slab_largest_buffer_bytes(const Geometry& g, std::size_t slices);
 
 // The most slices per slab within `limit` bytes (at least 1).

@@ -186,6 +186,31 @@ std::pair<double, double> detector_ends(std::size_t n, double offset, double pit
 
 }  // namespace
 
+double reading_count(const Geometry& g) {
+  return static_cast<double>(g.n_views()) * static_cast<double>(g.n_u) *
+         static_cast<double>(g.is_3d() ? g.n_v : 1);
+}
+
+double voxel_count(const Geometry& g) {
+  double n = 1.0;
+  for (const std::size_t d : g.volume_shape) n *= static_cast<double>(d);
+  return n;
+}
+
+void check_piece_size(const Geometry& g, const std::string& what) {
+  const auto refuse = [&](double count, const char* of) {
+    char line[320];
+    std::snprintf(line, sizeof(line),
+                  ": %.4g %s, more than the 2^31 - 1 one piece of work may hold (the kernels' "
+                  "32-bit indices): split it into slabs (riner reconstruct or fbp with "
+                  "--slab-slices or --memory-limit)",
+                  count, of);
+    throw InputError(what + line);
+  };
+  if (reading_count(g) > kMostElementsPerPiece) refuse(reading_count(g), "readings");
+  if (voxel_count(g) > kMostElementsPerPiece) refuse(voxel_count(g), "voxels");
+}
+
 bool covers_full_turn(const Geometry& g) {
   const std::size_t n = g.n_views();
   if (n < 2) return false;

@@ -1,9 +1,6 @@
 #include "ops/device_geometry.hpp"
 
 #include <cmath>
-#include <limits>
-
-#include "riner/error.hpp"
 
 namespace riner::ops {
 
@@ -39,12 +36,8 @@ std::vector<cl_float2> view_rotations(const Geometry& g) {
 }
 
 cl_uint ray_count(const Geometry& g) {
-  const double n = static_cast<double>(g.n_views()) * static_cast<double>(g.n_u) *
-                   static_cast<double>(g.is_3d() ? g.n_v : 1);
-  if (n >= static_cast<double>(std::numeric_limits<cl_uint>::max())) {
-    throw InputError("the scan has more than 2^32 rays; split it into slabs");
-  }
-  return static_cast<cl_uint>(n);
+  check_piece_size(g, "the scan");
+  return static_cast<cl_uint>(reading_count(g));
 }
 
 }  // namespace riner::ops

@@ -35,7 +35,8 @@ DeviceGeometry to_device(const Geometry& g);
 // (cos, sin) of every view angle, computed in double.
 std::vector<cl_float2> view_rotations(const Geometry& g);
 
-// Rays in the full measurement: views * rows * elements; InputError past 2^32.
+// Rays in the full measurement: views * rows * elements; InputError (check_piece_size) where the
+// readings or the voxels pass the kernels' 32-bit signed indices.
 cl_uint ray_count(const Geometry& g);
 
 }  // namespace riner::ops

@@ -85,6 +85,14 @@ std::size_t fbp_slices_within(const Geometry& g, std::size_t limit) {
                             [&](std::size_t n) { return fbp_slab_bytes(g, n); });
 }
 
+std::size_t fbp_slices_within_piece_size(const Geometry& g) {
+  return most_slices_within(g.volume_shape[0], static_cast<std::size_t>(kMostElementsPerPiece),
+                            [&](std::size_t n) {
+                              const SlabSize s = fbp_slab_size(g, n);
+                              return static_cast<std::size_t>(std::max(s.readings, s.voxels));
+                            });
+}
+
 std::size_t fbp_slab_device_bytes(const Geometry& g, std::size_t slices) {
   const SlabSize s = fbp_slab_size(g, slices);
   return static_cast<std::size_t>(4.0 * (2.0 * s.readings + s.voxels));
@@ -149,6 +157,13 @@ SlabFbpReport fbp_by_slabs(const ScanRows& source, const FbpOptions& options, Vo
     throw std::invalid_argument("fbp_by_slabs reconstructs every slice");
   }
   const std::size_t nz = g.volume_shape[0];
+  if (const std::size_t most = fbp_slices_within_piece_size(g);
+      std::min(slices_per_slab, nz) > most) {
+    throw InputError("slabs of " + std::to_string(std::min(slices_per_slab, nz)) +
+                     " slices would hold more than the 2^31 - 1 readings or voxels one piece of "
+                     "work may hold (the kernels' 32-bit indices): at most " +
+                     std::to_string(most) + " slices a slab for this scan");
+  }
   SlabFbpReport report;
   report.slabs = slab_count(nz, slices_per_slab);
   report.slices_per_slab = (nz + report.slabs - 1) / report.slabs;

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <utility>
 
@@ -179,10 +180,16 @@ SlabSize slab_size(const Geometry& g, std::size_t slices) {
   const std::size_t nz = g.volume_shape[0];
   slices = std::max<std::size_t>(1, std::min(slices, nz));
   const double per_row = static_cast<double>(g.n_views()) * static_cast<double>(g.n_u);
-  if (g.type != GeometryType::kCone3d || slices == nz) {
-    return {per_row * static_cast<double>(g.n_v) * static_cast<double>(slices) /
-                static_cast<double>(nz),
-            voxels_per_slice(g) * static_cast<double>(slices)};
+  if (g.type != GeometryType::kCone3d) {
+    // The rows whose centres fall within the slices' height, wherever the grid sits on the
+    // detector (a grid shorter than the detector reaches only its share of the rows).
+    const double rows =
+        std::min(static_cast<double>(g.n_v),
+                 std::ceil(static_cast<double>(slices) * g.voxel_mm / std::fabs(g.pitch_v) - 1e-9));
+    return {per_row * rows, voxels_per_slice(g) * static_cast<double>(slices)};
+  }
+  if (slices == nz) {
+    return {per_row * static_cast<double>(g.n_v), voxels_per_slice(g) * static_cast<double>(nz)};
   }
   SlabSize most;
   for (const auto& [first, count] : slab_cuts(g, slices)) {
@@ -256,8 +263,17 @@ std::size_t slab_device_bytes(const Geometry& g, std::size_t slices) {
                                                             kDeviceVoxelCopies * size.voxels));
 }
 
+std::size_t slices_within_piece_size(const Geometry& g) {
+  return most_slices_within(g.volume_shape[0], static_cast<std::size_t>(kMostElementsPerPiece),
+                            [&](std::size_t n) {
+                              const SlabSize size = slab_size(g, n);
+                              return static_cast<std::size_t>(std::max(size.readings, size.voxels));
+                            });
+}
+
 std::size_t slab_largest_buffer_bytes(const Geometry& g, std::size_t slices) {
-  return static_cast<std::size_t>(4.0 * slab_size(g, slices).readings);
+  const SlabSize size = slab_size(g, slices);
+  return static_cast<std::size_t>(4.0 * std::max(size.readings, size.voxels));
 }
 
 SlabSizing size_slabs(const Geometry& g, const SlabMemory& memory, int wanted_workers,
@@ -276,8 +292,15 @@ SlabSizing size_slabs(const Geometry& g, const SlabMemory& memory, int wanted_wo
         std::max<std::size_t>(1, memory.device_limit / slab_device_bytes(g, slices)));
   };
   SlabSizing out;
+  const std::size_t most = slices_within_piece_size(g);
   if (slices_per_slab) {
     out.slices_per_slab = std::min(slices_per_slab, nz);
+    if (out.slices_per_slab > most) {
+      throw InputError("slabs of " + std::to_string(out.slices_per_slab) +
+                       " slices would hold more than the 2^31 - 1 readings or voxels one piece "
+                       "of work may hold (the kernels' 32-bit indices): at most " +
+                       std::to_string(most) + " slices a slab for this scan");
+    }
   } else {
     // The slabs trained at once share each limit, and each gets a slab to train.
     const int on_host = std::min(wanted_workers * processes, host_fit(1));
@@ -298,7 +321,18 @@ SlabSizing size_slabs(const Geometry& g, const SlabMemory& memory, int wanted_wo
       out.device_bound = on_gpu < slices;
       slices = std::min(slices, on_gpu);
     }
-    out.slices_per_slab = std::max<std::size_t>(1, slices);
+    out.slices_per_slab = std::max<std::size_t>(1, std::min(slices, most));
+  }
+  // A cone beam's thinnest slab still trains every slice its rows' rays cross.
+  if (const SlabSize size = slab_size(g, out.slices_per_slab);
+      std::max(size.readings, size.voxels) > kMostElementsPerPiece) {
+    char line[400];
+    std::snprintf(line, sizeof(line),
+                  "a slab of %zu slice(s) of this scan holds %.4g readings and %.4g voxels (the "
+                  "slices its rows' rays cross), more than the 2^31 - 1 one piece of work may "
+                  "hold (the kernels' 32-bit indices): use larger voxels or a smaller volume",
+                  out.slices_per_slab, size.readings, size.voxels);
+    throw InputError(line);
   }
   const std::size_t slabs = (nz + out.slices_per_slab - 1) / out.slices_per_slab;
   const int by_host = host_fit(out.slices_per_slab) / processes;

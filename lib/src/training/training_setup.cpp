@@ -90,6 +90,8 @@ TrainingSetup::TrainingSetup(Scan s, RinerConfig c, std::optional<Device> device
     : scan(std::move(s)), config(std::move(c)) {
   config.validate();
   scan.geometry.validate();
+  // Ray ids, samples' voxels and the field's evaluation are 32-bit in the kernels.
+  check_piece_size(scan.geometry, "training");
   check_scan(scan);
   // A reading beyond any line integral is a corrupt value: dead for training as a non-finite
   // one is (FBP repairs both alike), not a target a field and alpha chase.
