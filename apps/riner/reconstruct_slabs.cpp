@@ -181,8 +181,8 @@ bool wants_slabs(const Args& args) {
     if (std::filesystem::exists(out / "training.checkpoint")) return false;
   }
   return g && g->is_3d() &&
-         (slices_2d_by_default(*g) || slab_bytes(*g, g->volume_shape[0]) > default_memory_limit() ||
-          slices_within_piece_size(*g) < g->volume_shape[0]);
+         (slices_2d_by_default(*g) || whole_run_bytes(*g) > default_memory_limit() ||
+          reading_count(*g) > kMostElementsPerPiece || voxel_count(*g) > kMostElementsPerPiece);
 }
 
 namespace {

@@ -9,7 +9,9 @@
 #include "analytic/fbp_setup.hpp"
 #include "cl/buffer.hpp"
 #include "cl/device_access.hpp"
+#include "ops/device_geometry.hpp"
 #include "ops/fbp.hpp"
+#include "ops/project.hpp"
 #include "reference/fbp_ref.hpp"
 #include "riner/error.hpp"
 #include "riner/fbp.hpp"
@@ -199,6 +201,29 @@ TEST_SUITE("fbp") {
         }
       }
     }
+  }
+
+  TEST_CASE("a few slices of a grid past 2^31 voxels: FBP fills them, a projector refuses") {
+    // FBP by slabs keeps the whole grid and fills a slab's slices: the voxels that count are
+    // the selected ones (an over-cap check on the grid refused every slab of a 2048^3 FDK).
+    riner::Geometry g = riner::test::small_parallel3d();
+    g.volume_shape = {std::size_t{1} << 25, 8, 8};  // 2^31 voxels, one over the bound
+    g.voxel_mm = g.pitch_v;
+    const riner::Scan scan{riner::Array(g.measurement_shape(), 1.0f), g, 0};
+    riner::FbpOptions options;
+    options.device = riner::test::device();
+    options.slices = riner::SliceSelection{g.volume_shape[0] / 2 - 1, 1, 2};
+    const riner::Array two = riner::fbp(scan, options);
+    CHECK(two.shape == std::vector<std::size_t>{2, 8, 8});
+    CHECK(std::isfinite(two.data[0]));
+    riner::cl::Context& context = riner::cl::context_of(riner::test::device());
+    CHECK_THROWS_WITH_AS(riner::ops::ProjectOp(context, g),
+                         doctest::Contains("the volume: 2.147e+09 voxels, more than the 2^31 - 1"),
+                         riner::InputError);
+    riner::Geometry wide = riner::test::small_parallel3d();
+    wide.n_u = std::size_t{1} << 28;  // 2^28 columns x views x rows: past the readings' bound
+    CHECK_THROWS_WITH_AS(riner::ops::ray_count(wide), doctest::Contains("readings, more than"),
+                         riner::InputError);
   }
 
   TEST_CASE("slice selections: spread, centred, and refused past the volume") {

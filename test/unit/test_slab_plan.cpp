@@ -422,6 +422,10 @@ TEST_CASE(
   CHECK(riner::slab_extent(roi, 0, 4).rows.count == 4);
   CHECK(riner::slab_bytes(roi, 4) == riner::slab_bytes(matched, 4));
   CHECK(riner::slab_device_bytes(roi, 4) == riner::slab_device_bytes(matched, 4));
+  // Trained whole (not by slabs), a scan reads every row: the decision to go by slabs counts
+  // them all (a review: a region of interest went whole on the slabs' estimate, out of memory).
+  CHECK(riner::whole_run_bytes(roi) > riner::slab_bytes(roi, 17));
+  CHECK(riner::whole_run_bytes(matched) == riner::slab_bytes(matched, 17));
   // Rows twice as fine as the voxels: twice the rows.
   const riner::Geometry fine = parallel3d(17, 34, 0.5, 0.0);
   CHECK(riner::slab_extent(fine, 0, 4).rows.count == 8);

@@ -80,8 +80,9 @@ inline constexpr double kMostElementsPerPiece = 2147483647.0;  // 2^31 - 1
 // The readings (views x rows x columns) and the voxels of g, in double (no overflow).
 double reading_count(const Geometry& g);
 double voxel_count(const Geometry& g);
-// InputError "<what>: N readings (or voxels), more than the 2^31 - 1 one piece of work may hold:
-// split it into slabs ..." where g's readings or voxels exceed kMostElementsPerPiece.
+// InputError "<what>: N readings (or voxels), more than the 2^31 - 1 ..." where the readings or
+// the voxels one piece of work holds exceed kMostElementsPerPiece; the Geometry form: all of g's.
+void check_piece_size(double readings, double voxels, const std::string& what);
 void check_piece_size(const Geometry& g, const std::string& what);
 
 // Whether the views go all the way round: no gap between neighbouring angles (mod 2 pi) of more

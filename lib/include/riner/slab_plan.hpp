@@ -51,6 +51,10 @@ Slab slab_extent(const Geometry& g, std::size_t first, std::size_t count);
 // hold at once.
 std::size_t slab_bytes(const Geometry& g, std::size_t slices);
 
+// The same for the whole scan trained in one piece (not by slabs): every detector row is read,
+// whatever rows the grid reaches.
+std::size_t whole_run_bytes(const Geometry& g);
+
 // Memory a slab of `slices` slices takes on a device with its own memory (a GPU; measured,
 // docs/history/RESULTS.md "device memory"): the model and the training's per-sample caches, and per
 // slice the quality check's FBP (its readings in two copies) and the voxels it evaluates.

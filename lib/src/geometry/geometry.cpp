@@ -197,18 +197,22 @@ double voxel_count(const Geometry& g) {
   return n;
 }
 
-void check_piece_size(const Geometry& g, const std::string& what) {
+void check_piece_size(double readings, double voxels, const std::string& what) {
   const auto refuse = [&](double count, const char* of) {
     char line[320];
     std::snprintf(line, sizeof(line),
                   ": %.4g %s, more than the 2^31 - 1 one piece of work may hold (the kernels' "
-                  "32-bit indices): split it into slabs (riner reconstruct or fbp with "
-                  "--slab-slices or --memory-limit)",
+                  "32-bit indices): a smaller piece (slabs of detector rows: riner reconstruct "
+                  "and riner fbp cut them by themselves)",
                   count, of);
     throw InputError(what + line);
   };
-  if (reading_count(g) > kMostElementsPerPiece) refuse(reading_count(g), "readings");
-  if (voxel_count(g) > kMostElementsPerPiece) refuse(voxel_count(g), "voxels");
+  if (readings > kMostElementsPerPiece) refuse(readings, "readings");
+  if (voxels > kMostElementsPerPiece) refuse(voxels, "voxels");
+}
+
+void check_piece_size(const Geometry& g, const std::string& what) {
+  check_piece_size(reading_count(g), voxel_count(g), what);
 }
 
 bool covers_full_turn(const Geometry& g) {

@@ -66,7 +66,7 @@ std::vector<std::uint8_t> stuck_elements(const Scan& scan, double noise_sigma) {
       if (!std::isfinite(own)) continue;
       bool found = false;
       for (long d = 1; d <= kFarthestNeighbour && !found; ++d) {
-        for (const auto [dr, dc] : {std::pair{0L, 1L}, std::pair{1L, 0L}}) {
+        for (const auto& [dr, dc] : {std::pair{0L, 1L}, std::pair{1L, 0L}}) {
           // Both neighbours there and varying (matter_at), the element steady against them.
           if (matter_at(r - d * dr, c - d * dc, -dr, -dc) &&
               matter_at(r + d * dr, c + d * dc, dr, dc) &&

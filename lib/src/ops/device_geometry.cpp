@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "riner/array.hpp"
+
 namespace riner::ops {
 
 DeviceGeometry to_device(const Geometry& g) {
@@ -36,8 +38,14 @@ std::vector<cl_float2> view_rotations(const Geometry& g) {
 }
 
 cl_uint ray_count(const Geometry& g) {
-  check_piece_size(g, "the scan");
+  // The voxels each op checks itself: FBP by slabs keeps the whole grid, filling a slab's slices.
+  check_piece_size(reading_count(g), 0.0, "the scan");
   return static_cast<cl_uint>(reading_count(g));
+}
+
+std::size_t checked_volume_size(const Geometry& g) {
+  check_piece_size(0.0, voxel_count(g), "the volume");
+  return shape_size(g.volume_shape);
 }
 
 }  // namespace riner::ops

@@ -36,7 +36,9 @@ DeviceGeometry to_device(const Geometry& g);
 std::vector<cl_float2> view_rotations(const Geometry& g);
 
 // Rays in the full measurement: views * rows * elements; InputError (check_piece_size) where the
-// readings or the voxels pass the kernels' 32-bit signed indices.
+// readings pass the kernels' 32-bit signed indices.
 cl_uint ray_count(const Geometry& g);
+// Voxels in the whole grid; InputError (check_piece_size) past the kernels' 32-bit indices.
+std::size_t checked_volume_size(const Geometry& g);
 
 }  // namespace riner::ops

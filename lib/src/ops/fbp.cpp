@@ -54,6 +54,7 @@ void FbpOp::filter(const cl::Buffer<float>& in, cl::Buffer<float>& out) {
 
 void FbpOp::backproject(const cl::Buffer<float>& filtered, cl::Buffer<float>& volume,
                         std::size_t first_slice, std::size_t slice_step) {
+  check_piece_size(0.0, static_cast<double>(volume.size()), "fbp");
   const std::size_t slices = volume.size() / slice_voxels_;
   if (filtered.size() != n_samples_ || volume.size() % slice_voxels_ != 0 || slices == 0 ||
       slice_step == 0 || first_slice + (slices - 1) * slice_step >= n_slices_) {

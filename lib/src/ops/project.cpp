@@ -10,7 +10,7 @@ ProjectOp::ProjectOp(cl::Context& context, const Geometry& geometry)
       geometry_(to_device(geometry)),
       views_(context, std::span<const cl_float2>(view_rotations(geometry))),
       n_rays_(ray_count(geometry)),
-      volume_size_(shape_size(geometry.volume_shape)),
+      volume_size_(checked_volume_size(geometry)),
       program_(context.program({"common", "ray_geometry", "joseph", "project"})),
       kernel_(*program_, "project_forward"),
       lanes_kernel_(*program_, "project_forward_lanes"),

@@ -247,14 +247,25 @@ Geometry slab_geometry(const Geometry& g, const Slab& slab) {
   return s;
 }
 
-std::size_t slab_bytes(const Geometry& g, std::size_t slices) {
-  const SlabSize size = slab_size(g, slices);
+namespace {
+
+std::size_t bytes_of(const SlabSize& size) {
   return kBaseBytes +
          static_cast<std::size_t>(4.0 *
                                   (kReadingCopies * size.readings + kVoxelCopies * size.voxels)) +
          // Falls past the table's size; most_slices_within still gives a size that fits (it
          // keeps only sizes found within the limit), at worst not the largest.
          model::RaySegments::held_bytes(static_cast<std::size_t>(size.readings));
+}
+
+}  // namespace
+
+std::size_t slab_bytes(const Geometry& g, std::size_t slices) {
+  return bytes_of(slab_size(g, slices));
+}
+
+std::size_t whole_run_bytes(const Geometry& g) {
+  return bytes_of({reading_count(g), voxel_count(g)});
 }
 
 std::size_t slab_device_bytes(const Geometry& g, std::size_t slices) {
