@@ -106,6 +106,12 @@ int run_destripe(int argc, char** argv, int first) {
   const FbpFilter filter = parse_fbp_filter(args.get("filter"));
   const LoadedScan loaded = scan_from(args, console);
   const Scan& scan = loaded.scan;
+  // Before any work: --reconstruct filters the whole scan in one piece.
+  if (args.is_set("reconstruct")) {
+    check_piece_size(scan.geometry,
+                     "--reconstruct (FBP of the whole scan; riner fbp SCAN --destripe METHOD goes "
+                     "by slabs)");
+  }
   const std::filesystem::path out = make_output_dir(args.get("out"));
   const std::vector<std::string> outputs = {"sino.npy",     "geometry.json", "stripes.npy",
                                             "response.npy", "image.nii",     "image.png",
