@@ -255,6 +255,8 @@ int reconstruct_by_slabs(const Args& args, const Console& console, const RinerCo
   require_quality_grid(source.geometry());
   require_training(settings);
   refuse_limit_below_one_slice(options, slab_bytes(source.geometry(), 1));
+  // Before the output folder is made, as the memory limit's refusal.
+  check_slabs_within_piece_size(source.geometry(), options.slices_per_slab);
   const std::filesystem::path out = make_output_dir(args.get("out"));
   // Refused now, not after every slab is trained.
   refuse_overwriting_input(out / "volume");

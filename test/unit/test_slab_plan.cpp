@@ -371,6 +371,11 @@ TEST_CASE("a slab never holds more readings or voxels than the kernels' 32-bit i
   CHECK_THROWS_WITH_AS(riner::size_slabs(g, {1024 * gib, 0, 0}, 1, 1, 500),
                        doctest::Contains("at most 233 slices a slab"), riner::InputError);
   CHECK(riner::size_slabs(g, {1024 * gib, 0, 0}, 1, 1, 233).slices_per_slab == 233);
+  // The same refusal before anything is planned (the CLI: before the output folder is made).
+  CHECK_THROWS_WITH_AS(riner::check_slabs_within_piece_size(g, 500),
+                       doctest::Contains("at most 233 slices a slab"), riner::InputError);
+  CHECK_NOTHROW(riner::check_slabs_within_piece_size(g, 0));
+  CHECK_NOTHROW(riner::check_slabs_within_piece_size(g, 233));
   // A slab's own geometry within it passes the training's and the kernels' check; the whole
   // stack does not.
   const std::vector<riner::Slab> slabs = riner::plan_slabs(g, most);
@@ -409,6 +414,9 @@ TEST_CASE("a slab never holds more readings or voxels than the kernels' 32-bit i
   cone.n_u = cone.n_v = 2048;
   cone.volume_shape = {2048, 2048, 2048};
   CHECK_THROWS_WITH_AS(riner::size_slabs(cone, {1024 * gib, 0, 0}, 1, 1),
+                       doctest::Contains("use larger voxels or a smaller volume"),
+                       riner::InputError);
+  CHECK_THROWS_WITH_AS(riner::check_slabs_within_piece_size(cone, 0),
                        doctest::Contains("use larger voxels or a smaller volume"),
                        riner::InputError);
 }

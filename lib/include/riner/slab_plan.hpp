@@ -62,6 +62,9 @@ std::size_t slab_device_bytes(const Geometry& g, std::size_t slices);
 // The most slices a slab may hold within kMostElementsPerPiece readings and voxels (riner/
 // geometry.hpp; at least 1). size_slabs cuts within it and refuses a slices_per_slab above it.
 std::size_t slices_within_piece_size(const Geometry& g);
+// InputError where slabs of `slices_per_slab` (0: as thin as need be) cannot stay within it:
+// thicker than slices_within_piece_size, or a cone beam whose thinnest slab exceeds it.
+void check_slabs_within_piece_size(const Geometry& g, std::size_t slices_per_slab);
 // The largest single device buffer of such a slab: one copy of its readings, or of its voxels
 // (a cone-beam slab trains more slices than its rows).
 std::size_t slab_largest_buffer_bytes(const Geometry& g, std::size_t slices);

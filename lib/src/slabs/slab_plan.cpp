@@ -282,6 +282,35 @@ std::size_t slices_within_piece_size(const Geometry& g) {
                             });
 }
 
+namespace {
+
+// A cone beam's thinnest slab still trains every slice its rows' rays cross.
+void refuse_slab_over_piece_size(const Geometry& g, std::size_t slices) {
+  const SlabSize size = slab_size(g, slices);
+  if (std::max(size.readings, size.voxels) <= kMostElementsPerPiece) return;
+  char line[400];
+  std::snprintf(line, sizeof(line),
+                "a slab of %zu slice(s) of this scan holds %.4g readings and %.4g voxels (the "
+                "slices its rows' rays cross), more than the 2^31 - 1 one piece of work may "
+                "hold (the kernels' 32-bit indices): use larger voxels or a smaller volume",
+                slices, size.readings, size.voxels);
+  throw InputError(line);
+}
+
+}  // namespace
+
+void check_slabs_within_piece_size(const Geometry& g, std::size_t slices_per_slab) {
+  const std::size_t most = slices_within_piece_size(g);
+  const std::size_t asked = std::min(slices_per_slab, g.volume_shape[0]);
+  if (asked > most) {
+    throw InputError("slabs of " + std::to_string(asked) +
+                     " slices would hold more than the 2^31 - 1 readings or voxels one piece "
+                     "of work may hold (the kernels' 32-bit indices): at most " +
+                     std::to_string(most) + " slices a slab for this scan");
+  }
+  refuse_slab_over_piece_size(g, most);
+}
+
 std::size_t slab_largest_buffer_bytes(const Geometry& g, std::size_t slices) {
   const SlabSize size = slab_size(g, slices);
   return static_cast<std::size_t>(4.0 * std::max(size.readings, size.voxels));
@@ -303,15 +332,10 @@ SlabSizing size_slabs(const Geometry& g, const SlabMemory& memory, int wanted_wo
         std::max<std::size_t>(1, memory.device_limit / slab_device_bytes(g, slices)));
   };
   SlabSizing out;
+  check_slabs_within_piece_size(g, slices_per_slab);
   const std::size_t most = slices_within_piece_size(g);
   if (slices_per_slab) {
     out.slices_per_slab = std::min(slices_per_slab, nz);
-    if (out.slices_per_slab > most) {
-      throw InputError("slabs of " + std::to_string(out.slices_per_slab) +
-                       " slices would hold more than the 2^31 - 1 readings or voxels one piece "
-                       "of work may hold (the kernels' 32-bit indices): at most " +
-                       std::to_string(most) + " slices a slab for this scan");
-    }
   } else {
     // The slabs trained at once share each limit, and each gets a slab to train.
     const int on_host = std::min(wanted_workers * processes, host_fit(1));
@@ -334,17 +358,7 @@ SlabSizing size_slabs(const Geometry& g, const SlabMemory& memory, int wanted_wo
     }
     out.slices_per_slab = std::max<std::size_t>(1, std::min(slices, most));
   }
-  // A cone beam's thinnest slab still trains every slice its rows' rays cross.
-  if (const SlabSize size = slab_size(g, out.slices_per_slab);
-      std::max(size.readings, size.voxels) > kMostElementsPerPiece) {
-    char line[400];
-    std::snprintf(line, sizeof(line),
-                  "a slab of %zu slice(s) of this scan holds %.4g readings and %.4g voxels (the "
-                  "slices its rows' rays cross), more than the 2^31 - 1 one piece of work may "
-                  "hold (the kernels' 32-bit indices): use larger voxels or a smaller volume",
-                  out.slices_per_slab, size.readings, size.voxels);
-    throw InputError(line);
-  }
+  refuse_slab_over_piece_size(g, out.slices_per_slab);
   const std::size_t slabs = (nz + out.slices_per_slab - 1) / out.slices_per_slab;
   const int by_host = host_fit(out.slices_per_slab) / processes;
   const int by_device = device_fit(out.slices_per_slab);
