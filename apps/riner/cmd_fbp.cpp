@@ -56,7 +56,7 @@ bool fbp_wants_slabs(const Args& args, const std::function<const FbpOptions&()>&
   const std::optional<Geometry> g = stack_geometry(args);
   return g && g->is_3d() &&
          (asked || folder || fbp_slab_bytes(*g, g->volume_shape[0]) > default_memory_limit() ||
-          reading_count(*g) > kMostElementsPerPiece || voxel_count(*g) > kMostElementsPerPiece ||
+          !within_piece_size(*g) ||
           fbp_device_slices(*g, SlabOptions{}, options()) < g->volume_shape[0]);
 }
 

@@ -182,7 +182,7 @@ bool wants_slabs(const Args& args) {
   }
   return g && g->is_3d() &&
          (slices_2d_by_default(*g) || whole_run_bytes(*g) > default_memory_limit() ||
-          reading_count(*g) > kMostElementsPerPiece || voxel_count(*g) > kMostElementsPerPiece);
+          !within_piece_size(*g));
 }
 
 namespace {

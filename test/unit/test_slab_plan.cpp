@@ -29,6 +29,16 @@ riner::Geometry parallel3d(std::size_t nz, std::size_t n_v, double pitch_v, doub
   return g;
 }
 
+// A synchrotron stack: 2560 columns, 3600 views, 2000 rows, its volume on the same grid.
+riner::Geometry synchrotron_stack() {
+  riner::Geometry g = parallel3d(2000, 2000, 1.0, 0.0);
+  g.n_u = 2560;
+  g.angles.clear();
+  for (int i = 0; i < 3600; ++i) g.angles.push_back(M_PI * i / 3600.0);
+  g.volume_shape = {2000, 2560, 2560};
+  return g;
+}
+
 }  // namespace
 
 TEST_CASE("slabs cover every slice once, as even as they come") {
@@ -302,12 +312,7 @@ TEST_CASE("a 2D geometry as a stack of slices, and a slice of it back") {
 }
 
 TEST_CASE("a GPU's own memory bounds the slabs trained on it at once") {
-  // A synchrotron stack: 2560 columns, 3600 views, 2000 rows, its volume on the same grid.
-  riner::Geometry g = parallel3d(2000, 2000, 1.0, 0.0);
-  g.n_u = 2560;
-  g.angles.clear();
-  for (int i = 0; i < 3600; ++i) g.angles.push_back(M_PI * i / 3600.0);
-  g.volume_shape = {2000, 2560, 2560};
+  const riner::Geometry g = synchrotron_stack();
   const std::size_t gib = std::size_t{1} << 30;
   riner::SlabMemory host_only{96 * gib, 0, 0};
   const riner::SlabSizing cpu = riner::size_slabs(g, host_only, 8, 1);
@@ -356,11 +361,7 @@ TEST_CASE("a GPU's own memory bounds the slabs trained on it at once") {
 TEST_CASE("a slab never holds more readings or voxels than the kernels' 32-bit indices reach") {
   // The synchrotron stack again (9.2e6 readings and 6.6e6 voxels a slice) on a 1 TB node: the
   // memory alone would take slabs of 4.6e9 readings (an audit's plan, 2026-12-07).
-  riner::Geometry g = parallel3d(2000, 2000, 1.0, 0.0);
-  g.n_u = 2560;
-  g.angles.clear();
-  for (int i = 0; i < 3600; ++i) g.angles.push_back(M_PI * i / 3600.0);
-  g.volume_shape = {2000, 2560, 2560};
+  const riner::Geometry g = synchrotron_stack();
   const std::size_t gib = std::size_t{1} << 30;
   const std::size_t most = riner::slices_within_piece_size(g);
   CHECK(most == 233);  // 2^31 / (3600 x 2560)

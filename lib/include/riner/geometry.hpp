@@ -84,6 +84,8 @@ double voxel_count(const Geometry& g);
 // the voxels one piece of work holds exceed kMostElementsPerPiece; the Geometry form: all of g's.
 void check_piece_size(double readings, double voxels, const std::string& what);
 void check_piece_size(const Geometry& g, const std::string& what);
+// Whether all of g's readings and voxels fit one piece of work (check_piece_size passes).
+bool within_piece_size(const Geometry& g);
 
 // Whether the views go all the way round: no gap between neighbouring angles (mod 2 pi) of more
 // than three mean steps.

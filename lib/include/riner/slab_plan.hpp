@@ -64,7 +64,11 @@ std::size_t slab_device_bytes(const Geometry& g, std::size_t slices);
 std::size_t slices_within_piece_size(const Geometry& g);
 // InputError where slabs of `slices_per_slab` (0: as thin as need be) cannot stay within it:
 // thicker than slices_within_piece_size, or a cone beam whose thinnest slab exceeds it.
-void check_slabs_within_piece_size(const Geometry& g, std::size_t slices_per_slab);
+// Returns slices_within_piece_size.
+std::size_t check_slabs_within_piece_size(const Geometry& g, std::size_t slices_per_slab);
+// InputError "slabs of N slices would hold more than ...: at most `most`" where `asked` (its
+// slices a slab, the volume's at most) exceeds `most` (slices_within_piece_size, or FBP's).
+void refuse_slabs_thicker_than(std::size_t asked, std::size_t most);
 // The largest single device buffer of such a slab: one copy of its readings, or of its voxels
 // (a cone-beam slab trains more slices than its rows).
 std::size_t slab_largest_buffer_bytes(const Geometry& g, std::size_t slices);

@@ -215,6 +215,10 @@ void check_piece_size(const Geometry& g, const std::string& what) {
   check_piece_size(reading_count(g), voxel_count(g), what);
 }
 
+bool within_piece_size(const Geometry& g) {
+  return reading_count(g) <= kMostElementsPerPiece && voxel_count(g) <= kMostElementsPerPiece;
+}
+
 bool covers_full_turn(const Geometry& g) {
   const std::size_t n = g.n_views();
   if (n < 2) return false;

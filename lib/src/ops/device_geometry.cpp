@@ -39,8 +39,9 @@ std::vector<cl_float2> view_rotations(const Geometry& g) {
 
 cl_uint ray_count(const Geometry& g) {
   // The voxels each op checks itself: FBP by slabs keeps the whole grid, filling a slab's slices.
-  check_piece_size(reading_count(g), 0.0, "the scan");
-  return static_cast<cl_uint>(reading_count(g));
+  const double readings = reading_count(g);
+  check_piece_size(readings, 0.0, "the scan");
+  return static_cast<cl_uint>(readings);
 }
 
 std::size_t checked_volume_size(const Geometry& g) {

@@ -157,13 +157,7 @@ SlabFbpReport fbp_by_slabs(const ScanRows& source, const FbpOptions& options, Vo
     throw std::invalid_argument("fbp_by_slabs reconstructs every slice");
   }
   const std::size_t nz = g.volume_shape[0];
-  if (const std::size_t most = fbp_slices_within_piece_size(g);
-      std::min(slices_per_slab, nz) > most) {
-    throw InputError("slabs of " + std::to_string(std::min(slices_per_slab, nz)) +
-                     " slices would hold more than the 2^31 - 1 readings or voxels one piece of "
-                     "work may hold (the kernels' 32-bit indices): at most " +
-                     std::to_string(most) + " slices a slab for this scan");
-  }
+  refuse_slabs_thicker_than(std::min(slices_per_slab, nz), fbp_slices_within_piece_size(g));
   SlabFbpReport report;
   report.slabs = slab_count(nz, slices_per_slab);
   report.slices_per_slab = (nz + report.slabs - 1) / report.slabs;

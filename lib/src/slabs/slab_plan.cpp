@@ -299,16 +299,19 @@ void refuse_slab_over_piece_size(const Geometry& g, std::size_t slices) {
 
 }  // namespace
 
-void check_slabs_within_piece_size(const Geometry& g, std::size_t slices_per_slab) {
+void refuse_slabs_thicker_than(std::size_t asked, std::size_t most) {
+  if (asked <= most) return;
+  throw InputError("slabs of " + std::to_string(asked) +
+                   " slices would hold more than the 2^31 - 1 readings or voxels one piece of "
+                   "work may hold (the kernels' 32-bit indices): at most " +
+                   std::to_string(most) + " slices a slab for this scan");
+}
+
+std::size_t check_slabs_within_piece_size(const Geometry& g, std::size_t slices_per_slab) {
   const std::size_t most = slices_within_piece_size(g);
-  const std::size_t asked = std::min(slices_per_slab, g.volume_shape[0]);
-  if (asked > most) {
-    throw InputError("slabs of " + std::to_string(asked) +
-                     " slices would hold more than the 2^31 - 1 readings or voxels one piece "
-                     "of work may hold (the kernels' 32-bit indices): at most " +
-                     std::to_string(most) + " slices a slab for this scan");
-  }
+  refuse_slabs_thicker_than(std::min(slices_per_slab, g.volume_shape[0]), most);
   refuse_slab_over_piece_size(g, most);
+  return most;
 }
 
 std::size_t slab_largest_buffer_bytes(const Geometry& g, std::size_t slices) {
@@ -332,8 +335,7 @@ SlabSizing size_slabs(const Geometry& g, const SlabMemory& memory, int wanted_wo
         std::max<std::size_t>(1, memory.device_limit / slab_device_bytes(g, slices)));
   };
   SlabSizing out;
-  check_slabs_within_piece_size(g, slices_per_slab);
-  const std::size_t most = slices_within_piece_size(g);
+  const std::size_t most = check_slabs_within_piece_size(g, slices_per_slab);
   if (slices_per_slab) {
     out.slices_per_slab = std::min(slices_per_slab, nz);
   } else {
